@@ -1,0 +1,61 @@
+#include "deform/mesh.h"
+
+#include <cmath>
+#include <string>
+
+namespace deform {
+
+mocap::Status Mesh::Check() const {
+  using mocap::ErrorCode;
+  const std::size_t n = positions.size();
+  if (!normals.empty() && normals.size() != n) {
+    return mocap::MakeError(ErrorCode::kCountMismatch, {},
+                            "mesh has " + std::to_string(n) + " positions but " +
+                                std::to_string(normals.size()) + " normals");
+  }
+  if (!colors.empty() && colors.size() != n) {
+    return mocap::MakeError(ErrorCode::kCountMismatch, {},
+                            "mesh has " + std::to_string(n) + " positions but " +
+                                std::to_string(colors.size()) + " colors");
+  }
+  for (std::size_t t = 0; t < triangles.size(); ++t) {
+    const glm::uvec3& tri = triangles[t];
+    if (tri.x >= n || tri.y >= n || tri.z >= n) {
+      return mocap::MakeError(ErrorCode::kCountMismatch, {},
+                              "triangle " + std::to_string(t) + " indexes past the " +
+                                  std::to_string(n) + " vertices");
+    }
+  }
+  for (const glm::vec3& p : positions) {
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
+      return mocap::MakeError(ErrorCode::kNonFinite, {}, "mesh has a non-finite position");
+    }
+  }
+  return mocap::Status::Ok();
+}
+
+void ComputeVertexNormals(std::span<const glm::vec3> positions,
+                          std::span<const glm::uvec3> triangles, std::span<glm::vec3> normals) {
+  for (glm::vec3& n : normals) n = glm::vec3(0.0f);
+  for (const glm::uvec3& t : triangles) {
+    const glm::vec3 a = positions[t.x];
+    const glm::vec3 b = positions[t.y];
+    const glm::vec3 c = positions[t.z];
+    const glm::vec3 area_normal = glm::cross(b - a, c - a);  // length = 2 x area
+    normals[t.x] += area_normal;
+    normals[t.y] += area_normal;
+    normals[t.z] += area_normal;
+  }
+  for (glm::vec3& n : normals) {
+    const float len = glm::length(n);
+    n = len > 0.0f ? n / len : glm::vec3(0.0f, 0.0f, 1.0f);
+  }
+}
+
+Bounds ComputeBounds(std::span<const glm::vec3> points) {
+  Bounds b;
+  for (const glm::vec3& p : points) b.Extend(p);
+  return b;
+}
+
+}  // namespace deform

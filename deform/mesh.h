@@ -1,0 +1,75 @@
+#pragma once
+// Triangle meshes and skin weights: the types every deformation job reads and
+// writes, and the only deform types the render module needs.
+//
+// Arrays are separate (structure of arrays): #V positions, #V normals, #T
+// triangles. Positions are in model space, in the units of the skeleton that
+// drives them.
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "mocap/error.h"
+
+namespace deform {
+
+// Maximum influences per vertex the skinning jobs support (4 or 8 are used).
+inline constexpr int kMaxInfluences = 8;
+
+struct Mesh {
+  std::vector<glm::vec3> positions;   // #V, model space
+  std::vector<glm::vec3> normals;     // #V unit normals, or empty (then computed on demand)
+  std::vector<glm::uvec3> triangles;  // #T, counter-clockwise seen from outside
+  std::vector<glm::vec3> colors;      // #V linear RGB in [0,1], or empty (default material)
+
+  int num_vertices() const { return static_cast<int>(positions.size()); }
+  int num_triangles() const { return static_cast<int>(triangles.size()); }
+  // Sizes agree, indices in range, values finite.
+  mocap::Status Check() const;
+};
+
+// Per-vertex skin weights with a fixed number of influences per vertex
+// (ozz fixes the count per SkinningJob). Unused slots have weight 0.
+struct SkinWeights {
+  int influences = 4;                  // 1..kMaxInfluences
+  std::vector<std::uint16_t> joints;   // #V x influences, indices into the skin's joints
+  std::vector<float> weights;          // #V x influences, >= 0, each row sums to 1
+
+  int num_vertices() const {
+    return influences > 0 ? static_cast<int>(weights.size()) / influences : 0;
+  }
+};
+
+// A mesh bound to a skeleton: the bind-pose mesh, its weights, and which
+// skeleton joint each skin joint is, with the inverse bind matrices
+// (bind_from_joint maps model-space bind positions into the joint's frame).
+struct SkinnedMesh {
+  Mesh bind;
+  SkinWeights weights;
+  std::vector<int> skin_joints;             // #S skeleton joint index of each skin joint
+  std::vector<glm::mat4> joint_from_bind;   // #S inverse bind matrices
+};
+
+// Area-weighted vertex normals of `positions` over `triangles` (zero-area
+// triangles contribute nothing; isolated vertices get (0,0,1)).
+void ComputeVertexNormals(std::span<const glm::vec3> positions,
+                          std::span<const glm::uvec3> triangles, std::span<glm::vec3> normals);
+
+// Axis-aligned bounds of a point set; min > max when empty.
+struct Bounds {
+  glm::vec3 min{1e30f};
+  glm::vec3 max{-1e30f};
+  void Extend(const glm::vec3& p) {
+    min = glm::min(min, p);
+    max = glm::max(max, p);
+  }
+  bool empty() const { return min.x > max.x; }
+  glm::vec3 center() const { return 0.5f * (min + max); }
+  glm::vec3 size() const { return max - min; }
+};
+Bounds ComputeBounds(std::span<const glm::vec3> points);
+
+}  // namespace deform

@@ -1,0 +1,39 @@
+#pragma once
+// Where tests find their inputs. TEST_DATA_DIR is tests/data (small inputs the
+// project made); SHARED_DATA_DIR is ../shared/data (real captures, not in the
+// repo). Tests that need the shared data skip with a clear message without it.
+
+#include <filesystem>
+#include <string>
+
+#include <gtest/gtest.h>
+
+namespace testsupport {
+
+inline std::filesystem::path TestDataPath(const std::string& relative) {
+  return std::filesystem::path(TEST_DATA_DIR) / relative;
+}
+
+inline std::filesystem::path SharedDataPath(const std::string& relative) {
+  return std::filesystem::path(SHARED_DATA_DIR) / relative;
+}
+
+inline bool HaveSharedData() { return std::filesystem::is_directory(SHARED_DATA_DIR); }
+
+// A folder under the build tree for files a test writes (created on demand).
+inline std::filesystem::path TestOutputPath(const std::string& relative) {
+  std::filesystem::path p = std::filesystem::path(TEST_OUTPUT_DIR) / relative;
+  std::filesystem::create_directories(p.parent_path());
+  return p;
+}
+
+}  // namespace testsupport
+
+// Skips the current test when a file of ../shared/data is missing.
+#define PATCHSKIN_REQUIRE_SHARED_FILE(path)                                              \
+  do {                                                                                   \
+    if (!std::filesystem::exists(path)) {                                                \
+      GTEST_SKIP() << "shared data file " << (path)                                      \
+                   << " is absent (set PATCHSKIN_DATA_DIR to ../shared/data to run this)"; \
+    }                                                                                    \
+  } while (false)
