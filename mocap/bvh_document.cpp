@@ -284,13 +284,13 @@ class HierarchyParser {
                                                         (value_text.empty() ? std::string("end of file")
                                                                             : "'" + std::string(value_text) + "'"));
     }
-    if (frames < 0) {
-      return Fail(ErrorCode::kBadNumber, value_tok, "expected a frame count of 0 or more, found " + std::to_string(frames));
-    }
     if (r.ec == std::errc::result_out_of_range || frames > INT_MAX) {
       return Fail(ErrorCode::kLimitExceeded, value_tok,
                   "declared frame count " + std::string(value_text) + " is larger than the limit of " +
                       std::to_string(INT_MAX));
+    }
+    if (frames < 0) {
+      return Fail(ErrorCode::kBadNumber, value_tok, "expected a frame count of 0 or more, found " + std::to_string(frames));
     }
     doc_.declared_frames = frames;
 

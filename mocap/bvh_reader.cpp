@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "mocap/internal/bvh_number.h"
+#include "mocap/pose.h"
 
 namespace mocap {
 
@@ -55,6 +56,13 @@ class MotionParser {
       out += num_channels;
     }
     if (static_cast<long long>(frames) < declared) {
+      // Stopped by the size bound: whatever is left cannot be a whole frame,
+      // so parsing it yields the precise error for that line.
+      SkipSpace();
+      if (p_ != end_) {
+        std::vector<float> scratch(static_cast<std::size_t>(num_channels));
+        if (Status s = ParseLine(static_cast<long long>(frames) + 1, num_channels, scratch.data()); !s) return s;
+      }
       const std::string counts = "'Frames:' declares " + std::to_string(declared) + " frames but the file holds " +
                                  std::to_string(frames);
       if (!options.allow_short_motion) {
@@ -222,6 +230,28 @@ float RestHeight(const Skeleton& skeleton, UpAxis up) {
   return hi >= lo ? hi - lo : 0.0f;
 }
 
+float FirstFrameHeight(const Skeleton& skeleton, const Motion& motion, UpAxis up) {
+  if (motion.num_frames < 1) return 0.0f;
+  const std::size_t n = skeleton.rest_translations.size();
+  std::vector<JointTransform> locals(n);
+  std::vector<glm::mat4> model(n);
+  if (!LocalPoseJob{&skeleton, motion.frame(0), locals}.Run()) return 0.0f;
+  if (!LocalToModelJob{skeleton.parents, locals, glm::mat4(1.0f), model}.Run()) return 0.0f;
+  const int axis = up == UpAxis::kY ? 1 : 2;
+  float lo = std::numeric_limits<float>::max();
+  float hi = std::numeric_limits<float>::lowest();
+  for (const glm::mat4& m : model) {
+    lo = std::min(lo, m[3][axis]);
+    hi = std::max(hi, m[3][axis]);
+  }
+  for (const EndSite& e : skeleton.end_sites) {
+    const float h = (model[static_cast<std::size_t>(e.parent)] * glm::vec4(e.offset, 1.0f))[axis];
+    lo = std::min(lo, h);
+    hi = std::max(hi, h);
+  }
+  return hi >= lo ? hi - lo : 0.0f;
+}
+
 const char* DetectUnits(float h) {
   if (h >= 0.5f && h <= 3.0f) return "m";
   if (h >= 40.0f && h < 100.0f) return "inch";
@@ -288,7 +318,10 @@ Result<BvhFile> ParseBvh(std::string_view text, const std::string& file_name, co
   SkeletonInfo& info = file.skeleton.info;
   info.up_axis = options.up_axis.has_value() ? *options.up_axis : DetectBvhUpAxis(file.skeleton);
   const float raw_height = RestHeight(file.skeleton, info.up_axis);
-  info.detected_units = DetectUnits(raw_height);
+  // A rest pose need not stand upright (Bandai Namco's bones lie along X), so
+  // the units come from the taller of the rest pose and the first frame.
+  info.detected_units =
+      DetectUnits(std::max(raw_height, FirstFrameHeight(file.skeleton, file.motion, info.up_axis)));
   float scale = options.scale;
   if (scale == 0.0f) {
     scale = info.detected_units == std::string("m")      ? 1.0f

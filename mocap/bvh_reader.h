@@ -27,7 +27,9 @@
 //   arms, along X in the usual T-pose, do not vote.
 // - Height: extent along the up axis of the rest positions of all joints and end
 //   sites (offsets chained from the roots at the origin), after scale.
-// - Units from that height h (before scale), for a human-sized figure:
+// - Units from h = the larger of that rest height and the same extent in the
+//   first frame's pose (some rest poses do not stand upright: Bandai Namco's
+//   bones lie along X), before scale, for a human-sized figure:
 //   0.5 <= h <= 3 -> "m"; 40 <= h < 100 -> "inch"; 100 <= h <= 300 -> "cm";
 //   otherwise "unknown" (e.g. CMU cgspeed files, ~26 units tall).
 //
@@ -87,7 +89,9 @@ struct BvhFile {
 UpAxis DetectBvhUpAxis(const Skeleton& skeleton);
 // Extent along `up` of the rest positions of all joints and end sites.
 float RestHeight(const Skeleton& skeleton, UpAxis up);
-// "m", "inch", "cm" or "unknown" for a rest height.
+// Extent along `up` of joints and end sites posed by frame 0 (0 without frames).
+float FirstFrameHeight(const Skeleton& skeleton, const Motion& motion, UpAxis up);
+// "m", "inch", "cm" or "unknown" for a figure's height.
 const char* DetectUnits(float rest_height);
 
 // Multiplies offsets, end sites and position channels of `motion` by `factor`.

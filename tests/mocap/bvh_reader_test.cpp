@@ -326,6 +326,22 @@ TEST(BvhReader, ZUpIsDetectedAndConvertedToTheSamePoses) {
   }
 }
 
+TEST(BvhReader, JointAndDepthLimitsAreOptions) {
+  BvhReadOptions options;
+  options.max_joints = 1;
+  auto joints = ParseBvh(kSmall, "t.bvh", options);
+  ASSERT_FALSE(joints.ok());
+  EXPECT_EQ(joints.error().code, ErrorCode::kLimitExceeded);
+  EXPECT_EQ(joints.error().loc.line, 6);
+  EXPECT_EQ(joints.error().loc.column, 3);
+  options = {};
+  options.max_depth = 1;
+  auto depth = ParseBvh(kSmall, "t.bvh", options);
+  ASSERT_FALSE(depth.ok());
+  EXPECT_EQ(depth.error().code, ErrorCode::kLimitExceeded);
+  EXPECT_EQ(depth.error().loc.line, 6);
+}
+
 TEST(BvhReader, MissingFileIsAnIoError) {
   auto result = mocap::ReadBvhFile("/nonexistent/walk.bvh");
   ASSERT_FALSE(result.ok());
@@ -341,6 +357,7 @@ struct SharedCase {
   int end_sites;
   int frames;
   double fps;
+  const char* units;  // what DetectUnits should say
 };
 
 std::vector<float> SplitLine(const std::string& line) {
@@ -364,6 +381,8 @@ TEST_P(SharedBvh, LoadsWithDocumentedCountsAndValues) {
   EXPECT_EQ(static_cast<int>(file.skeleton.end_sites.size()), c.end_sites);
   EXPECT_EQ(file.motion.num_frames, c.frames);
   EXPECT_EQ(mocap::NominalFps(file.motion.frame_time_s), c.fps);
+  EXPECT_EQ(file.skeleton.info.detected_units, c.units);
+  EXPECT_EQ(file.skeleton.info.up_axis, mocap::UpAxis::kY);  // all eight are Y-up
   EXPECT_TRUE(file.warnings.empty());
   EXPECT_TRUE(file.skeleton.Check().ok());
 
@@ -387,13 +406,13 @@ TEST_P(SharedBvh, LoadsWithDocumentedCountsAndValues) {
 
 INSTANTIATE_TEST_SUITE_P(
     SharedData, SharedBvh,
-    testing::Values(SharedCase{"bvh/cmu_cgspeed/01_01.bvh", 31, 7, 2752, 120},
-                    SharedCase{"bvh/cmu_cgspeed/01_03.bvh", 31, 7, 4511, 120},
-                    SharedCase{"bvh/bandai_namco/dataset-1_walk_normal_001.bvh", 22, 5, 195, 30},
-                    SharedCase{"bvh/bandai_namco/dataset-2_run_active_034.bvh", 22, 5, 75, 30},
-                    SharedCase{"bvh/lafan1_resolved/Geno_bind.bvh", 75, 21, 2, 60},
-                    SharedCase{"bvh/lafan1_resolved/Geno_stance.bvh", 75, 21, 2, 60},
-                    SharedCase{"bvh/bvh_python/test_mocapbank.bvh", 19, 5, 455, 30},
-                    SharedCase{"bvh/bvh_python/test_freebvh.bvh", 55, 15, 69, 30}));
+    testing::Values(SharedCase{"bvh/cmu_cgspeed/01_01.bvh", 31, 7, 2752, 120, "unknown"},
+                    SharedCase{"bvh/cmu_cgspeed/01_03.bvh", 31, 7, 4511, 120, "unknown"},
+                    SharedCase{"bvh/bandai_namco/dataset-1_walk_normal_001.bvh", 22, 5, 195, 30, "cm"},
+                    SharedCase{"bvh/bandai_namco/dataset-2_run_active_034.bvh", 22, 5, 75, 30, "cm"},
+                    SharedCase{"bvh/lafan1_resolved/Geno_bind.bvh", 75, 21, 2, 60, "cm"},
+                    SharedCase{"bvh/lafan1_resolved/Geno_stance.bvh", 75, 21, 2, 60, "cm"},
+                    SharedCase{"bvh/bvh_python/test_mocapbank.bvh", 19, 5, 455, 30, "cm"},
+                    SharedCase{"bvh/bvh_python/test_freebvh.bvh", 55, 15, 69, 30, "cm"}));
 
 }  // namespace
