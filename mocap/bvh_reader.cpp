@@ -45,15 +45,19 @@ class MotionParser {
     const std::size_t per_frame_min = 2 * static_cast<std::size_t>(num_channels);
     const std::size_t fit = (remaining + 1) / per_frame_min;
     const std::size_t capacity = std::min(static_cast<std::size_t>(declared), fit);
-    motion->values.resize(capacity * static_cast<std::size_t>(num_channels));
-
-    float* out = motion->values.data();
+    // reserve, not resize: the pages are touched once, by the copies below,
+    // instead of being zeroed first. Each line is parsed into a small buffer
+    // that stays in L1 and appended whole once it has exactly #C values.
+    motion->values.clear();
+    motion->values.reserve(capacity * static_cast<std::size_t>(num_channels));
+    std::vector<float> line_values(static_cast<std::size_t>(num_channels));
+    float* out = line_values.data();
     std::size_t frames = 0;
     for (; frames < capacity; ++frames) {
       SkipSpace();
       if (p_ == end_) break;
       if (Status s = ParseLine(static_cast<long long>(frames) + 1, num_channels, out); !s) return s;
-      out += num_channels;
+      motion->values.insert(motion->values.end(), out, out + num_channels);
     }
     if (static_cast<long long>(frames) < declared) {
       // Stopped by the size bound: whatever is left cannot be a whole frame,
@@ -69,7 +73,6 @@ class MotionParser {
         return MakeError(ErrorCode::kCountMismatch, Loc(p_), counts);
       }
       warnings->push_back(Warning{Loc(p_), counts + "; loading " + std::to_string(frames)});
-      motion->values.resize(frames * static_cast<std::size_t>(num_channels));
     } else {
       SkipSpace();
       if (p_ != end_) WarnExtraLines(warnings, declared);
