@@ -1,0 +1,360 @@
+#include "mocap/bvh_reader.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <limits>
+
+#include "mocap/internal/bvh_number.h"
+#include "mocap/pose.h"
+
+namespace mocap {
+
+namespace {
+
+inline bool IsBlank(char c) { return c == ' ' || c == '\t' || c == '\f' || c == '\v'; }
+inline bool IsLineEnd(char c) { return c == '\n' || c == '\r'; }
+
+// Reads the frame data: one pass over the buffer, writing straight into the
+// preallocated array. Line numbers are counted as we go; columns are computed
+// only when an error is reported.
+class MotionParser {
+ public:
+  MotionParser(std::string_view text, const BvhDocument& doc)
+      : p_(text.data() + doc.motion_offset),
+        end_(text.data() + text.size()),
+        line_start_(text.data() + doc.motion_line_start),
+        line_(doc.motion_line),
+        doc_(doc) {}
+
+  Status Run(const BvhReadOptions& options, Motion* motion, std::vector<Warning>* warnings) {
+    const int num_channels = doc_.num_channels;
+    motion->num_channels = num_channels;
+    motion->frame_time_s = doc_.frame_time_s;
+    const long long declared = doc_.declared_frames;
+    if (num_channels == 0) {
+      // Nothing to read per frame; frames are only a count.
+      motion->num_frames = static_cast<int>(declared);
+      motion->values.clear();
+      SkipSpace();
+      if (p_ != end_) WarnExtraLines(warnings, 0);
+      return Status::Ok();
+    }
+    // A frame needs at least one digit and one separator per value.
+    const std::size_t remaining = static_cast<std::size_t>(end_ - p_);
+    const std::size_t per_frame_min = 2 * static_cast<std::size_t>(num_channels);
+    const std::size_t fit = (remaining + 1) / per_frame_min;
+    const std::size_t capacity = std::min(static_cast<std::size_t>(declared), fit);
+    // reserve, not resize: the pages are touched once, by the copies below,
+    // instead of being zeroed first. Each line is parsed into a small buffer
+    // that stays in L1 and appended whole once it has exactly #C values.
+    motion->values.clear();
+    motion->values.reserve(capacity * static_cast<std::size_t>(num_channels));
+    std::vector<float> line_values(static_cast<std::size_t>(num_channels));
+    float* out = line_values.data();
+    std::size_t frames = 0;
+    for (; frames < capacity; ++frames) {
+      SkipSpace();
+      if (p_ == end_) break;
+      if (Status s = ParseLine(static_cast<long long>(frames) + 1, num_channels, out); !s) return s;
+      motion->values.insert(motion->values.end(), out, out + num_channels);
+    }
+    if (static_cast<long long>(frames) < declared) {
+      // Stopped by the size bound: whatever is left cannot be a whole frame,
+      // so parsing it yields the precise error for that line.
+      SkipSpace();
+      if (p_ != end_) {
+        std::vector<float> scratch(static_cast<std::size_t>(num_channels));
+        if (Status s = ParseLine(static_cast<long long>(frames) + 1, num_channels, scratch.data()); !s) return s;
+      }
+      const std::string counts = "'Frames:' declares " + std::to_string(declared) + " frames but the file holds " +
+                                 std::to_string(frames);
+      if (!options.allow_short_motion) {
+        return MakeError(ErrorCode::kCountMismatch, Loc(p_), counts);
+      }
+      warnings->push_back(Warning{Loc(p_), counts + "; loading " + std::to_string(frames)});
+    } else {
+      SkipSpace();
+      if (p_ != end_) WarnExtraLines(warnings, declared);
+    }
+    motion->num_frames = static_cast<int>(frames);
+    return Status::Ok();
+  }
+
+ private:
+  FileLoc Loc(const char* where) const {
+    return FileLoc{doc_.file_name, line_, static_cast<int>(where - line_start_) + 1, {}};
+  }
+
+  // Skips blanks and line ends, counting lines (LF, CRLF and CR each end one).
+  void SkipSpace() {
+    while (p_ != end_) {
+      const char c = *p_;
+      if (IsBlank(c)) {
+        ++p_;
+      } else if (c == '\n') {
+        ++p_;
+        ++line_;
+        line_start_ = p_;
+      } else if (c == '\r') {
+        ++p_;
+        if (p_ != end_ && *p_ == '\n') ++p_;
+        ++line_;
+        line_start_ = p_;
+      } else {
+        return;
+      }
+    }
+  }
+
+  // Parses one data line starting at a non-blank byte; leaves p_ at its line end.
+  Status ParseLine(long long frame, int num_channels, float* out) {
+    int count = 0;
+    for (;;) {
+      const char* token = p_;
+      if (count == num_channels) return TooMany(frame, num_channels, token);
+      const char* next = nullptr;
+      const internal::NumberStatus s = internal::ParseBvhNumber(p_, end_, out[count], &next);
+      if (s != internal::NumberStatus::kOk || (next != end_ && !IsBlank(*next) && !IsLineEnd(*next))) {
+        return BadNumber(frame, count, s, token);
+      }
+      ++count;
+      p_ = next;
+      while (p_ != end_ && IsBlank(*p_)) ++p_;
+      if (p_ == end_ || IsLineEnd(*p_)) break;
+    }
+    if (count != num_channels) {
+      return MakeError(ErrorCode::kCountMismatch, Loc(p_),
+                       "expected " + std::to_string(num_channels) + " values in frame " + std::to_string(frame) +
+                           ", found " + std::to_string(count));
+    }
+    return Status::Ok();
+  }
+
+  Error TooMany(long long frame, int num_channels, const char* extra) {
+    int count = num_channels;
+    const char* q = extra;
+    while (q != end_ && !IsLineEnd(*q)) {
+      while (q != end_ && IsBlank(*q)) ++q;
+      if (q == end_ || IsLineEnd(*q)) break;
+      ++count;
+      while (q != end_ && !IsBlank(*q) && !IsLineEnd(*q)) ++q;
+    }
+    return MakeError(ErrorCode::kCountMismatch, Loc(extra),
+                     "expected " + std::to_string(num_channels) + " values in frame " + std::to_string(frame) +
+                         ", found " + std::to_string(count));
+  }
+
+  Error BadNumber(long long frame, int index, internal::NumberStatus s, const char* token) {
+    const char* q = token;
+    while (q != end_ && !IsBlank(*q) && !IsLineEnd(*q) && q - token < 40) ++q;
+    const std::string found(token, static_cast<std::size_t>(q - token));
+    const bool non_finite = s == internal::NumberStatus::kNonFinite;
+    return MakeError(non_finite ? ErrorCode::kNonFinite : ErrorCode::kBadNumber, Loc(token),
+                     std::string(non_finite ? "expected a finite number" : "expected a number") + " for value " +
+                         std::to_string(index + 1) + " of frame " + std::to_string(frame) + ", found '" + found +
+                         "'");
+  }
+
+  void WarnExtraLines(std::vector<Warning>* warnings, long long declared) {
+    const FileLoc first = Loc(p_);
+    long long extra = 0;
+    while (p_ != end_) {
+      ++extra;
+      while (p_ != end_ && !IsLineEnd(*p_)) ++p_;
+      SkipSpace();
+    }
+    warnings->push_back(Warning{first, std::to_string(extra) + " data line(s) after the " + std::to_string(declared) +
+                                           " frames 'Frames:' declares; ignored"});
+  }
+
+  const char* p_;
+  const char* end_;
+  const char* line_start_;
+  int line_;
+  const BvhDocument& doc_;
+};
+
+glm::vec3 ZUpToYUp(const glm::vec3& v) { return {v.x, v.z, -v.y}; }
+
+}  // namespace
+
+UpAxis DetectBvhUpAxis(const Skeleton& skeleton) {
+  auto vote = [](const glm::vec3& v, int* y_votes, int* z_votes) {
+    const glm::vec3 a = glm::abs(v);
+    if (a.y > a.x && a.y > a.z) ++*y_votes;
+    if (a.z > a.x && a.z > a.y) ++*z_votes;
+  };
+  int y_votes = 0;
+  int z_votes = 0;
+  bool any = false;
+  for (int j = 0; j < skeleton.num_joints(); ++j) {
+    const std::size_t js = static_cast<std::size_t>(j);
+    if (skeleton.parents[js] == kNoParent) continue;
+    bool has_position = false;
+    const JointChannels& c = skeleton.channels[js];
+    for (int k = 0; k < c.count; ++k) {
+      const ChannelType t = c.types[static_cast<std::size_t>(k)];
+      has_position |= t == ChannelType::kXPosition || t == ChannelType::kYPosition || t == ChannelType::kZPosition;
+    }
+    if (has_position) continue;
+    vote(skeleton.rest_translations[js], &y_votes, &z_votes);
+    any = true;
+  }
+  for (const EndSite& e : skeleton.end_sites) {
+    vote(e.offset, &y_votes, &z_votes);
+    any = true;
+  }
+  if (!any) {
+    for (int j = 0; j < skeleton.num_joints(); ++j) {
+      const std::size_t js = static_cast<std::size_t>(j);
+      if (skeleton.parents[js] != kNoParent) vote(skeleton.rest_translations[js], &y_votes, &z_votes);
+    }
+  }
+  return z_votes > y_votes ? UpAxis::kZ : UpAxis::kY;
+}
+
+float RestHeight(const Skeleton& skeleton, UpAxis up) {
+  const int axis = up == UpAxis::kY ? 1 : 2;
+  std::vector<glm::vec3> model(skeleton.rest_translations.size());
+  float lo = std::numeric_limits<float>::max();
+  float hi = std::numeric_limits<float>::lowest();
+  for (std::size_t j = 0; j < model.size(); ++j) {
+    const int p = skeleton.parents[j];
+    model[j] = skeleton.rest_translations[j] + (p == kNoParent ? glm::vec3(0.0f) : model[static_cast<std::size_t>(p)]);
+    lo = std::min(lo, model[j][axis]);
+    hi = std::max(hi, model[j][axis]);
+  }
+  for (const EndSite& e : skeleton.end_sites) {
+    const float h = model[static_cast<std::size_t>(e.parent)][axis] + e.offset[axis];
+    lo = std::min(lo, h);
+    hi = std::max(hi, h);
+  }
+  return hi >= lo ? hi - lo : 0.0f;
+}
+
+float FirstFrameHeight(const Skeleton& skeleton, const Motion& motion, UpAxis up) {
+  if (motion.num_frames < 1) return 0.0f;
+  const std::size_t n = skeleton.rest_translations.size();
+  std::vector<JointTransform> locals(n);
+  std::vector<glm::mat4> model(n);
+  if (!LocalPoseJob{&skeleton, motion.frame(0), locals}.Run()) return 0.0f;
+  if (!LocalToModelJob{skeleton.parents, locals, glm::mat4(1.0f), model}.Run()) return 0.0f;
+  const int axis = up == UpAxis::kY ? 1 : 2;
+  float lo = std::numeric_limits<float>::max();
+  float hi = std::numeric_limits<float>::lowest();
+  for (const glm::mat4& m : model) {
+    lo = std::min(lo, m[3][axis]);
+    hi = std::max(hi, m[3][axis]);
+  }
+  for (const EndSite& e : skeleton.end_sites) {
+    const float h = (model[static_cast<std::size_t>(e.parent)] * glm::vec4(e.offset, 1.0f))[axis];
+    lo = std::min(lo, h);
+    hi = std::max(hi, h);
+  }
+  return hi >= lo ? hi - lo : 0.0f;
+}
+
+const char* DetectUnits(float h) {
+  if (h >= 0.5f && h <= 3.0f) return "m";
+  if (h >= 40.0f && h < 100.0f) return "inch";
+  if (h >= 100.0f && h <= 300.0f) return "cm";
+  return "unknown";
+}
+
+void ScaleSkeletonAndMotion(float factor, Skeleton* skeleton, Motion* motion) {
+  for (glm::vec3& t : skeleton->rest_translations) t *= factor;
+  for (EndSite& e : skeleton->end_sites) e.offset *= factor;
+  std::vector<int> columns;
+  for (const JointChannels& c : skeleton->channels) {
+    for (int k = 0; k < c.count; ++k) {
+      const ChannelType t = c.types[static_cast<std::size_t>(k)];
+      if (t == ChannelType::kXPosition || t == ChannelType::kYPosition || t == ChannelType::kZPosition) {
+        columns.push_back(static_cast<int>(c.first) + k);
+      }
+    }
+  }
+  for (int f = 0; f < motion->num_frames; ++f) {
+    std::span<float> row = motion->frame(f);
+    for (int c : columns) row[static_cast<std::size_t>(c)] *= factor;
+  }
+}
+
+void ConvertZUpToYUp(Skeleton* skeleton, Motion* motion) {
+  for (glm::vec3& t : skeleton->rest_translations) t = ZUpToYUp(t);
+  for (EndSite& e : skeleton->end_sites) e.offset = ZUpToYUp(e.offset);
+  std::vector<int> negate;
+  for (JointChannels& c : skeleton->channels) {
+    for (int k = 0; k < c.count; ++k) {
+      ChannelType& t = c.types[static_cast<std::size_t>(k)];
+      const int column = static_cast<int>(c.first) + k;
+      switch (t) {
+        case ChannelType::kYPosition: t = ChannelType::kZPosition; negate.push_back(column); break;
+        case ChannelType::kZPosition: t = ChannelType::kYPosition; break;
+        case ChannelType::kYRotation: t = ChannelType::kZRotation; negate.push_back(column); break;
+        case ChannelType::kZRotation: t = ChannelType::kYRotation; break;
+        default: break;
+      }
+    }
+  }
+  for (int f = 0; f < motion->num_frames; ++f) {
+    std::span<float> row = motion->frame(f);
+    for (int c : negate) row[static_cast<std::size_t>(c)] = -row[static_cast<std::size_t>(c)];
+  }
+  skeleton->info.up_axis = UpAxis::kY;
+}
+
+Result<BvhFile> ParseBvh(std::string_view text, const std::string& file_name, const BvhReadOptions& options) {
+  if (!(options.scale >= 0.0f) || !std::isfinite(options.scale)) {
+    return MakeError(ErrorCode::kInvalidArgument, FileLoc{file_name, 0, 0, {}},
+                     "scale must be finite and >= 0 (0 = automatic), got " + std::to_string(options.scale));
+  }
+  Result<BvhDocument> document = ParseBvhHierarchy(text, file_name, {options.max_depth, options.max_joints});
+  if (!document) return std::move(document).error();
+  BvhFile file;
+  file.warnings = std::move(document->warnings);
+  Result<Skeleton> skeleton = BuildBvhSkeleton(*document, options.position_mode, &file.warnings);
+  if (!skeleton) return std::move(skeleton).error();
+  file.skeleton = std::move(skeleton).value();
+  if (Status s = MotionParser(text, *document).Run(options, &file.motion, &file.warnings); !s) return s.error();
+
+  SkeletonInfo& info = file.skeleton.info;
+  info.up_axis = options.up_axis.has_value() ? *options.up_axis : DetectBvhUpAxis(file.skeleton);
+  const float raw_height = RestHeight(file.skeleton, info.up_axis);
+  // A rest pose need not stand upright (Bandai Namco's bones lie along X), so
+  // the units come from the taller of the rest pose and the first frame.
+  info.detected_units =
+      DetectUnits(std::max(raw_height, FirstFrameHeight(file.skeleton, file.motion, info.up_axis)));
+  float scale = options.scale;
+  if (scale == 0.0f) {
+    scale = info.detected_units == std::string("m")      ? 1.0f
+            : info.detected_units == std::string("cm")   ? 0.01f
+            : info.detected_units == std::string("inch") ? 0.0254f
+                                                         : 1.0f;
+    if (info.detected_units == std::string("unknown")) {
+      file.warnings.push_back(Warning{FileLoc{file_name, 0, 0, {}},
+                                      "units not recognised from a rest height of " + std::to_string(raw_height) +
+                                          "; automatic scale left at 1"});
+    }
+  }
+  if (scale != 1.0f) ScaleSkeletonAndMotion(scale, &file.skeleton, &file.motion);
+  info.scale_applied = scale;
+  info.rest_height = raw_height * scale;
+  if (options.convert_to_y_up && info.up_axis == UpAxis::kZ) ConvertZUpToYUp(&file.skeleton, &file.motion);
+  return file;
+}
+
+Result<BvhFile> ReadBvhFile(const std::string& path, const BvhReadOptions& options) {
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
+  if (!in) return MakeError(ErrorCode::kIo, FileLoc{path, 0, 0, {}}, "cannot open the file for reading");
+  const std::streamoff size = in.tellg();
+  if (size < 0) return MakeError(ErrorCode::kIo, FileLoc{path, 0, 0, {}}, "cannot determine the file size");
+  std::string text(static_cast<std::size_t>(size), '\0');
+  in.seekg(0);
+  if (!in.read(text.data(), size)) {
+    return MakeError(ErrorCode::kIo, FileLoc{path, 0, 0, {}}, "cannot read the file");
+  }
+  return ParseBvh(text, path, options);
+}
+
+}  // namespace mocap

@@ -1,0 +1,102 @@
+#pragma once
+// BVH import: text -> (Skeleton, Motion, warnings).
+//
+// Output conventions
+// - Joints come in file order, which is parent-before-child; several ROOTs give
+//   several trees (kNoParent parents). Rest rotations are identity, rest scales
+//   one, rest translations the OFFSETs; end sites are kept with their parent.
+// - Motion is one contiguous #F x #C float array in the file's column order;
+//   rotation channels stay in degrees and in the file's Euler order.
+// - Position channels (see PositionChannelMode): by default they are the joint's
+//   whole local translation and replace OFFSET (Blender, Assimp; LAFAN-style
+//   files repeat the offsets in every frame). kAddToOffset adds them to OFFSET
+//   (three.js). The mode is stored in Skeleton::position_mode; pose.h applies it.
+// - Axes: the file's axes are kept unless `convert_to_y_up` is set and the file
+//   is Z-up, in which case every offset, end site and channel is rotated by
+//   -90 degrees about X, (x, y, z) -> (x, z, -y): Yposition becomes Zposition
+//   (negated), Zposition becomes Yposition, Yrotation becomes Zrotation (negated),
+//   Zrotation becomes Yrotation. The Euler order is kept, so poses are exactly
+//   the rotated poses of the file. SkeletonInfo::up_axis then says kY.
+//
+// Detection rules (reported in SkeletonInfo, used by `inspect`)
+// - Up axis: each bone (the OFFSET of a non-root joint without position
+//   channels, and of every end site; if that leaves none, every non-root joint)
+//   votes for the axis, Y or Z, on which its offset is longest, when that axis is
+//   also its longest overall. More Z votes than Y votes means Z-up. Legs, spine
+//   and neck are vertical in a rest pose and outnumber the forward-pointing feet;
+//   arms, along X in the usual T-pose, do not vote.
+// - Height: extent along the up axis of the rest positions of all joints and end
+//   sites (offsets chained from the roots at the origin), after scale.
+// - Units from h = the larger of that rest height and the same extent in the
+//   first frame's pose (some rest poses do not stand upright: Bandai Namco's
+//   bones lie along X), before scale, for a human-sized figure:
+//   0.5 <= h <= 3 -> "m"; 40 <= h < 100 -> "inch"; 100 <= h <= 300 -> "cm";
+//   otherwise "unknown" (e.g. CMU cgspeed files, ~26 units tall).
+//
+// Errors (codes from mocap::ErrorCode, messages "file:line:col: error: ...")
+// - Every frame is one non-blank line holding exactly #C numbers; a short or long
+//   line is kCountMismatch "expected 96 values in frame 118, found 95".
+// - A number must fill its whole token; NaN, infinity and overflow are kNonFinite.
+// - More data lines than "Frames:" declares: the declared frames are loaded and a
+//   warning names the extra lines. Fewer: kCountMismatch naming both counts,
+//   unless allow_short_motion, which loads the complete frames found and warns.
+// - The frame array is never sized from the declared count alone: at most
+//   (bytes left + 1) / (2 * #C) frames can fit in the rest of the file, and no
+//   more are allocated.
+
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "mocap/bvh_document.h"
+#include "mocap/error.h"
+#include "mocap/motion.h"
+#include "mocap/skeleton.h"
+
+namespace mocap {
+
+struct BvhReadOptions {
+  // Factor applied to offsets, end sites and position channels. 0 means
+  // automatic: convert the detected units to metres (cm 0.01, inch 0.0254, m 1;
+  // "unknown" keeps 1 and warns). Negative or non-finite is kInvalidArgument.
+  float scale = 1.0f;
+  // The file's up axis; empty = detect (rule above).
+  std::optional<UpAxis> up_axis;
+  // Rotate a Z-up file to Y-up (see above). No effect on a Y-up file.
+  bool convert_to_y_up = false;
+  PositionChannelMode position_mode = PositionChannelMode::kReplaceOffset;
+  // Load the complete frames of a file with fewer data lines than declared.
+  bool allow_short_motion = false;
+  int max_depth = kDefaultBvhMaxDepth;  // deepest ROOT/JOINT nesting (ROOT = 1)
+  int max_joints = kMaxJoints;          // most joints; values above kMaxJoints mean kMaxJoints
+};
+
+struct BvhFile {
+  Skeleton skeleton;
+  Motion motion;
+  std::vector<Warning> warnings;  // non-fatal findings, in file order where possible
+};
+
+// Parses a whole BVH text. `file_name_for_messages` only labels errors and warnings.
+[[nodiscard]] Result<BvhFile> ParseBvh(std::string_view text, const std::string& file_name_for_messages,
+                                       const BvhReadOptions& options = {});
+
+// Reads `path` into memory and parses it (kIo when it cannot be read).
+[[nodiscard]] Result<BvhFile> ReadBvhFile(const std::string& path, const BvhReadOptions& options = {});
+
+// Detection helpers (rules above), exposed for tests and `inspect`.
+UpAxis DetectBvhUpAxis(const Skeleton& skeleton);
+// Extent along `up` of the rest positions of all joints and end sites.
+float RestHeight(const Skeleton& skeleton, UpAxis up);
+// Extent along `up` of joints and end sites posed by frame 0 (0 without frames).
+float FirstFrameHeight(const Skeleton& skeleton, const Motion& motion, UpAxis up);
+// "m", "inch", "cm" or "unknown" for a figure's height.
+const char* DetectUnits(float rest_height);
+
+// Multiplies offsets, end sites and position channels of `motion` by `factor`.
+void ScaleSkeletonAndMotion(float factor, Skeleton* skeleton, Motion* motion);
+// Rotates a Z-up skeleton and motion to Y-up as described above.
+void ConvertZUpToYUp(Skeleton* skeleton, Motion* motion);
+
+}  // namespace mocap
