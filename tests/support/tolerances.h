@@ -12,4 +12,15 @@ inline constexpr float kAngleTolDeg = 1e-3f;
 // Double-precision solves (fits, RBF, projections).
 inline constexpr double kDoubleTol = 1e-9;
 
+// Euler angles (degrees) extracted from a float quaternion and compared with the
+// angles that built it: float quaternion round-off (~6e-8) amplified by the
+// atan2/asin of the extraction, away from gimbal lock.
+inline constexpr float kEulerRoundTripTolDeg = 2e-3f;
+// Angle between two rotations (radians) after a float round trip.
+inline constexpr float kRotationTolRad = 1e-5f;
+// Within 0.1 degree of gimbal lock asin loses half the digits: rotations rebuilt
+// from extracted angles agree to ~sqrt(float eps).
+inline constexpr float kGimbalRotationTolRad = 2e-3f;
+inline constexpr float kGimbalAngleTolDeg = 0.1f;
+
 }  // namespace testsupport
