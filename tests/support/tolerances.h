@@ -22,5 +22,11 @@ inline constexpr float kRotationTolRad = 1e-5f;
 // from extracted angles agree to ~sqrt(float eps).
 inline constexpr float kGimbalRotationTolRad = 2e-3f;
 inline constexpr float kGimbalAngleTolDeg = 0.1f;
+// Channel values (degrees or file units of order 100) after a resampling round
+// trip: sampled exactly at the original frames, then re-extracted from floats.
+inline constexpr float kResampleChannelTol = 5e-3f;
+// Largest change of an Euler channel between neighbouring resampled frames of a
+// smooth motion that moves < 40 degrees per frame: catches 360-degree jumps.
+inline constexpr float kMaxAngleStepDeg = 45.0f;
 
 }  // namespace testsupport
