@@ -29,4 +29,16 @@ inline constexpr float kResampleChannelTol = 5e-3f;
 // smooth motion that moves < 40 degrees per frame: catches 360-degree jumps.
 inline constexpr float kMaxAngleStepDeg = 45.0f;
 
+// Finite-difference kinematics. Tests compute their tolerance from the scheme's
+// truncation bound (h^2/6 |x'''| for central first derivatives, h^2/12 |x''''|
+// for second ones, h |x'''| for the first-order end formulas) plus float
+// round-off of the model matrices, times this safety factor.
+inline constexpr double kFdSafety = 2.0;
+// Relative float round-off of a model-matrix position after a short joint chain.
+inline constexpr double kMatrixRoundoff = 4.0 * 1.1920929e-7;
+// Halving the step of a second-order scheme divides its error by 4; accept >3.
+inline constexpr double kSecondOrderMinRatio = 3.0;
+// Relative float error of rotating a vector into a joint's frame.
+inline constexpr float kLocalFrameRelTol = 1e-5f;
+
 }  // namespace testsupport
