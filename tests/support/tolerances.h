@@ -41,4 +41,19 @@ inline constexpr double kSecondOrderMinRatio = 3.0;
 // Relative float error of rotating a vector into a joint's frame.
 inline constexpr float kLocalFrameRelTol = 1e-5f;
 
+// Synthetic motions. A procedural walk keeps the stance foot within this of the
+// ground (the hips bob is solved exactly; float positions round at ~1e-5 cm, so
+// this is slack for the foot-flat approximation only).
+inline constexpr float kGroundContactTolCm = 0.05f;
+// Joint bend angles measured from float model positions (acos near 0 and 180
+// degrees loses precision: sqrt(float eps) ~ 3e-4 rad ~ 0.02 degrees).
+inline constexpr float kBendMeasureTolDeg = 0.05f;
+// Hips vertical acceleration of the jump at 120 fps: the motion is piecewise
+// quadratic, so central differences are exact up to float round-off of positions
+// near 100 cm (4 * 1e-5 cm / h^2 = 0.6 cm/s^2).
+inline constexpr float kJumpAccelTolCmPerS2 = 2.0f;
+// Apex of the hips sampled at 120 fps: the nearest frame is at most h/2 from the
+// peak, so at most g (h/2)^2 / 2 = 0.009 cm below it, plus round-off.
+inline constexpr float kJumpApexTolCm = 0.02f;
+
 }  // namespace testsupport
