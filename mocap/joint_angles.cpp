@@ -119,6 +119,25 @@ void QuatToEulerNear(const glm::quat& q, const ChannelType* axes, int count,
   for (int i = 0; i < n; ++i) angles_deg[i] = static_cast<float>(best[i]);
 }
 
+int JointEulerAngles(const Skeleton& skeleton, int joint, const glm::quat& local_rotation,
+                     float* angles_deg, const float* reference_deg) {
+  const std::size_t j = static_cast<std::size_t>(joint);
+  const JointChannels& ch = skeleton.channels[j];
+  ChannelType axes[3];
+  int n = 0;
+  for (int c = 0; c < ch.count && n < 3; ++c) {
+    if (AxisIndex(ch.types[static_cast<std::size_t>(c)]) >= 0) axes[n++] = ch.types[static_cast<std::size_t>(c)];
+  }
+  if (n == 0) return 0;
+  const glm::quat euler = glm::conjugate(skeleton.rest_rotations[j]) * local_rotation;
+  if (reference_deg != nullptr) {
+    QuatToEulerNear(euler, axes, n, reference_deg, angles_deg);
+  } else {
+    QuatToEuler(euler, axes, n, angles_deg);
+  }
+  return n;
+}
+
 glm::vec3 QuatToRotationVector(const glm::quat& q) {
   glm::dquat qd(q.w, q.x, q.y, q.z);
   if (qd.w < 0.0) qd = -qd;

@@ -39,6 +39,15 @@ void QuatToEuler(const glm::quat& q, const ChannelType* axes, int count, float* 
 void QuatToEulerNear(const glm::quat& q, const ChannelType* axes, int count,
                      const float* reference_deg, float* angles_deg);
 
+// Joint angles theta of one joint (the Euler pose feature of 5.1): the angles of
+// its Euler channels, in its own channel order, for `local_rotation` relative to
+// its rest rotation (LocalPoseJob builds rest_rotation * Euler). Writes up to 3
+// angles (degrees) in the order the channels appear and returns how many (0 for
+// a joint without Euler channels). With `reference_deg` (optional, same count)
+// the angles continue it as QuatToEulerNear does. joint must be in range.
+int JointEulerAngles(const Skeleton& skeleton, int joint, const glm::quat& local_rotation,
+                     float* angles_deg, const float* reference_deg = nullptr);
+
 // Rotation vector (axis * angle, radians) of a unit quaternion, on the shorter
 // arc: q is first negated if w < 0, so |r| <= pi. r = 2 atan2(|v|, w) v/|v|,
 // and r = 2 v when |v| < 1e-12 (ALGORITHMS.md 5.1).

@@ -3,6 +3,7 @@
 #include <array>
 #include <cmath>
 #include <numbers>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -88,6 +89,34 @@ TEST(QuatToEulerNear, AvoidsJumpsAcross180) {
   previous[2] = 30.0f;
   mocap::QuatToEulerNear(mocap::EulerToQuat(zxy, past_pole, 3), zxy, 3, previous, out);
   for (int i = 0; i < 3; ++i) EXPECT_NEAR(out[i], past_pole[i], testsupport::kEulerRoundTripTolDeg);
+}
+
+TEST(JointEulerAngles, GivesBackTheChannelValuesOfAPose) {
+  mocap::Skeleton s;
+  s.names = {"root", "yxz", "xz"};
+  s.parents = {mocap::kNoParent, 0, 1};
+  s.rest_translations.assign(3, glm::vec3(0, 10, 0));
+  s.rest_rotations = {glm::quat(1, 0, 0, 0), glm::angleAxis(0.5f, glm::normalize(glm::vec3(1, 1, 0))),
+                      glm::quat(1, 0, 0, 0)};
+  s.rest_scales.assign(3, glm::vec3(1));
+  s.channels.resize(3);
+  s.channels[0] = {0, 3, {ChannelType::kXPosition, ChannelType::kYPosition, ChannelType::kZPosition}};
+  s.channels[1] = {3, 3, {kY, kX, kZ}};
+  s.channels[2] = {6, 2, {kX, kZ}};
+  s.num_channels = 8;
+  const std::vector<float> frame = {1, 2, 3, 40, -25, 130, -60, 75};
+  std::vector<mocap::JointTransform> locals(3);
+  ASSERT_TRUE((mocap::LocalPoseJob{&s, frame, locals}).Run().ok());
+  float angles[3];
+  EXPECT_EQ(mocap::JointEulerAngles(s, 0, locals[0].rotation, angles), 0);
+  ASSERT_EQ(mocap::JointEulerAngles(s, 1, locals[1].rotation, angles), 3);
+  for (int i = 0; i < 3; ++i) EXPECT_NEAR(angles[i], frame[3 + i], testsupport::kEulerRoundTripTolDeg);
+  ASSERT_EQ(mocap::JointEulerAngles(s, 2, locals[2].rotation, angles), 2);
+  EXPECT_NEAR(angles[0], -60.0f, testsupport::kEulerRoundTripTolDeg);
+  EXPECT_NEAR(angles[1], 75.0f, testsupport::kEulerRoundTripTolDeg);
+  const float reference[2] = {300.0f, 75.0f};  // continue a joint that has turned past 180
+  ASSERT_EQ(mocap::JointEulerAngles(s, 2, locals[2].rotation, angles, reference), 2);
+  EXPECT_NEAR(angles[0], 300.0f, testsupport::kEulerRoundTripTolDeg);
 }
 
 TEST(RotationVector, MatchesAxisAngleAndRoundTrips) {

@@ -279,6 +279,30 @@ TEST(KinematicsJob, SplitRangesGiveTheSameBits) {
   }
 }
 
+TEST(KinematicsJob, ShortMotions) {
+  Analytic an;
+  const mocap::Skeleton s = an.MakeSkeleton();
+  an.duration = 0.1;
+  const mocap::Motion two = an.MakeMotion(10);  // 2 frames
+  ASSERT_EQ(two.num_frames, 2);
+  auto k = mocap::ComputeKinematics(s, two);
+  ASSERT_TRUE(k.ok());
+  const glm::dvec3 expected_v = (an.Hand(0.1).p - an.Hand(0.0).p) / 0.1;
+  ExpectVecNear((*k)[2].linear_velocity, expected_v, VelocityTol(an, 0.1, 0.0, 100.0), "v", 0, 2);
+  ExpectVecNear((*k)[5].linear_velocity, expected_v, VelocityTol(an, 0.1, 0.0, 100.0), "v", 1, 2);
+  EXPECT_EQ((*k)[5].linear_acceleration, glm::vec3(0.0f));
+  mocap::Motion one = two;
+  one.num_frames = 1;
+  one.values.resize(9);
+  auto k1 = mocap::ComputeKinematics(s, one);
+  ASSERT_TRUE(k1.ok());
+  EXPECT_EQ((*k1)[2].linear_velocity, glm::vec3(0.0f));
+  mocap::Motion none = one;
+  none.num_frames = 0;
+  none.values.clear();
+  EXPECT_EQ(mocap::ComputeKinematics(s, none).error().code, mocap::ErrorCode::kInvalidArgument);
+}
+
 TEST(SampleJointKinematics, ExactAtFramesAndCloseBetween) {
   const Analytic an;
   const mocap::Skeleton s = an.MakeSkeleton();
