@@ -12,4 +12,48 @@ inline constexpr float kAngleTolDeg = 1e-3f;
 // Double-precision solves (fits, RBF, projections).
 inline constexpr double kDoubleTol = 1e-9;
 
+// Euler angles (degrees) extracted from a float quaternion and compared with the
+// angles that built it: float quaternion round-off (~6e-8) amplified by the
+// atan2/asin of the extraction, away from gimbal lock.
+inline constexpr float kEulerRoundTripTolDeg = 2e-3f;
+// Angle between two rotations (radians) after a float round trip.
+inline constexpr float kRotationTolRad = 1e-5f;
+// Within 0.1 degree of gimbal lock asin loses half the digits: rotations rebuilt
+// from extracted angles agree to ~sqrt(float eps).
+inline constexpr float kGimbalRotationTolRad = 2e-3f;
+inline constexpr float kGimbalAngleTolDeg = 0.1f;
+// Channel values (degrees or file units of order 100) after a resampling round
+// trip: sampled exactly at the original frames, then re-extracted from floats.
+inline constexpr float kResampleChannelTol = 5e-3f;
+// Largest change of an Euler channel between neighbouring resampled frames of a
+// smooth motion that moves < 40 degrees per frame: catches 360-degree jumps.
+inline constexpr float kMaxAngleStepDeg = 45.0f;
+
+// Finite-difference kinematics. Tests compute their tolerance from the scheme's
+// truncation bound (h^2/6 |x'''| for central first derivatives, h^2/12 |x''''|
+// for second ones, h |x'''| for the first-order end formulas) plus float
+// round-off of the model matrices, times this safety factor.
+inline constexpr double kFdSafety = 2.0;
+// Relative float round-off of a model-matrix position after a short joint chain.
+inline constexpr double kMatrixRoundoff = 4.0 * 1.1920929e-7;
+// Halving the step of a second-order scheme divides its error by 4; accept >3.
+inline constexpr double kSecondOrderMinRatio = 3.0;
+// Relative float error of rotating a vector into a joint's frame.
+inline constexpr float kLocalFrameRelTol = 1e-5f;
+
+// Synthetic motions. A procedural walk keeps the stance foot within this of the
+// ground (the hips bob is solved exactly; float positions round at ~1e-5 cm, so
+// this is slack for the foot-flat approximation only).
+inline constexpr float kGroundContactTolCm = 0.05f;
+// Joint bend angles measured from float model positions (acos near 0 and 180
+// degrees loses precision: sqrt(float eps) ~ 3e-4 rad ~ 0.02 degrees).
+inline constexpr float kBendMeasureTolDeg = 0.05f;
+// Hips vertical acceleration of the jump at 120 fps: the motion is piecewise
+// quadratic, so central differences are exact up to float round-off of positions
+// near 100 cm (4 * 1e-5 cm / h^2 = 0.6 cm/s^2).
+inline constexpr float kJumpAccelTolCmPerS2 = 2.0f;
+// Apex of the hips sampled at 120 fps: the nearest frame is at most h/2 from the
+// peak, so at most g (h/2)^2 / 2 = 0.009 cm below it, plus round-off.
+inline constexpr float kJumpApexTolCm = 0.02f;
+
 }  // namespace testsupport

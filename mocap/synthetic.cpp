@@ -1,0 +1,435 @@
+#include "mocap/synthetic.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include "mocap/joint_angles.h"
+#include "mocap/pose.h"
+
+namespace mocap {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+constexpr std::array<ChannelType, 3> kZxy = {ChannelType::kZRotation, ChannelType::kXRotation,
+                                             ChannelType::kYRotation};
+// Humanoid leg segments (cm): hip joint -> knee -> ankle.
+constexpr double kThighCm = 42.0;
+constexpr double kShinCm = 42.0;
+constexpr float kHipsRestY = 97.0f;
+
+// Appends joints in parent-before-child order with contiguous channels.
+class Builder {
+ public:
+  int Add(const std::string& name, int parent, glm::vec3 offset, bool with_position = false) {
+    JointChannels ch;
+    ch.first = static_cast<std::uint32_t>(s_.num_channels);
+    int c = 0;
+    if (with_position) {
+      for (ChannelType t : {ChannelType::kXPosition, ChannelType::kYPosition, ChannelType::kZPosition}) {
+        ch.types[static_cast<std::size_t>(c++)] = t;
+      }
+    }
+    for (ChannelType t : kZxy) ch.types[static_cast<std::size_t>(c++)] = t;
+    ch.count = static_cast<std::uint8_t>(c);
+    s_.num_channels += c;
+    s_.names.push_back(name);
+    s_.parents.push_back(static_cast<std::int16_t>(parent));
+    s_.rest_translations.push_back(offset);
+    s_.rest_rotations.emplace_back(1.0f, 0.0f, 0.0f, 0.0f);
+    s_.rest_scales.emplace_back(1.0f);
+    s_.channels.push_back(ch);
+    return static_cast<int>(s_.names.size()) - 1;
+  }
+  void End(int parent, glm::vec3 offset) { s_.end_sites.push_back({parent, offset, "End Site"}); }
+  Skeleton Finish(const char* source) {
+    s_.info.source_file = source;
+    s_.info.detected_units = "cm";
+    s_.info.up_axis = UpAxis::kY;
+    return std::move(s_);
+  }
+
+ private:
+  Skeleton s_;
+};
+
+// Joint rotation from ZXY Euler angles in degrees (R = Rz * Rx * Ry).
+glm::quat Zxy(double z_deg, double x_deg, double y_deg) {
+  const float angles[3] = {static_cast<float>(z_deg), static_cast<float>(x_deg), static_cast<float>(y_deg)};
+  return EulerToQuat(kZxy.data(), angles, 3);
+}
+
+// The humanoid joints the generators drive, in a fixed order.
+enum H : int {
+  kHips, kSpine, kSpine1, kSpine2, kNeck, kHead,
+  kLShoulder, kLArm, kLForeArm, kLHand, kLIndex,
+  kRShoulder, kRArm, kRForeArm, kRHand, kRIndex,
+  kLUpLeg, kLLeg, kLFoot, kLToe, kRUpLeg, kRLeg, kRFoot, kRToe, kNumH
+};
+constexpr std::array<const char*, kNumH> kHumanoidNames = {
+    "Hips", "Spine", "Spine1", "Spine2", "Neck", "Head",
+    "LeftShoulder", "LeftArm", "LeftForeArm", "LeftHand", "LeftHandIndex1",
+    "RightShoulder", "RightArm", "RightForeArm", "RightHand", "RightHandIndex1",
+    "LeftUpLeg", "LeftLeg", "LeftFoot", "LeftToeBase", "RightUpLeg", "RightLeg", "RightFoot",
+    "RightToeBase"};
+
+// One intended pose: root position and per-humanoid-joint rotation relative to rest.
+struct HumanoidPose {
+  glm::vec3 root_position{0.0f, kHipsRestY, 0.0f};
+  std::array<glm::quat, kNumH> rotations;
+  HumanoidPose() { rotations.fill(glm::quat(1.0f, 0.0f, 0.0f, 0.0f)); }
+};
+
+// Writes motions of a humanoid skeleton frame by frame, whatever its channel order.
+class MotionWriter {
+ public:
+  static Result<MotionWriter> Create(const Skeleton& s, double frame_time_s, int num_frames) {
+    const FileLoc loc{s.info.source_file, 0, 0, {}};
+    if (!(frame_time_s > 0.0) || !std::isfinite(frame_time_s) || num_frames < 1 ||
+        num_frames > (1 << 20)) {
+      return MakeError(ErrorCode::kInvalidArgument, loc,
+                       "expected a positive frame time and duration, found frame time " +
+                           std::to_string(frame_time_s) + " s for " + std::to_string(num_frames) + " frames");
+    }
+    const Status check = s.Check();
+    if (!check) return check.error();
+    MotionWriter w(s);
+    for (int i = 0; i < kNumH; ++i) {
+      w.index_[static_cast<std::size_t>(i)] = s.FindJoint(kHumanoidNames[static_cast<std::size_t>(i)]);
+      if (w.index_[static_cast<std::size_t>(i)] < 0) {
+        return MakeError(ErrorCode::kNotFound, loc,
+                         std::string("expected a humanoid joint named '") +
+                             kHumanoidNames[static_cast<std::size_t>(i)] + "'");
+      }
+    }
+    w.motion_.frame_time_s = frame_time_s;
+    w.motion_.num_channels = s.num_channels;
+    w.motion_.num_frames = num_frames;
+    w.motion_.values.assign(static_cast<std::size_t>(num_frames) * static_cast<std::size_t>(s.num_channels),
+                            0.0f);
+    return w;
+  }
+
+  int num_frames() const { return motion_.num_frames; }
+  double time(int f) const { return f * motion_.frame_time_s; }
+
+  void Write(int f, const HumanoidPose& pose) {
+    std::vector<glm::quat> delta(skeleton_->parents.size(), glm::quat(1.0f, 0.0f, 0.0f, 0.0f));
+    for (int i = 0; i < kNumH; ++i) {
+      delta[static_cast<std::size_t>(index_[static_cast<std::size_t>(i)])] = pose.rotations[static_cast<std::size_t>(i)];
+    }
+    const std::size_t root = static_cast<std::size_t>(index_[kHips]);
+    std::span<float> row = motion_.frame(f);
+    const std::span<const float> previous = f > 0 ? std::span<const float>(motion_.frame(f - 1)) : row;
+    for (std::size_t j = 0; j < delta.size(); ++j) {
+      const JointChannels& ch = skeleton_->channels[j];
+      const glm::vec3 translation = j == root ? pose.root_position : skeleton_->rest_translations[j];
+      ChannelType axes[3];
+      std::uint32_t where[3];
+      int n = 0;
+      for (int c = 0; c < ch.count; ++c) {
+        const ChannelType t = ch.types[static_cast<std::size_t>(c)];
+        const std::uint32_t k = ch.first + static_cast<std::uint32_t>(c);
+        const int type = static_cast<int>(t);
+        if (type <= 2) {  // kX/Y/ZPosition
+          row[k] = translation[type] -
+                   (skeleton_->position_mode == PositionChannelMode::kAddToOffset
+                        ? skeleton_->rest_translations[j][type]
+                        : 0.0f);
+        } else if (type <= 5 && n < 3) {
+          axes[n] = t;
+          where[n++] = k;
+        } else if (t >= ChannelType::kQuatX && t <= ChannelType::kQuatW) {
+          const glm::quat q = skeleton_->rest_rotations[j] * delta[j];
+          const float v[4] = {q.x, q.y, q.z, q.w};
+          row[k] = v[type - static_cast<int>(ChannelType::kQuatX)];
+        } else {
+          row[k] = skeleton_->rest_scales[j][type - static_cast<int>(ChannelType::kXScale)];
+        }
+      }
+      if (n > 0) {
+        float ref[3] = {0.0f, 0.0f, 0.0f};
+        float out[3];
+        if (f > 0) {
+          for (int i = 0; i < n; ++i) ref[i] = previous[where[i]];
+        }
+        QuatToEulerNear(delta[j], axes, n, ref, out);
+        for (int i = 0; i < n; ++i) row[where[i]] = out[i];
+      }
+    }
+  }
+  Motion Take() { return std::move(motion_); }
+
+ private:
+  explicit MotionWriter(const Skeleton& s) : skeleton_(&s) {}
+  const Skeleton* skeleton_;
+  std::array<int, kNumH> index_{};
+  Motion motion_;
+};
+
+int FramesFor(double duration_s, double frame_time_s) {
+  if (!(frame_time_s > 0.0) || !(duration_s > 0.0) || !std::isfinite(duration_s / frame_time_s)) return 0;
+  return static_cast<int>(std::min(std::round(duration_s / frame_time_s), 1e7)) + 1;
+}
+
+// Rise of the ankle (cm) above the straight-leg position for thigh and shin
+// pitches (degrees, the joints' X rotations).
+double AnkleRise(double thigh_x_deg, double knee_x_deg) {
+  const double a1 = glm::radians(thigh_x_deg);
+  const double a2 = glm::radians(thigh_x_deg + knee_x_deg);
+  return kThighCm * (1.0 - std::cos(a1)) + kShinCm * (1.0 - std::cos(a2));
+}
+
+// Forward reach (cm, +Z) of the ankle from the hip joint.
+double AnkleReach(double thigh_x_deg, double knee_x_deg) {
+  return -kThighCm * std::sin(glm::radians(thigh_x_deg)) -
+         kShinCm * std::sin(glm::radians(thigh_x_deg + knee_x_deg));
+}
+
+// Sets thigh, knee and a foot kept parallel to the ground (their X rotations sum to 0).
+void SetLeg(HumanoidPose* p, int up_leg, double thigh_x_deg, double knee_x_deg) {
+  p->rotations[static_cast<std::size_t>(up_leg)] = Zxy(0, thigh_x_deg, 0);
+  p->rotations[static_cast<std::size_t>(up_leg + 1)] = Zxy(0, knee_x_deg, 0);
+  p->rotations[static_cast<std::size_t>(up_leg + 2)] = Zxy(0, -(thigh_x_deg + knee_x_deg), 0);
+}
+
+}  // namespace
+
+Skeleton MakeHumanoidSkeleton() {
+  Builder b;
+  const int hips = b.Add("Hips", kNoParent, {0.0f, kHipsRestY, 0.0f}, true);
+  const int spine = b.Add("Spine", hips, {0, 8, 0});
+  const int spine1 = b.Add("Spine1", spine, {0, 12, 0});
+  const int spine2 = b.Add("Spine2", spine1, {0, 12, 0});
+  const int neck = b.Add("Neck", spine2, {0, 16, 0});
+  const int head = b.Add("Head", neck, {0, 9, 0});
+  b.End(head, {0, 18, 0});
+  for (float side : {1.0f, -1.0f}) {
+    const std::string s = side > 0 ? "Left" : "Right";
+    const int shoulder = b.Add(s + "Shoulder", spine2, {4 * side, 11, 0});
+    const int arm = b.Add(s + "Arm", shoulder, {13 * side, 0, 0});
+    const int fore = b.Add(s + "ForeArm", arm, {28 * side, 0, 0});
+    const int hand = b.Add(s + "Hand", fore, {25 * side, 0, 0});
+    const int index = b.Add(s + "HandIndex1", hand, {9 * side, 0, 0});
+    b.End(index, {7 * side, 0, 0});
+  }
+  for (float side : {1.0f, -1.0f}) {
+    const std::string s = side > 0 ? "Left" : "Right";
+    const int up = b.Add(s + "UpLeg", hips, {9 * side, -5, 0});
+    const int leg = b.Add(s + "Leg", up, {0, -static_cast<float>(kThighCm), 0});
+    const int foot = b.Add(s + "Foot", leg, {0, -static_cast<float>(kShinCm), 0});
+    const int toe = b.Add(s + "ToeBase", foot, {0, -7, 12});
+    b.End(toe, {0, 0, 6});
+  }
+  Skeleton s = b.Finish("synthetic:humanoid");
+  s.info.rest_height = 172.0f;
+  return s;
+}
+
+Result<Motion> MakeWalkMotion(const Skeleton& humanoid, const WalkOptions& o) {
+  const int frames = o.num_cycles >= 1 && o.cycle_s > 0.0
+                         ? FramesFor(o.num_cycles * o.cycle_s, o.frame_time_s) - 1
+                         : 0;
+  auto writer = MotionWriter::Create(humanoid, o.frame_time_s, frames);
+  if (!writer.ok()) return std::move(writer).error();
+  const auto flex = [&](double psi) { return 10.0 + o.hip_swing_deg * std::sin(psi); };  // forward
+  const auto knee = [&](double psi) {
+    const double c = std::max(0.0, std::cos(psi + 0.4));  // bent in swing (thigh moving forward)
+    return 5.0 + (o.knee_peak_deg - 5.0) * c * c;
+  };
+  // Hip speed that matches the stance foot's backward travel between heel strike
+  // (psi = pi/2) and toe off (psi = 3 pi/2), half a cycle apart.
+  const double speed = (AnkleReach(-flex(kPi / 2), knee(kPi / 2)) -
+                        AnkleReach(-flex(3 * kPi / 2), knee(3 * kPi / 2))) /
+                       (0.5 * o.cycle_s);
+  for (int f = 0; f < writer->num_frames(); ++f) {
+    const double t = writer->time(f);
+    const double phi = 2.0 * kPi * t / o.cycle_s;
+    const double sp = std::sin(phi);
+    HumanoidPose p;
+    const double left_rise = AnkleRise(-flex(phi), knee(phi));
+    const double right_rise = AnkleRise(-flex(phi + kPi), knee(phi + kPi));
+    p.root_position = glm::vec3(static_cast<float>(-2.0 * std::cos(phi)),
+                                static_cast<float>(kHipsRestY - std::min(left_rise, right_rise)),
+                                static_cast<float>(speed * t));
+    SetLeg(&p, kLUpLeg, -flex(phi), knee(phi));
+    SetLeg(&p, kRUpLeg, -flex(phi + kPi), knee(phi + kPi));
+    // Pelvis yaws with the forward leg; the spine and neck undo it so the head faces +Z.
+    p.rotations[kHips] = Zxy(0, 0, -6.0 * sp);
+    p.rotations[kSpine] = Zxy(0, 3, 3.0 * sp);
+    p.rotations[kSpine1] = Zxy(0, 1, 2.5 * sp);
+    p.rotations[kSpine2] = Zxy(0, 0, 2.0 * sp);
+    p.rotations[kNeck] = Zxy(0, 0, -1.0 * sp);
+    p.rotations[kHead] = Zxy(0, -4, -0.5 * sp);
+    // Arms hang 75 degrees down and swing against the same-side leg; the elbow
+    // bends more as the arm comes forward.
+    const double swing = o.arm_swing_deg;
+    const double left_fwd = -swing * sp;
+    const double right_fwd = swing * sp;
+    const auto elbow = [&](double fwd) {
+      const double u = swing > 0.0 ? 0.5 + 0.5 * fwd / swing : 0.5;
+      return 15.0 + (o.elbow_peak_deg - 15.0) * u;
+    };
+    p.rotations[kLArm] = Zxy(-75, 0, -left_fwd);
+    p.rotations[kRArm] = Zxy(75, 0, right_fwd);
+    p.rotations[kLForeArm] = Zxy(0, 0, -elbow(left_fwd));
+    p.rotations[kRForeArm] = Zxy(0, 0, elbow(right_fwd));
+    writer->Write(f, p);
+  }
+  return writer->Take();
+}
+
+Result<Motion> MakeBendRamp(const Skeleton& humanoid, float end_deg, double duration_s,
+                            double frame_time_s) {
+  auto writer = MotionWriter::Create(humanoid, frame_time_s, FramesFor(duration_s, frame_time_s));
+  if (!writer.ok()) return std::move(writer).error();
+  const int last = writer->num_frames() - 1;
+  for (int f = 0; f <= last; ++f) {
+    const double a = last > 0 ? end_deg * static_cast<double>(f) / last : end_deg;
+    HumanoidPose p;
+    p.rotations[kLForeArm] = Zxy(0, 0, -a);  // forearms bend forward (+Z)
+    p.rotations[kRForeArm] = Zxy(0, 0, a);
+    SetLeg(&p, kLUpLeg, -0.4 * a, a);        // knee forward, shin back: clear of the body
+    writer->Write(f, p);
+  }
+  return writer->Take();
+}
+
+Result<Motion> MakeTwistRamp(const Skeleton& humanoid, float end_deg, double duration_s,
+                             double frame_time_s) {
+  auto writer = MotionWriter::Create(humanoid, frame_time_s, FramesFor(duration_s, frame_time_s));
+  if (!writer.ok()) return std::move(writer).error();
+  const int last = writer->num_frames() - 1;
+  for (int f = 0; f <= last; ++f) {
+    const double a = last > 0 ? end_deg * static_cast<double>(f) / last : end_deg;
+    HumanoidPose p;
+    p.rotations[kLForeArm] = Zxy(0, a, 0);  // about the bone axis (+X on the left)
+    p.rotations[kRForeArm] = Zxy(0, -a, 0);
+    writer->Write(f, p);
+  }
+  return writer->Take();
+}
+
+JumpTimeline MakeJumpTimeline(const JumpOptions& o) {
+  JumpTimeline t{};
+  const double g = kGravityCmPerS2;
+  t.takeoff_speed_cm_per_s = std::sqrt(2.0 * g * std::max(o.height_cm, 0.0));
+  const double v0 = t.takeoff_speed_cm_per_s;
+  t.push_acceleration_cm_per_s2 = v0 * v0 / (2.0 * o.crouch_cm);
+  t.landing_acceleration_cm_per_s2 = v0 * v0 / (2.0 * o.landing_crouch_cm);
+  t.crouch_start_s = 0.3;
+  t.push_start_s = t.crouch_start_s + 0.5;
+  t.takeoff_s = t.push_start_s + 2.0 * o.crouch_cm / v0;
+  t.touchdown_s = t.takeoff_s + 2.0 * v0 / g;
+  t.landed_s = t.touchdown_s + 2.0 * o.landing_crouch_cm / v0;
+  t.recovered_s = t.landed_s + 0.5;
+  t.end_s = t.recovered_s + 0.3;
+  return t;
+}
+
+Result<Motion> MakeJumpMotion(const Skeleton& humanoid, const JumpOptions& o) {
+  const double leg = kThighCm + kShinCm;
+  if (!(o.height_cm > 0.0) || !(o.crouch_cm > 0.0 && o.crouch_cm < leg) ||
+      !(o.landing_crouch_cm > 0.0 && o.landing_crouch_cm < leg)) {
+    return MakeError(ErrorCode::kInvalidArgument, {humanoid.info.source_file, 0, 0, {}},
+                     "expected a positive jump height and crouch depths below the leg length (84 cm)");
+  }
+  const JumpTimeline tl = MakeJumpTimeline(o);
+  auto writer = MotionWriter::Create(humanoid, o.frame_time_s, FramesFor(tl.end_s, o.frame_time_s));
+  if (!writer.ok()) return std::move(writer).error();
+  const double g = kGravityCmPerS2;
+  const double v0 = tl.takeoff_speed_cm_per_s;
+  const auto hip_offset = [&](double t) {  // hips height relative to standing, cm
+    if (t < tl.crouch_start_s) return 0.0;
+    if (t < tl.push_start_s) {
+      return -o.crouch_cm * 0.5 * (1.0 - std::cos(kPi * (t - tl.crouch_start_s) / 0.5));
+    }
+    if (t < tl.takeoff_s) {
+      const double u = t - tl.push_start_s;
+      return -o.crouch_cm + 0.5 * tl.push_acceleration_cm_per_s2 * u * u;
+    }
+    if (t < tl.touchdown_s) {
+      const double u = t - tl.takeoff_s;
+      return v0 * u - 0.5 * g * u * u;
+    }
+    if (t < tl.landed_s) {
+      const double u = t - tl.touchdown_s;
+      return -v0 * u + 0.5 * tl.landing_acceleration_cm_per_s2 * u * u;
+    }
+    if (t < tl.recovered_s) {
+      return -o.landing_crouch_cm * 0.5 * (1.0 + std::cos(kPi * (t - tl.landed_s) / 0.5));
+    }
+    return 0.0;
+  };
+  for (int f = 0; f < writer->num_frames(); ++f) {
+    const double t = writer->time(f);
+    const double y = hip_offset(t);
+    HumanoidPose p;
+    p.root_position.y = static_cast<float>(kHipsRestY + y);
+    // Two-bone IK with equal segments: the hip joint is (leg + y) above the ankle.
+    const double reach = std::clamp((leg + std::min(y, 0.0)) / leg, -1.0, 1.0);
+    const double bend = glm::degrees(std::acos(reach));  // thigh flexion; the knee bends twice that
+    SetLeg(&p, kLUpLeg, -bend, 2.0 * bend);
+    SetLeg(&p, kRUpLeg, -bend, 2.0 * bend);
+    p.rotations[kSpine] = Zxy(0, 0.5 * bend, 0);  // lean over the knees
+    p.rotations[kHead] = Zxy(0, -0.3 * bend, 0);
+    const double depth = t < tl.takeoff_s ? std::clamp(-y / o.crouch_cm, 0.0, 1.0)
+                                          : std::clamp(-y / o.landing_crouch_cm, 0.0, 1.0);
+    p.rotations[kLArm] = Zxy(-75, 0, -40.0 * depth);
+    p.rotations[kRArm] = Zxy(75, 0, 40.0 * depth);
+    p.rotations[kLForeArm] = Zxy(0, 0, -15.0);
+    p.rotations[kRForeArm] = Zxy(0, 0, 15.0);
+    writer->Write(f, p);
+  }
+  return writer->Take();
+}
+
+Result<Skeleton> MakeChainSkeleton(int num_joints, float segment_length_cm) {
+  if (num_joints < 1 || num_joints > kMaxJoints || !(segment_length_cm > 0.0f) ||
+      !std::isfinite(segment_length_cm)) {
+    return MakeError(ErrorCode::kInvalidArgument, {"synthetic:chain", 0, 0, {}},
+                     "expected 1.." + std::to_string(kMaxJoints) +
+                         " joints and a positive segment length, found " + std::to_string(num_joints) +
+                         " joints of " + std::to_string(segment_length_cm) + " cm");
+  }
+  Builder b;
+  int parent = b.Add("Chain0", kNoParent, {0, 50, 0}, true);
+  for (int j = 1; j < num_joints; ++j) {
+    parent = b.Add("Chain" + std::to_string(j), parent, {0, 0, -segment_length_cm});
+  }
+  b.End(parent, {0, 0, -segment_length_cm});
+  return b.Finish("synthetic:chain");
+}
+
+Skeleton MakeQuadrupedSkeleton() {
+  Builder b;
+  const int hips = b.Add("Hips", kNoParent, {0, 60, 0}, true);
+  const int spine = b.Add("Spine", hips, {0, 2, 20});
+  const int chest = b.Add("Chest", spine, {0, 0, 20});
+  const int neck = b.Add("Neck", chest, {0, 8, 12});
+  const int head = b.Add("Head", neck, {0, 10, 10});
+  b.End(head, {0, 0, 18});
+  for (const char* end : {"Front", "Hind"}) {
+    const bool front = std::string(end) == "Front";
+    for (float side : {1.0f, -1.0f}) {
+      const std::string s = std::string(side > 0 ? "Left" : "Right") + end;
+      // Front legs hang from the chest (y 62), hind legs from the hips (y 60).
+      const int up = b.Add(s + "UpLeg", front ? chest : hips, {10 * side, front ? -6.0f : -4.0f, 0});
+      const int leg = b.Add(s + "Leg", up, {0, -24, 0});
+      const int foot = b.Add(s + "Foot", leg, {0, -24, 0});
+      const int toe = b.Add(s + "ToeBase", foot, {0, -7, 5});
+      b.End(toe, {0, 0, 5});
+    }
+  }
+  const int tail = b.Add("Tail", hips, {0, 4, -10});
+  const int tail1 = b.Add("Tail1", tail, {0, -3, -15});
+  b.End(tail1, {0, -3, -15});
+  Skeleton s = b.Finish("synthetic:quadruped");
+  s.info.rest_height = 98.0f;
+  return s;
+}
+
+}  // namespace mocap

@@ -1,0 +1,98 @@
+#pragma once
+// Deterministic procedural skeletons and motions for tests, samples and the
+// demo. Nothing here reads files or uses random numbers: the same call always
+// gives the same bits.
+//
+// Humanoid conventions (like a real capture): centimetres, Y up, the character
+// faces +Z, its left side is +X. Rest pose is a T-pose standing on the ground
+// plane y = 0 (toes at y = 1, ankles at y = 8, head top at y = 172). Every joint
+// has three rotation channels in ZXY order (R = Rz * Rx * Ry, degrees); the root
+// (Hips) also has Xposition Yposition Zposition first, which replace its offset.
+// Joints (24): Hips, Spine, Spine1, Spine2, Neck, Head, {Left,Right}Shoulder,
+// {Left,Right}Arm, {Left,Right}ForeArm, {Left,Right}Hand, {Left,Right}HandIndex1,
+// {Left,Right}UpLeg, {Left,Right}Leg, {Left,Right}Foot, {Left,Right}ToeBase; end
+// sites above the head, past the index fingers and in front of the toes.
+//
+// The motion generators take the skeleton they write for and look joints up by
+// name, so they also fill a humanoid with other channel orders (Euler channels
+// are extracted from the intended joint rotations in each joint's own order,
+// relative to its rest rotation). They return kNotFound naming the first missing
+// joint, and kInvalidArgument for a non-positive frame time or duration.
+
+#include "mocap/error.h"
+#include "mocap/motion.h"
+#include "mocap/skeleton.h"
+
+namespace mocap {
+
+// Standard gravity in the humanoid's units (cm/s^2), used by the jump.
+inline constexpr double kGravityCmPerS2 = 981.0;
+
+// The humanoid described above, in its T-pose rest.
+Skeleton MakeHumanoidSkeleton();
+
+// A looping walk cycle. Hips move forward along +Z at the speed that keeps the
+// stance foot from sliding, bob so the lower ankle stays at its rest height, and
+// yaw against a spine counter-twist; legs and arms swing in opposite phase;
+// arms hang 75 degrees below horizontal; feet stay parallel to the ground.
+// Frame k+cycle_frames has the same joint rotations as frame k (the hips have
+// moved one stride). Duration num_cycles * cycle_s, the end frame excluded.
+struct WalkOptions {
+  double frame_time_s = 1.0 / 30.0;
+  int num_cycles = 3;            // >= 1
+  double cycle_s = 1.0;          // one left and one right step
+  float hip_swing_deg = 20.0f;   // thigh flexion amplitude about a 10-degree bias
+  float knee_peak_deg = 65.0f;   // knee flexion at mid-swing (<= 120)
+  float arm_swing_deg = 15.0f;   // upper-arm swing amplitude
+  float elbow_peak_deg = 45.0f;  // elbow flexion with the arm fully forward (<= 120)
+};
+Result<Motion> MakeWalkMotion(const Skeleton& humanoid, const WalkOptions& options = {});
+
+// Elbows (both, arms in T-pose, forearms bending forward) and the left knee
+// (the thigh flexing forward to 0.4x the knee angle, so the shin stays clear of
+// the body) bend linearly from 0 to end_deg over duration_s; the right leg
+// stands still. num_frames = round(duration_s / frame_time_s) + 1.
+Result<Motion> MakeBendRamp(const Skeleton& humanoid, float end_deg = 150.0f,
+                            double duration_s = 2.0, double frame_time_s = 1.0 / 30.0);
+
+// Both forearms twist about their bone axis (X) linearly from 0 to end_deg
+// (mirrored: the right forearm by -end_deg about +X), arms in T-pose.
+Result<Motion> MakeTwistRamp(const Skeleton& humanoid, float end_deg = 180.0f,
+                             double duration_s = 2.0, double frame_time_s = 1.0 / 30.0);
+
+// A standing vertical jump: stand, crouch (cosine ease), push with constant
+// upward hip acceleration v0^2 / (2 crouch) until the legs are straight at
+// take-off speed v0 = sqrt(2 g height), ballistic flight (acceleration -g), a
+// landing that absorbs v0 over landing_crouch_cm, recover, stand. The hips'
+// vertical acceleration therefore jumps between +push, -g and +landing: the
+// spike the elastic layer should answer. Legs follow by two-bone IK with the
+// ankles above their rest spot and the feet flat; arms swing forward in the crouch.
+struct JumpOptions {
+  double frame_time_s = 1.0 / 30.0;
+  double height_cm = 30.0;          // hip rise above standing at the apex
+  double crouch_cm = 25.0;          // hip drop before take-off (< 84, the leg length)
+  double landing_crouch_cm = 20.0;  // hip drop while landing
+};
+Result<Motion> MakeJumpMotion(const Skeleton& humanoid, const JumpOptions& options = {});
+
+// Times (seconds from the first frame) of the jump's phases, for tests.
+struct JumpTimeline {
+  double crouch_start_s, push_start_s, takeoff_s, touchdown_s, landed_s, recovered_s, end_s;
+  double takeoff_speed_cm_per_s;
+  double push_acceleration_cm_per_s2;     // upward, constant during the push
+  double landing_acceleration_cm_per_s2;  // upward, constant while landing
+};
+JumpTimeline MakeJumpTimeline(const JumpOptions& options);
+
+// A single chain ("tail") of num_joints joints named Chain0..Chain{N-1}: Chain0
+// is the root at (0, 50, 0) with position channels, every next joint is
+// segment_length_cm further along -Z; all ZXY rotation channels; an end site.
+// kInvalidArgument unless 1 <= num_joints <= kMaxJoints and the length is > 0.
+Result<Skeleton> MakeChainSkeleton(int num_joints, float segment_length_cm = 10.0f);
+
+// A simple quadruped standing on y = 0, facing +Z, in cm: Hips (root), Spine,
+// Chest, Neck, Head, four legs {Left,Right}{Front,Hind}{UpLeg,Leg,Foot,ToeBase}
+// and a two-joint tail (Tail, Tail1); 23 joints, ZXY channels.
+Skeleton MakeQuadrupedSkeleton();
+
+}  // namespace mocap
