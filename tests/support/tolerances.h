@@ -57,3 +57,14 @@ inline constexpr float kJumpAccelTolCmPerS2 = 2.0f;
 inline constexpr float kJumpApexTolCm = 0.02f;
 
 }  // namespace testsupport
+
+namespace testsupport {
+
+// Inverse bind matrix x rest-pose joint matrix vs identity: the files store
+// both in float after an exporter's own float products.
+inline constexpr float kBindIdentityTol = 1e-4f;
+// Skinned glTF vertices (metres) from two float evaluation paths compared
+// with a double reference: float round-off over a ~20-joint chain.
+inline constexpr double kSkinnedVertexTol = 1e-4;
+
+}  // namespace testsupport
