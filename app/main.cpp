@@ -1,22 +1,34 @@
 // patchskin: the command line. Parses arguments and dispatches to a subcommand;
-// no algorithm lives here.
+// no algorithm lives here. Exit codes: 0 ok, 1 usage (or a failed comparison),
+// 2 bad input, 3 internal error.
 
 #include <cstdio>
+#include <exception>
 #include <string>
 
 #include <CLI/CLI.hpp>
+
+#include "app/inspect_command.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"patchskin: motion-capture driven layered skinning and software rendering"};
   app.set_version_flag("--version", std::string("patchskin 0.1.0"));
   app.require_subcommand(0, 1);
+
+  app::InspectOptions inspect_options;
+  CLI::App* inspect = app::AddInspectCommand(app, inspect_options);
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? 0 : 1;
   }
-  if (app.get_subcommands().empty()) {
-    std::fputs(app.help().c_str(), stdout);
+  try {
+    if (inspect->parsed()) return app::RunInspect(inspect_options);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "patchskin: internal error: %s\n", e.what());
+    return 3;
   }
+  std::fputs(app.help().c_str(), stdout);
   return 0;
 }

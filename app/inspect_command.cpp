@@ -1,0 +1,200 @@
+#include "app/inspect_command.h"
+
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include <glm/gtc/quaternion.hpp>
+#include <nlohmann/json.hpp>
+
+#include "app/motion_source.h"
+#include "mocap/joint_angles.h"
+#include "mocap/pose.h"
+
+namespace app {
+namespace {
+
+const char* UpAxisName(mocap::UpAxis up) { return up == mocap::UpAxis::kY ? "Y" : "Z"; }
+
+std::string ChannelList(const mocap::JointChannels& c) {
+  std::string out;
+  for (int i = 0; i < c.count; ++i) {
+    if (i > 0) out += ' ';
+    out += mocap::ChannelTypeName(c.types[static_cast<std::size_t>(i)]);
+  }
+  return out;
+}
+
+// Depth of each joint in the tree (roots 0); parents precede children.
+std::vector<int> JointDepths(const mocap::Skeleton& s) {
+  std::vector<int> depth(static_cast<std::size_t>(s.num_joints()), 0);
+  for (std::size_t j = 0; j < depth.size(); ++j) {
+    const int p = s.parents[j];
+    if (p != mocap::kNoParent) depth[j] = depth[static_cast<std::size_t>(p)] + 1;
+  }
+  return depth;
+}
+
+struct PoseAtFrame {
+  std::vector<glm::vec3> positions;   // #J world positions
+  std::vector<glm::quat> rotations;   // #J world rotations
+};
+
+PoseAtFrame EvaluateFrame(const mocap::Skeleton& s, const mocap::Motion& m, int frame) {
+  const auto n = static_cast<std::size_t>(s.num_joints());
+  std::vector<mocap::JointTransform> locals(n);
+  std::vector<glm::mat4> model(n);
+  if (m.num_frames > 0) {
+    (void)mocap::LocalPoseJob{&s, m.frame(frame), locals}.Run();
+  } else {
+    mocap::RestPose(s, locals);
+  }
+  (void)mocap::LocalToModelJob{.parents = s.parents, .locals = locals, .model_from_joint = model}
+      .Run();
+  PoseAtFrame pose;
+  for (const glm::mat4& mj : model) {
+    pose.positions.emplace_back(mj[3]);
+    pose.rotations.push_back(glm::normalize(glm::quat_cast(glm::mat3(mj))));
+  }
+  return pose;
+}
+
+nlohmann::json Vec(const glm::vec3& v) { return {v.x, v.y, v.z}; }
+
+void PrintText(const MotionSource& src, const InspectOptions& options) {
+  const mocap::Skeleton& s = src.skeleton;
+  const mocap::Motion& m = src.motion;
+  std::printf("file:        %s (%s)\n", options.file.c_str(), src.format.c_str());
+  std::printf("joints:      %d (+%zu end sites), %d channels\n", s.num_joints(), s.end_sites.size(),
+              s.num_channels);
+  std::printf("frames:      %d\n", m.num_frames);
+  std::printf("frame time:  %.9g s (%g fps)\n", m.frame_time_s, mocap::NominalFps(m.frame_time_s));
+  std::printf("duration:    %.6g s\n", m.duration_s());
+  std::printf("up axis:     %s\n", UpAxisName(s.info.up_axis));
+  std::printf("units:       %s (rest height %.6g, scale applied %g)\n",
+              s.info.detected_units.c_str(), s.info.rest_height, s.info.scale_applied);
+  if (src.mesh_vertices > 0) {
+    std::printf("mesh:        %d vertices, %d triangles\n", src.mesh_vertices, src.mesh_triangles);
+  }
+  std::printf("\nhierarchy:\n");
+  const std::vector<int> depth = JointDepths(s);
+  for (int j = 0; j < s.num_joints(); ++j) {
+    const auto js = static_cast<std::size_t>(j);
+    const glm::vec3 o = s.rest_translations[js];
+    std::printf("%*s%s  offset (%g, %g, %g)  [%s]\n", 2 + 2 * depth[js], "", s.names[js].c_str(),
+                o.x, o.y, o.z, ChannelList(s.channels[js]).c_str());
+  }
+  if (!options.frame) return;
+  const PoseAtFrame pose = EvaluateFrame(s, m, *options.frame);
+  std::printf("\nframe %d (t = %.6g s): world position, rotation (w x y z)\n", *options.frame,
+              *options.frame * m.frame_time_s);
+  for (int j = 0; j < s.num_joints(); ++j) {
+    const auto js = static_cast<std::size_t>(j);
+    const glm::vec3 p = pose.positions[js];
+    const glm::quat q = pose.rotations[js];
+    std::printf("  %-24s (%.6g, %.6g, %.6g)  (%.6f %.6f %.6f %.6f)\n", s.names[js].c_str(), p.x,
+                p.y, p.z, q.w, q.x, q.y, q.z);
+  }
+}
+
+void PrintJson(const MotionSource& src, const InspectOptions& options) {
+  const mocap::Skeleton& s = src.skeleton;
+  const mocap::Motion& m = src.motion;
+  nlohmann::ordered_json doc;
+  doc["file"] = options.file;
+  doc["format"] = src.format;
+  doc["num_joints"] = s.num_joints();
+  doc["num_channels"] = s.num_channels;
+  doc["frames"] = m.num_frames;
+  doc["frame_time_s"] = m.frame_time_s;
+  doc["fps"] = mocap::NominalFps(m.frame_time_s);
+  doc["duration_s"] = m.duration_s();
+  doc["up_axis"] = UpAxisName(s.info.up_axis);
+  doc["units"] = s.info.detected_units;
+  doc["rest_height"] = s.info.rest_height;
+  doc["scale_applied"] = s.info.scale_applied;
+  nlohmann::ordered_json joints = nlohmann::ordered_json::array();
+  for (int j = 0; j < s.num_joints(); ++j) {
+    const auto js = static_cast<std::size_t>(j);
+    nlohmann::ordered_json jj;
+    jj["name"] = s.names[js];
+    jj["parent"] = s.parents[js] == mocap::kNoParent
+                       ? nlohmann::ordered_json(nullptr)
+                       : nlohmann::ordered_json(s.names[static_cast<std::size_t>(s.parents[js])]);
+    jj["offset"] = Vec(s.rest_translations[js]);
+    nlohmann::ordered_json channels = nlohmann::ordered_json::array();
+    for (int c = 0; c < s.channels[js].count; ++c) {
+      channels.push_back(mocap::ChannelTypeName(s.channels[js].types[static_cast<std::size_t>(c)]));
+    }
+    jj["channels"] = channels;
+    joints.push_back(jj);
+  }
+  doc["joints"] = joints;
+  nlohmann::ordered_json ends = nlohmann::ordered_json::array();
+  for (const mocap::EndSite& e : s.end_sites) {
+    ends.push_back({{"name", e.name},
+                    {"parent", s.names[static_cast<std::size_t>(e.parent)]},
+                    {"offset", Vec(e.offset)}});
+  }
+  doc["end_sites"] = ends;
+  if (options.frame) {
+    const PoseAtFrame pose = EvaluateFrame(s, m, *options.frame);
+    doc["frame"] = *options.frame;
+    doc["time_s"] = *options.frame * m.frame_time_s;
+    nlohmann::ordered_json positions;
+    nlohmann::ordered_json rotations;
+    for (int j = 0; j < s.num_joints(); ++j) {
+      const auto js = static_cast<std::size_t>(j);
+      positions[s.names[js]] = Vec(pose.positions[js]);
+      const glm::quat q = pose.rotations[js];
+      rotations[s.names[js]] = {q.w, q.x, q.y, q.z};
+    }
+    doc["positions"] = positions;
+    doc["rotations"] = rotations;
+  }
+  std::printf("%s\n", doc.dump(2).c_str());
+}
+
+}  // namespace
+
+CLI::App* AddInspectCommand(CLI::App& parent, InspectOptions& options) {
+  CLI::App* cmd = parent.add_subcommand("inspect", "Print a capture's skeleton, timing and poses");
+  cmd->add_option("file", options.file, "BVH, glTF or GLB file")->required();
+  cmd->add_option("--frame", options.frame, "Also print world joint positions at this frame (0-based)");
+  cmd->add_flag("--json", options.json, "Print one JSON document (schema in the README)");
+  cmd->add_option("--scale", options.scale,
+                  "Multiply lengths by this factor (0: convert detected units to metres)");
+  cmd->add_flag("--y-up", options.y_up, "Rotate a Z-up capture to Y-up");
+  cmd->add_flag("--add-position-to-offset", options.add_position_to_offset,
+                "BVH position channels add to OFFSET (three.js) instead of replacing it");
+  return cmd;
+}
+
+int RunInspect(const InspectOptions& options) {
+  MotionSourceOptions load;
+  load.scale = options.scale;
+  load.y_up = options.y_up;
+  load.add_position_to_offset = options.add_position_to_offset;
+  mocap::Result<MotionSource> src = LoadMotionSource(options.file, load);
+  if (!src.ok()) {
+    std::fprintf(stderr, "%s\n", src.error().ToString().c_str());
+    return 2;
+  }
+  for (const mocap::Warning& w : src->warnings) std::fprintf(stderr, "%s\n", w.ToString().c_str());
+  if (options.frame) {
+    const int last = src->motion.num_frames - 1;
+    if (*options.frame < 0 || *options.frame > std::max(last, 0)) {
+      std::fprintf(stderr, "%s: error: --frame %d is outside the capture's frames 0..%d\n",
+                   options.file.c_str(), *options.frame, std::max(last, 0));
+      return 2;
+    }
+  }
+  if (options.json) {
+    PrintJson(*src, options);
+  } else {
+    PrintText(*src, options);
+  }
+  return 0;
+}
+
+}  // namespace app

@@ -1,0 +1,30 @@
+#pragma once
+// `patchskin inspect FILE [--frame N] [--json]`: the skeleton tree with its
+// channels, frame count, frame time, duration, detected units and up axis; with
+// --frame, every joint's world position and rotation at that frame, in the
+// file's own units and axes unless --scale / --y-up ask otherwise. The JSON
+// schema is documented in the README ("inspect --json").
+
+#include <optional>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+namespace app {
+
+struct InspectOptions {
+  std::string file;
+  std::optional<int> frame;       // 0-based frame index
+  bool json = false;
+  float scale = 1.0f;             // 0 = automatic (detected units to metres)
+  bool y_up = false;              // rotate a Z-up file to Y-up
+  bool add_position_to_offset = false;
+};
+
+// Registers the subcommand and its options; the callback stores into `options`.
+CLI::App* AddInspectCommand(CLI::App& parent, InspectOptions& options);
+
+// Runs it. Returns the process exit code (0 ok, 2 bad input); errors go to stderr.
+int RunInspect(const InspectOptions& options);
+
+}  // namespace app
