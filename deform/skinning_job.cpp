@@ -10,6 +10,10 @@
 #if defined(__SSE2__) && !defined(PATCHSKIN_SCALAR_SKINNING)
 #include <emmintrin.h>
 #define PATCHSKIN_SKINNING_SSE2 1
+#if defined(__GNUC__) && defined(__x86_64__) && !defined(PATCHSKIN_NO_AVX_SKINNING)
+#include <immintrin.h>
+#define PATCHSKIN_SKINNING_AVX 1
+#endif
 #endif
 
 namespace deform {
@@ -64,6 +68,54 @@ void SkinSpan(const SkinningJob& job) {
   }
 }
 
+#if defined(PATCHSKIN_SKINNING_AVX)
+// The same computation with the influence blend two columns at a time in
+// 256-bit registers. Every lane sees the same multiplies and adds in the same
+// order as SkinSpan, so both paths give identical bits. Compiled for AVX with
+// a function attribute and chosen at run time, so the build stays portable.
+template <int kN, bool kNormals>
+__attribute__((target("avx"))) void SkinSpanAvx(const SkinningJob& job) {
+  const float* palette = glm::value_ptr(job.model_from_bind[0]);
+  const std::uint16_t* indices = job.joint_indices.data();
+  const float* weights = job.joint_weights.data();
+  const std::size_t n = job.rest_positions.size();
+  for (std::size_t v = 0; v < n; ++v, indices += kN, weights += kN) {
+    const float* m = palette + 16 * static_cast<std::size_t>(indices[0]);
+    __m256 w = _mm256_set1_ps(weights[0]);
+    __m256 c01 = _mm256_mul_ps(_mm256_loadu_ps(m + 0), w);
+    __m256 c23 = _mm256_mul_ps(_mm256_loadu_ps(m + 8), w);
+    for (int i = 1; i < kN; ++i) {
+      m = palette + 16 * static_cast<std::size_t>(indices[i]);
+      w = _mm256_set1_ps(weights[i]);
+      c01 = _mm256_add_ps(c01, _mm256_mul_ps(_mm256_loadu_ps(m + 0), w));
+      c23 = _mm256_add_ps(c23, _mm256_mul_ps(_mm256_loadu_ps(m + 8), w));
+    }
+    const __m128 c0 = _mm256_castps256_ps128(c01);
+    const __m128 c1 = _mm256_extractf128_ps(c01, 1);
+    const __m128 c2 = _mm256_castps256_ps128(c23);
+    const __m128 c3 = _mm256_extractf128_ps(c23, 1);
+    const glm::vec3& p = job.rest_positions[v];
+    const __m128 out_p = _mm_add_ps(
+        _mm_add_ps(_mm_add_ps(_mm_mul_ps(c0, _mm_set1_ps(p.x)), _mm_mul_ps(c1, _mm_set1_ps(p.y))),
+                   _mm_mul_ps(c2, _mm_set1_ps(p.z))),
+        c3);
+    Store3(job.positions[v], out_p);
+    if constexpr (kNormals) {
+      const glm::vec3& nr = job.rest_normals[v];
+      const __m128 out_n = _mm_add_ps(
+          _mm_add_ps(_mm_mul_ps(c0, _mm_set1_ps(nr.x)), _mm_mul_ps(c1, _mm_set1_ps(nr.y))),
+          _mm_mul_ps(c2, _mm_set1_ps(nr.z)));
+      Store3(job.normals[v], out_n);
+    }
+  }
+}
+
+bool CpuHasAvx() {
+  static const bool has = __builtin_cpu_supports("avx");
+  return has;
+}
+#endif
+
 #else  // portable scalar loop, same order of operations as the SSE2 one
 
 template <int kN, bool kNormals>
@@ -99,7 +151,17 @@ void SkinSpan(const SkinningJob& job) {
 #endif
 
 template <int kN>
-void SkinDispatchNormals(const SkinningJob& job) {
+void SkinDispatchNormals(const SkinningJob& job, [[maybe_unused]] bool allow_avx) {
+#if defined(PATCHSKIN_SKINNING_AVX)
+  if (allow_avx && CpuHasAvx()) {
+    if (job.rest_normals.empty()) {
+      SkinSpanAvx<kN, false>(job);
+    } else {
+      SkinSpanAvx<kN, true>(job);
+    }
+    return;
+  }
+#endif
   if (job.rest_normals.empty()) {
     SkinSpan<kN, false>(job);
   } else {
@@ -108,6 +170,17 @@ void SkinDispatchNormals(const SkinningJob& job) {
 }
 
 }  // namespace
+
+const char* SkinningSimdPath() {
+#if defined(PATCHSKIN_SKINNING_AVX)
+  if (CpuHasAvx()) return "avx";
+#endif
+#if defined(PATCHSKIN_SKINNING_SSE2)
+  return "sse2";
+#else
+  return "scalar";
+#endif
+}
 
 JobStatus SkinningJob::Validate() const {
   if (influences < 1 || influences > kMaxInfluences) {
@@ -136,18 +209,22 @@ JobStatus SkinningJob::Validate() const {
   return mocap::kJobOk;
 }
 
-JobStatus SkinningJob::Run() const {
+JobStatus SkinningJob::Run() const { return RunImpl(true); }
+
+JobStatus SkinningJob::RunWithoutAvx() const { return RunImpl(false); }
+
+JobStatus SkinningJob::RunImpl(bool allow_avx) const {
   const JobStatus status = Validate();
   if (!status.ok() || rest_positions.empty()) return status;
   switch (influences) {
-    case 1: SkinDispatchNormals<1>(*this); break;
-    case 2: SkinDispatchNormals<2>(*this); break;
-    case 3: SkinDispatchNormals<3>(*this); break;
-    case 4: SkinDispatchNormals<4>(*this); break;
-    case 5: SkinDispatchNormals<5>(*this); break;
-    case 6: SkinDispatchNormals<6>(*this); break;
-    case 7: SkinDispatchNormals<7>(*this); break;
-    default: SkinDispatchNormals<8>(*this); break;
+    case 1: SkinDispatchNormals<1>(*this, allow_avx); break;
+    case 2: SkinDispatchNormals<2>(*this, allow_avx); break;
+    case 3: SkinDispatchNormals<3>(*this, allow_avx); break;
+    case 4: SkinDispatchNormals<4>(*this, allow_avx); break;
+    case 5: SkinDispatchNormals<5>(*this, allow_avx); break;
+    case 6: SkinDispatchNormals<6>(*this, allow_avx); break;
+    case 7: SkinDispatchNormals<7>(*this, allow_avx); break;
+    default: SkinDispatchNormals<8>(*this, allow_avx); break;
   }
   return mocap::kJobOk;
 }

@@ -15,8 +15,11 @@
 // the same order of operations, so any split gives bit-identical output.
 //
 // On x86-64 the inner loop uses SSE2 (part of the x86-64 baseline, so the
-// default build stays portable); elsewhere a scalar loop with the same order of
-// operations runs. The build never uses -march=native.
+// default build stays portable), and AVX for the matrix blend when the CPU
+// reports it at run time (a function compiled with target("avx"), bit-identical
+// to the SSE2 path; -DPATCHSKIN_NO_AVX_SKINNING removes it). Elsewhere a scalar
+// loop with the same order of operations runs. Never -march=native, never FMA
+// (the project builds with -ffp-contract=off), so results match across paths.
 
 #include <cstdint>
 #include <span>
@@ -56,7 +59,16 @@ struct SkinningJob {
   // Validate(), then skin every vertex. Never allocates; thread-safe for
   // disjoint outputs.
   [[nodiscard]] mocap::JobStatus Run() const;
+  // Run() without the AVX path (SSE2 or scalar only), so tests and benchmarks
+  // can compare the paths; the output bits are the same.
+  [[nodiscard]] mocap::JobStatus RunWithoutAvx() const;
+
+ private:
+  [[nodiscard]] mocap::JobStatus RunImpl(bool allow_avx) const;
 };
+
+// The instruction set SkinningJob uses on this machine: "avx", "sse2" or "scalar".
+const char* SkinningSimdPath();
 
 // Fills the #S skinning palette of `mesh`: model_from_bind[s] =
 // model_from_joint[mesh.skin_joints[s]] * mesh.joint_from_bind[s].

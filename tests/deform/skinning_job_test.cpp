@@ -215,6 +215,19 @@ TEST_P(SkinningJobInfluences, SplitRunsEqualOneRunBitForBit) {
   EXPECT_EQ(std::memcmp(n.data(), n2.data(), n.size() * sizeof(glm::vec3)), 0);
 }
 
+TEST_P(SkinningJobInfluences, SimdPathsAgreeBitForBit) {
+  const RandomSkin s = MakeRandomSkin(777, GetParam(), 9, 12);
+  std::mt19937 rng(13);
+  std::vector<glm::mat4> palette;
+  for (int j = 0; j < 9; ++j) palette.push_back(RandomRigid(rng));
+  std::vector<glm::vec3> p, n, p2, n2;
+  ASSERT_TRUE(MakeJob(s, palette, p, n).Run().ok());
+  ASSERT_TRUE(MakeJob(s, palette, p2, n2).RunWithoutAvx().ok());
+  RecordProperty("simd_path", deform::SkinningSimdPath());
+  EXPECT_EQ(std::memcmp(p.data(), p2.data(), p.size() * sizeof(glm::vec3)), 0);
+  EXPECT_EQ(std::memcmp(n.data(), n2.data(), n.size() * sizeof(glm::vec3)), 0);
+}
+
 INSTANTIATE_TEST_SUITE_P(Counts, SkinningJobInfluences, testing::Values(1, 2, 3, 4, 5, 8));
 
 TEST(SkinningJob, FourAndEightInfluencesAgreeWhenExtraWeightsAreZero) {
