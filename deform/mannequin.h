@@ -11,7 +11,7 @@
 //     starts at each root toward the child with the most descendants; at
 //     every branch point a chain continues into the straightest child and each
 //     other child starts a new chain (arms, legs, tails). Side branches whose
-//     reach is below `min_branch_extent` S (fingers, eyes, toes' helpers) are
+//     reach is below `min_branch_extent` S (fingers, eyes, small helpers) are
 //     folded into a mitten on their chain.
 //  3. Each chain becomes one tube swept along a centripetal Catmull-Rom curve
 //     through its points, rings of `ring_vertices` vertices, radii per point
@@ -43,7 +43,7 @@ struct MannequinOptions {
   int ring_vertices = 24;            // vertices per tube ring, 8..64
   int target_vertices = 20000;       // aimed-for total vertex count, 10000..40000
   float radius_scale = 1.0f;         // multiplies every radius, 0.25..4
-  float min_branch_extent = 0.06f;   // side branches reaching less than this x S are folded in
+  float min_branch_extent = 0.15f;   // side branches reaching less than this x S are folded in
   float blend_width = 1.0f;          // half-width of a joint's weight blend, in local radii
 };
 
