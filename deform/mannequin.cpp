@@ -231,13 +231,13 @@ mocap::Result<SkinnedMesh> BuildMannequin(const mocap::Skeleton& skeleton,
     bounds.Extend(p);
   }
   const glm::vec3 extent = bounds.size();
-  const float size = std::max({extent.x, extent.y, extent.z});  // S
-  if (!(size > 0.0f) || !std::isfinite(size)) {
+  const float raw_size = std::max({extent.x, extent.y, extent.z});
+  if (!(raw_size > 0.0f) || !std::isfinite(raw_size)) {
     return MakeError(ErrorCode::kInvalidArgument, {},
                      "skeleton has no bone of non-zero length (all joints at one point); "
                      "cannot build a mannequin");
   }
-  const float merge_dist = kMergeFraction * size;
+  const float merge_dist = kMergeFraction * raw_size;
 
   // 1. The point tree without zero-length bones.
   std::vector<Point> pts;
@@ -312,6 +312,23 @@ mocap::Result<SkinnedMesh> BuildMannequin(const mocap::Skeleton& skeleton,
       if (pts[static_cast<std::size_t>(c)].descendants > pts[static_cast<std::size_t>(heavy)].descendants) heavy = c;
     }
     todo.push_back({r, heavy, -1, ChainKind::kSpine});
+  }
+  // Body size S over the points that make up the body: a positioning root
+  // (often left at the origin while the capture walks away) must not count.
+  Bounds body;
+  for (const Pending& spine : todo) {
+    std::vector<int> stack = {spine.start};
+    while (!stack.empty()) {
+      const int c = stack.back();
+      stack.pop_back();
+      body.Extend(pos_of(c));
+      for (int g : pts[static_cast<std::size_t>(c)].children) stack.push_back(g);
+    }
+  }
+  const float size = body.empty() ? 0.0f : std::max({body.size().x, body.size().y, body.size().z});
+  if (!(size > merge_dist)) {
+    return MakeError(ErrorCode::kInvalidArgument, {},
+                     "skeleton has no bone of non-zero length; cannot build a mannequin");
   }
   std::vector<Chain> chains;
   for (std::size_t t = 0; t < todo.size(); ++t) {
@@ -430,9 +447,9 @@ mocap::Result<SkinnedMesh> BuildMannequin(const mocap::Skeleton& skeleton,
     if (torso) {
       chain_minor[c] = forward;
       for (int i = 0; i < n; ++i) {
-        const bool body = i <= last_branch[c];
-        sh.radius[static_cast<std::size_t>(i)] = (body ? 0.09f : 0.035f) * size;
-        sh.flatten[static_cast<std::size_t>(i)] = body ? 0.65f : 1.0f;
+        const bool trunk = i <= last_branch[c];
+        sh.radius[static_cast<std::size_t>(i)] = (trunk ? 0.09f : 0.035f) * size;
+        sh.flatten[static_cast<std::size_t>(i)] = trunk ? 0.65f : 1.0f;
       }
       if (n >= 3 && arcs[c][static_cast<std::size_t>(n - 1)] - arcs[c][static_cast<std::size_t>(n - 2)] >= 0.05f * size) {
         sh.geometry_end = n - 2;  // the head bone lies inside the head ellipsoid

@@ -127,6 +127,26 @@ TEST(Mannequin, BandaiLikeBonesAlongLocalX) {
   ExpectValidBody(b, Build(b), true);
 }
 
+TEST(Mannequin, PositioningRootFarFromTheBodyIsIgnored) {
+  // Bandai files keep joint_Root on the floor at the origin while the capture
+  // walks away; the body's size must come from the body alone.
+  std::vector<testsupport::JointSpec> specs = {{"joint_Root", -1, {0, 0, 0}}};
+  for (testsupport::JointSpec j : testsupport::Humanoid(1.0f, false, false, "")) {
+    j.parent += 1;
+    j.model_pos += glm::vec3(400, 0, 300);
+    specs.push_back(j);
+  }
+  const BuiltSkeleton b = SkeletonFrom(specs, true, 8.0f);
+  const deform::SkinnedMesh m = Build(b);
+  ExpectValidBody(b, m, true);
+  const BuiltSkeleton centred =
+      SkeletonFrom(testsupport::Humanoid(1.0f, false, false, ""), true, 8.0f);
+  const deform::Bounds far = deform::ComputeBounds(m.bind.positions);
+  const deform::Bounds near = deform::ComputeBounds(Build(centred).bind.positions);
+  EXPECT_NEAR(far.size().x, near.size().x, testsupport::kPositionTol * 100.0f);
+  EXPECT_NEAR(far.size().y, near.size().y, testsupport::kPositionTol * 100.0f);
+}
+
 TEST(Mannequin, MixamoLikeWithFingersInMetres) {
   const BuiltSkeleton b =
       SkeletonFrom(testsupport::Humanoid(0.01f, false, true, "mixamorig:"), false, 0.08f);
