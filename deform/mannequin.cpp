@@ -19,6 +19,7 @@ constexpr int kMaxVertices = 40000;
 constexpr int kCapRings = 3;          // rings of each domed cap, besides its pole
 constexpr int kCurveSamples = 24;     // dense Catmull-Rom samples per bone
 constexpr float kMergeFraction = 1e-4f;
+constexpr float kTorsoRadius = 0.09f;  // half the torso width, in body sizes S
 
 // A point of the simplified tree: a joint with a bone of non-zero length, a
 // root, or an end site.
@@ -448,14 +449,14 @@ mocap::Result<SkinnedMesh> BuildMannequin(const mocap::Skeleton& skeleton,
       chain_minor[c] = forward;
       for (int i = 0; i < n; ++i) {
         const bool trunk = i <= last_branch[c];
-        sh.radius[static_cast<std::size_t>(i)] = (trunk ? 0.09f : 0.035f) * size;
+        sh.radius[static_cast<std::size_t>(i)] = (trunk ? kTorsoRadius : 0.035f) * size;
         sh.flatten[static_cast<std::size_t>(i)] = trunk ? 0.65f : 1.0f;
       }
       if (n >= 3 && arcs[c][static_cast<std::size_t>(n - 1)] - arcs[c][static_cast<std::size_t>(n - 2)] >= 0.05f * size) {
         sh.geometry_end = n - 2;  // the head bone lies inside the head ellipsoid
       }
     } else {
-      const float factor = root_limb ? 1.2f : 1.0f;
+      const float factor = root_limb ? 1.05f : 1.0f;  // thighs a little thicker than arms
       for (int i = 0; i < n; ++i) {
         const float r = factor * total * (0.12f - 0.06f * arcs[c][static_cast<std::size_t>(i)] / total);
         sh.radius[static_cast<std::size_t>(i)] = std::clamp(r, 0.004f * size, 0.08f * size);
@@ -473,7 +474,12 @@ mocap::Result<SkinnedMesh> BuildMannequin(const mocap::Skeleton& skeleton,
       if (flat_from > 0) {
         for (int i = flat_from + 1; i < n; ++i) sh.flatten[static_cast<std::size_t>(i)] = 0.5f;
       }
-      if (on_torso && n >= 3) sh.geometry_begin = 1;  // the branch bone lies inside the torso
+      // A branch bone shorter than the torso radius (pelvis to hip, chest to
+      // clavicle) lies inside the torso; a longer one (CMU's clavicle) is kept
+      // so the limb stays attached.
+      if (on_torso && n >= 3 && arcs[c][1] < kTorsoRadius * size * o.radius_scale) {
+        sh.geometry_begin = 1;
+      }
     }
     for (float& r : sh.radius) r *= o.radius_scale;
   }
