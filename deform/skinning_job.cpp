@@ -28,6 +28,17 @@ inline void Store3(glm::vec3& out, __m128 v) {
   _mm_store_ss(&out.z, _mm_movehl_ps(v, v));           // z
 }
 
+// Writes x, y, z of `v` to out[i]. Except at the last vertex of the span, one
+// 16-byte store is used: its fourth float lands on out[i + 1].x, which this
+// same loop overwrites next, so nothing outside the span is ever touched.
+inline void StoreVertex(glm::vec3* out, std::size_t i, std::size_t n, __m128 v) {
+  if (i + 1 < n) {
+    _mm_storeu_ps(&out[i].x, v);
+  } else {
+    Store3(out[i], v);
+  }
+}
+
 // kN influences, with or without normals. The blended matrix lives in four
 // SSE registers (one column each, the w lane unused); adding the influences in
 // slot order makes an identity palette reproduce the input exactly.
@@ -37,6 +48,12 @@ void SkinSpan(const SkinningJob& job) {
   const std::uint16_t* indices = job.joint_indices.data();
   const float* weights = job.joint_weights.data();
   const std::size_t n = job.rest_positions.size();
+  // Locals, not job fields: the stores below could alias the job as far as the
+  // compiler knows, which would reload every span pointer per vertex.
+  const glm::vec3* rest_positions = job.rest_positions.data();
+  const glm::vec3* rest_normals = job.rest_normals.data();
+  glm::vec3* out_positions = job.positions.data();
+  glm::vec3* out_normals = job.normals.data();
   for (std::size_t v = 0; v < n; ++v, indices += kN, weights += kN) {
     const float* m = palette + 16 * static_cast<std::size_t>(indices[0]);
     __m128 w = _mm_set1_ps(weights[0]);
@@ -52,18 +69,18 @@ void SkinSpan(const SkinningJob& job) {
       c2 = _mm_add_ps(c2, _mm_mul_ps(_mm_loadu_ps(m + 8), w));
       c3 = _mm_add_ps(c3, _mm_mul_ps(_mm_loadu_ps(m + 12), w));
     }
-    const glm::vec3& p = job.rest_positions[v];
+    const glm::vec3& p = rest_positions[v];
     const __m128 out_p = _mm_add_ps(
         _mm_add_ps(_mm_add_ps(_mm_mul_ps(c0, _mm_set1_ps(p.x)), _mm_mul_ps(c1, _mm_set1_ps(p.y))),
                    _mm_mul_ps(c2, _mm_set1_ps(p.z))),
         c3);
-    Store3(job.positions[v], out_p);
+    StoreVertex(out_positions, v, n, out_p);
     if constexpr (kNormals) {
-      const glm::vec3& nr = job.rest_normals[v];
+      const glm::vec3& nr = rest_normals[v];
       const __m128 out_n = _mm_add_ps(
           _mm_add_ps(_mm_mul_ps(c0, _mm_set1_ps(nr.x)), _mm_mul_ps(c1, _mm_set1_ps(nr.y))),
           _mm_mul_ps(c2, _mm_set1_ps(nr.z)));
-      Store3(job.normals[v], out_n);
+      StoreVertex(out_normals, v, n, out_n);
     }
   }
 }
@@ -79,6 +96,12 @@ __attribute__((target("avx"))) void SkinSpanAvx(const SkinningJob& job) {
   const std::uint16_t* indices = job.joint_indices.data();
   const float* weights = job.joint_weights.data();
   const std::size_t n = job.rest_positions.size();
+  // Locals, not job fields: the stores below could alias the job as far as the
+  // compiler knows, which would reload every span pointer per vertex.
+  const glm::vec3* rest_positions = job.rest_positions.data();
+  const glm::vec3* rest_normals = job.rest_normals.data();
+  glm::vec3* out_positions = job.positions.data();
+  glm::vec3* out_normals = job.normals.data();
   for (std::size_t v = 0; v < n; ++v, indices += kN, weights += kN) {
     const float* m = palette + 16 * static_cast<std::size_t>(indices[0]);
     __m256 w = _mm256_set1_ps(weights[0]);
@@ -94,18 +117,18 @@ __attribute__((target("avx"))) void SkinSpanAvx(const SkinningJob& job) {
     const __m128 c1 = _mm256_extractf128_ps(c01, 1);
     const __m128 c2 = _mm256_castps256_ps128(c23);
     const __m128 c3 = _mm256_extractf128_ps(c23, 1);
-    const glm::vec3& p = job.rest_positions[v];
+    const glm::vec3& p = rest_positions[v];
     const __m128 out_p = _mm_add_ps(
         _mm_add_ps(_mm_add_ps(_mm_mul_ps(c0, _mm_set1_ps(p.x)), _mm_mul_ps(c1, _mm_set1_ps(p.y))),
                    _mm_mul_ps(c2, _mm_set1_ps(p.z))),
         c3);
-    Store3(job.positions[v], out_p);
+    StoreVertex(out_positions, v, n, out_p);
     if constexpr (kNormals) {
-      const glm::vec3& nr = job.rest_normals[v];
+      const glm::vec3& nr = rest_normals[v];
       const __m128 out_n = _mm_add_ps(
           _mm_add_ps(_mm_mul_ps(c0, _mm_set1_ps(nr.x)), _mm_mul_ps(c1, _mm_set1_ps(nr.y))),
           _mm_mul_ps(c2, _mm_set1_ps(nr.z)));
-      Store3(job.normals[v], out_n);
+      StoreVertex(out_normals, v, n, out_n);
     }
   }
 }
@@ -123,6 +146,8 @@ void SkinSpan(const SkinningJob& job) {
   const std::uint16_t* indices = job.joint_indices.data();
   const float* weights = job.joint_weights.data();
   const std::size_t n = job.rest_positions.size();
+  const glm::vec3* rest_positions = job.rest_positions.data();
+  const glm::vec3* rest_normals = job.rest_normals.data();
   for (std::size_t v = 0; v < n; ++v, indices += kN, weights += kN) {
     float c[12];
     const glm::mat4& m0 = job.model_from_bind[indices[0]];
@@ -135,12 +160,12 @@ void SkinSpan(const SkinningJob& job) {
         for (int row = 0; row < 3; ++row) c[col * 3 + row] += m[col][row] * weights[i];
       }
     }
-    const glm::vec3& p = job.rest_positions[v];
+    const glm::vec3& p = rest_positions[v];
     for (int row = 0; row < 3; ++row) {
       job.positions[v][row] = c[row] * p.x + c[3 + row] * p.y + c[6 + row] * p.z + c[9 + row];
     }
     if constexpr (kNormals) {
-      const glm::vec3& nr = job.rest_normals[v];
+      const glm::vec3& nr = rest_normals[v];
       for (int row = 0; row < 3; ++row) {
         job.normals[v][row] = c[row] * nr.x + c[3 + row] * nr.y + c[6 + row] * nr.z;
       }
