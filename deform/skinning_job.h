@@ -17,8 +17,9 @@
 // On x86-64 the inner loop uses SSE2 (part of the x86-64 baseline, so the
 // default build stays portable), and AVX for the matrix blend when the CPU
 // reports it at run time (a function compiled with target("avx"), bit-identical
-// to the SSE2 path; -DPATCHSKIN_NO_AVX_SKINNING removes it). Elsewhere a scalar
-// loop with the same order of operations runs. Never -march=native, never FMA
+// to the SSE2 path; -DPATCHSKIN_NO_AVX_SKINNING removes it). Elsewhere, or with
+// the CMake option PATCHSKIN_SKINNING_SIMD=OFF, a scalar loop with the same
+// order of operations runs. Never -march=native, never FMA
 // (the project builds with -ffp-contract=off), so results match across paths.
 
 #include <cstdint>
