@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include "deform/dqs_job.h"
 #include "deform/skinning_job.h"
 #include "support/test_skeletons.h"
 #include "support/tolerances.h"
@@ -201,6 +202,60 @@ TEST(Mannequin, WeightsFallOffAcrossJoints) {
   EXPECT_GT(blended, 48);  // at least two rings inside the blend zone
   EXPECT_NEAR(samples.front().second, 0.0f, testsupport::kFloatTol);
   EXPECT_NEAR(samples.back().second, 1.0f, testsupport::kFloatTol);
+}
+
+double Volume(std::span<const glm::vec3> p, std::span<const glm::uvec3> tris) {
+  double v = 0.0;
+  for (const glm::uvec3& t : tris) {
+    v += glm::dot(glm::dvec3(p[t.x]), glm::cross(glm::dvec3(p[t.y]), glm::dvec3(p[t.z]))) / 6.0;
+  }
+  return v;
+}
+
+TEST(Mannequin, BentElbowsAndKneesLoseLessVolumeWithDqs) {
+  const BuiltSkeleton b = SkeletonFrom(testsupport::Humanoid(1.0f, false, false, ""), false, 8.0f);
+  const deform::SkinnedMesh m = Build(b);
+  std::vector<mocap::JointTransform> locals(static_cast<std::size_t>(b.skeleton.num_joints()));
+  mocap::RestPose(b.skeleton, locals);
+  // Forearms (along x in the T-pose) bend about y, shins (along y) about x.
+  const std::pair<const char*, glm::vec3> bends[] = {{"LeftForeArm", {0, 1, 0}},
+                                                     {"RightForeArm", {0, 1, 0}},
+                                                     {"LeftLeg", {1, 0, 0}},
+                                                     {"RightLeg", {1, 0, 0}}};
+  for (const auto& [name, axis] : bends) {
+    const std::size_t j = static_cast<std::size_t>(b.skeleton.FindJoint(name));
+    locals[j].rotation = glm::angleAxis(glm::radians(90.0f), axis);
+  }
+  std::vector<glm::mat4> model(locals.size());
+  ASSERT_TRUE((mocap::LocalToModelJob{.parents = b.skeleton.parents, .locals = locals,
+                                      .model_from_joint = model})
+                  .Run()
+                  .ok());
+  std::vector<glm::mat4> palette(m.skin_joints.size());
+  ASSERT_TRUE(deform::BuildSkinningPalette(model, m, palette).ok());
+  std::vector<deform::DualQuat> dq(palette.size());
+  ASSERT_TRUE(deform::BuildDualQuatPalette(palette, dq).ok());
+  std::vector<glm::vec3> ssd(m.bind.positions.size()), dqs(ssd.size());
+  ASSERT_TRUE((deform::SkinningJob{.model_from_bind = palette, .influences = 4,
+                                   .joint_indices = m.weights.joints,
+                                   .joint_weights = m.weights.weights,
+                                   .rest_positions = m.bind.positions, .rest_normals = {},
+                                   .positions = ssd, .normals = {}})
+                  .Run()
+                  .ok());
+  ASSERT_TRUE((deform::DqsJob{.palette = dq, .influences = 4, .joint_indices = m.weights.joints,
+                              .joint_weights = m.weights.weights,
+                              .rest_positions = m.bind.positions, .rest_normals = {},
+                              .positions = dqs, .normals = {}})
+                  .Run()
+                  .ok());
+  const double rest = Volume(m.bind.positions, m.bind.triangles);
+  const double v_ssd = Volume(ssd, m.bind.triangles);
+  const double v_dqs = Volume(dqs, m.bind.triangles);
+  std::printf("body volume with elbows and knees at 90 degrees / rest: SSD %.4f, DQS %.4f\n",
+              v_ssd / rest, v_dqs / rest);
+  EXPECT_LT(v_ssd, rest);  // the linear blend collapses the joints
+  EXPECT_LT(std::abs(v_dqs - rest), std::abs(v_ssd - rest));
 }
 
 TEST(Mannequin, TailChain) {
