@@ -295,6 +295,23 @@ TEST(Mannequin, DegenerateSkeletonsGiveClearErrors) {
   EXPECT_EQ(deform::BuildMannequin(stub.skeleton, nan).error().code, mocap::ErrorCode::kNonFinite);
 }
 
+TEST(Mannequin, HugeSkeletonsGiveAValidMeshOrALimitError) {
+  // The longest chain a Skeleton may hold: still one tube within budget.
+  const BuiltSkeleton chain = SkeletonFrom(testsupport::Tail(mocap::kMaxJoints, 500.0f), false, 0.0f);
+  ExpectValidBody(chain, Build(chain), false);
+  // A root with 300 spokes would need 300 tubes: refused with a clear error.
+  std::vector<testsupport::JointSpec> star = {{"hub", -1, {0, 0, 0}}};
+  for (int i = 0; i < 300; ++i) {
+    const float a = 0.1f * static_cast<float>(i);
+    star.push_back({"spoke" + std::to_string(i), 0, {10 * std::cos(a), 10 * std::sin(a), 0.01f * static_cast<float>(i)}});
+  }
+  const BuiltSkeleton b = SkeletonFrom(star, false, 0.0f);
+  auto r = deform::BuildMannequin(b.skeleton, b.model_from_joint);
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.error().code, mocap::ErrorCode::kLimitExceeded);
+  EXPECT_NE(r.error().message.find("chains"), std::string::npos) << r.error().message;
+}
+
 TEST(Mannequin, IsDeterministic) {
   const BuiltSkeleton b = SkeletonFrom(testsupport::Humanoid(1.0f, true, true, ""), true, 8.0f);
   const deform::SkinnedMesh a = Build(b);
