@@ -17,9 +17,13 @@
 //     through its points, rings of `ring_vertices` vertices, radii per point
 //     from the chain length and S (torso wide and flattened front to back,
 //     thigh thicker than shin, feet and hands flattened), closed with domed
-//     caps. A humanoid or quadruped spine ends in an ellipsoid head. The result
-//     is a set of closed, outward-oriented components that overlap at
-//     shoulders and hips (not one welded surface).
+//     caps. A limb's first bone is left out when it is shorter than the torso
+//     radius (pelvis to hip: the torso covers it). A spine with big side
+//     chains (a humanoid or quadruped) is a torso ending in an ellipsoid head.
+//     The result is a set of closed, outward-oriented components that overlap
+//     at shoulders and hips (not one welded surface). The body size S is
+//     measured without a root that only positions the body (Bandai's
+//     joint_Root on the floor): a root with one child that branches is skipped.
 //  4. Weights: a ring on bone k (points k -> k+1) follows the bone's parent
 //     joint; around each interior point the weight moves to the next bone with
 //     a smoothstep over +-`blend_width` radii (at most 0.45 of either bone), so
