@@ -456,6 +456,14 @@ mocap::Result<SkinnedMesh> BuildMannequin(const mocap::Skeleton& skeleton,
     const float length = curve.back().arc;
     const int count = std::max(3, static_cast<int>(std::lround(length / spacing)) + 1);
     std::vector<Ring> rings;
+    const auto point_at = [&curve](float target) {  // curve point at an arc length
+      const auto it = std::lower_bound(curve.begin() + 1, curve.end() - 1, target,
+                                       [](const Sample& smp, float t) { return smp.arc < t; });
+      const Sample& hi = *it;
+      const Sample& lo = *(it - 1);
+      const float x = std::clamp((target - lo.arc) / std::max(hi.arc - lo.arc, 1e-12f), 0.0f, 1.0f);
+      return lo.pos + x * (hi.pos - lo.pos);
+    };
     std::size_t q = 0;
     for (int i = 0; i < count; ++i) {
       const float target = length * static_cast<float>(i) / static_cast<float>(count - 1);
@@ -467,14 +475,20 @@ mocap::Result<SkinnedMesh> BuildMannequin(const mocap::Skeleton& skeleton,
       r.center = a.pos + x * (b.pos - a.pos);
       const float s = a.s + x * (b.s - a.s);
       r.tangent = glm::length(b.pos - a.pos) > 0.0f ? glm::normalize(b.pos - a.pos) : up;
-      r.n = AnyPerpendicular(r.tangent, rings.empty() ? forward : rings.back().n);  // transport
-      r.b = glm::cross(r.tangent, r.n);
       int k = 0;  // bone holding s
       while (k + 2 < n && s > arc[static_cast<std::size_t>(k + 1)]) ++k;
       const float len = std::max(arc[static_cast<std::size_t>(k + 1)] - arc[static_cast<std::size_t>(k)], 1e-12f);
       const float w = Smoothstep((s - arc[static_cast<std::size_t>(k)]) / len);
       r.radius = sh.radius[static_cast<std::size_t>(k)] + w * (sh.radius[static_cast<std::size_t>(k + 1)] - sh.radius[static_cast<std::size_t>(k)]);
       r.flatten = sh.flatten[static_cast<std::size_t>(k)] + w * (sh.flatten[static_cast<std::size_t>(k + 1)] - sh.flatten[static_cast<std::size_t>(k)]);
+      // Ring planes follow the curve's chord over +-0.75 radius rather than its
+      // local tangent: at a sharp turn (ankle) neighbouring rings fan out
+      // instead of cutting through each other on the inner side.
+      const float h = 0.75f * r.radius;
+      const glm::vec3 chord = point_at(std::min(target + h, length)) - point_at(std::max(target - h, 0.0f));
+      if (glm::length(chord) > 1e-6f * size) r.tangent = glm::normalize(chord);
+      r.n = AnyPerpendicular(r.tangent, rings.empty() ? forward : rings.back().n);  // transport
+      r.b = glm::cross(r.tangent, r.n);
       r.minor = chain_minor[c];
       r.joint[0] = r.joint[1] = bone_joint(k);
       r.weight[0] = 1.0f;
