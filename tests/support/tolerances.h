@@ -68,3 +68,19 @@ inline constexpr float kBindIdentityTol = 1e-4f;
 inline constexpr double kSkinnedVertexTol = 1e-4;
 
 }  // namespace testsupport
+
+namespace testsupport {
+
+// Skinning with a rigid palette: positions of order 1..10 after one blended
+// 3x4 transform (edge lengths, rigid-map comparisons).
+inline constexpr float kSkinningTol = 1e-4f;
+// Smallest triangle area accepted in a generated mesh, as a fraction of the
+// body size squared (a 24-vertex ring at 0.004 S radius makes ~1e-6 S^2 cells).
+inline constexpr float kMinTriangleAreaFraction = 1e-9f;
+// How far the mannequin's height along the up axis may differ from the
+// skeleton's joint-and-end-site height (head and foot soles add thickness).
+inline constexpr float kMannequinHeightTolFraction = 0.25f;
+// Cross-section area ratios of a 64-gon ring (polygon vs analytic shrink).
+inline constexpr float kAreaRatioTol = 0.01f;
+
+}  // namespace testsupport
