@@ -91,6 +91,31 @@ void BM_KinematicsJob(benchmark::State& state) {
 }
 BENCHMARK(BM_KinematicsJob)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
+void BM_SmoothTrajectoriesJob(benchmark::State& state) {
+  const Clip& c = ClipOf(state);
+  const std::size_t nj = static_cast<std::size_t>(c.skeleton.num_joints());
+  std::vector<mocap::JointTransform> locals(nj);
+  std::vector<glm::mat4> model(static_cast<std::size_t>(c.motion.num_frames) * nj);
+  (void)mocap::ModelMatricesJob{.skeleton = &c.skeleton, .motion = &c.motion, .locals = locals,
+                                .model_from_joint = model}
+      .Run();
+  std::vector<glm::mat4> out(model.size());
+  for (auto _ : state) {
+    // 10 Hz at 30 fps is a 1-tap kernel; use 4 Hz so the window has 3 taps.
+    const mocap::JobStatus s = mocap::SmoothTrajectoriesJob{.model_from_joint = model,
+                                                            .num_joints = static_cast<int>(nj),
+                                                            .frame_time_s = c.motion.frame_time_s,
+                                                            .cutoff_hz = 4.0,
+                                                            .output = out}
+                                   .Run();
+    benchmark::DoNotOptimize(s);
+    benchmark::DoNotOptimize(out.data());
+  }
+  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(out.size()));
+  state.SetLabel(state.range(0) == 0 ? "chain60 30s" : "humanoid24 walk 30s");
+}
+BENCHMARK(BM_SmoothTrajectoriesJob)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+
 void BM_Resample30To120(benchmark::State& state) {
   const Clip& c = ClipOf(state);
   std::int64_t frames = 0;

@@ -91,6 +91,31 @@ struct KinematicsJob {
   [[nodiscard]] JobStatus Run() const;
 };
 
+// Optional zero-phase low-pass of the joint trajectories before KinematicsJob
+// (ALGORITHMS.md 6: differentiating captured data twice amplifies noise).
+// A symmetric (hence zero-phase) Gaussian FIR kernel over frames with standard
+// deviation sigma = sqrt(ln 2) / (2 pi cutoff_hz) seconds, so the gain
+// exp(-(2 pi f sigma)^2 / 2) is 1/sqrt(2) at the cutoff (10 Hz: 0.986 at 2 Hz,
+// 0.004 at 40 Hz). Truncated at +-3 sigma; at the clip ends the window is cut and
+// its weights renormalized. Positions are averaged; rotations are averaged as
+// quaternions sign-aligned with the centre frame, then normalized (close to the
+// rotation mean for the small spread inside a window); the scale of the centre
+// frame is kept. Smoothing leaves the second derivative of a quadratic
+// trajectory unchanged (it adds sigma^2 x'' / 2 to positions). With
+// sigma < h / 3 the kernel is a single tap and the matrices are copied.
+struct SmoothTrajectoriesJob {
+  std::span<const glm::mat4> model_from_joint;  // #F x #J, ALL frames, frame-major
+  int num_joints = 0;                           // #J >= 1
+  double frame_time_s = 0.0;                    // h > 0
+  double cutoff_hz = 10.0;                      // > 0
+  int first_frame = 0;                          // frame of output[0 .. #J)
+  std::span<glm::mat4> output;                  // #F' x #J smoothed matrices; must not alias input
+
+  // Same checks as KinematicsJob, plus kOutOfRange for cutoff_hz <= 0.
+  [[nodiscard]] JobStatus Validate() const;
+  [[nodiscard]] JobStatus Run() const;  // no allocation; splitting ranges gives the same bits
+};
+
 // Convenience: model matrices and kinematics of all frames (#F x #J, frame-major),
 // allocated once. Errors (kInvalidArgument) for a motion that does not match the
 // skeleton or has no frames or a non-positive frame time.

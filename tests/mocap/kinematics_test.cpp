@@ -303,6 +303,59 @@ TEST(KinematicsJob, ShortMotions) {
   EXPECT_EQ(mocap::ComputeKinematics(s, none).error().code, mocap::ErrorCode::kInvalidArgument);
 }
 
+TEST(SmoothTrajectoriesJob, Validity) {
+  std::vector<glm::mat4> model(6), out(6), odd(5);
+  EXPECT_EQ((mocap::SmoothTrajectoriesJob{.model_from_joint = model, .num_joints = 2, .frame_time_s = 0.1,
+                                          .cutoff_hz = 0.0, .output = out})
+                .Validate().code, mocap::JobStatus::kOutOfRange);
+  EXPECT_EQ((mocap::SmoothTrajectoriesJob{.model_from_joint = model, .num_joints = 2, .frame_time_s = 0.1,
+                                          .output = odd})
+                .Validate().code, mocap::JobStatus::kSizeMismatch);
+  EXPECT_EQ((mocap::SmoothTrajectoriesJob{.model_from_joint = model, .num_joints = 2, .frame_time_s = 0.1,
+                                          .first_frame = 2, .output = out})
+                .Validate().code, mocap::JobStatus::kOutOfRange);
+  EXPECT_TRUE((mocap::SmoothTrajectoriesJob{.model_from_joint = model, .num_joints = 2, .frame_time_s = 0.1,
+                                            .output = out})
+                  .Run().ok());
+}
+
+// 40 Hz jitter on the root (as capture noise) swamps the second difference; the
+// 10 Hz low-pass removes it and leaves the quadratic trajectory's acceleration.
+TEST(SmoothTrajectoriesJob, RemovesHighFrequencyNoiseBeforeDifferencing) {
+  const Analytic an;
+  const mocap::Skeleton s = an.MakeSkeleton();
+  mocap::Motion m = an.MakeMotion(120);
+  const double noise_cm = 0.2;
+  for (int f = 0; f < m.num_frames; ++f) {
+    m.frame(f)[0] += static_cast<float>(noise_cm * std::sin(2.0 * 3.14159265358979 * 40.0 * f * m.frame_time_s));
+  }
+  std::vector<mocap::JointTransform> locals(3);
+  std::vector<glm::mat4> model(static_cast<std::size_t>(m.num_frames) * 3), smooth(model.size());
+  ASSERT_TRUE((mocap::ModelMatricesJob{.skeleton = &s, .motion = &m, .locals = locals, .model_from_joint = model})
+                  .Run().ok());
+  ASSERT_TRUE((mocap::SmoothTrajectoriesJob{.model_from_joint = model, .num_joints = 3,
+                                            .frame_time_s = m.frame_time_s, .cutoff_hz = 10.0, .output = smooth})
+                  .Run().ok());
+  std::vector<mocap::JointKinematics> raw(model.size()), filtered(model.size());
+  ASSERT_TRUE((mocap::KinematicsJob{.model_from_joint = model, .num_joints = 3, .frame_time_s = m.frame_time_s,
+                                    .output = raw}).Run().ok());
+  ASSERT_TRUE((mocap::KinematicsJob{.model_from_joint = smooth, .num_joints = 3, .frame_time_s = m.frame_time_s,
+                                    .output = filtered}).Run().ok());
+  double raw_error = 0.0, filtered_error = 0.0, w_error = 0.0;
+  const int margin = 6;  // > 3 sigma = 2.4 frames at 120 fps: windows not cut by the ends
+  for (int f = margin; f + margin < m.num_frames; ++f) {
+    const Analytic::State want = an.Root(f * m.frame_time_s);
+    raw_error = std::max(raw_error, glm::length(glm::dvec3(raw[f * 3u].linear_acceleration) - want.acc));
+    filtered_error = std::max(filtered_error, glm::length(glm::dvec3(filtered[f * 3u].linear_acceleration) - want.acc));
+    w_error = std::max(w_error, glm::length(glm::dvec3(filtered[f * 3u].angular_velocity) - want.w));
+  }
+  // Raw: the noise's second difference, ~ noise (2 pi 40)^2 = 1.2e4 cm/s^2.
+  EXPECT_GT(raw_error, 0.5 * noise_cm * std::pow(2.0 * 3.14159265358979 * 40.0, 2));
+  EXPECT_LT(filtered_error, testsupport::kLowPassResidual * raw_error);
+  // Rotation about a fixed axis with a quadratic angle keeps its velocity.
+  EXPECT_LT(w_error, testsupport::kLowPassAngularVelTol);
+}
+
 TEST(SampleJointKinematics, ExactAtFramesAndCloseBetween) {
   const Analytic an;
   const mocap::Skeleton s = an.MakeSkeleton();

@@ -40,6 +40,12 @@ inline constexpr double kMatrixRoundoff = 4.0 * 1.1920929e-7;
 inline constexpr double kSecondOrderMinRatio = 3.0;
 // Relative float error of rotating a vector into a joint's frame.
 inline constexpr float kLocalFrameRelTol = 1e-5f;
+// The 10 Hz Gaussian low-pass passes 0.4% of a 40 Hz component (sampled kernel:
+// a little more); accept up to 2% of the unfiltered error.
+inline constexpr double kLowPassResidual = 0.02;
+// Angular velocity (rad/s) after smoothing a fixed-axis quadratic rotation: the
+// normalized quaternion mean differs from the angle mean at O(spread^3).
+inline constexpr double kLowPassAngularVelTol = 1e-3;
 
 // Synthetic motions. A procedural walk keeps the stance foot within this of the
 // ground (the hips bob is solved exactly; float positions round at ~1e-5 cm, so
