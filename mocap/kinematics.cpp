@@ -79,11 +79,12 @@ JobStatus ModelMatricesJob::Run() const {
     const int f = first_frame + static_cast<int>(k);
     const JobStatus pose = LocalPoseJob{skeleton, motion->frame(f), locals}.Run();
     if (!pose) return pose;
-    const JobStatus model = LocalToModelJob{.parents = skeleton->parents,
-                                            .locals = locals,
-                                            .model_from_root = model_from_root,
-                                            .model_from_joint = model_from_joint.subspan(k * num_joints, num_joints)}
-                                .Run();
+    const JobStatus model =
+        LocalToModelJob{.parents = skeleton->parents,
+                        .locals = locals,
+                        .model_from_root = model_from_root,
+                        .model_from_joint = model_from_joint.subspan(k * num_joints, num_joints)}
+            .Run();
     if (!model) return model;
   }
   return kJobOk;
@@ -160,12 +161,12 @@ JobStatus KinematicsJob::Run() const {
 }
 
 JobStatus SmoothTrajectoriesJob::Validate() const {
-  const JobStatus base = KinematicsJob{.model_from_joint = model_from_joint,
-                                       .num_joints = num_joints,
-                                       .frame_time_s = frame_time_s,
-                                       .first_frame = first_frame,
-                                       .output = {}}
-                             .Validate();
+  const JobStatus base = KinematicsJob{
+      .model_from_joint = model_from_joint,
+      .num_joints = num_joints,
+      .frame_time_s = frame_time_s,
+      .first_frame = first_frame,
+      .output = {}}.Validate();
   if (!base) return base;
   if (output.size() % static_cast<std::size_t>(num_joints) != 0) {
     return {JobStatus::kSizeMismatch, "output must hold whole frames"};
@@ -186,7 +187,8 @@ JobStatus SmoothTrajectoriesJob::Run() const {
   const std::size_t nj = static_cast<std::size_t>(num_joints);
   const int num_frames = static_cast<int>(model_from_joint.size() / nj);
   const int out_frames = static_cast<int>(output.size() / nj);
-  const double sigma_frames = std::sqrt(std::log(2.0)) / (2.0 * std::numbers::pi * cutoff_hz) / frame_time_s;
+  const double sigma_frames =
+      std::sqrt(std::log(2.0)) / (2.0 * std::numbers::pi * cutoff_hz) / frame_time_s;
   // Radius capped so a tiny cutoff cannot make the window unbounded.
   const int radius = static_cast<int>(std::min(std::floor(3.0 * sigma_frames), 1e4));
   for (int k = 0; k < out_frames; ++k) {
@@ -223,7 +225,8 @@ JobStatus SmoothTrajectoriesJob::Run() const {
   return kJobOk;
 }
 
-Result<std::vector<JointKinematics>> ComputeKinematics(const Skeleton& skeleton, const Motion& motion) {
+Result<std::vector<JointKinematics>> ComputeKinematics(const Skeleton& skeleton,
+                                                       const Motion& motion) {
   const FileLoc loc{skeleton.info.source_file, 0, 0, {}};
   const std::size_t nj = static_cast<std::size_t>(skeleton.num_joints());
   if (nj == 0 || motion.num_frames < 1 || motion.num_channels != skeleton.num_channels ||
@@ -238,9 +241,10 @@ Result<std::vector<JointKinematics>> ComputeKinematics(const Skeleton& skeleton,
   const std::size_t frames = static_cast<std::size_t>(motion.num_frames);
   std::vector<JointTransform> locals(nj);
   std::vector<glm::mat4> model(frames * nj);
-  const JobStatus m = ModelMatricesJob{.skeleton = &skeleton, .motion = &motion, .locals = locals,
-                                       .model_from_joint = model}
-                          .Run();
+  const JobStatus m =
+      ModelMatricesJob{
+          .skeleton = &skeleton, .motion = &motion, .locals = locals, .model_from_joint = model}
+          .Run();
   if (!m) return MakeError(ErrorCode::kInternal, loc, m.what);
   std::vector<JointKinematics> out(frames * nj);
   const JobStatus k = KinematicsJob{.model_from_joint = model,
@@ -252,9 +256,11 @@ Result<std::vector<JointKinematics>> ComputeKinematics(const Skeleton& skeleton,
   return out;
 }
 
-JobStatus SampleJointKinematics(std::span<const JointKinematics> kinematics, int num_joints, int joint,
-                                double frame_time_s, double time_s, JointKinematics* out) {
-  if (out == nullptr || kinematics.empty()) return {JobStatus::kMissingInput, "no buffer or no output"};
+JobStatus SampleJointKinematics(std::span<const JointKinematics> kinematics, int num_joints,
+                                int joint, double frame_time_s, double time_s,
+                                JointKinematics* out) {
+  if (out == nullptr || kinematics.empty())
+    return {JobStatus::kMissingInput, "no buffer or no output"};
   if (num_joints <= 0 || joint < 0 || joint >= num_joints) {
     return {JobStatus::kOutOfRange, "joint outside [0, num_joints)"};
   }

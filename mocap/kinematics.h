@@ -26,7 +26,8 @@
 // artefacts. Joint-frame values are R^T times the model-space values, with R the
 // joint's model rotation at that frame. Each joint's rotation must change by
 // less than pi between neighbouring frames (any real capture does).
-// Differentiating captured data twice amplifies noise; no filtering is done here.
+// Differentiating captured data twice amplifies noise: SmoothTrajectoriesJob
+// below can low-pass the matrices first (not done unless the caller runs it).
 
 #include <span>
 #include <vector>
@@ -57,13 +58,13 @@ struct JointKinematics {
 
 // Model matrices of a range of frames: LocalPoseJob + LocalToModelJob per frame.
 struct ModelMatricesJob {
-  const Skeleton* skeleton = nullptr;         // required
-  const Motion* motion = nullptr;             // required, num_channels == skeleton->num_channels
-  int first_frame = 0;                        // first frame evaluated
-  glm::mat4 model_from_root{1.0f};            // applied above every root joint
-  std::span<JointTransform> locals;           // #J caller-owned workspace
-  std::span<glm::mat4> model_from_joint;      // #F' x #J output, frame-major: frame
-                                              // first_frame + k at [k * #J, (k+1) * #J)
+  const Skeleton* skeleton = nullptr;     // required
+  const Motion* motion = nullptr;         // required, num_channels == skeleton->num_channels
+  int first_frame = 0;                    // first frame evaluated
+  glm::mat4 model_from_root{1.0f};        // applied above every root joint
+  std::span<JointTransform> locals;       // #J caller-owned workspace
+  std::span<glm::mat4> model_from_joint;  // #F' x #J output, frame-major: frame
+                                          // first_frame + k at [k * #J, (k+1) * #J)
 
   // kMissingInput: null skeleton or motion, or a skeleton without joints;
   // kSizeMismatch: locals, channel counts, or an output that is not a whole
@@ -119,7 +120,8 @@ struct SmoothTrajectoriesJob {
 // Convenience: model matrices and kinematics of all frames (#F x #J, frame-major),
 // allocated once. Errors (kInvalidArgument) for a motion that does not match the
 // skeleton or has no frames or a non-positive frame time.
-Result<std::vector<JointKinematics>> ComputeKinematics(const Skeleton& skeleton, const Motion& motion);
+Result<std::vector<JointKinematics>> ComputeKinematics(const Skeleton& skeleton,
+                                                       const Motion& motion);
 
 // Kinematics of ONE joint at any time t (seconds), e.g. an RK4 stage time, from
 // the two frames around t in a per-frame buffer (as KinematicsJob fills it, for

@@ -29,7 +29,8 @@ class Builder {
     ch.first = static_cast<std::uint32_t>(s_.num_channels);
     int c = 0;
     if (with_position) {
-      for (ChannelType t : {ChannelType::kXPosition, ChannelType::kYPosition, ChannelType::kZPosition}) {
+      for (ChannelType t :
+           {ChannelType::kXPosition, ChannelType::kYPosition, ChannelType::kZPosition}) {
         ch.types[static_cast<std::size_t>(c++)] = t;
       }
     }
@@ -58,23 +59,27 @@ class Builder {
 
 // Joint rotation from ZXY Euler angles in degrees (R = Rz * Rx * Ry).
 glm::quat Zxy(double z_deg, double x_deg, double y_deg) {
-  const float angles[3] = {static_cast<float>(z_deg), static_cast<float>(x_deg), static_cast<float>(y_deg)};
+  const float angles[3] = {static_cast<float>(z_deg), static_cast<float>(x_deg),
+                           static_cast<float>(y_deg)};
   return EulerToQuat(kZxy.data(), angles, 3);
 }
 
 // The humanoid joints the generators drive, in a fixed order.
+// clang-format off
 enum H : int {
   kHips, kSpine, kSpine1, kSpine2, kNeck, kHead,
   kLShoulder, kLArm, kLForeArm, kLHand, kLIndex,
   kRShoulder, kRArm, kRForeArm, kRHand, kRIndex,
   kLUpLeg, kLLeg, kLFoot, kLToe, kRUpLeg, kRLeg, kRFoot, kRToe, kNumH
 };
+// clang-format on
 constexpr std::array<const char*, kNumH> kHumanoidNames = {
-    "Hips", "Spine", "Spine1", "Spine2", "Neck", "Head",
-    "LeftShoulder", "LeftArm", "LeftForeArm", "LeftHand", "LeftHandIndex1",
-    "RightShoulder", "RightArm", "RightForeArm", "RightHand", "RightHandIndex1",
-    "LeftUpLeg", "LeftLeg", "LeftFoot", "LeftToeBase", "RightUpLeg", "RightLeg", "RightFoot",
-    "RightToeBase"};
+    "Hips",        "Spine",        "Spine1",         "Spine2",
+    "Neck",        "Head",         "LeftShoulder",   "LeftArm",
+    "LeftForeArm", "LeftHand",     "LeftHandIndex1", "RightShoulder",
+    "RightArm",    "RightForeArm", "RightHand",      "RightHandIndex1",
+    "LeftUpLeg",   "LeftLeg",      "LeftFoot",       "LeftToeBase",
+    "RightUpLeg",  "RightLeg",     "RightFoot",      "RightToeBase"};
 
 // One intended pose: root position and per-humanoid-joint rotation relative to rest.
 struct HumanoidPose {
@@ -92,13 +97,15 @@ class MotionWriter {
         num_frames > (1 << 20)) {
       return MakeError(ErrorCode::kInvalidArgument, loc,
                        "expected a positive frame time and duration, found frame time " +
-                           std::to_string(frame_time_s) + " s for " + std::to_string(num_frames) + " frames");
+                           std::to_string(frame_time_s) + " s for " + std::to_string(num_frames) +
+                           " frames");
     }
     const Status check = s.Check();
     if (!check) return check.error();
     MotionWriter w(s);
     for (int i = 0; i < kNumH; ++i) {
-      w.index_[static_cast<std::size_t>(i)] = s.FindJoint(kHumanoidNames[static_cast<std::size_t>(i)]);
+      w.index_[static_cast<std::size_t>(i)] =
+          s.FindJoint(kHumanoidNames[static_cast<std::size_t>(i)]);
       if (w.index_[static_cast<std::size_t>(i)] < 0) {
         return MakeError(ErrorCode::kNotFound, loc,
                          std::string("expected a humanoid joint named '") +
@@ -108,8 +115,8 @@ class MotionWriter {
     w.motion_.frame_time_s = frame_time_s;
     w.motion_.num_channels = s.num_channels;
     w.motion_.num_frames = num_frames;
-    w.motion_.values.assign(static_cast<std::size_t>(num_frames) * static_cast<std::size_t>(s.num_channels),
-                            0.0f);
+    w.motion_.values.assign(
+        static_cast<std::size_t>(num_frames) * static_cast<std::size_t>(s.num_channels), 0.0f);
     return w;
   }
 
@@ -119,14 +126,17 @@ class MotionWriter {
   void Write(int f, const HumanoidPose& pose) {
     std::vector<glm::quat> delta(skeleton_->parents.size(), glm::quat(1.0f, 0.0f, 0.0f, 0.0f));
     for (int i = 0; i < kNumH; ++i) {
-      delta[static_cast<std::size_t>(index_[static_cast<std::size_t>(i)])] = pose.rotations[static_cast<std::size_t>(i)];
+      delta[static_cast<std::size_t>(index_[static_cast<std::size_t>(i)])] =
+          pose.rotations[static_cast<std::size_t>(i)];
     }
     const std::size_t root = static_cast<std::size_t>(index_[kHips]);
     std::span<float> row = motion_.frame(f);
-    const std::span<const float> previous = f > 0 ? std::span<const float>(motion_.frame(f - 1)) : row;
+    const std::span<const float> previous =
+        f > 0 ? std::span<const float>(motion_.frame(f - 1)) : row;
     for (std::size_t j = 0; j < delta.size(); ++j) {
       const JointChannels& ch = skeleton_->channels[j];
-      const glm::vec3 translation = j == root ? pose.root_position : skeleton_->rest_translations[j];
+      const glm::vec3 translation =
+          j == root ? pose.root_position : skeleton_->rest_translations[j];
       ChannelType axes[3];
       std::uint32_t where[3];
       int n = 0;
@@ -135,10 +145,10 @@ class MotionWriter {
         const std::uint32_t k = ch.first + static_cast<std::uint32_t>(c);
         const int type = static_cast<int>(t);
         if (type <= 2) {  // kX/Y/ZPosition
-          row[k] = translation[type] -
-                   (skeleton_->position_mode == PositionChannelMode::kAddToOffset
-                        ? skeleton_->rest_translations[j][type]
-                        : 0.0f);
+          row[k] =
+              translation[type] - (skeleton_->position_mode == PositionChannelMode::kAddToOffset
+                                       ? skeleton_->rest_translations[j][type]
+                                       : 0.0f);
         } else if (type <= 5 && n < 3) {
           axes[n] = t;
           where[n++] = k;
@@ -171,7 +181,8 @@ class MotionWriter {
 };
 
 int FramesFor(double duration_s, double frame_time_s) {
-  if (!(frame_time_s > 0.0) || !(duration_s > 0.0) || !std::isfinite(duration_s / frame_time_s)) return 0;
+  if (!(frame_time_s > 0.0) || !(duration_s > 0.0) || !std::isfinite(duration_s / frame_time_s))
+    return 0;
   return static_cast<int>(std::min(std::round(duration_s / frame_time_s), 1e7)) + 1;
 }
 
@@ -292,7 +303,7 @@ Result<Motion> MakeBendRamp(const Skeleton& humanoid, float end_deg, double dura
     HumanoidPose p;
     p.rotations[kLForeArm] = Zxy(0, 0, -a);  // forearms bend forward (+Z)
     p.rotations[kRForeArm] = Zxy(0, 0, a);
-    SetLeg(&p, kLUpLeg, -0.4 * a, a);        // knee forward, shin back: clear of the body
+    SetLeg(&p, kLUpLeg, -0.4 * a, a);  // knee forward, shin back: clear of the body
     writer->Write(f, p);
   }
   return writer->Take();
@@ -334,8 +345,9 @@ Result<Motion> MakeJumpMotion(const Skeleton& humanoid, const JumpOptions& o) {
   const double leg = kThighCm + kShinCm;
   if (!(o.height_cm > 0.0) || !(o.crouch_cm > 0.0 && o.crouch_cm < leg) ||
       !(o.landing_crouch_cm > 0.0 && o.landing_crouch_cm < leg)) {
-    return MakeError(ErrorCode::kInvalidArgument, {humanoid.info.source_file, 0, 0, {}},
-                     "expected a positive jump height and crouch depths below the leg length (84 cm)");
+    return MakeError(
+        ErrorCode::kInvalidArgument, {humanoid.info.source_file, 0, 0, {}},
+        "expected a positive jump height and crouch depths below the leg length (84 cm)");
   }
   const JumpTimeline tl = MakeJumpTimeline(o);
   auto writer = MotionWriter::Create(humanoid, o.frame_time_s, FramesFor(tl.end_s, o.frame_time_s));
@@ -392,8 +404,9 @@ Result<Skeleton> MakeChainSkeleton(int num_joints, float segment_length_cm) {
       !std::isfinite(segment_length_cm)) {
     return MakeError(ErrorCode::kInvalidArgument, {"synthetic:chain", 0, 0, {}},
                      "expected 1.." + std::to_string(kMaxJoints) +
-                         " joints and a positive segment length, found " + std::to_string(num_joints) +
-                         " joints of " + std::to_string(segment_length_cm) + " cm");
+                         " joints and a positive segment length, found " +
+                         std::to_string(num_joints) + " joints of " +
+                         std::to_string(segment_length_cm) + " cm");
   }
   Builder b;
   int parent = b.Add("Chain0", kNoParent, {0, 50, 0}, true);
@@ -417,7 +430,8 @@ Skeleton MakeQuadrupedSkeleton() {
     for (float side : {1.0f, -1.0f}) {
       const std::string s = std::string(side > 0 ? "Left" : "Right") + end;
       // Front legs hang from the chest (y 62), hind legs from the hips (y 60).
-      const int up = b.Add(s + "UpLeg", front ? chest : hips, {10 * side, front ? -6.0f : -4.0f, 0});
+      const int up =
+          b.Add(s + "UpLeg", front ? chest : hips, {10 * side, front ? -6.0f : -4.0f, 0});
       const int leg = b.Add(s + "Leg", up, {0, -24, 0});
       const int foot = b.Add(s + "Foot", leg, {0, -24, 0});
       const int toe = b.Add(s + "ToeBase", foot, {0, -7, 5});
