@@ -186,25 +186,30 @@ int FramesFor(double duration_s, double frame_time_s) {
   return static_cast<int>(std::min(std::round(duration_s / frame_time_s), 1e7)) + 1;
 }
 
-// Rise of the ankle (cm) above the straight-leg position for thigh and shin
-// pitches (degrees, the joints' X rotations).
-double AnkleRise(double thigh_x_deg, double knee_x_deg) {
-  const double a1 = glm::radians(thigh_x_deg);
-  const double a2 = glm::radians(thigh_x_deg + knee_x_deg);
-  return kThighCm * (1.0 - std::cos(a1)) + kShinCm * (1.0 - std::cos(a2));
-}
-
-// Forward reach (cm, +Z) of the ankle from the hip joint.
-double AnkleReach(double thigh_x_deg, double knee_x_deg) {
-  return -kThighCm * std::sin(glm::radians(thigh_x_deg)) -
-         kShinCm * std::sin(glm::radians(thigh_x_deg + knee_x_deg));
-}
-
 // Sets thigh, knee and a foot kept parallel to the ground (their X rotations sum to 0).
 void SetLeg(HumanoidPose* p, int up_leg, double thigh_x_deg, double knee_x_deg) {
   p->rotations[static_cast<std::size_t>(up_leg)] = Zxy(0, thigh_x_deg, 0);
   p->rotations[static_cast<std::size_t>(up_leg + 1)] = Zxy(0, knee_x_deg, 0);
   p->rotations[static_cast<std::size_t>(up_leg + 2)] = Zxy(0, -(thigh_x_deg + knee_x_deg), 0);
+}
+
+// Two-bone IK for a leg under unrotated hips: puts the ankle at `ankle` (cm,
+// relative to the hip joint, hips frame) with the knee pointing forward and the
+// foot flat and facing +Z. The leg first tilts about Z by tau so the ankle's
+// sideways offset lies in its plane, then bends in that plane: the thigh flexes
+// by gamma + a and the knee by 2a (equal segments), gamma the forward angle of
+// the hip->ankle line, a = acos(d / 2L). Targets beyond reach are clamped.
+void SolveLeg(HumanoidPose* p, int up_leg, const glm::dvec3& ankle) {
+  const double r = std::hypot(ankle.x, ankle.y);  // length of the tilted plane's down axis
+  const double tau = std::atan2(ankle.x, -ankle.y);
+  const double d = std::min(std::hypot(r, ankle.z), 0.9995 * (kThighCm + kShinCm));
+  const double a = std::acos(d / (kThighCm + kShinCm));
+  const double gamma = std::atan2(ankle.z, r);
+  const glm::quat thigh = Zxy(glm::degrees(tau), -glm::degrees(gamma + a), 0);
+  const glm::quat knee = Zxy(0, glm::degrees(2 * a), 0);
+  p->rotations[static_cast<std::size_t>(up_leg)] = thigh;
+  p->rotations[static_cast<std::size_t>(up_leg + 1)] = knee;
+  p->rotations[static_cast<std::size_t>(up_leg + 2)] = glm::conjugate(thigh * knee);
 }
 
 }  // namespace
@@ -241,48 +246,78 @@ Skeleton MakeHumanoidSkeleton() {
 }
 
 Result<Motion> MakeWalkMotion(const Skeleton& humanoid, const WalkOptions& o) {
+  if (!(o.step_length_cm > 0.0 && o.step_length_cm <= 60.0) ||
+      !(o.foot_lift_cm >= 0.0 && o.foot_lift_cm <= 30.0)) {
+    return MakeError(ErrorCode::kInvalidArgument, {humanoid.info.source_file, 0, 0, {}},
+                     "expected a step length in (0, 60] cm and a foot lift in [0, 30] cm");
+  }
   const int frames = o.num_cycles >= 1 && o.cycle_s > 0.0
                          ? FramesFor(o.num_cycles * o.cycle_s, o.frame_time_s) - 1
                          : 0;
   auto writer = MotionWriter::Create(humanoid, o.frame_time_s, frames);
   if (!writer.ok()) return std::move(writer).error();
-  const auto flex = [&](double psi) { return 10.0 + o.hip_swing_deg * std::sin(psi); };  // forward
-  const auto knee = [&](double psi) {
-    const double c = std::max(0.0, std::cos(psi + 0.4));  // bent in swing (thigh moving forward)
-    return 5.0 + (o.knee_peak_deg - 5.0) * c * c;
+  constexpr double kDuty = 0.6;        // stance fraction of the cycle
+  constexpr double kHipHeight = 80.0;  // mean hip joint height above the ankle, cm
+  constexpr double kBob = 2.0;         // cm
+  const double step = o.step_length_cm;
+  const double speed = step / (kDuty * o.cycle_s);  // cm/s
+  const double swing_s = (1.0 - kDuty) * o.cycle_s;
+  // Hip joint height above the ankles at cycle phase u of the left leg: highest
+  // at each leg's mid-stance (u = 0.3 and 0.8).
+  const auto hip_height = [&](double u) {
+    return kHipHeight + kBob * std::cos(4 * kPi * (u - 0.3));
   };
-  // Hip speed that matches the stance foot's backward travel between heel strike
-  // (psi = pi/2) and toe off (psi = 3 pi/2), half a cycle apart.
-  const double speed = (AnkleReach(-flex(kPi / 2), knee(kPi / 2)) -
-                        AnkleReach(-flex(3 * kPi / 2), knee(3 * kPi / 2))) /
-                       (0.5 * o.cycle_s);
+  // Ankle path relative to the hip joint (z forward, lift up) at the leg's own phase u.
+  const auto ankle_path = [&](double u, double* z, double* lift) {
+    if (u < kDuty) {
+      *z = 0.5 * step - speed * u * o.cycle_s;  // planted: moves back at the hips' speed
+      *lift = 0.0;
+      return;
+    }
+    const double s = (u - kDuty) / (1.0 - kDuty);
+    const double s2 = s * s;
+    const double s3 = s2 * s;
+    const double slope = -speed * swing_s;  // ground speed 0 at both ends
+    *z = (2 * s3 - 3 * s2 + 1) * (-0.5 * step) + (s3 - 2 * s2 + s) * slope +
+         (-2 * s3 + 3 * s2) * (0.5 * step) + (s3 - s2) * slope;
+    *lift = o.foot_lift_cm * std::sin(kPi * s) * std::sin(kPi * s);
+  };
+  const double hip_offset_y = -humanoid
+                                   .rest_translations[static_cast<std::size_t>(
+                                       std::max(humanoid.FindJoint("LeftUpLeg"), 0))]
+                                   .y;  // hips above the hip joints
+  const double ankle_rest_y = kHipsRestY - hip_offset_y - (kThighCm + kShinCm);
   for (int f = 0; f < writer->num_frames(); ++f) {
     const double t = writer->time(f);
-    const double phi = 2.0 * kPi * t / o.cycle_s;
-    const double sp = std::sin(phi);
+    const double u_left = t / o.cycle_s - std::floor(t / o.cycle_s);
+    const double u_right = u_left + 0.5 - std::floor(u_left + 0.5);
+    const double height = hip_height(u_left);
+    const double sway = 2.0 * std::cos(2 * kPi * (u_left - 0.3));  // over the stance foot
+    const double c = std::cos(2 * kPi * u_left);                   // +1 when the left foot lands
     HumanoidPose p;
-    const double left_rise = AnkleRise(-flex(phi), knee(phi));
-    const double right_rise = AnkleRise(-flex(phi + kPi), knee(phi + kPi));
-    p.root_position = glm::vec3(static_cast<float>(-2.0 * std::cos(phi)),
-                                static_cast<float>(kHipsRestY - std::min(left_rise, right_rise)),
+    p.root_position = glm::vec3(static_cast<float>(sway),
+                                static_cast<float>(ankle_rest_y + height + hip_offset_y),
                                 static_cast<float>(speed * t));
-    SetLeg(&p, kLUpLeg, -flex(phi), knee(phi));
-    SetLeg(&p, kRUpLeg, -flex(phi + kPi), knee(phi + kPi));
-    // Pelvis yaws with the forward leg; the spine and neck undo it so the head faces +Z.
-    p.rotations[kHips] = Zxy(0, 0, -6.0 * sp);
-    p.rotations[kSpine] = Zxy(0, 3, 3.0 * sp);
-    p.rotations[kSpine1] = Zxy(0, 1, 2.5 * sp);
-    p.rotations[kSpine2] = Zxy(0, 0, 2.0 * sp);
-    p.rotations[kNeck] = Zxy(0, 0, -1.0 * sp);
-    p.rotations[kHead] = Zxy(0, -4, -0.5 * sp);
-    // Arms hang 75 degrees down and swing against the same-side leg; the elbow
-    // bends more as the arm comes forward.
+    double z = 0.0;
+    double lift = 0.0;
+    ankle_path(u_left, &z, &lift);
+    SolveLeg(&p, kLUpLeg, {-sway, -(height - lift), z});
+    ankle_path(u_right, &z, &lift);
+    SolveLeg(&p, kRUpLeg, {-sway, -(height - lift), z});
+    // The chest turns with the forward arm (right arm forward when c = 1); neck
+    // and head undo it so the gaze stays on +Z.
+    p.rotations[kSpine] = Zxy(0, 3, 1.5 * c);
+    p.rotations[kSpine1] = Zxy(0, 1, 1.5 * c);
+    p.rotations[kSpine2] = Zxy(0, 0, 1.0 * c);
+    p.rotations[kNeck] = Zxy(0, 0, -2.0 * c);
+    p.rotations[kHead] = Zxy(0, -4, -2.0 * c);
+    // Arms hang 75 degrees down and swing against the same-side leg.
     const double swing = o.arm_swing_deg;
-    const double left_fwd = -swing * sp;
-    const double right_fwd = swing * sp;
+    const double left_fwd = -swing * c;
+    const double right_fwd = swing * c;
     const auto elbow = [&](double fwd) {
-      const double u = swing > 0.0 ? 0.5 + 0.5 * fwd / swing : 0.5;
-      return 15.0 + (o.elbow_peak_deg - 15.0) * u;
+      const double w = swing > 0.0 ? 0.5 + 0.5 * fwd / swing : 0.5;
+      return 15.0 + (o.elbow_peak_deg - 15.0) * w;
     };
     p.rotations[kLArm] = Zxy(-75, 0, -left_fwd);
     p.rotations[kRArm] = Zxy(75, 0, right_fwd);

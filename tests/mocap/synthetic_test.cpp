@@ -116,6 +116,37 @@ TEST(Synthetic, WalkKeepsFeetOnTheGroundAndMovesForward) {
   EXPECT_LE(max_elbow, 120.0f);
 }
 
+TEST(Synthetic, WalkPlantsTheStanceFootAndMovesSmoothly) {
+  const mocap::Skeleton s = mocap::MakeHumanoidSkeleton();
+  auto m = mocap::MakeWalkMotion(s);
+  ASSERT_TRUE(m.ok());
+  const Probe pr{s, Positions(s, *m)};
+  int planted_pairs = 0;
+  for (int f = 1; f < m->num_frames; ++f) {
+    for (const char* foot : {"LeftFoot", "RightFoot"}) {
+      const glm::vec3 a = pr.At(f - 1, foot);
+      const glm::vec3 b = pr.At(f, foot);
+      const float ankle_rest_y = 8.0f;
+      if (std::abs(a.y - ankle_rest_y) < testsupport::kFootSlideTolCm &&
+          std::abs(b.y - ankle_rest_y) < testsupport::kFootSlideTolCm) {
+        EXPECT_LT(std::hypot(b.x - a.x, b.z - a.z), testsupport::kFootSlideTolCm)
+            << foot << " slides at frame " << f;
+        ++planted_pairs;
+      }
+    }
+  }
+  // Stance is 60% of the cycle for each foot.
+  EXPECT_GT(planted_pairs, m->num_frames);
+  // Hips: no vertical acceleration spikes (a real walk stays well under 0.5 g).
+  auto k = mocap::ComputeKinematics(s, *m);
+  ASSERT_TRUE(k.ok());
+  for (int f = 0; f < m->num_frames; ++f) {
+    EXPECT_LT(std::abs((*k)[static_cast<std::size_t>(f * s.num_joints())].linear_acceleration.y),
+              0.5 * mocap::kGravityCmPerS2)
+        << "frame " << f;
+  }
+}
+
 TEST(Synthetic, WalkLoops) {
   const mocap::Skeleton s = mocap::MakeHumanoidSkeleton();
   auto m = mocap::MakeWalkMotion(s, {.num_cycles = 2});
@@ -220,6 +251,8 @@ TEST(Synthetic, JumpHasAnAccelerationSpikeAndFreeFall) {
 TEST(Synthetic, GeneratorsRejectBadInput) {
   const mocap::Skeleton s = mocap::MakeHumanoidSkeleton();
   EXPECT_EQ(mocap::MakeBendRamp(s, 150.0f, 2.0, 0.0).error().code,
+            mocap::ErrorCode::kInvalidArgument);
+  EXPECT_EQ(mocap::MakeWalkMotion(s, {.step_length_cm = 90.0}).error().code,
             mocap::ErrorCode::kInvalidArgument);
   EXPECT_EQ(mocap::MakeWalkMotion(s, {.num_cycles = 0}).error().code,
             mocap::ErrorCode::kInvalidArgument);

@@ -51,6 +51,9 @@ inline constexpr double kLowPassAngularVelTol = 1e-3;
 // ground (the hips bob is solved exactly; float positions round at ~1e-5 cm, so
 // this is slack for the foot-flat approximation only).
 inline constexpr float kGroundContactTolCm = 0.05f;
+// A planted foot moves less than this between frames (float positions of
+// order 300 cm round at ~4e-5 cm).
+inline constexpr float kFootSlideTolCm = 0.01f;
 // Joint bend angles measured from float model positions (acos near 0 and 180
 // degrees loses precision: sqrt(float eps) ~ 3e-4 rad ~ 0.02 degrees).
 inline constexpr float kBendMeasureTolDeg = 0.05f;
