@@ -25,7 +25,7 @@
 // differences, so it is independent of the channel order and has no gimbal
 // artefacts. Joint-frame values are R^T times the model-space values, with R the
 // joint's model rotation at that frame. Each joint's rotation must change by
-// less than pi between neighbouring frames (any real capture does).
+// less than pi over two frame steps (any real capture does).
 // Differentiating captured data twice amplifies noise: SmoothTrajectoriesJob
 // below can low-pass the matrices first (not done unless the caller runs it).
 
