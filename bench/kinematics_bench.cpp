@@ -49,7 +49,9 @@ const Clip& WalkClip() {
   return clip;
 }
 
-const Clip& ClipOf(const benchmark::State& state) { return state.range(0) == 0 ? ChainClip() : WalkClip(); }
+const Clip& ClipOf(const benchmark::State& state) {
+  return state.range(0) == 0 ? ChainClip() : WalkClip();
+}
 
 void BM_ModelMatricesJob(benchmark::State& state) {
   const Clip& c = ClipOf(state);
@@ -57,8 +59,10 @@ void BM_ModelMatricesJob(benchmark::State& state) {
   std::vector<mocap::JointTransform> locals(nj);
   std::vector<glm::mat4> model(static_cast<std::size_t>(c.motion.num_frames) * nj);
   for (auto _ : state) {
-    const mocap::JobStatus s = mocap::ModelMatricesJob{.skeleton = &c.skeleton, .motion = &c.motion,
-                                                       .locals = locals, .model_from_joint = model}
+    const mocap::JobStatus s = mocap::ModelMatricesJob{.skeleton = &c.skeleton,
+                                                       .motion = &c.motion,
+                                                       .locals = locals,
+                                                       .model_from_joint = model}
                                    .Run();
     benchmark::DoNotOptimize(s);
     benchmark::DoNotOptimize(model.data());
@@ -73,8 +77,8 @@ void BM_KinematicsJob(benchmark::State& state) {
   const std::size_t nj = static_cast<std::size_t>(c.skeleton.num_joints());
   std::vector<mocap::JointTransform> locals(nj);
   std::vector<glm::mat4> model(static_cast<std::size_t>(c.motion.num_frames) * nj);
-  (void)mocap::ModelMatricesJob{.skeleton = &c.skeleton, .motion = &c.motion, .locals = locals,
-                                .model_from_joint = model}
+  (void)mocap::ModelMatricesJob{
+      .skeleton = &c.skeleton, .motion = &c.motion, .locals = locals, .model_from_joint = model}
       .Run();
   std::vector<mocap::JointKinematics> out(model.size());
   for (auto _ : state) {
@@ -90,6 +94,31 @@ void BM_KinematicsJob(benchmark::State& state) {
   state.SetLabel(state.range(0) == 0 ? "chain60 30s" : "humanoid24 walk 30s");
 }
 BENCHMARK(BM_KinematicsJob)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+
+void BM_SmoothTrajectoriesJob(benchmark::State& state) {
+  const Clip& c = ClipOf(state);
+  const std::size_t nj = static_cast<std::size_t>(c.skeleton.num_joints());
+  std::vector<mocap::JointTransform> locals(nj);
+  std::vector<glm::mat4> model(static_cast<std::size_t>(c.motion.num_frames) * nj);
+  (void)mocap::ModelMatricesJob{
+      .skeleton = &c.skeleton, .motion = &c.motion, .locals = locals, .model_from_joint = model}
+      .Run();
+  std::vector<glm::mat4> out(model.size());
+  for (auto _ : state) {
+    // 10 Hz at 30 fps is a 1-tap kernel; use 4 Hz so the window has 3 taps.
+    const mocap::JobStatus s = mocap::SmoothTrajectoriesJob{.model_from_joint = model,
+                                                            .num_joints = static_cast<int>(nj),
+                                                            .frame_time_s = c.motion.frame_time_s,
+                                                            .cutoff_hz = 4.0,
+                                                            .output = out}
+                                   .Run();
+    benchmark::DoNotOptimize(s);
+    benchmark::DoNotOptimize(out.data());
+  }
+  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(out.size()));
+  state.SetLabel(state.range(0) == 0 ? "chain60 30s" : "humanoid24 walk 30s");
+}
+BENCHMARK(BM_SmoothTrajectoriesJob)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
 void BM_Resample30To120(benchmark::State& state) {
   const Clip& c = ClipOf(state);
@@ -112,8 +141,11 @@ void BM_SampleLocalsJob(benchmark::State& state) {
   for (auto _ : state) {
     t += 0.0123;
     if (t > kClipSeconds) t = 0.0;
-    const mocap::JobStatus s = mocap::SampleLocalsJob{.skeleton = &c.skeleton, .motion = &c.motion,
-                                                      .time_s = t, .scratch = scratch, .locals = locals}
+    const mocap::JobStatus s = mocap::SampleLocalsJob{.skeleton = &c.skeleton,
+                                                      .motion = &c.motion,
+                                                      .time_s = t,
+                                                      .scratch = scratch,
+                                                      .locals = locals}
                                    .Run();
     benchmark::DoNotOptimize(s);
     benchmark::DoNotOptimize(locals.data());

@@ -14,10 +14,14 @@ constexpr double kGimbalCos = 1e-7;
 
 int AxisIndex(ChannelType type) {
   switch (type) {
-    case ChannelType::kXRotation: return 0;
-    case ChannelType::kYRotation: return 1;
-    case ChannelType::kZRotation: return 2;
-    default: return -1;
+    case ChannelType::kXRotation:
+      return 0;
+    case ChannelType::kYRotation:
+      return 1;
+    case ChannelType::kZRotation:
+      return 2;
+    default:
+      return -1;
   }
 }
 
@@ -56,7 +60,8 @@ void QuatToEuler(const glm::quat& q, const ChannelType* axes, int count, float* 
   for (int i = 0; i < count && i < 3; ++i) idx[i] = AxisIndex(axes[i]);
   for (int i = 0; i < count; ++i) angles_deg[i] = 0.0f;
   if (count == 1) {
-    if (idx[0] >= 0) angles_deg[0] = static_cast<float>(TwistAngle(qd, UnitAxis(idx[0])) * kRadToDeg);
+    if (idx[0] >= 0)
+      angles_deg[0] = static_cast<float>(TwistAngle(qd, UnitAxis(idx[0])) * kRadToDeg);
     return;
   }
   if (count < 2 || idx[0] < 0 || idx[1] < 0 || idx[0] == idx[1]) return;
@@ -126,7 +131,8 @@ int JointEulerAngles(const Skeleton& skeleton, int joint, const glm::quat& local
   ChannelType axes[3];
   int n = 0;
   for (int c = 0; c < ch.count && n < 3; ++c) {
-    if (AxisIndex(ch.types[static_cast<std::size_t>(c)]) >= 0) axes[n++] = ch.types[static_cast<std::size_t>(c)];
+    if (AxisIndex(ch.types[static_cast<std::size_t>(c)]) >= 0)
+      axes[n++] = ch.types[static_cast<std::size_t>(c)];
   }
   if (n == 0) return 0;
   const glm::quat euler = glm::conjugate(skeleton.rest_rotations[j]) * local_rotation;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 #include "mocap/joint_angles.h"
 #include "mocap/sampling.h"
@@ -78,11 +79,12 @@ JobStatus ModelMatricesJob::Run() const {
     const int f = first_frame + static_cast<int>(k);
     const JobStatus pose = LocalPoseJob{skeleton, motion->frame(f), locals}.Run();
     if (!pose) return pose;
-    const JobStatus model = LocalToModelJob{.parents = skeleton->parents,
-                                            .locals = locals,
-                                            .model_from_root = model_from_root,
-                                            .model_from_joint = model_from_joint.subspan(k * num_joints, num_joints)}
-                                .Run();
+    const JobStatus model =
+        LocalToModelJob{.parents = skeleton->parents,
+                        .locals = locals,
+                        .model_from_root = model_from_root,
+                        .model_from_joint = model_from_joint.subspan(k * num_joints, num_joints)}
+            .Run();
     if (!model) return model;
   }
   return kJobOk;
@@ -158,7 +160,73 @@ JobStatus KinematicsJob::Run() const {
   return kJobOk;
 }
 
-Result<std::vector<JointKinematics>> ComputeKinematics(const Skeleton& skeleton, const Motion& motion) {
+JobStatus SmoothTrajectoriesJob::Validate() const {
+  const JobStatus base = KinematicsJob{
+      .model_from_joint = model_from_joint,
+      .num_joints = num_joints,
+      .frame_time_s = frame_time_s,
+      .first_frame = first_frame,
+      .output = {}}.Validate();
+  if (!base) return base;
+  if (output.size() % static_cast<std::size_t>(num_joints) != 0) {
+    return {JobStatus::kSizeMismatch, "output must hold whole frames"};
+  }
+  if (static_cast<std::size_t>(first_frame) * static_cast<std::size_t>(num_joints) + output.size() >
+      model_from_joint.size()) {
+    return {JobStatus::kOutOfRange, "output frames outside the motion"};
+  }
+  if (!(cutoff_hz > 0.0) || !std::isfinite(cutoff_hz)) {
+    return {JobStatus::kOutOfRange, "cutoff_hz must be positive and finite"};
+  }
+  return kJobOk;
+}
+
+JobStatus SmoothTrajectoriesJob::Run() const {
+  const JobStatus status = Validate();
+  if (!status) return status;
+  const std::size_t nj = static_cast<std::size_t>(num_joints);
+  const int num_frames = static_cast<int>(model_from_joint.size() / nj);
+  const int out_frames = static_cast<int>(output.size() / nj);
+  const double sigma_frames =
+      std::sqrt(std::log(2.0)) / (2.0 * std::numbers::pi * cutoff_hz) / frame_time_s;
+  // Radius capped so a tiny cutoff cannot make the window unbounded.
+  const int radius = static_cast<int>(std::min(std::floor(3.0 * sigma_frames), 1e4));
+  for (int k = 0; k < out_frames; ++k) {
+    const int f = first_frame + k;
+    const int lo = std::max(0, f - radius);
+    const int hi = std::min(num_frames - 1, f + radius);
+    for (std::size_t j = 0; j < nj; ++j) {
+      const glm::mat4& centre = model_from_joint[static_cast<std::size_t>(f) * nj + j];
+      glm::mat4& out = output[static_cast<std::size_t>(k) * nj + j];
+      if (radius == 0) {
+        out = centre;
+        continue;
+      }
+      const Sample c = SampleOf(centre);
+      glm::dvec3 p(0.0);
+      glm::dquat q(0.0, 0.0, 0.0, 0.0);
+      double total = 0.0;
+      for (int i = lo; i <= hi; ++i) {
+        const double u = (i - f) / sigma_frames;
+        const double w = std::exp(-0.5 * u * u);
+        const Sample s = SampleOf(model_from_joint[static_cast<std::size_t>(i) * nj + j]);
+        p += w * s.p;
+        q += (glm::dot(s.q, c.q) < 0.0 ? -w : w) * s.q;
+        total += w;
+      }
+      p /= total;
+      const glm::mat3 r = glm::mat3_cast(glm::quat(glm::normalize(q)));
+      for (int col = 0; col < 3; ++col) {
+        out[col] = glm::vec4(r[col] * glm::length(glm::vec3(centre[col])), 0.0f);
+      }
+      out[3] = glm::vec4(glm::vec3(p), 1.0f);
+    }
+  }
+  return kJobOk;
+}
+
+Result<std::vector<JointKinematics>> ComputeKinematics(const Skeleton& skeleton,
+                                                       const Motion& motion) {
   const FileLoc loc{skeleton.info.source_file, 0, 0, {}};
   const std::size_t nj = static_cast<std::size_t>(skeleton.num_joints());
   if (nj == 0 || motion.num_frames < 1 || motion.num_channels != skeleton.num_channels ||
@@ -173,9 +241,10 @@ Result<std::vector<JointKinematics>> ComputeKinematics(const Skeleton& skeleton,
   const std::size_t frames = static_cast<std::size_t>(motion.num_frames);
   std::vector<JointTransform> locals(nj);
   std::vector<glm::mat4> model(frames * nj);
-  const JobStatus m = ModelMatricesJob{.skeleton = &skeleton, .motion = &motion, .locals = locals,
-                                       .model_from_joint = model}
-                          .Run();
+  const JobStatus m =
+      ModelMatricesJob{
+          .skeleton = &skeleton, .motion = &motion, .locals = locals, .model_from_joint = model}
+          .Run();
   if (!m) return MakeError(ErrorCode::kInternal, loc, m.what);
   std::vector<JointKinematics> out(frames * nj);
   const JobStatus k = KinematicsJob{.model_from_joint = model,
@@ -187,9 +256,11 @@ Result<std::vector<JointKinematics>> ComputeKinematics(const Skeleton& skeleton,
   return out;
 }
 
-JobStatus SampleJointKinematics(std::span<const JointKinematics> kinematics, int num_joints, int joint,
-                                double frame_time_s, double time_s, JointKinematics* out) {
-  if (out == nullptr || kinematics.empty()) return {JobStatus::kMissingInput, "no buffer or no output"};
+JobStatus SampleJointKinematics(std::span<const JointKinematics> kinematics, int num_joints,
+                                int joint, double frame_time_s, double time_s,
+                                JointKinematics* out) {
+  if (out == nullptr || kinematics.empty())
+    return {JobStatus::kMissingInput, "no buffer or no output"};
   if (num_joints <= 0 || joint < 0 || joint >= num_joints) {
     return {JobStatus::kOutOfRange, "joint outside [0, num_joints)"};
   }

@@ -25,8 +25,9 @@
 // differences, so it is independent of the channel order and has no gimbal
 // artefacts. Joint-frame values are R^T times the model-space values, with R the
 // joint's model rotation at that frame. Each joint's rotation must change by
-// less than pi between neighbouring frames (any real capture does).
-// Differentiating captured data twice amplifies noise; no filtering is done here.
+// less than pi over two frame steps (any real capture does).
+// Differentiating captured data twice amplifies noise: SmoothTrajectoriesJob
+// below can low-pass the matrices first (not done unless the caller runs it).
 
 #include <span>
 #include <vector>
@@ -57,13 +58,13 @@ struct JointKinematics {
 
 // Model matrices of a range of frames: LocalPoseJob + LocalToModelJob per frame.
 struct ModelMatricesJob {
-  const Skeleton* skeleton = nullptr;         // required
-  const Motion* motion = nullptr;             // required, num_channels == skeleton->num_channels
-  int first_frame = 0;                        // first frame evaluated
-  glm::mat4 model_from_root{1.0f};            // applied above every root joint
-  std::span<JointTransform> locals;           // #J caller-owned workspace
-  std::span<glm::mat4> model_from_joint;      // #F' x #J output, frame-major: frame
-                                              // first_frame + k at [k * #J, (k+1) * #J)
+  const Skeleton* skeleton = nullptr;     // required
+  const Motion* motion = nullptr;         // required, num_channels == skeleton->num_channels
+  int first_frame = 0;                    // first frame evaluated
+  glm::mat4 model_from_root{1.0f};        // applied above every root joint
+  std::span<JointTransform> locals;       // #J caller-owned workspace
+  std::span<glm::mat4> model_from_joint;  // #F' x #J output, frame-major: frame
+                                          // first_frame + k at [k * #J, (k+1) * #J)
 
   // kMissingInput: null skeleton or motion, or a skeleton without joints;
   // kSizeMismatch: locals, channel counts, or an output that is not a whole
@@ -91,10 +92,36 @@ struct KinematicsJob {
   [[nodiscard]] JobStatus Run() const;
 };
 
+// Optional zero-phase low-pass of the joint trajectories before KinematicsJob
+// (ALGORITHMS.md 6: differentiating captured data twice amplifies noise).
+// A symmetric (hence zero-phase) Gaussian FIR kernel over frames with standard
+// deviation sigma = sqrt(ln 2) / (2 pi cutoff_hz) seconds, so the gain
+// exp(-(2 pi f sigma)^2 / 2) is 1/sqrt(2) at the cutoff (10 Hz: 0.986 at 2 Hz,
+// 0.004 at 40 Hz). Truncated at +-3 sigma; at the clip ends the window is cut and
+// its weights renormalized. Positions are averaged; rotations are averaged as
+// quaternions sign-aligned with the centre frame, then normalized (close to the
+// rotation mean for the small spread inside a window); the scale of the centre
+// frame is kept. Smoothing leaves the second derivative of a quadratic
+// trajectory unchanged (it adds sigma^2 x'' / 2 to positions). With
+// sigma < h / 3 the kernel is a single tap and the matrices are copied.
+struct SmoothTrajectoriesJob {
+  std::span<const glm::mat4> model_from_joint;  // #F x #J, ALL frames, frame-major
+  int num_joints = 0;                           // #J >= 1
+  double frame_time_s = 0.0;                    // h > 0
+  double cutoff_hz = 10.0;                      // > 0
+  int first_frame = 0;                          // frame of output[0 .. #J)
+  std::span<glm::mat4> output;                  // #F' x #J smoothed matrices; must not alias input
+
+  // Same checks as KinematicsJob, plus kOutOfRange for cutoff_hz <= 0.
+  [[nodiscard]] JobStatus Validate() const;
+  [[nodiscard]] JobStatus Run() const;  // no allocation; splitting ranges gives the same bits
+};
+
 // Convenience: model matrices and kinematics of all frames (#F x #J, frame-major),
 // allocated once. Errors (kInvalidArgument) for a motion that does not match the
 // skeleton or has no frames or a non-positive frame time.
-Result<std::vector<JointKinematics>> ComputeKinematics(const Skeleton& skeleton, const Motion& motion);
+Result<std::vector<JointKinematics>> ComputeKinematics(const Skeleton& skeleton,
+                                                       const Motion& motion);
 
 // Kinematics of ONE joint at any time t (seconds), e.g. an RK4 stage time, from
 // the two frames around t in a per-frame buffer (as KinematicsJob fills it, for

@@ -74,11 +74,13 @@ JobStatus SampleLocalsJob::Run() const {
   if (!status) return status;
   const FrameBlend blend = FindFrameBlend(motion->num_frames, motion->frame_time_s, time_s);
   const JobStatus first =
-      LocalPoseJob{.skeleton = skeleton, .frame_values = motion->frame(blend.frame0), .locals = locals}
+      LocalPoseJob{
+          .skeleton = skeleton, .frame_values = motion->frame(blend.frame0), .locals = locals}
           .Run();
   if (!first || blend.frame1 == blend.frame0) return first;
   const JobStatus second =
-      LocalPoseJob{.skeleton = skeleton, .frame_values = motion->frame(blend.frame1), .locals = scratch}
+      LocalPoseJob{
+          .skeleton = skeleton, .frame_values = motion->frame(blend.frame1), .locals = scratch}
           .Run();
   if (!second) return second;
   const float w = blend.weight;
@@ -112,7 +114,8 @@ void WriteJointChannels(const Skeleton& s, std::size_t j, const JointTransform& 
       case ChannelType::kZPosition: {
         const int axis = static_cast<int>(type);  // kX/Y/ZPosition are 0, 1, 2
         float value = local.translation[axis];
-        if (s.position_mode == PositionChannelMode::kAddToOffset) value -= s.rest_translations[j][axis];
+        if (s.position_mode == PositionChannelMode::kAddToOffset)
+          value -= s.rest_translations[j][axis];
         row[index] = value;
         break;
       }
@@ -125,13 +128,27 @@ void WriteJointChannels(const Skeleton& s, std::size_t j, const JointTransform& 
           ++num_euler;
         }
         break;
-      case ChannelType::kQuatX: quat_index[0] = static_cast<int>(index); break;
-      case ChannelType::kQuatY: quat_index[1] = static_cast<int>(index); break;
-      case ChannelType::kQuatZ: quat_index[2] = static_cast<int>(index); break;
-      case ChannelType::kQuatW: quat_index[3] = static_cast<int>(index); break;
-      case ChannelType::kXScale: row[index] = local.scale.x; break;
-      case ChannelType::kYScale: row[index] = local.scale.y; break;
-      case ChannelType::kZScale: row[index] = local.scale.z; break;
+      case ChannelType::kQuatX:
+        quat_index[0] = static_cast<int>(index);
+        break;
+      case ChannelType::kQuatY:
+        quat_index[1] = static_cast<int>(index);
+        break;
+      case ChannelType::kQuatZ:
+        quat_index[2] = static_cast<int>(index);
+        break;
+      case ChannelType::kQuatW:
+        quat_index[3] = static_cast<int>(index);
+        break;
+      case ChannelType::kXScale:
+        row[index] = local.scale.x;
+        break;
+      case ChannelType::kYScale:
+        row[index] = local.scale.y;
+        break;
+      case ChannelType::kZScale:
+        row[index] = local.scale.z;
+        break;
     }
   }
   if (num_euler > 0) {
@@ -161,8 +178,9 @@ void WriteJointChannels(const Skeleton& s, std::size_t j, const JointTransform& 
 Result<Motion> Resample(const Skeleton& skeleton, const Motion& motion, double new_frame_time_s) {
   const FileLoc loc{skeleton.info.source_file, 0, 0, {}};
   if (!std::isfinite(new_frame_time_s) || new_frame_time_s <= 0.0) {
-    return MakeError(ErrorCode::kInvalidArgument, loc,
-                     "expected a positive finite frame time, found " + std::to_string(new_frame_time_s));
+    return MakeError(
+        ErrorCode::kInvalidArgument, loc,
+        "expected a positive finite frame time, found " + std::to_string(new_frame_time_s));
   }
   if (motion.num_channels != skeleton.num_channels || motion.num_frames < 1 ||
       motion.values.size() != static_cast<std::size_t>(motion.num_frames) *
@@ -178,16 +196,16 @@ Result<Motion> Resample(const Skeleton& skeleton, const Motion& motion, double n
   if (!check) return check.error();
   const double steps = std::floor(motion.duration_s() / new_frame_time_s + 1e-9);
   if (!(steps + 1.0 <= static_cast<double>(kMaxResampledFrames))) {
-    return MakeError(ErrorCode::kLimitExceeded, loc,
-                     "resampling would produce more than " + std::to_string(kMaxResampledFrames) +
-                         " frames");
+    return MakeError(
+        ErrorCode::kLimitExceeded, loc,
+        "resampling would produce more than " + std::to_string(kMaxResampledFrames) + " frames");
   }
   Motion out;
   out.num_frames = static_cast<int>(steps) + 1;
   out.num_channels = motion.num_channels;
   out.frame_time_s = new_frame_time_s;
-  out.values.assign(static_cast<std::size_t>(out.num_frames) * static_cast<std::size_t>(out.num_channels),
-                    0.0f);
+  out.values.assign(
+      static_cast<std::size_t>(out.num_frames) * static_cast<std::size_t>(out.num_channels), 0.0f);
   const std::size_t num_joints = static_cast<std::size_t>(skeleton.num_joints());
   std::vector<JointTransform> locals(num_joints);
   std::vector<JointTransform> scratch(num_joints);

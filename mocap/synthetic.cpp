@@ -29,7 +29,8 @@ class Builder {
     ch.first = static_cast<std::uint32_t>(s_.num_channels);
     int c = 0;
     if (with_position) {
-      for (ChannelType t : {ChannelType::kXPosition, ChannelType::kYPosition, ChannelType::kZPosition}) {
+      for (ChannelType t :
+           {ChannelType::kXPosition, ChannelType::kYPosition, ChannelType::kZPosition}) {
         ch.types[static_cast<std::size_t>(c++)] = t;
       }
     }
@@ -58,23 +59,27 @@ class Builder {
 
 // Joint rotation from ZXY Euler angles in degrees (R = Rz * Rx * Ry).
 glm::quat Zxy(double z_deg, double x_deg, double y_deg) {
-  const float angles[3] = {static_cast<float>(z_deg), static_cast<float>(x_deg), static_cast<float>(y_deg)};
+  const float angles[3] = {static_cast<float>(z_deg), static_cast<float>(x_deg),
+                           static_cast<float>(y_deg)};
   return EulerToQuat(kZxy.data(), angles, 3);
 }
 
 // The humanoid joints the generators drive, in a fixed order.
+// clang-format off
 enum H : int {
   kHips, kSpine, kSpine1, kSpine2, kNeck, kHead,
   kLShoulder, kLArm, kLForeArm, kLHand, kLIndex,
   kRShoulder, kRArm, kRForeArm, kRHand, kRIndex,
   kLUpLeg, kLLeg, kLFoot, kLToe, kRUpLeg, kRLeg, kRFoot, kRToe, kNumH
 };
+// clang-format on
 constexpr std::array<const char*, kNumH> kHumanoidNames = {
-    "Hips", "Spine", "Spine1", "Spine2", "Neck", "Head",
-    "LeftShoulder", "LeftArm", "LeftForeArm", "LeftHand", "LeftHandIndex1",
-    "RightShoulder", "RightArm", "RightForeArm", "RightHand", "RightHandIndex1",
-    "LeftUpLeg", "LeftLeg", "LeftFoot", "LeftToeBase", "RightUpLeg", "RightLeg", "RightFoot",
-    "RightToeBase"};
+    "Hips",        "Spine",        "Spine1",         "Spine2",
+    "Neck",        "Head",         "LeftShoulder",   "LeftArm",
+    "LeftForeArm", "LeftHand",     "LeftHandIndex1", "RightShoulder",
+    "RightArm",    "RightForeArm", "RightHand",      "RightHandIndex1",
+    "LeftUpLeg",   "LeftLeg",      "LeftFoot",       "LeftToeBase",
+    "RightUpLeg",  "RightLeg",     "RightFoot",      "RightToeBase"};
 
 // One intended pose: root position and per-humanoid-joint rotation relative to rest.
 struct HumanoidPose {
@@ -92,13 +97,15 @@ class MotionWriter {
         num_frames > (1 << 20)) {
       return MakeError(ErrorCode::kInvalidArgument, loc,
                        "expected a positive frame time and duration, found frame time " +
-                           std::to_string(frame_time_s) + " s for " + std::to_string(num_frames) + " frames");
+                           std::to_string(frame_time_s) + " s for " + std::to_string(num_frames) +
+                           " frames");
     }
     const Status check = s.Check();
     if (!check) return check.error();
     MotionWriter w(s);
     for (int i = 0; i < kNumH; ++i) {
-      w.index_[static_cast<std::size_t>(i)] = s.FindJoint(kHumanoidNames[static_cast<std::size_t>(i)]);
+      w.index_[static_cast<std::size_t>(i)] =
+          s.FindJoint(kHumanoidNames[static_cast<std::size_t>(i)]);
       if (w.index_[static_cast<std::size_t>(i)] < 0) {
         return MakeError(ErrorCode::kNotFound, loc,
                          std::string("expected a humanoid joint named '") +
@@ -108,8 +115,8 @@ class MotionWriter {
     w.motion_.frame_time_s = frame_time_s;
     w.motion_.num_channels = s.num_channels;
     w.motion_.num_frames = num_frames;
-    w.motion_.values.assign(static_cast<std::size_t>(num_frames) * static_cast<std::size_t>(s.num_channels),
-                            0.0f);
+    w.motion_.values.assign(
+        static_cast<std::size_t>(num_frames) * static_cast<std::size_t>(s.num_channels), 0.0f);
     return w;
   }
 
@@ -119,14 +126,17 @@ class MotionWriter {
   void Write(int f, const HumanoidPose& pose) {
     std::vector<glm::quat> delta(skeleton_->parents.size(), glm::quat(1.0f, 0.0f, 0.0f, 0.0f));
     for (int i = 0; i < kNumH; ++i) {
-      delta[static_cast<std::size_t>(index_[static_cast<std::size_t>(i)])] = pose.rotations[static_cast<std::size_t>(i)];
+      delta[static_cast<std::size_t>(index_[static_cast<std::size_t>(i)])] =
+          pose.rotations[static_cast<std::size_t>(i)];
     }
     const std::size_t root = static_cast<std::size_t>(index_[kHips]);
     std::span<float> row = motion_.frame(f);
-    const std::span<const float> previous = f > 0 ? std::span<const float>(motion_.frame(f - 1)) : row;
+    const std::span<const float> previous =
+        f > 0 ? std::span<const float>(motion_.frame(f - 1)) : row;
     for (std::size_t j = 0; j < delta.size(); ++j) {
       const JointChannels& ch = skeleton_->channels[j];
-      const glm::vec3 translation = j == root ? pose.root_position : skeleton_->rest_translations[j];
+      const glm::vec3 translation =
+          j == root ? pose.root_position : skeleton_->rest_translations[j];
       ChannelType axes[3];
       std::uint32_t where[3];
       int n = 0;
@@ -135,10 +145,10 @@ class MotionWriter {
         const std::uint32_t k = ch.first + static_cast<std::uint32_t>(c);
         const int type = static_cast<int>(t);
         if (type <= 2) {  // kX/Y/ZPosition
-          row[k] = translation[type] -
-                   (skeleton_->position_mode == PositionChannelMode::kAddToOffset
-                        ? skeleton_->rest_translations[j][type]
-                        : 0.0f);
+          row[k] =
+              translation[type] - (skeleton_->position_mode == PositionChannelMode::kAddToOffset
+                                       ? skeleton_->rest_translations[j][type]
+                                       : 0.0f);
         } else if (type <= 5 && n < 3) {
           axes[n] = t;
           where[n++] = k;
@@ -171,22 +181,9 @@ class MotionWriter {
 };
 
 int FramesFor(double duration_s, double frame_time_s) {
-  if (!(frame_time_s > 0.0) || !(duration_s > 0.0) || !std::isfinite(duration_s / frame_time_s)) return 0;
+  if (!(frame_time_s > 0.0) || !(duration_s > 0.0) || !std::isfinite(duration_s / frame_time_s))
+    return 0;
   return static_cast<int>(std::min(std::round(duration_s / frame_time_s), 1e7)) + 1;
-}
-
-// Rise of the ankle (cm) above the straight-leg position for thigh and shin
-// pitches (degrees, the joints' X rotations).
-double AnkleRise(double thigh_x_deg, double knee_x_deg) {
-  const double a1 = glm::radians(thigh_x_deg);
-  const double a2 = glm::radians(thigh_x_deg + knee_x_deg);
-  return kThighCm * (1.0 - std::cos(a1)) + kShinCm * (1.0 - std::cos(a2));
-}
-
-// Forward reach (cm, +Z) of the ankle from the hip joint.
-double AnkleReach(double thigh_x_deg, double knee_x_deg) {
-  return -kThighCm * std::sin(glm::radians(thigh_x_deg)) -
-         kShinCm * std::sin(glm::radians(thigh_x_deg + knee_x_deg));
 }
 
 // Sets thigh, knee and a foot kept parallel to the ground (their X rotations sum to 0).
@@ -194,6 +191,25 @@ void SetLeg(HumanoidPose* p, int up_leg, double thigh_x_deg, double knee_x_deg) 
   p->rotations[static_cast<std::size_t>(up_leg)] = Zxy(0, thigh_x_deg, 0);
   p->rotations[static_cast<std::size_t>(up_leg + 1)] = Zxy(0, knee_x_deg, 0);
   p->rotations[static_cast<std::size_t>(up_leg + 2)] = Zxy(0, -(thigh_x_deg + knee_x_deg), 0);
+}
+
+// Two-bone IK for a leg under unrotated hips: puts the ankle at `ankle` (cm,
+// relative to the hip joint, hips frame) with the knee pointing forward and the
+// foot flat and facing +Z. The leg first tilts about Z by tau so the ankle's
+// sideways offset lies in its plane, then bends in that plane: the thigh flexes
+// by gamma + a and the knee by 2a (equal segments), gamma the forward angle of
+// the hip->ankle line, a = acos(d / 2L). Targets beyond reach are clamped.
+void SolveLeg(HumanoidPose* p, int up_leg, const glm::dvec3& ankle) {
+  const double r = std::hypot(ankle.x, ankle.y);  // length of the tilted plane's down axis
+  const double tau = std::atan2(ankle.x, -ankle.y);
+  const double d = std::min(std::hypot(r, ankle.z), 0.9995 * (kThighCm + kShinCm));
+  const double a = std::acos(d / (kThighCm + kShinCm));
+  const double gamma = std::atan2(ankle.z, r);
+  const glm::quat thigh = Zxy(glm::degrees(tau), -glm::degrees(gamma + a), 0);
+  const glm::quat knee = Zxy(0, glm::degrees(2 * a), 0);
+  p->rotations[static_cast<std::size_t>(up_leg)] = thigh;
+  p->rotations[static_cast<std::size_t>(up_leg + 1)] = knee;
+  p->rotations[static_cast<std::size_t>(up_leg + 2)] = glm::conjugate(thigh * knee);
 }
 
 }  // namespace
@@ -230,48 +246,78 @@ Skeleton MakeHumanoidSkeleton() {
 }
 
 Result<Motion> MakeWalkMotion(const Skeleton& humanoid, const WalkOptions& o) {
+  if (!(o.step_length_cm > 0.0 && o.step_length_cm <= 60.0) ||
+      !(o.foot_lift_cm >= 0.0 && o.foot_lift_cm <= 30.0)) {
+    return MakeError(ErrorCode::kInvalidArgument, {humanoid.info.source_file, 0, 0, {}},
+                     "expected a step length in (0, 60] cm and a foot lift in [0, 30] cm");
+  }
   const int frames = o.num_cycles >= 1 && o.cycle_s > 0.0
                          ? FramesFor(o.num_cycles * o.cycle_s, o.frame_time_s) - 1
                          : 0;
   auto writer = MotionWriter::Create(humanoid, o.frame_time_s, frames);
   if (!writer.ok()) return std::move(writer).error();
-  const auto flex = [&](double psi) { return 10.0 + o.hip_swing_deg * std::sin(psi); };  // forward
-  const auto knee = [&](double psi) {
-    const double c = std::max(0.0, std::cos(psi + 0.4));  // bent in swing (thigh moving forward)
-    return 5.0 + (o.knee_peak_deg - 5.0) * c * c;
+  constexpr double kDuty = 0.6;        // stance fraction of the cycle
+  constexpr double kHipHeight = 80.0;  // mean hip joint height above the ankle, cm
+  constexpr double kBob = 2.0;         // cm
+  const double step = o.step_length_cm;
+  const double speed = step / (kDuty * o.cycle_s);  // cm/s
+  const double swing_s = (1.0 - kDuty) * o.cycle_s;
+  // Hip joint height above the ankles at cycle phase u of the left leg: highest
+  // at each leg's mid-stance (u = 0.3 and 0.8).
+  const auto hip_height = [&](double u) {
+    return kHipHeight + kBob * std::cos(4 * kPi * (u - 0.3));
   };
-  // Hip speed that matches the stance foot's backward travel between heel strike
-  // (psi = pi/2) and toe off (psi = 3 pi/2), half a cycle apart.
-  const double speed = (AnkleReach(-flex(kPi / 2), knee(kPi / 2)) -
-                        AnkleReach(-flex(3 * kPi / 2), knee(3 * kPi / 2))) /
-                       (0.5 * o.cycle_s);
+  // Ankle path relative to the hip joint (z forward, lift up) at the leg's own phase u.
+  const auto ankle_path = [&](double u, double* z, double* lift) {
+    if (u < kDuty) {
+      *z = 0.5 * step - speed * u * o.cycle_s;  // planted: moves back at the hips' speed
+      *lift = 0.0;
+      return;
+    }
+    const double s = (u - kDuty) / (1.0 - kDuty);
+    const double s2 = s * s;
+    const double s3 = s2 * s;
+    const double slope = -speed * swing_s;  // ground speed 0 at both ends
+    *z = (2 * s3 - 3 * s2 + 1) * (-0.5 * step) + (s3 - 2 * s2 + s) * slope +
+         (-2 * s3 + 3 * s2) * (0.5 * step) + (s3 - s2) * slope;
+    *lift = o.foot_lift_cm * std::sin(kPi * s) * std::sin(kPi * s);
+  };
+  const double hip_offset_y = -humanoid
+                                   .rest_translations[static_cast<std::size_t>(
+                                       std::max(humanoid.FindJoint("LeftUpLeg"), 0))]
+                                   .y;  // hips above the hip joints
+  const double ankle_rest_y = kHipsRestY - hip_offset_y - (kThighCm + kShinCm);
   for (int f = 0; f < writer->num_frames(); ++f) {
     const double t = writer->time(f);
-    const double phi = 2.0 * kPi * t / o.cycle_s;
-    const double sp = std::sin(phi);
+    const double u_left = t / o.cycle_s - std::floor(t / o.cycle_s);
+    const double u_right = u_left + 0.5 - std::floor(u_left + 0.5);
+    const double height = hip_height(u_left);
+    const double sway = 2.0 * std::cos(2 * kPi * (u_left - 0.3));  // over the stance foot
+    const double c = std::cos(2 * kPi * u_left);                   // +1 when the left foot lands
     HumanoidPose p;
-    const double left_rise = AnkleRise(-flex(phi), knee(phi));
-    const double right_rise = AnkleRise(-flex(phi + kPi), knee(phi + kPi));
-    p.root_position = glm::vec3(static_cast<float>(-2.0 * std::cos(phi)),
-                                static_cast<float>(kHipsRestY - std::min(left_rise, right_rise)),
+    p.root_position = glm::vec3(static_cast<float>(sway),
+                                static_cast<float>(ankle_rest_y + height + hip_offset_y),
                                 static_cast<float>(speed * t));
-    SetLeg(&p, kLUpLeg, -flex(phi), knee(phi));
-    SetLeg(&p, kRUpLeg, -flex(phi + kPi), knee(phi + kPi));
-    // Pelvis yaws with the forward leg; the spine and neck undo it so the head faces +Z.
-    p.rotations[kHips] = Zxy(0, 0, -6.0 * sp);
-    p.rotations[kSpine] = Zxy(0, 3, 3.0 * sp);
-    p.rotations[kSpine1] = Zxy(0, 1, 2.5 * sp);
-    p.rotations[kSpine2] = Zxy(0, 0, 2.0 * sp);
-    p.rotations[kNeck] = Zxy(0, 0, -1.0 * sp);
-    p.rotations[kHead] = Zxy(0, -4, -0.5 * sp);
-    // Arms hang 75 degrees down and swing against the same-side leg; the elbow
-    // bends more as the arm comes forward.
+    double z = 0.0;
+    double lift = 0.0;
+    ankle_path(u_left, &z, &lift);
+    SolveLeg(&p, kLUpLeg, {-sway, -(height - lift), z});
+    ankle_path(u_right, &z, &lift);
+    SolveLeg(&p, kRUpLeg, {-sway, -(height - lift), z});
+    // The chest turns with the forward arm (right arm forward when c = 1); neck
+    // and head undo it so the gaze stays on +Z.
+    p.rotations[kSpine] = Zxy(0, 3, 1.5 * c);
+    p.rotations[kSpine1] = Zxy(0, 1, 1.5 * c);
+    p.rotations[kSpine2] = Zxy(0, 0, 1.0 * c);
+    p.rotations[kNeck] = Zxy(0, 0, -2.0 * c);
+    p.rotations[kHead] = Zxy(0, -4, -2.0 * c);
+    // Arms hang 75 degrees down and swing against the same-side leg.
     const double swing = o.arm_swing_deg;
-    const double left_fwd = -swing * sp;
-    const double right_fwd = swing * sp;
+    const double left_fwd = -swing * c;
+    const double right_fwd = swing * c;
     const auto elbow = [&](double fwd) {
-      const double u = swing > 0.0 ? 0.5 + 0.5 * fwd / swing : 0.5;
-      return 15.0 + (o.elbow_peak_deg - 15.0) * u;
+      const double w = swing > 0.0 ? 0.5 + 0.5 * fwd / swing : 0.5;
+      return 15.0 + (o.elbow_peak_deg - 15.0) * w;
     };
     p.rotations[kLArm] = Zxy(-75, 0, -left_fwd);
     p.rotations[kRArm] = Zxy(75, 0, right_fwd);
@@ -292,7 +338,7 @@ Result<Motion> MakeBendRamp(const Skeleton& humanoid, float end_deg, double dura
     HumanoidPose p;
     p.rotations[kLForeArm] = Zxy(0, 0, -a);  // forearms bend forward (+Z)
     p.rotations[kRForeArm] = Zxy(0, 0, a);
-    SetLeg(&p, kLUpLeg, -0.4 * a, a);        // knee forward, shin back: clear of the body
+    SetLeg(&p, kLUpLeg, -0.4 * a, a);  // knee forward, shin back: clear of the body
     writer->Write(f, p);
   }
   return writer->Take();
@@ -334,8 +380,9 @@ Result<Motion> MakeJumpMotion(const Skeleton& humanoid, const JumpOptions& o) {
   const double leg = kThighCm + kShinCm;
   if (!(o.height_cm > 0.0) || !(o.crouch_cm > 0.0 && o.crouch_cm < leg) ||
       !(o.landing_crouch_cm > 0.0 && o.landing_crouch_cm < leg)) {
-    return MakeError(ErrorCode::kInvalidArgument, {humanoid.info.source_file, 0, 0, {}},
-                     "expected a positive jump height and crouch depths below the leg length (84 cm)");
+    return MakeError(
+        ErrorCode::kInvalidArgument, {humanoid.info.source_file, 0, 0, {}},
+        "expected a positive jump height and crouch depths below the leg length (84 cm)");
   }
   const JumpTimeline tl = MakeJumpTimeline(o);
   auto writer = MotionWriter::Create(humanoid, o.frame_time_s, FramesFor(tl.end_s, o.frame_time_s));
@@ -392,8 +439,9 @@ Result<Skeleton> MakeChainSkeleton(int num_joints, float segment_length_cm) {
       !std::isfinite(segment_length_cm)) {
     return MakeError(ErrorCode::kInvalidArgument, {"synthetic:chain", 0, 0, {}},
                      "expected 1.." + std::to_string(kMaxJoints) +
-                         " joints and a positive segment length, found " + std::to_string(num_joints) +
-                         " joints of " + std::to_string(segment_length_cm) + " cm");
+                         " joints and a positive segment length, found " +
+                         std::to_string(num_joints) + " joints of " +
+                         std::to_string(segment_length_cm) + " cm");
   }
   Builder b;
   int parent = b.Add("Chain0", kNoParent, {0, 50, 0}, true);
@@ -417,7 +465,8 @@ Skeleton MakeQuadrupedSkeleton() {
     for (float side : {1.0f, -1.0f}) {
       const std::string s = std::string(side > 0 ? "Left" : "Right") + end;
       // Front legs hang from the chest (y 62), hind legs from the hips (y 60).
-      const int up = b.Add(s + "UpLeg", front ? chest : hips, {10 * side, front ? -6.0f : -4.0f, 0});
+      const int up =
+          b.Add(s + "UpLeg", front ? chest : hips, {10 * side, front ? -6.0f : -4.0f, 0});
       const int leg = b.Add(s + "Leg", up, {0, -24, 0});
       const int foot = b.Add(s + "Foot", leg, {0, -24, 0});
       const int toe = b.Add(s + "ToeBase", foot, {0, -7, 5});

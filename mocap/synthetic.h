@@ -31,18 +31,26 @@ inline constexpr double kGravityCmPerS2 = 981.0;
 // The humanoid described above, in its T-pose rest.
 Skeleton MakeHumanoidSkeleton();
 
-// A looping walk cycle. Hips move forward along +Z at the speed that keeps the
-// stance foot from sliding, bob so the lower ankle stays at its rest height, and
-// yaw against a spine counter-twist; legs and arms swing in opposite phase;
-// arms hang 75 degrees below horizontal; feet stay parallel to the ground.
-// Frame k+cycle_frames has the same joint rotations as frame k (the hips have
-// moved one stride). Duration num_cycles * cycle_s, the end frame excluded.
+// A looping walk cycle at constant speed along +Z. Each ankle follows a
+// prescribed path relative to its hip joint and the legs are solved by two-bone
+// IK, so a stance foot stays exactly planted (no sliding) and flat:
+// - stance (duty 60% of the cycle, so both feet are down 20% of it): the ankle
+//   moves back by step_length_cm at the walking speed step_length_cm / (0.6 cycle_s);
+// - swing: a C1 cubic forward (zero ground speed at lift-off and touch-down)
+//   with a sin^2 lift of foot_lift_cm; the knee peaks near 60 degrees.
+// Hips bob 2 cm (highest at mid-stance, vertical acceleration ~0.3 g) and sway
+// 2 cm over the stance foot (legs tilt to keep the feet planted); the chest
+// counter-twists with the arm swing (spine twist; neck and head undo it);
+// arms hang 75 degrees below horizontal and swing against the same-side leg,
+// the elbow bending more as the arm comes forward. Frame k + cycle frames has
+// the same joint rotations as frame k (the hips have moved one stride).
+// Duration num_cycles * cycle_s, the end frame excluded.
 struct WalkOptions {
   double frame_time_s = 1.0 / 30.0;
   int num_cycles = 3;            // >= 1
   double cycle_s = 1.0;          // one left and one right step
-  float hip_swing_deg = 20.0f;   // thigh flexion amplitude about a 10-degree bias
-  float knee_peak_deg = 65.0f;   // knee flexion at mid-swing (<= 120)
+  double step_length_cm = 56.0;  // ankle travel during stance, in (0, 60]
+  double foot_lift_cm = 10.0;    // ankle lift at mid-swing, in [0, 30]
   float arm_swing_deg = 15.0f;   // upper-arm swing amplitude
   float elbow_peak_deg = 45.0f;  // elbow flexion with the arm fully forward (<= 120)
 };

@@ -17,8 +17,8 @@ constexpr ChannelType kX = ChannelType::kXRotation;
 constexpr ChannelType kY = ChannelType::kYRotation;
 constexpr ChannelType kZ = ChannelType::kZRotation;
 
-const std::array<std::array<ChannelType, 3>, 6> kOrders = {{
-    {kX, kY, kZ}, {kX, kZ, kY}, {kY, kX, kZ}, {kY, kZ, kX}, {kZ, kX, kY}, {kZ, kY, kX}}};
+const std::array<std::array<ChannelType, 3>, 6> kOrders = {
+    {{kX, kY, kZ}, {kX, kZ, kY}, {kY, kX, kZ}, {kY, kZ, kX}, {kZ, kX, kY}, {kZ, kY, kX}}};
 
 // Angle between two rotations (radians), sign of the quaternion ignored.
 float RotationDistance(const glm::quat& a, const glm::quat& b) {
@@ -27,15 +27,15 @@ float RotationDistance(const glm::quat& a, const glm::quat& b) {
 }
 
 TEST(QuatToEuler, RoundTripAllOrders) {
-  const float samples[][3] = {{10, 20, 30},   {-170, 80, 45},  {179, -89, -179},
-                              {0, 0, 0},      {-45, -30, 120}, {90, 45, -90},
-                              {33, 60, 150}};
+  const float samples[][3] = {{10, 20, 30},    {-170, 80, 45}, {179, -89, -179}, {0, 0, 0},
+                              {-45, -30, 120}, {90, 45, -90},  {33, 60, 150}};
   for (const auto& order : kOrders) {
     for (const auto& angles : samples) {
       const glm::quat q = mocap::EulerToQuat(order.data(), angles, 3);
       float out[3];
       mocap::QuatToEuler(q, order.data(), 3, out);
-      for (int i = 0; i < 3; ++i) EXPECT_NEAR(out[i], angles[i], testsupport::kEulerRoundTripTolDeg);
+      for (int i = 0; i < 3; ++i)
+        EXPECT_NEAR(out[i], angles[i], testsupport::kEulerRoundTripTolDeg);
       EXPECT_LT(RotationDistance(mocap::EulerToQuat(order.data(), out, 3), q),
                 testsupport::kRotationTolRad);
     }
@@ -96,11 +96,13 @@ TEST(JointEulerAngles, GivesBackTheChannelValuesOfAPose) {
   s.names = {"root", "yxz", "xz"};
   s.parents = {mocap::kNoParent, 0, 1};
   s.rest_translations.assign(3, glm::vec3(0, 10, 0));
-  s.rest_rotations = {glm::quat(1, 0, 0, 0), glm::angleAxis(0.5f, glm::normalize(glm::vec3(1, 1, 0))),
+  s.rest_rotations = {glm::quat(1, 0, 0, 0),
+                      glm::angleAxis(0.5f, glm::normalize(glm::vec3(1, 1, 0))),
                       glm::quat(1, 0, 0, 0)};
   s.rest_scales.assign(3, glm::vec3(1));
   s.channels.resize(3);
-  s.channels[0] = {0, 3, {ChannelType::kXPosition, ChannelType::kYPosition, ChannelType::kZPosition}};
+  s.channels[0] = {
+      0, 3, {ChannelType::kXPosition, ChannelType::kYPosition, ChannelType::kZPosition}};
   s.channels[1] = {3, 3, {kY, kX, kZ}};
   s.channels[2] = {6, 2, {kX, kZ}};
   s.num_channels = 8;
@@ -110,7 +112,8 @@ TEST(JointEulerAngles, GivesBackTheChannelValuesOfAPose) {
   float angles[3];
   EXPECT_EQ(mocap::JointEulerAngles(s, 0, locals[0].rotation, angles), 0);
   ASSERT_EQ(mocap::JointEulerAngles(s, 1, locals[1].rotation, angles), 3);
-  for (int i = 0; i < 3; ++i) EXPECT_NEAR(angles[i], frame[3 + i], testsupport::kEulerRoundTripTolDeg);
+  for (int i = 0; i < 3; ++i)
+    EXPECT_NEAR(angles[i], frame[3 + i], testsupport::kEulerRoundTripTolDeg);
   ASSERT_EQ(mocap::JointEulerAngles(s, 2, locals[2].rotation, angles), 2);
   EXPECT_NEAR(angles[0], -60.0f, testsupport::kEulerRoundTripTolDeg);
   EXPECT_NEAR(angles[1], 75.0f, testsupport::kEulerRoundTripTolDeg);
@@ -135,7 +138,8 @@ TEST(RotationVector, MatchesAxisAngleAndRoundTrips) {
   }
   // A rotation of more than pi comes back as the shorter one the other way.
   const glm::vec3 r = mocap::QuatToRotationVector(glm::angleAxis(4.0f, axis));
-  EXPECT_NEAR(glm::length(r), 2.0f * std::numbers::pi_v<float> - 4.0f, testsupport::kRotationTolRad);
+  EXPECT_NEAR(glm::length(r), 2.0f * std::numbers::pi_v<float> - 4.0f,
+              testsupport::kRotationTolRad);
   EXPECT_LT(glm::dot(r, axis), 0.0f);
 }
 
@@ -178,8 +182,8 @@ TEST(SwingTwist, RecomposesAndSeparatesTheParts) {
 
 TEST(SwingTwist, HalfTurnSwingHasIdentityTwist) {
   const glm::vec3 axis(0, 1, 0);
-  const mocap::SwingTwist st =
-      mocap::DecomposeSwingTwist(glm::angleAxis(std::numbers::pi_v<float>, glm::vec3(1, 0, 0)), axis);
+  const mocap::SwingTwist st = mocap::DecomposeSwingTwist(
+      glm::angleAxis(std::numbers::pi_v<float>, glm::vec3(1, 0, 0)), axis);
   EXPECT_NEAR(st.twist_angle_rad, 0.0f, testsupport::kFloatTol);
   EXPECT_NEAR(st.twist.w, 1.0f, testsupport::kFloatTol);
 }

@@ -13,7 +13,8 @@ namespace {
 using mocap::ChannelType;
 
 // Root with 6 channels (ZXY), one child with ZXY rotation, one child with quaternion channels.
-mocap::Skeleton ThreeJoints(mocap::PositionChannelMode mode = mocap::PositionChannelMode::kReplaceOffset) {
+mocap::Skeleton ThreeJoints(
+    mocap::PositionChannelMode mode = mocap::PositionChannelMode::kReplaceOffset) {
   mocap::Skeleton s;
   s.names = {"root", "elbow", "quat"};
   s.parents = {mocap::kNoParent, 0, 1};
@@ -22,11 +23,14 @@ mocap::Skeleton ThreeJoints(mocap::PositionChannelMode mode = mocap::PositionCha
                       glm::quat(1, 0, 0, 0)};
   s.rest_scales.assign(3, glm::vec3(1));
   s.channels.resize(3);
-  s.channels[0] = {0, 6, {ChannelType::kXPosition, ChannelType::kYPosition, ChannelType::kZPosition,
-                          ChannelType::kZRotation, ChannelType::kXRotation, ChannelType::kYRotation}};
-  s.channels[1] = {6, 3, {ChannelType::kZRotation, ChannelType::kXRotation, ChannelType::kYRotation}};
-  s.channels[2] = {9, 4, {ChannelType::kQuatX, ChannelType::kQuatY, ChannelType::kQuatZ,
-                          ChannelType::kQuatW}};
+  s.channels[0] = {0,
+                   6,
+                   {ChannelType::kXPosition, ChannelType::kYPosition, ChannelType::kZPosition,
+                    ChannelType::kZRotation, ChannelType::kXRotation, ChannelType::kYRotation}};
+  s.channels[1] = {
+      6, 3, {ChannelType::kZRotation, ChannelType::kXRotation, ChannelType::kYRotation}};
+  s.channels[2] = {
+      9, 4, {ChannelType::kQuatX, ChannelType::kQuatY, ChannelType::kQuatZ, ChannelType::kQuatW}};
   s.num_channels = 13;
   s.position_mode = mode;
   return s;
@@ -42,19 +46,29 @@ mocap::Motion Wander(int num_frames, double frame_time_s) {
     const float t = static_cast<float>(f * frame_time_s);
     const glm::quat q = glm::angleAxis(1.5f * t, glm::normalize(glm::vec3(1, std::sin(t), 0.5f)));
     const float sign = (f % 3 == 0) ? -1.0f : 1.0f;  // stored signs flip: sampling must not care
-    const float row[13] = {10 * t, 90 + 3 * std::sin(4 * t), -5 * t,
-                           170 + 40 * t, 20 * std::sin(2 * t), 160 + 30 * std::cos(t),
-                           -30 + 120 * t, 35 * std::sin(3 * t), 10,
-                           sign * q.x, sign * q.y, sign * q.z, sign * q.w};
+    const float row[13] = {10 * t,
+                           90 + 3 * std::sin(4 * t),
+                           -5 * t,
+                           170 + 40 * t,
+                           20 * std::sin(2 * t),
+                           160 + 30 * std::cos(t),
+                           -30 + 120 * t,
+                           35 * std::sin(3 * t),
+                           10,
+                           sign * q.x,
+                           sign * q.y,
+                           sign * q.z,
+                           sign * q.w};
     m.values.insert(m.values.end(), row, row + 13);
   }
   return m;
 }
 
-std::vector<mocap::JointTransform> PoseAt(const mocap::Skeleton& s, const mocap::Motion& m, double t) {
+std::vector<mocap::JointTransform> PoseAt(const mocap::Skeleton& s, const mocap::Motion& m,
+                                          double t) {
   std::vector<mocap::JointTransform> locals(3), scratch(3);
-  EXPECT_TRUE((mocap::SampleLocalsJob{.skeleton = &s, .motion = &m, .time_s = t,
-                                      .scratch = scratch, .locals = locals})
+  EXPECT_TRUE((mocap::SampleLocalsJob{
+                   .skeleton = &s, .motion = &m, .time_s = t, .scratch = scratch, .locals = locals})
                   .Run()
                   .ok());
   return locals;
@@ -85,22 +99,39 @@ TEST(SampleLocalsJob, Validity) {
   const mocap::Skeleton s = ThreeJoints();
   mocap::Motion m = Wander(4, 0.1);
   std::vector<mocap::JointTransform> locals(3), scratch(3), small(2);
-  EXPECT_EQ((mocap::SampleLocalsJob{.skeleton = nullptr, .motion = &m, .scratch = scratch, .locals = locals})
-                .Validate().code, mocap::JobStatus::kMissingInput);
-  EXPECT_EQ((mocap::SampleLocalsJob{.skeleton = &s, .motion = &m, .scratch = small, .locals = locals})
-                .Validate().code, mocap::JobStatus::kSizeMismatch);
-  EXPECT_EQ((mocap::SampleLocalsJob{.skeleton = &s, .motion = &m, .scratch = scratch, .locals = small})
-                .Validate().code, mocap::JobStatus::kSizeMismatch);
+  EXPECT_EQ((mocap::SampleLocalsJob{
+                 .skeleton = nullptr, .motion = &m, .scratch = scratch, .locals = locals})
+                .Validate()
+                .code,
+            mocap::JobStatus::kMissingInput);
+  EXPECT_EQ(
+      (mocap::SampleLocalsJob{.skeleton = &s, .motion = &m, .scratch = small, .locals = locals})
+          .Validate()
+          .code,
+      mocap::JobStatus::kSizeMismatch);
+  EXPECT_EQ(
+      (mocap::SampleLocalsJob{.skeleton = &s, .motion = &m, .scratch = scratch, .locals = small})
+          .Validate()
+          .code,
+      mocap::JobStatus::kSizeMismatch);
   mocap::Motion bad_time = m;
   bad_time.frame_time_s = 0.0;
-  EXPECT_EQ((mocap::SampleLocalsJob{.skeleton = &s, .motion = &bad_time, .scratch = scratch, .locals = locals})
-                .Validate().code, mocap::JobStatus::kOutOfRange);
+  EXPECT_EQ((mocap::SampleLocalsJob{
+                 .skeleton = &s, .motion = &bad_time, .scratch = scratch, .locals = locals})
+                .Validate()
+                .code,
+            mocap::JobStatus::kOutOfRange);
   mocap::Motion empty = m;
   empty.num_frames = 0;
-  EXPECT_EQ((mocap::SampleLocalsJob{.skeleton = &s, .motion = &empty, .scratch = scratch, .locals = locals})
-                .Run().code, mocap::JobStatus::kMissingInput);
-  EXPECT_TRUE((mocap::SampleLocalsJob{.skeleton = &s, .motion = &m, .scratch = scratch, .locals = locals})
-                  .Run().ok());
+  EXPECT_EQ((mocap::SampleLocalsJob{
+                 .skeleton = &s, .motion = &empty, .scratch = scratch, .locals = locals})
+                .Run()
+                .code,
+            mocap::JobStatus::kMissingInput);
+  EXPECT_TRUE(
+      (mocap::SampleLocalsJob{.skeleton = &s, .motion = &m, .scratch = scratch, .locals = locals})
+          .Run()
+          .ok());
 }
 
 TEST(SampleLocalsJob, ExactAtFrameTimes) {
@@ -126,17 +157,20 @@ TEST(SampleLocalsJob, SlerpMidpointAndLerp) {
   // Elbow Z 0 -> 90; quat joint 0 -> 120 degrees about X stored with a negative w
   // (the long way round if taken literally); root x 0 -> 8.
   const glm::quat q1 = glm::angleAxis(glm::radians(120.0f), glm::vec3(1, 0, 0));
-  m.values = {0, 90, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1,
+  m.values = {0, 90, 0, 0, 0, 0, 0,  0, 0, 0,     0,     0,     1,
               8, 90, 0, 0, 0, 0, 90, 0, 0, -q1.x, -q1.y, -q1.z, -q1.w};
   const auto mid = PoseAt(s, m, 0.25);
-  const glm::quat expected_elbow = s.rest_rotations[1] * glm::angleAxis(glm::radians(45.0f), glm::vec3(0, 0, 1));
+  const glm::quat expected_elbow =
+      s.rest_rotations[1] * glm::angleAxis(glm::radians(45.0f), glm::vec3(0, 0, 1));
   EXPECT_LT(RotationDistance(mid[1].rotation, expected_elbow), testsupport::kRotationTolRad);
-  EXPECT_LT(RotationDistance(mid[2].rotation, glm::angleAxis(glm::radians(60.0f), glm::vec3(1, 0, 0))),
-            testsupport::kRotationTolRad);
+  EXPECT_LT(
+      RotationDistance(mid[2].rotation, glm::angleAxis(glm::radians(60.0f), glm::vec3(1, 0, 0))),
+      testsupport::kRotationTolRad);
   EXPECT_NEAR(mid[0].translation.x, 4.0f, testsupport::kFloatTol);
   const auto quarter = PoseAt(s, m, 0.125);
   EXPECT_NEAR(quarter[0].translation.x, 2.0f, testsupport::kFloatTol);
-  EXPECT_LT(RotationDistance(quarter[2].rotation, glm::angleAxis(glm::radians(30.0f), glm::vec3(1, 0, 0))),
+  EXPECT_LT(RotationDistance(quarter[2].rotation,
+                             glm::angleAxis(glm::radians(30.0f), glm::vec3(1, 0, 0))),
             testsupport::kRotationTolRad);
   // Clamped outside the clip.
   EXPECT_EQ(PoseAt(s, m, 7.0)[0].translation.x, 8.0f);
@@ -151,16 +185,19 @@ void ExpectChannelsNear(const mocap::Motion& a, int fa, const mocap::Motion& b, 
 }
 
 TEST(Resample, RoundTrip30To120To30) {
-  for (auto mode : {mocap::PositionChannelMode::kReplaceOffset, mocap::PositionChannelMode::kAddToOffset}) {
+  for (auto mode :
+       {mocap::PositionChannelMode::kReplaceOffset, mocap::PositionChannelMode::kAddToOffset}) {
     const mocap::Skeleton s = ThreeJoints(mode);
     mocap::Motion m = Wander(31, 1.0 / 30.0);
     // Canonical quaternion signs (w >= 0 at frame 0, then continuous) so the values compare.
     for (int f = 0; f < m.num_frames; ++f) {
       auto row = m.frame(f);
-      const float prev_dot = f == 0 ? row[12]
-                                    : row[9] * m.frame(f - 1)[9] + row[10] * m.frame(f - 1)[10] +
-                                          row[11] * m.frame(f - 1)[11] + row[12] * m.frame(f - 1)[12];
-      if (prev_dot < 0) for (int c = 9; c < 13; ++c) row[c] = -row[c];
+      const float prev_dot = f == 0
+                                 ? row[12]
+                                 : row[9] * m.frame(f - 1)[9] + row[10] * m.frame(f - 1)[10] +
+                                       row[11] * m.frame(f - 1)[11] + row[12] * m.frame(f - 1)[12];
+      if (prev_dot < 0)
+        for (int c = 9; c < 13; ++c) row[c] = -row[c];
     }
     auto up = mocap::Resample(s, m, 1.0 / 120.0);
     ASSERT_TRUE(up.ok()) << up.error().ToString();

@@ -16,8 +16,10 @@ namespace {
 std::vector<glm::vec3> Positions(const mocap::Skeleton& s, const mocap::Motion& m) {
   std::vector<mocap::JointTransform> locals(static_cast<std::size_t>(s.num_joints()));
   std::vector<glm::mat4> model(static_cast<std::size_t>(m.num_frames * s.num_joints()));
-  EXPECT_TRUE((mocap::ModelMatricesJob{.skeleton = &s, .motion = &m, .locals = locals, .model_from_joint = model})
-                  .Run().ok());
+  EXPECT_TRUE((mocap::ModelMatricesJob{
+                   .skeleton = &s, .motion = &m, .locals = locals, .model_from_joint = model})
+                  .Run()
+                  .ok());
   std::vector<glm::vec3> p(model.size());
   for (std::size_t i = 0; i < model.size(); ++i) p[i] = glm::vec3(model[i][3]);
   return p;
@@ -48,7 +50,8 @@ void ExpectWellFormed(const mocap::Skeleton& s, const mocap::Motion& m) {
 // Lowest foot point (ankle or toe) of each side must touch y = 0 within this.
 float LowestFootY(const Probe& pr, int f, const char* side) {
   const std::string s(side);
-  return std::min(pr.At(f, (s + "Foot").c_str()).y - 7.0f, pr.At(f, (s + "ToeBase").c_str()).y - 1.0f);
+  return std::min(pr.At(f, (s + "Foot").c_str()).y - 7.0f,
+                  pr.At(f, (s + "ToeBase").c_str()).y - 1.0f);
 }
 
 TEST(Synthetic, HumanoidSkeletonLooksLikeACapture) {
@@ -56,10 +59,11 @@ TEST(Synthetic, HumanoidSkeletonLooksLikeACapture) {
   ASSERT_TRUE(s.Check().ok());
   EXPECT_EQ(s.num_joints(), 24);
   EXPECT_EQ(s.num_channels, 6 + 23 * 3);
-  for (const char* name : {"Hips", "Spine", "Spine1", "Neck", "Head", "LeftShoulder", "LeftArm", "LeftForeArm",
-                           "LeftHand", "LeftUpLeg", "LeftLeg", "LeftFoot", "LeftToeBase", "RightShoulder",
-                           "RightArm", "RightForeArm", "RightHand", "RightUpLeg", "RightLeg", "RightFoot",
-                           "RightToeBase"}) {
+  for (const char* name :
+       {"Hips",        "Spine",         "Spine1",      "Neck",         "Head",      "LeftShoulder",
+        "LeftArm",     "LeftForeArm",   "LeftHand",    "LeftUpLeg",    "LeftLeg",   "LeftFoot",
+        "LeftToeBase", "RightShoulder", "RightArm",    "RightForeArm", "RightHand", "RightUpLeg",
+        "RightLeg",    "RightFoot",     "RightToeBase"}) {
     EXPECT_GE(s.FindJoint(name), 0) << name;
   }
   EXPECT_EQ(s.channels[0].count, 6);
@@ -96,8 +100,10 @@ TEST(Synthetic, WalkKeepsFeetOnTheGroundAndMovesForward) {
     if (f > 0) {
       EXPECT_GT(pr.At(f, "Hips").z, pr.At(f - 1, "Hips").z);
     }
-    max_knee = std::max(max_knee, BendDeg(pr.At(f, "LeftUpLeg"), pr.At(f, "LeftLeg"), pr.At(f, "LeftFoot")));
-    max_elbow = std::max(max_elbow, BendDeg(pr.At(f, "LeftArm"), pr.At(f, "LeftForeArm"), pr.At(f, "LeftHand")));
+    max_knee = std::max(max_knee,
+                        BendDeg(pr.At(f, "LeftUpLeg"), pr.At(f, "LeftLeg"), pr.At(f, "LeftFoot")));
+    max_elbow = std::max(
+        max_elbow, BendDeg(pr.At(f, "LeftArm"), pr.At(f, "LeftForeArm"), pr.At(f, "LeftHand")));
     // Hands stay outside the torso: lateral distance from the spine > 15 cm.
     for (const char* hand : {"LeftHand", "RightHand"}) {
       const glm::vec3 d = pr.At(f, hand) - pr.At(f, "Spine1");
@@ -110,13 +116,45 @@ TEST(Synthetic, WalkKeepsFeetOnTheGroundAndMovesForward) {
   EXPECT_LE(max_elbow, 120.0f);
 }
 
+TEST(Synthetic, WalkPlantsTheStanceFootAndMovesSmoothly) {
+  const mocap::Skeleton s = mocap::MakeHumanoidSkeleton();
+  auto m = mocap::MakeWalkMotion(s);
+  ASSERT_TRUE(m.ok());
+  const Probe pr{s, Positions(s, *m)};
+  int planted_pairs = 0;
+  for (int f = 1; f < m->num_frames; ++f) {
+    for (const char* foot : {"LeftFoot", "RightFoot"}) {
+      const glm::vec3 a = pr.At(f - 1, foot);
+      const glm::vec3 b = pr.At(f, foot);
+      const float ankle_rest_y = 8.0f;
+      if (std::abs(a.y - ankle_rest_y) < testsupport::kFootSlideTolCm &&
+          std::abs(b.y - ankle_rest_y) < testsupport::kFootSlideTolCm) {
+        EXPECT_LT(std::hypot(b.x - a.x, b.z - a.z), testsupport::kFootSlideTolCm)
+            << foot << " slides at frame " << f;
+        ++planted_pairs;
+      }
+    }
+  }
+  // Stance is 60% of the cycle for each foot.
+  EXPECT_GT(planted_pairs, m->num_frames);
+  // Hips: no vertical acceleration spikes (a real walk stays well under 0.5 g).
+  auto k = mocap::ComputeKinematics(s, *m);
+  ASSERT_TRUE(k.ok());
+  for (int f = 0; f < m->num_frames; ++f) {
+    EXPECT_LT(std::abs((*k)[static_cast<std::size_t>(f * s.num_joints())].linear_acceleration.y),
+              0.5 * mocap::kGravityCmPerS2)
+        << "frame " << f;
+  }
+}
+
 TEST(Synthetic, WalkLoops) {
   const mocap::Skeleton s = mocap::MakeHumanoidSkeleton();
   auto m = mocap::MakeWalkMotion(s, {.num_cycles = 2});
   ASSERT_TRUE(m.ok());
   const int cycle = m->num_frames / 2;
   for (int c = 3; c < m->num_channels; ++c) {  // all but the root position
-    EXPECT_NEAR(m->frame(cycle)[c], m->frame(0)[c], testsupport::kResampleChannelTol) << "channel " << c;
+    EXPECT_NEAR(m->frame(cycle)[c], m->frame(0)[c], testsupport::kResampleChannelTol)
+        << "channel " << c;
   }
   EXPECT_NEAR(m->frame(cycle)[1], m->frame(0)[1], testsupport::kResampleChannelTol);
   auto again = mocap::MakeWalkMotion(s, {.num_cycles = 2});
@@ -131,15 +169,21 @@ TEST(Synthetic, BendRampReaches150Degrees) {
   const Probe pr{s, Positions(s, *m)};
   const int last = m->num_frames - 1;
   const float tol = testsupport::kBendMeasureTolDeg;
-  EXPECT_NEAR(BendDeg(pr.At(0, "LeftArm"), pr.At(0, "LeftForeArm"), pr.At(0, "LeftHand")), 0.0f, tol);
-  EXPECT_NEAR(BendDeg(pr.At(last, "LeftArm"), pr.At(last, "LeftForeArm"), pr.At(last, "LeftHand")), 150.0f, tol);
-  EXPECT_NEAR(BendDeg(pr.At(last, "RightArm"), pr.At(last, "RightForeArm"), pr.At(last, "RightHand")), 150.0f, tol);
-  EXPECT_NEAR(BendDeg(pr.At(last, "LeftUpLeg"), pr.At(last, "LeftLeg"), pr.At(last, "LeftFoot")), 150.0f, tol);
+  EXPECT_NEAR(BendDeg(pr.At(0, "LeftArm"), pr.At(0, "LeftForeArm"), pr.At(0, "LeftHand")), 0.0f,
+              tol);
+  EXPECT_NEAR(BendDeg(pr.At(last, "LeftArm"), pr.At(last, "LeftForeArm"), pr.At(last, "LeftHand")),
+              150.0f, tol);
+  EXPECT_NEAR(
+      BendDeg(pr.At(last, "RightArm"), pr.At(last, "RightForeArm"), pr.At(last, "RightHand")),
+      150.0f, tol);
+  EXPECT_NEAR(BendDeg(pr.At(last, "LeftUpLeg"), pr.At(last, "LeftLeg"), pr.At(last, "LeftFoot")),
+              150.0f, tol);
   const int mid = last / 2;
-  EXPECT_NEAR(BendDeg(pr.At(mid, "LeftUpLeg"), pr.At(mid, "LeftLeg"), pr.At(mid, "LeftFoot")), 75.0f, tol);
+  EXPECT_NEAR(BendDeg(pr.At(mid, "LeftUpLeg"), pr.At(mid, "LeftLeg"), pr.At(mid, "LeftFoot")),
+              75.0f, tol);
   for (int f = 0; f <= last; ++f) {
     EXPECT_NEAR(LowestFootY(pr, f, "Right"), 0.0f, testsupport::kPositionTol);  // standing leg
-    EXPECT_GT(LowestFootY(pr, f, "Left"), -testsupport::kPositionTol);           // lifted leg
+    EXPECT_GT(LowestFootY(pr, f, "Left"), -testsupport::kPositionTol);          // lifted leg
     // Forearms bend forward, never into the chest.
     EXPECT_GE(pr.At(f, "LeftHand").z, -testsupport::kPositionTol);
   }
@@ -155,8 +199,8 @@ TEST(Synthetic, TwistRampTurnsTheForearmsAboutTheirAxis) {
   float previous = 0.0f;
   for (int f = 0; f < m->num_frames; ++f) {
     ASSERT_TRUE((mocap::LocalPoseJob{&s, m->frame(f), locals}).Run().ok());
-    const mocap::SwingTwist st = mocap::DecomposeSwingTwist(locals[static_cast<std::size_t>(fore)].rotation,
-                                                            glm::vec3(1, 0, 0));
+    const mocap::SwingTwist st = mocap::DecomposeSwingTwist(
+        locals[static_cast<std::size_t>(fore)].rotation, glm::vec3(1, 0, 0));
     const float twist = std::abs(glm::degrees(st.twist_angle_rad));
     const float expected = 180.0f * static_cast<float>(f) / static_cast<float>(m->num_frames - 1);
     EXPECT_NEAR(twist, expected, testsupport::kBendMeasureTolDeg);
@@ -192,7 +236,8 @@ TEST(Synthetic, JumpHasAnAccelerationSpikeAndFreeFall) {
       EXPECT_GT(LowestFootY(pr, f, "Left"), 0.0f);
     }
     if (t > tl.push_start_s + h && t < tl.takeoff_s - h) {
-      EXPECT_NEAR(ay, tl.push_acceleration_cm_per_s2, testsupport::kJumpAccelTolCmPerS2) << "t " << t;
+      EXPECT_NEAR(ay, tl.push_acceleration_cm_per_s2, testsupport::kJumpAccelTolCmPerS2)
+          << "t " << t;
     }
     if (t < tl.takeoff_s - h || t > tl.touchdown_s + h) {
       EXPECT_NEAR(LowestFootY(pr, f, "Left"), 0.0f, testsupport::kPositionTol) << "t " << t;
@@ -205,9 +250,14 @@ TEST(Synthetic, JumpHasAnAccelerationSpikeAndFreeFall) {
 
 TEST(Synthetic, GeneratorsRejectBadInput) {
   const mocap::Skeleton s = mocap::MakeHumanoidSkeleton();
-  EXPECT_EQ(mocap::MakeBendRamp(s, 150.0f, 2.0, 0.0).error().code, mocap::ErrorCode::kInvalidArgument);
-  EXPECT_EQ(mocap::MakeWalkMotion(s, {.num_cycles = 0}).error().code, mocap::ErrorCode::kInvalidArgument);
-  EXPECT_EQ(mocap::MakeJumpMotion(s, {.crouch_cm = 100.0}).error().code, mocap::ErrorCode::kInvalidArgument);
+  EXPECT_EQ(mocap::MakeBendRamp(s, 150.0f, 2.0, 0.0).error().code,
+            mocap::ErrorCode::kInvalidArgument);
+  EXPECT_EQ(mocap::MakeWalkMotion(s, {.step_length_cm = 90.0}).error().code,
+            mocap::ErrorCode::kInvalidArgument);
+  EXPECT_EQ(mocap::MakeWalkMotion(s, {.num_cycles = 0}).error().code,
+            mocap::ErrorCode::kInvalidArgument);
+  EXPECT_EQ(mocap::MakeJumpMotion(s, {.crouch_cm = 100.0}).error().code,
+            mocap::ErrorCode::kInvalidArgument);
   auto chain = mocap::MakeChainSkeleton(5);
   ASSERT_TRUE(chain.ok());
   const auto missing = mocap::MakeTwistRamp(*chain);
@@ -215,7 +265,8 @@ TEST(Synthetic, GeneratorsRejectBadInput) {
   EXPECT_EQ(missing.error().code, mocap::ErrorCode::kNotFound);
   EXPECT_NE(missing.error().message.find("Hips"), std::string::npos);
   EXPECT_EQ(mocap::MakeChainSkeleton(0).error().code, mocap::ErrorCode::kInvalidArgument);
-  EXPECT_EQ(mocap::MakeChainSkeleton(mocap::kMaxJoints + 1).error().code, mocap::ErrorCode::kInvalidArgument);
+  EXPECT_EQ(mocap::MakeChainSkeleton(mocap::kMaxJoints + 1).error().code,
+            mocap::ErrorCode::kInvalidArgument);
 }
 
 TEST(Synthetic, GeneratorsFollowAnyChannelOrder) {
@@ -252,7 +303,8 @@ TEST(Synthetic, ChainAndQuadrupedSkeletons) {
   rest.values.assign(static_cast<std::size_t>(q.num_channels), 0.0f);
   rest.values[1] = q.rest_translations[0].y;
   const Probe pr{q, Positions(q, rest)};
-  for (const char* toe : {"LeftFrontToeBase", "RightFrontToeBase", "LeftHindToeBase", "RightHindToeBase"}) {
+  for (const char* toe :
+       {"LeftFrontToeBase", "RightFrontToeBase", "LeftHindToeBase", "RightHindToeBase"}) {
     EXPECT_NEAR(pr.At(0, toe).y, 1.0f, testsupport::kPositionTol) << toe;
   }
   EXPECT_GT(pr.At(0, "Head").z, pr.At(0, "Hips").z);  // faces +Z

@@ -40,11 +40,20 @@ inline constexpr double kMatrixRoundoff = 4.0 * 1.1920929e-7;
 inline constexpr double kSecondOrderMinRatio = 3.0;
 // Relative float error of rotating a vector into a joint's frame.
 inline constexpr float kLocalFrameRelTol = 1e-5f;
+// The 10 Hz Gaussian low-pass passes 0.4% of a 40 Hz component (sampled kernel:
+// a little more); accept up to 2% of the unfiltered error.
+inline constexpr double kLowPassResidual = 0.02;
+// Angular velocity (rad/s) after smoothing a fixed-axis quadratic rotation: the
+// normalized quaternion mean differs from the angle mean at O(spread^3).
+inline constexpr double kLowPassAngularVelTol = 1e-3;
 
 // Synthetic motions. A procedural walk keeps the stance foot within this of the
 // ground (the hips bob is solved exactly; float positions round at ~1e-5 cm, so
 // this is slack for the foot-flat approximation only).
 inline constexpr float kGroundContactTolCm = 0.05f;
+// A planted foot moves less than this between frames (float positions of
+// order 300 cm round at ~4e-5 cm).
+inline constexpr float kFootSlideTolCm = 0.01f;
 // Joint bend angles measured from float model positions (acos near 0 and 180
 // degrees loses precision: sqrt(float eps) ~ 3e-4 rad ~ 0.02 degrees).
 inline constexpr float kBendMeasureTolDeg = 0.05f;
