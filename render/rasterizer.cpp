@@ -14,6 +14,8 @@ namespace {
 constexpr float kGuardLimitSamples = 131072.0f;
 constexpr int kMaxRasterSize = 16384;
 constexpr int kMaxClipVertices = 9;  // a triangle clipped by 5 planes
+// Triangles whose vertices span less than this (fixed point) use the int32 loop.
+constexpr std::int32_t kSmallTriangleExtent = 48 * kSubpixelScale;
 
 // Floor division for a possibly negative numerator and positive divisor.
 std::int32_t FloorDiv(std::int64_t a, std::int64_t b) {
@@ -266,6 +268,40 @@ void Rasterizer::RasterizeTile(int tile, std::span<float> depth,
     const float inv_area = 1.0f / static_cast<float>(area2);
     const float z0 = tri.inv_w[0] * inv_area, z1 = tri.inv_w[1] * inv_area,
                 z2 = tri.inv_w[2] * inv_area;
+    const std::int32_t extent_x = std::max({tri.x[0], tri.x[1], tri.x[2]}) - std::min({tri.x[0], tri.x[1], tri.x[2]});
+    const std::int32_t extent_y = std::max({tri.y[0], tri.y[1], tri.y[2]}) - std::min({tri.y[0], tri.y[1], tri.y[2]});
+    if (extent_x < kSmallTriangleExtent && extent_y < kSmallTriangleExtent) {
+      // Small triangle: every edge value inside its bounds fits in 32 bits
+      // (|dx|, |dy| < 2^14 fixed-point units, so |E| < 2^30), so the loop can
+      // run on int32 lanes without branches.
+      std::int32_t row32[3], sx32[3], sy32[3];
+      for (int i = 0; i < 3; ++i) {
+        row32[i] = static_cast<std::int32_t>(row[i]);
+        sx32[i] = static_cast<std::int32_t>(step_x[i]);
+        sy32[i] = static_cast<std::int32_t>(step_y[i]);
+      }
+      const int n = bx1 - bx0 + 1;
+      for (int sy = by0; sy <= by1; ++sy) {
+        float* d = depth.data() + static_cast<std::size_t>(sy - y0) * kTileSize +
+                   static_cast<std::size_t>(bx0 - x0);
+        std::uint32_t* out = ids.data() + (d - depth.data());
+        std::int32_t e0 = row32[0], e1 = row32[1], e2 = row32[2];
+        for (int i = 0; i < n; ++i) {
+          const float z = static_cast<float>(e0) * z0 + static_cast<float>(e1) * z1 +
+                          static_cast<float>(e2) * z2;
+          const bool pass = ((e0 | e1 | e2) >= 0) & (z > d[i]);
+          d[i] = pass ? z : d[i];
+          out[i] = pass ? id : out[i];
+          e0 += sx32[0];
+          e1 += sx32[1];
+          e2 += sx32[2];
+        }
+        row32[0] += sy32[0];
+        row32[1] += sy32[1];
+        row32[2] += sy32[2];
+      }
+      continue;
+    }
     for (int sy = by0; sy <= by1; ++sy) {
       std::int64_t e0 = row[0], e1 = row[1], e2 = row[2];
       const std::size_t base = static_cast<std::size_t>(sy - y0) * kTileSize;

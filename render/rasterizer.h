@@ -103,6 +103,15 @@ class Rasterizer {
   // corners at the centre of sample (sx, sy), for visibility id `id`.
   glm::vec3 Barycentrics(std::uint32_t id, int sx, int sy) const;
 
+  // Source-corner weights of a clipped triangle's vertices (column i =
+  // weights of vertex i), or nullptr when the triangle was not clipped.
+  const glm::mat3* corner_weights(std::uint32_t id) const {
+    const RasterTriangle& tri = triangle(id);
+    return tri.clip_slot < 0 ? nullptr
+                             : &per_thread_[id >> kThreadShift]
+                                    .corner_weights[static_cast<std::size_t>(tri.clip_slot)];
+  }
+
   // 1 / view depth of triangle `id` at the centre of sample (sx, sy).
   float InverseDepth(std::uint32_t id, int sx, int sy) const;
 

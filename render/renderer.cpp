@@ -2,7 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <limits>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #include "render/internal/parallel.h"
 
@@ -10,6 +16,32 @@ namespace render {
 namespace {
 
 constexpr int kMaxSamplesPerAxis = 16384;
+
+// The image is written once per frame and not read back by this thread:
+// non-temporal stores skip the read-for-ownership of every output cache line.
+inline void StreamStore(glm::vec4* dst, const glm::vec4& v) {
+#if defined(__SSE2__)
+  if ((reinterpret_cast<std::uintptr_t>(dst) & 15u) == 0) {
+    _mm_stream_ps(reinterpret_cast<float*>(dst), _mm_set_ps(v.w, v.z, v.y, v.x));
+    return;
+  }
+#endif
+  *dst = v;
+}
+inline void StreamStore(float* dst, float v) {
+#if defined(__SSE2__)
+  int bits;
+  std::memcpy(&bits, &v, sizeof bits);
+  _mm_stream_si32(reinterpret_cast<int*>(dst), bits);
+#else
+  *dst = v;
+#endif
+}
+inline void StreamFence() {
+#if defined(__SSE2__)
+  _mm_sfence();
+#endif
+}
 
 mocap::JobStatus Fail(mocap::JobStatus::Code code, const char* what) { return {code, what}; }
 
@@ -144,6 +176,135 @@ mocap::JobStatus Renderer::Render(const Camera& camera, std::span<const SceneMes
   return mocap::kJobOk;
 }
 
+// Shades visible samples. Neighbouring samples usually hit the same few
+// triangles, so each triangle's vertex attributes (mapped to the setup
+// triangle's vertex order) and edge-function coefficients are kept in a small
+// direct-mapped cache. Every cached value is a pure function of the id, so
+// results do not depend on the order samples are visited in.
+class Renderer::SampleShader {
+ public:
+  SampleShader(const Rasterizer& raster, std::span<const SceneMesh> meshes,
+               const RenderSettings& settings, const Renderer& renderer)
+      : raster_(raster), meshes_(meshes), settings_(settings), r_(renderer) {}
+
+  glm::vec3 Shade(std::uint32_t id, int sx, int sy) {
+    Entry& t = cache_[id & (kCacheSize - 1)];
+    if (t.id != id) Load(id, t);
+    // Perspective-correct weights up to a common scale: edge function times
+    // 1/w, as planes in sample space around the triangle's reference sample.
+    const auto fx = static_cast<float>(sx - t.ref_x), fy = static_cast<float>(sy - t.ref_y);
+    const float w0 = t.wc[0] + t.wa[0] * fx + t.wb[0] * fy;
+    const float w1 = t.wc[1] + t.wa[1] * fx + t.wb[1] * fy;
+    const float w2 = t.wc[2] + t.wa[2] * fx + t.wb[2] * fy;
+    const ShadingContext& ctx = r_.context_;
+    const LightingModel model = ctx.model;
+    if (t.ground) {
+      const float inv = 1.0f / (w0 + w1 + w2);
+      const glm::vec3 p = (w0 * inv) * t.p[0] + (w1 * inv) * t.p[1] + (w2 * inv) * t.p[2];
+      const glm::vec3 albedo = GroundAlbedo(settings_.ground_style, r_.grid_spacing_, p);
+      const float shadow = ContactShadowFactor(r_.shadows_, p);
+      if (model == LightingModel::kUnlit) return albedo * shadow;
+      return albedo * (ctx.ambient + ctx.key_radiance * std::max(ctx.key_dir.y, 0.0f) +
+                       ctx.fill_radiance * std::max(ctx.fill_dir.y, 0.0f)) *
+             shadow;
+    }
+    glm::vec3 albedo = t.albedo;
+    const bool need_weights = t.interpolate_color || model == LightingModel::kBlinnPhong;
+    float l0 = w0, l1 = w1, l2 = w2;
+    if (need_weights) {
+      const float inv = 1.0f / (w0 + w1 + w2);
+      l0 = w0 * inv;
+      l1 = w1 * inv;
+      l2 = w2 * inv;
+    }
+    if (t.interpolate_color) albedo = l0 * t.col[0] + l1 * t.col[1] + l2 * t.col[2];
+    if (model == LightingModel::kUnlit) return albedo;
+    glm::vec3 n = t.face_normal;
+    if (t.smooth) {
+      // Unnormalized weights suffice: the normal is renormalized.
+      n = w0 * t.n[0] + w1 * t.n[1] + w2 * t.n[2];
+      const float len2 = glm::dot(n, n);
+      n = len2 > 0.0f ? n * (1.0f / std::sqrt(len2)) : t.face_normal;
+    }
+    if (model == LightingModel::kLambert) {
+      return albedo * (ctx.ambient + ctx.key_radiance * std::max(glm::dot(n, ctx.key_dir), 0.0f));
+    }
+    const glm::vec3 p = l0 * t.p[0] + l1 * t.p[1] + l2 * t.p[2];
+    return ShadeSurface(ctx, albedo, n, p);
+  }
+
+ private:
+  static constexpr std::uint32_t kCacheSize = 64;
+  struct Entry {
+    std::uint32_t id = kNoTriangle;
+    bool ground = false, smooth = false, interpolate_color = false;
+    int ref_x = 0, ref_y = 0;  // reference sample (the triangle's bounds corner)
+    float wa[3] = {}, wb[3] = {}, wc[3] = {};  // weight_i = wc + wa * (x - ref_x) + wb * (y - ref_y)
+    glm::vec3 n[3], col[3], p[3], face_normal{0.0f, 0.0f, 1.0f}, albedo{1.0f};
+  };
+
+  void Load(std::uint32_t id, Entry& t) const {
+    t.id = id;
+    const RasterTriangle& tri = raster_.triangle(id);
+    t.ref_x = tri.min_x;
+    t.ref_y = tri.min_y;
+    for (int i = 0; i < 3; ++i) {
+      const int a = (i + 1) % 3, b = (i + 2) % 3;
+      const std::int32_t dx = tri.x[b] - tri.x[a], dy = tri.y[b] - tri.y[a];
+      const std::int64_t e = EdgeValue(tri.x[a], tri.y[a], tri.x[b], tri.y[b], t.ref_x, t.ref_y);
+      t.wa[i] = static_cast<float>(-std::int64_t{dy} * kSubpixelScale) * tri.inv_w[i];
+      t.wb[i] = static_cast<float>(std::int64_t{dx} * kSubpixelScale) * tri.inv_w[i];
+      t.wc[i] = static_cast<float>(e) * tri.inv_w[i];
+    }
+    const glm::mat3* weights = raster_.corner_weights(id);
+    // Attribute of setup vertex i from the three source-corner values.
+    auto to_vertices = [&](const glm::vec3 (&corner)[3], glm::vec3 (&out)[3]) {
+      for (int i = 0; i < 3; ++i) {
+        out[i] = weights == nullptr ? corner[tri.order[i]]
+                                    : (*weights)[i].x * corner[0] + (*weights)[i].y * corner[1] +
+                                          (*weights)[i].z * corner[2];
+      }
+    };
+    t.ground = tri.mesh == static_cast<std::uint32_t>(meshes_.size());
+    glm::vec3 corner[3];
+    if (t.ground) {
+      const glm::uvec3 v = r_.ground_triangles_[tri.triangle];
+      for (int k = 0; k < 3; ++k) corner[k] = r_.ground_positions_[v[k]];
+      to_vertices(corner, t.p);
+      return;
+    }
+    const SceneMesh& mesh = meshes_[tri.mesh];
+    const glm::uvec3 v = mesh.triangles[tri.triangle];
+    for (int k = 0; k < 3; ++k) corner[k] = mesh.positions[v[k]];
+    t.face_normal = glm::cross(corner[1] - corner[0], corner[2] - corner[0]);
+    const float len2 = glm::dot(t.face_normal, t.face_normal);
+    t.face_normal = len2 > 0.0f ? t.face_normal * (1.0f / std::sqrt(len2)) : glm::vec3(0, 0, 1);
+    if (tri.back_facing) t.face_normal = -t.face_normal;
+    if (r_.context_.model == LightingModel::kBlinnPhong) to_vertices(corner, t.p);
+    t.smooth = settings_.shading == ShadingMode::kSmooth && !mesh.normals.empty();
+    if (t.smooth) {
+      const float sign = tri.back_facing ? -1.0f : 1.0f;
+      for (int k = 0; k < 3; ++k) corner[k] = sign * mesh.normals[v[k]];
+      to_vertices(corner, t.n);
+    }
+    t.interpolate_color = false;
+    t.albedo = mesh.base_color;
+    if (!mesh.triangle_colors.empty()) {
+      t.albedo = mesh.triangle_colors[tri.triangle];
+    } else if (!mesh.vertex_colors.empty()) {
+      t.interpolate_color = true;
+      for (int k = 0; k < 3; ++k) corner[k] = mesh.vertex_colors[v[k]];
+      to_vertices(corner, t.col);
+    }
+  }
+
+  const Rasterizer& raster_;
+  std::span<const SceneMesh> meshes_;
+  const RenderSettings& settings_;
+  const Renderer& r_;
+  Entry cache_[kCacheSize];
+};
+
 void Renderer::ShadeTile(int tile, const RenderSettings& settings,
                          std::span<const SceneMesh> meshes, TileScratch& s, Image& image) const {
   const int ss = settings.supersample;
@@ -154,67 +315,26 @@ void Renderer::ShadeTile(int tile, const RenderSettings& settings,
   const bool transparent = settings.background.transparent;
   const bool write_depth = !image.depth.empty();
   const float inf = std::numeric_limits<float>::infinity();
-  const auto ground_mesh = static_cast<std::uint32_t>(meshes.size());
-  const ShadingContext& ctx = context_;
 
-  // Colour of one visible sample.
-  auto shade = [&](std::uint32_t id, int sx, int sy) -> glm::vec3 {
-    const RasterTriangle& tri = rasterizer_.triangle(id);
-    const glm::vec3 b = rasterizer_.Barycentrics(id, sx, sy);
-    if (tri.mesh == ground_mesh) {
-      const glm::uvec3 t = ground_triangles_[tri.triangle];
-      const glm::vec3 p = b.x * ground_positions_[t.x] + b.y * ground_positions_[t.y] +
-                          b.z * ground_positions_[t.z];
-      const glm::vec3 albedo = GroundAlbedo(settings.ground_style, grid_spacing_, p);
-      const float n_dot_l = std::max(ctx.key_dir.y, 0.0f);
-      const glm::vec3 lit = albedo * (ctx.ambient + ctx.key_radiance * n_dot_l +
-                                      ctx.fill_radiance * std::max(ctx.fill_dir.y, 0.0f));
-      return ctx.model == LightingModel::kUnlit ? albedo * ContactShadowFactor(shadows_, p)
-                                                : lit * ContactShadowFactor(shadows_, p);
-    }
-    const SceneMesh& mesh = meshes[tri.mesh];
-    const glm::uvec3 t = mesh.triangles[tri.triangle];
-    const glm::vec3& p0 = mesh.positions[t.x];
-    const glm::vec3& p1 = mesh.positions[t.y];
-    const glm::vec3& p2 = mesh.positions[t.z];
-    glm::vec3 albedo = mesh.base_color;
-    if (!mesh.triangle_colors.empty()) {
-      albedo = mesh.triangle_colors[tri.triangle];
-    } else if (!mesh.vertex_colors.empty()) {
-      albedo = b.x * mesh.vertex_colors[t.x] + b.y * mesh.vertex_colors[t.y] +
-               b.z * mesh.vertex_colors[t.z];
-    }
-    if (ctx.model == LightingModel::kUnlit) return albedo;
-    glm::vec3 n;
-    if (settings.shading == ShadingMode::kSmooth && !mesh.normals.empty()) {
-      n = b.x * mesh.normals[t.x] + b.y * mesh.normals[t.y] + b.z * mesh.normals[t.z];
-    } else {
-      n = glm::cross(p1 - p0, p2 - p0);
-    }
-    const float len2 = glm::dot(n, n);
-    n = len2 > 0.0f ? n * (1.0f / std::sqrt(len2)) : glm::vec3(0.0f, 0.0f, 1.0f);
-    if (tri.back_facing) n = -n;
-    const glm::vec3 p = b.x * p0 + b.y * p1 + b.z * p2;
-    return ShadeSurface(ctx, albedo, n, p);
-  };
+  SampleShader shader(rasterizer_, meshes, settings, *this);
+  auto shade = [&](std::uint32_t id, int sx, int sy) { return shader.Shade(id, sx, sy); };
 
   if (ss == 1) {
     for (int sy = y0; sy < y1; ++sy) {
-      const glm::vec3 bg = background_rows_[static_cast<std::size_t>(sy)];
+      const glm::vec4 bg = transparent ? glm::vec4(0.0f)
+                                       : glm::vec4(background_rows_[static_cast<std::size_t>(sy)], 1.0f);
       const std::size_t row = static_cast<std::size_t>(sy - y0) * kTileSize;
-      for (int sx = x0; sx < x1; ++sx) {
+      glm::vec4* rgba = image.rgba.data() + image.index(x0, sy);
+      float* depth = write_depth ? image.depth.data() + image.index(x0, sy) : nullptr;
+      for (int sx = x0; sx < x1; ++sx, ++rgba) {
         const std::size_t at = row + static_cast<std::size_t>(sx - x0);
         const std::uint32_t id = s.ids[at];
-        const std::size_t out = image.index(sx, sy);
-        if (id == kNoTriangle) {
-          image.rgba[out] = transparent ? glm::vec4(0.0f) : glm::vec4(bg, 1.0f);
-          if (write_depth) image.depth[out] = inf;
-        } else {
-          image.rgba[out] = glm::vec4(shade(id, sx, sy), 1.0f);
-          if (write_depth) image.depth[out] = 1.0f / s.depth[at];
-        }
+        const bool hit = id != kNoTriangle;
+        StreamStore(rgba, hit ? glm::vec4(shade(id, sx, sy), 1.0f) : bg);
+        if (depth != nullptr) StreamStore(depth++, hit ? 1.0f / s.depth[at] : inf);
       }
     }
+    StreamFence();
     return;
   }
 

@@ -77,6 +77,7 @@ class Renderer {
     std::vector<glm::vec4> accum;           // output pixels of one tile: rgb sum, covered count
     std::vector<float> nearest;             // output pixels of one tile: min view depth
   };
+  class SampleShader;
   void ShadeTile(int tile, const RenderSettings& settings, std::span<const SceneMesh> meshes,
                  TileScratch& scratch, Image& image) const;
 
