@@ -3,6 +3,10 @@
 #include <algorithm>
 #include <cmath>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include "render/internal/parallel.h"
 
 namespace render {
@@ -16,6 +20,15 @@ constexpr int kMaxRasterSize = 16384;
 constexpr int kMaxClipVertices = 9;  // a triangle clipped by 5 planes
 // Triangles whose vertices span less than this (fixed point) use the int32 loop.
 constexpr std::int32_t kSmallTriangleExtent = 48 * kSubpixelScale;
+
+// Round to nearest (ties to even), as lrint in the default rounding mode.
+std::int32_t RoundToInt(float x) {
+#if defined(__SSE2__)
+  return _mm_cvtss_si32(_mm_set_ss(x));
+#else
+  return static_cast<std::int32_t>(std::lrint(x));
+#endif
+}
 
 // Floor division for a possibly negative numerator and positive divisor.
 std::int32_t FloorDiv(std::int64_t a, std::int64_t b) {
@@ -49,20 +62,35 @@ std::size_t Rasterizer::num_triangles() const {
   return n;
 }
 
+bool Rasterizer::Snap(const glm::vec4& clip, SnappedVertex& v) const {
+  if (!(clip.w > 0.0f)) return false;
+  const float inv_w = 1.0f / clip.w;
+  const float sx = (clip.x * inv_w + 1.0f) * (0.5f * static_cast<float>(width_));
+  const float sy = (1.0f - clip.y * inv_w) * (0.5f * static_cast<float>(height_));
+  if (!(std::abs(sx) <= kGuardLimitSamples && std::abs(sy) <= kGuardLimitSamples)) return false;
+  v.x = RoundToInt(sx * static_cast<float>(kSubpixelScale));
+  v.y = RoundToInt(sy * static_cast<float>(kSubpixelScale));
+  v.inv_w = inv_w;
+  return true;
+}
+
 bool Rasterizer::EmitTriangle(const glm::vec4 (&clip)[3], const glm::mat3* weights,
                               std::uint32_t mesh, std::uint32_t triangle, PerThread& out) const {
+  SnappedVertex v[3];
+  for (int i = 0; i < 3; ++i)
+    if (!Snap(clip[i], v[i])) return false;
+  return EmitSnapped(v[0], v[1], v[2], weights, mesh, triangle, out);
+}
+
+bool Rasterizer::EmitSnapped(const SnappedVertex& v0, const SnappedVertex& v1,
+                             const SnappedVertex& v2, const glm::mat3* weights, std::uint32_t mesh,
+                             std::uint32_t triangle, PerThread& out) const {
   RasterTriangle tri;
-  const float half_w = 0.5f * static_cast<float>(width_);
-  const float half_h = 0.5f * static_cast<float>(height_);
+  const SnappedVertex* v[3] = {&v0, &v1, &v2};
   for (int i = 0; i < 3; ++i) {
-    if (!(clip[i].w > 0.0f)) return false;
-    const float inv_w = 1.0f / clip[i].w;
-    const float sx = (clip[i].x * inv_w + 1.0f) * half_w;
-    const float sy = (1.0f - clip[i].y * inv_w) * half_h;
-    if (!(std::abs(sx) <= kGuardLimitSamples && std::abs(sy) <= kGuardLimitSamples)) return false;
-    tri.x[i] = static_cast<std::int32_t>(std::lrint(sx * static_cast<float>(kSubpixelScale)));
-    tri.y[i] = static_cast<std::int32_t>(std::lrint(sy * static_cast<float>(kSubpixelScale)));
-    tri.inv_w[i] = inv_w;
+    tri.x[i] = v[i]->x;
+    tri.y[i] = v[i]->y;
+    tri.inv_w[i] = v[i]->inv_w;
     tri.order[i] = static_cast<std::uint8_t>(i);
   }
   const std::int64_t area2 = std::int64_t{tri.x[1] - tri.x[0]} * (tri.y[2] - tri.y[0]) -
@@ -163,24 +191,20 @@ void Rasterizer::SetupRange(std::span<const ClipMesh> meshes, std::size_t begin,
     const std::size_t n = mesh.triangles.size();
     const std::size_t lo = std::max(begin, first), hi = std::min(end, first + n);
     const std::size_t num_vertices = mesh.clip_positions.size();
+    const SnappedVertex* snapped = snapped_.data() + vertex_offsets_[m];
+    const std::uint8_t* outcodes = outcodes_.data() + vertex_offsets_[m];
     for (std::size_t g = lo; g < hi; ++g) {
       const std::size_t t = g - first;
       const glm::uvec3 idx = mesh.triangles[t];
       if (idx.x >= num_vertices || idx.y >= num_vertices || idx.z >= num_vertices) continue;
-      const glm::vec4 clip[3] = {mesh.clip_positions[idx.x], mesh.clip_positions[idx.y],
-                                 mesh.clip_positions[idx.z]};
-      // Which planes each vertex is outside of, as bit masks.
-      unsigned outside[3];
-      for (int i = 0; i < 3; ++i) {
-        outside[i] = 0;
-        for (int p = 0; p < 5; ++p)
-          if (!(PlaneDistance(clip[i], p, guard_) >= 0.0f)) outside[i] |= 1u << p;
-      }
-      if ((outside[0] & outside[1] & outside[2]) != 0) continue;  // all beyond one plane
+      const unsigned o0 = outcodes[idx.x], o1 = outcodes[idx.y], o2 = outcodes[idx.z];
+      if ((o0 & o1 & o2) != 0) continue;  // all beyond one plane
       const auto mi = static_cast<std::uint32_t>(m), ti = static_cast<std::uint32_t>(t);
-      if ((outside[0] | outside[1] | outside[2]) == 0) {
-        EmitTriangle(clip, nullptr, mi, ti, out);
+      if ((o0 | o1 | o2) == 0) {
+        EmitSnapped(snapped[idx.x], snapped[idx.y], snapped[idx.z], nullptr, mi, ti, out);
       } else {
+        const glm::vec4 clip[3] = {mesh.clip_positions[idx.x], mesh.clip_positions[idx.y],
+                                   mesh.clip_positions[idx.z]};
         EmitClipped(clip, mi, ti, out);
       }
     }
@@ -203,6 +227,30 @@ bool Rasterizer::Setup(std::span<const ClipMesh> meshes, const RasterSettings& s
   guard_ = kGuardLimitSamples / static_cast<float>(std::max(width_, height_)) - 1.0f;
   std::size_t total = 0;
   for (const ClipMesh& mesh : meshes) total += mesh.triangles.size();
+  // Outcodes and snapped positions once per vertex; a triangle inside every
+  // plane reuses them, so shared vertices snap identically by construction.
+  vertex_offsets_.assign(meshes.size() + 1, 0);
+  for (std::size_t m = 0; m < meshes.size(); ++m)
+    vertex_offsets_[m + 1] = vertex_offsets_[m] + meshes[m].clip_positions.size();
+  snapped_.resize(vertex_offsets_.back());
+  outcodes_.resize(vertex_offsets_.back());
+  const int vertex_threads = vertex_offsets_.back() > 16384 ? settings.threads : 1;
+  internal::RunOnThreads(vertex_threads, [&](int t) {
+    for (std::size_t m = 0; m < meshes.size(); ++m) {
+      const std::span<const glm::vec4> clip = meshes[m].clip_positions;
+      const std::size_t begin = clip.size() * static_cast<std::size_t>(t) / static_cast<std::size_t>(vertex_threads);
+      const std::size_t end = clip.size() * static_cast<std::size_t>(t + 1) / static_cast<std::size_t>(vertex_threads);
+      for (std::size_t i = begin; i < end; ++i) {
+        unsigned code = 0;
+        for (int p = 0; p < 5; ++p)
+          if (!(PlaneDistance(clip[i], p, guard_) >= 0.0f)) code |= 1u << p;
+        SnappedVertex& v = snapped_[vertex_offsets_[m] + i];
+        // Inside every plane yet not snappable cannot happen; be safe anyway.
+        if (code == 0 && !Snap(clip[i], v)) code = 1u;
+        outcodes_[vertex_offsets_[m] + i] = static_cast<std::uint8_t>(code);
+      }
+    }
+  });
   const int threads = static_cast<int>(
       std::max<std::size_t>(1, std::min<std::size_t>(static_cast<std::size_t>(settings.threads),
                                                       total / 1024 + 1)));
@@ -324,39 +372,6 @@ void Rasterizer::RasterizeTile(int tile, std::span<float> depth,
       row[2] += step_y[2];
     }
   }
-}
-
-glm::vec3 Rasterizer::Barycentrics(std::uint32_t id, int sx, int sy) const {
-  const RasterTriangle& tri = triangle(id);
-  float b[3];
-  for (int i = 0; i < 3; ++i) {
-    const int a = (i + 1) % 3, c = (i + 2) % 3;
-    b[i] = static_cast<float>(EdgeValue(tri.x[a], tri.y[a], tri.x[c], tri.y[c], sx, sy)) *
-           tri.inv_w[i];
-  }
-  const float inv_sum = 1.0f / (b[0] + b[1] + b[2]);
-  const glm::vec3 local(b[0] * inv_sum, b[1] * inv_sum, b[2] * inv_sum);
-  if (tri.clip_slot < 0) {
-    glm::vec3 out;
-    out[tri.order[0]] = local[0];
-    out[tri.order[1]] = local[1];
-    out[tri.order[2]] = local[2];
-    return out;
-  }
-  return per_thread_[id >> kThreadShift].corner_weights[static_cast<std::size_t>(tri.clip_slot)] *
-         local;
-}
-
-float Rasterizer::InverseDepth(std::uint32_t id, int sx, int sy) const {
-  const RasterTriangle& tri = triangle(id);
-  float num = 0.0f, den = 0.0f;
-  for (int i = 0; i < 3; ++i) {
-    const int a = (i + 1) % 3, c = (i + 2) % 3;
-    const auto e = static_cast<float>(EdgeValue(tri.x[a], tri.y[a], tri.x[c], tri.y[c], sx, sy));
-    num += e * tri.inv_w[i];
-    den += e;
-  }
-  return num / den;
 }
 
 }  // namespace render

@@ -7,7 +7,7 @@
 // with kSubpixelBits fractional bits, binning into square tiles) ->
 // RasterizeTile() per tile (integer edge functions with an exact top-left fill
 // rule, z-buffer on 1/w) -> a visibility buffer (nearest triangle id per
-// sample) that the caller shades with Barycentrics().
+// sample) that the caller shades (see Renderer).
 //
 // Coordinates: "samples" are the pixels of the (possibly supersampled) raster,
 // row 0 at the top; sample (x, y) is tested at its centre (x + 0.5, y + 0.5).
@@ -99,10 +99,6 @@ class Rasterizer {
     return per_thread_[id >> kThreadShift].triangles[id & kLocalMask];
   }
 
-  // Perspective-correct barycentric weights of the *source* triangle's three
-  // corners at the centre of sample (sx, sy), for visibility id `id`.
-  glm::vec3 Barycentrics(std::uint32_t id, int sx, int sy) const;
-
   // Source-corner weights of a clipped triangle's vertices (column i =
   // weights of vertex i), or nullptr when the triangle was not clipped.
   const glm::mat3* corner_weights(std::uint32_t id) const {
@@ -111,9 +107,6 @@ class Rasterizer {
                              : &per_thread_[id >> kThreadShift]
                                     .corner_weights[static_cast<std::size_t>(tri.clip_slot)];
   }
-
-  // 1 / view depth of triangle `id` at the centre of sample (sx, sy).
-  float InverseDepth(std::uint32_t id, int sx, int sy) const;
 
   // Visits every setup triangle in order (for tests).
   template <class Fn>
@@ -130,6 +123,14 @@ class Rasterizer {
     std::vector<glm::mat3> corner_weights;  // column i: source-corner weights of vertex i
     std::vector<std::uint32_t> tile_counts;  // per tile
   };
+  struct SnappedVertex {
+    std::int32_t x, y;  // fixed-point sample coordinates
+    float inv_w;        // 1 / clip w
+  };
+  bool Snap(const glm::vec4& clip, SnappedVertex& v) const;
+  bool EmitSnapped(const SnappedVertex& v0, const SnappedVertex& v1, const SnappedVertex& v2,
+                   const glm::mat3* weights, std::uint32_t mesh, std::uint32_t triangle,
+                   PerThread& out) const;
   void SetupRange(std::span<const ClipMesh> meshes, std::size_t begin, std::size_t end,
                   PerThread& out) const;
   void EmitClipped(const glm::vec4 (&clip)[3], std::uint32_t mesh, std::uint32_t triangle,
@@ -141,6 +142,9 @@ class Rasterizer {
   bool cull_ = false;
   float guard_ = 1.0f;  // NDC guard band: |x|,|y| <= guard_ * w keeps fixed point in range
   std::vector<PerThread> per_thread_;
+  std::vector<std::size_t> vertex_offsets_;   // per mesh, into snapped_ / outcodes_
+  std::vector<SnappedVertex> snapped_;        // per vertex, valid where its outcode is 0
+  std::vector<std::uint8_t> outcodes_;        // per vertex: bit p set = outside clip plane p
   std::vector<std::uint32_t> tile_offsets_;  // num_tiles + 1
   std::vector<std::uint32_t> bins_;          // triangle ids grouped by tile
 };

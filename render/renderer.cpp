@@ -187,7 +187,7 @@ class Renderer::SampleShader {
                const RenderSettings& settings, const Renderer& renderer)
       : raster_(raster), meshes_(meshes), settings_(settings), r_(renderer) {}
 
-  glm::vec3 Shade(std::uint32_t id, int sx, int sy) {
+  [[gnu::always_inline]] glm::vec3 Shade(std::uint32_t id, int sx, int sy) {
     Entry& t = cache_[id & (kCacheSize - 1)];
     if (t.id != id) Load(id, t);
     // Perspective-correct weights up to a common scale: edge function times
@@ -220,15 +220,16 @@ class Renderer::SampleShader {
     if (t.interpolate_color) albedo = l0 * t.col[0] + l1 * t.col[1] + l2 * t.col[2];
     if (model == LightingModel::kUnlit) return albedo;
     glm::vec3 n = t.face_normal;
-    if (t.smooth) {
-      // Unnormalized weights suffice: the normal is renormalized.
-      n = w0 * t.n[0] + w1 * t.n[1] + w2 * t.n[2];
-      const float len2 = glm::dot(n, n);
-      n = len2 > 0.0f ? n * (1.0f / std::sqrt(len2)) : t.face_normal;
-    }
+    // Unnormalized weights suffice: the interpolated normal is renormalized.
+    if (t.smooth) n = w0 * t.n[0] + w1 * t.n[1] + w2 * t.n[2];
+    const float len2 = glm::dot(n, n);
     if (model == LightingModel::kLambert) {
-      return albedo * (ctx.ambient + ctx.key_radiance * std::max(glm::dot(n, ctx.key_dir), 0.0f));
+      // N.L / |N|, with the square root only for lit samples.
+      const float d = glm::dot(n, ctx.key_dir);
+      const float n_dot_l = d > 0.0f && len2 > 0.0f ? d / std::sqrt(len2) : 0.0f;
+      return albedo * (ctx.ambient + ctx.key_radiance * n_dot_l);
     }
+    n = len2 > 0.0f ? n * (1.0f / std::sqrt(len2)) : t.face_normal;
     const glm::vec3 p = l0 * t.p[0] + l1 * t.p[1] + l2 * t.p[2];
     return ShadeSurface(ctx, albedo, n, p);
   }
@@ -243,7 +244,7 @@ class Renderer::SampleShader {
     glm::vec3 n[3], col[3], p[3], face_normal{0.0f, 0.0f, 1.0f}, albedo{1.0f};
   };
 
-  void Load(std::uint32_t id, Entry& t) const {
+  [[gnu::noinline]] void Load(std::uint32_t id, Entry& t) const {
     t.id = id;
     const RasterTriangle& tri = raster_.triangle(id);
     t.ref_x = tri.min_x;
@@ -317,7 +318,6 @@ void Renderer::ShadeTile(int tile, const RenderSettings& settings,
   const float inf = std::numeric_limits<float>::infinity();
 
   SampleShader shader(rasterizer_, meshes, settings, *this);
-  auto shade = [&](std::uint32_t id, int sx, int sy) { return shader.Shade(id, sx, sy); };
 
   if (ss == 1) {
     for (int sy = y0; sy < y1; ++sy) {
@@ -330,7 +330,7 @@ void Renderer::ShadeTile(int tile, const RenderSettings& settings,
         const std::size_t at = row + static_cast<std::size_t>(sx - x0);
         const std::uint32_t id = s.ids[at];
         const bool hit = id != kNoTriangle;
-        StreamStore(rgba, hit ? glm::vec4(shade(id, sx, sy), 1.0f) : bg);
+        StreamStore(rgba, hit ? glm::vec4(shader.Shade(id, sx, sy), 1.0f) : bg);
         if (depth != nullptr) StreamStore(depth++, hit ? 1.0f / s.depth[at] : inf);
       }
     }
@@ -354,7 +354,7 @@ void Renderer::ShadeTile(int tile, const RenderSettings& settings,
       if (id == kNoTriangle) {
         if (!transparent) acc += glm::vec4(bg, 0.0f);
       } else {
-        acc += glm::vec4(shade(id, sx, sy), 1.0f);
+        acc += glm::vec4(shader.Shade(id, sx, sy), 1.0f);
         float& nearest = s.nearest[out_row + static_cast<std::size_t>((sx - x0) / ss)];
         nearest = std::min(nearest, 1.0f / s.depth[at]);
       }
