@@ -83,6 +83,12 @@ class Rasterizer {
   // Number of setup triangles (clipped pieces count separately).
   std::size_t num_triangles() const;
 
+  // Number of triangles binned to `tile` (0 = the tile shows only background).
+  std::uint32_t tile_triangle_count(int tile) const {
+    const auto t = static_cast<std::size_t>(tile);
+    return tile_offsets_[t + 1] - tile_offsets_[t];
+  }
+
   // Rasterizes tile `tile` (row-major over tiles_x() x tiles_y()) into
   // kTileSize x kTileSize buffers, row-major over the tile with row stride
   // kTileSize: `depth` gets the largest 1/w seen (0 = empty) and `ids` the id of

@@ -159,6 +159,10 @@ mocap::JobStatus Renderer::Render(const Camera& camera, std::span<const SceneMes
   }
   internal::ParallelForDynamic(rasterizer_.num_tiles(), threads, [&](int tile, int thread) {
     TileScratch& s = scratch_[static_cast<std::size_t>(thread)];
+    if (rasterizer_.tile_triangle_count(tile) == 0) {
+      FillBackgroundTile(tile, settings, image);
+      return;
+    }
     rasterizer_.RasterizeTile(tile, s.depth, s.ids);
     ShadeTile(tile, settings, meshes, s, image);
   });
@@ -377,6 +381,37 @@ void Renderer::ShadeTile(int tile, const RenderSettings& settings,
       if (write_depth) image.depth[out] = s.nearest[local];
     }
   }
+}
+
+void Renderer::FillBackgroundTile(int tile, const RenderSettings& settings, Image& image) const {
+  // Same values the shading path gives an empty pixel: the box average of the
+  // background rows it covers (transparent: zero colour and alpha).
+  const int ss = settings.supersample;
+  const int ox0 = (tile % rasterizer_.tiles_x()) * kTileSize / ss;
+  const int oy0 = (tile / rasterizer_.tiles_x()) * kTileSize / ss;
+  const int ox1 = std::min(ox0 + kTileSize / ss, image.width);
+  const int oy1 = std::min(oy0 + kTileSize / ss, image.height);
+  const float inf = std::numeric_limits<float>::infinity();
+  const float inv_n = 1.0f / static_cast<float>(ss * ss);
+  for (int oy = oy0; oy < oy1; ++oy) {
+    glm::vec4 color(0.0f);
+    if (!settings.background.transparent) {
+      // Sum in the order ShadeTile accumulates: sample rows, then columns.
+      glm::vec4 acc(0.0f);
+      for (int j = 0; j < ss; ++j)
+        for (int i = 0; i < ss; ++i)
+          acc += glm::vec4(background_rows_[static_cast<std::size_t>(oy * ss + j)], 0.0f);
+      color = ss == 1 ? glm::vec4(background_rows_[static_cast<std::size_t>(oy)], 1.0f)
+                      : glm::vec4(glm::vec3(acc) * inv_n, 1.0f);
+    }
+    glm::vec4* rgba = image.rgba.data() + image.index(ox0, oy);
+    for (int ox = ox0; ox < ox1; ++ox) StreamStore(rgba++, color);
+    if (!image.depth.empty()) {
+      float* depth = image.depth.data() + image.index(ox0, oy);
+      for (int ox = ox0; ox < ox1; ++ox) StreamStore(depth++, inf);
+    }
+  }
+  StreamFence();
 }
 
 Image Render(const Camera& camera, std::span<const SceneMesh> meshes, const Overlays& overlays,

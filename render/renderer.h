@@ -78,6 +78,7 @@ class Renderer {
     std::vector<float> nearest;             // output pixels of one tile: min view depth
   };
   class SampleShader;
+  void FillBackgroundTile(int tile, const RenderSettings& settings, Image& image) const;
   void ShadeTile(int tile, const RenderSettings& settings, std::span<const SceneMesh> meshes,
                  TileScratch& scratch, Image& image) const;
 
