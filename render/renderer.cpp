@@ -280,13 +280,21 @@ class Renderer::SampleShader {
     }
     const SceneMesh& mesh = meshes_[tri.mesh];
     const glm::uvec3 v = mesh.triangles[tri.triangle];
-    for (int k = 0; k < 3; ++k) corner[k] = mesh.positions[v[k]];
-    t.face_normal = glm::cross(corner[1] - corner[0], corner[2] - corner[0]);
-    const float len2 = glm::dot(t.face_normal, t.face_normal);
-    t.face_normal = len2 > 0.0f ? t.face_normal * (1.0f / std::sqrt(len2)) : glm::vec3(0, 0, 1);
-    if (tri.back_facing) t.face_normal = -t.face_normal;
-    if (r_.context_.model == LightingModel::kBlinnPhong) to_vertices(corner, t.p);
     t.smooth = settings_.shading == ShadingMode::kSmooth && !mesh.normals.empty();
+    const bool need_positions = r_.context_.model == LightingModel::kBlinnPhong;
+    if (!t.smooth || need_positions) {
+      for (int k = 0; k < 3; ++k) corner[k] = mesh.positions[v[k]];
+      if (need_positions) to_vertices(corner, t.p);
+    }
+    // The geometric normal shades flat triangles. A smooth triangle whose
+    // interpolated normal vanishes gets ambient light only (zero normal).
+    t.face_normal = glm::vec3(0.0f);
+    if (!t.smooth) {
+      const glm::vec3 f = glm::cross(corner[1] - corner[0], corner[2] - corner[0]);
+      const float len2 = glm::dot(f, f);
+      t.face_normal = len2 > 0.0f ? f * (1.0f / std::sqrt(len2)) : glm::vec3(0.0f);
+      if (tri.back_facing) t.face_normal = -t.face_normal;
+    }
     if (t.smooth) {
       const float sign = tri.back_facing ? -1.0f : 1.0f;
       for (int k = 0; k < 3; ++k) corner[k] = sign * mesh.normals[v[k]];
