@@ -91,5 +91,14 @@ inline constexpr float kMinTriangleAreaFraction = 1e-9f;
 inline constexpr float kMannequinHeightTolFraction = 0.25f;
 // Cross-section area ratios of a 64-gon ring (polygon vs analytic shrink).
 inline constexpr float kAreaRatioTol = 0.01f;
+// Rendered colour against an analytic value where only float round-off and
+// 1/256-pixel vertex snapping differ (perspective-correct interpolation).
+inline constexpr float kRenderTol = 2e-3f;
+// Shading of a tessellated sphere against the analytic sphere's N.L (the
+// interpolated normal of a 64x128 UV sphere is off by well under 1 degree).
+inline constexpr float kTessellatedShadingTol = 5e-3f;
+// A smoothly varying shaded value read at the pixel containing a projected
+// point rather than at the point itself.
+inline constexpr float kPixelFootprintTol = 2e-2f;
 
 }  // namespace testsupport

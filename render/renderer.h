@@ -1,0 +1,101 @@
+#pragma once
+// The top-level frame renderer: camera + meshes + overlays -> Image.
+//
+//   render::Renderer renderer;                 // keep one per output stream
+//   render::RenderSettings settings{.width = 1280, .height = 720, .supersample = 2};
+//   render::SceneMesh body{.positions = p, .normals = n, .triangles = t};
+//   mocap::JobStatus s = renderer.Render(camera, {&body, 1}, overlays, settings, image);
+//
+// Stages: world -> clip transform (threaded over vertices), rasterizer setup
+// and binning, then per 64x64-sample tile: visibility (z-buffer) pass,
+// deferred shading of each visible sample once, box resolve of the
+// supersample x supersample samples of each output pixel; then overlays.
+// Output bytes are identical for any thread count.
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "mocap/error.h"
+#include "render/camera.h"
+#include "render/image.h"
+#include "render/overlay.h"
+#include "render/rasterizer.h"
+#include "render/shading.h"
+
+namespace render {
+
+// One triangle mesh in world space. Spans are borrowed for the Render call.
+struct SceneMesh {
+  std::span<const glm::vec3> positions{};        // #V world-space positions
+  std::span<const glm::vec3> normals{};          // #V unit normals, or empty (flat shading)
+  std::span<const glm::uvec3> triangles{};       // #T vertex indices, counter-clockwise = front
+  std::span<const glm::vec3> vertex_colors{};    // #V linear RGB albedo, or empty
+  std::span<const glm::vec3> triangle_colors{};  // #T albedo per triangle (e.g. per patch), or
+                                               // empty; wins over vertex_colors
+  glm::vec3 base_color{0.75f, 0.72f, 0.68f};   // albedo when both colour spans are empty
+  bool casts_contact_shadow = true;            // darken the ground under this mesh
+};
+
+struct RenderSettings {
+  int width = 1280;        // output pixels, >= 1; width * supersample <= 16384
+  int height = 720;        // output pixels, >= 1; height * supersample <= 16384
+  int supersample = 1;     // samples per axis per pixel: 1, 2 or 4 (box resolve)
+  int threads = 0;         // worker threads; 0 = hardware concurrency
+  bool cull_back_faces = false;
+  ShadingMode shading = ShadingMode::kSmooth;
+  LightingModel lighting = LightingModel::kBlinnPhong;
+  LightRig lights;
+  bool ground = true;          // draw the ground plane
+  bool ground_at_scene_min = true;  // place the ground at the lowest scene y ...
+  float ground_y = 0.0f;       // ... or at this world y when ground_at_scene_min is false
+  GroundStyle ground_style;
+  Background background;
+  bool write_depth = true;     // fill Image::depth (needed for depth-tested overlays)
+};
+
+// Renders frames, reusing its buffers between calls; not thread-safe itself
+// (it uses its own threads inside Render).
+class Renderer {
+ public:
+  // Validates sizes (spans against #V/#T, settings ranges), then renders into
+  // `image`, resizing it to width x height. Triangles with out-of-range
+  // indices are skipped. On a bad argument returns the failed check and leaves
+  // `image` untouched.
+  mocap::JobStatus Render(const Camera& camera, std::span<const SceneMesh> meshes,
+                          const Overlays& overlays, const RenderSettings& settings, Image& image);
+
+  // The rasterizer of the last frame (for tests and statistics).
+  const Rasterizer& rasterizer() const { return rasterizer_; }
+
+ private:
+  struct TileScratch {
+    std::vector<float> depth;               // kTileSize^2 samples, 1/view depth
+    std::vector<std::uint32_t> ids;         // kTileSize^2 samples
+    std::vector<glm::vec4> accum;           // output pixels of one tile: rgb sum, covered count
+    std::vector<float> nearest;             // output pixels of one tile: min view depth
+  };
+  class SampleShader;
+  void FillBackgroundTile(int tile, const RenderSettings& settings, Image& image) const;
+  void ShadeTile(int tile, const RenderSettings& settings, std::span<const SceneMesh> meshes,
+                 TileScratch& scratch, Image& image) const;
+
+  Rasterizer rasterizer_;
+  std::vector<std::vector<glm::vec4>> clip_positions_;  // per mesh (+ ground), #V
+  std::vector<glm::vec3> ground_positions_;             // 4 corners of the ground quad
+  std::vector<glm::uvec3> ground_triangles_;            // its 2 triangles
+  std::vector<ContactShadow> shadows_;
+  std::vector<glm::vec3> background_rows_;              // per sample row
+  std::vector<TileScratch> scratch_;                    // per thread
+  ShadingContext context_;
+  float grid_spacing_ = 1.0f;
+};
+
+// One-shot convenience: a temporary Renderer. Returns an empty image when the
+// arguments fail validation.
+Image Render(const Camera& camera, std::span<const SceneMesh> meshes, const Overlays& overlays,
+             const RenderSettings& settings);
+
+}  // namespace render

@@ -1,0 +1,105 @@
+#include "render/shading.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace render {
+
+namespace {
+glm::vec3 ToWorld(const glm::mat3& world_from_view, const glm::vec3& v) {
+  const float len = glm::length(v);
+  return len > 0.0f ? world_from_view * (v / len) : glm::vec3(0.0f, 0.0f, 1.0f);
+}
+}  // namespace
+
+ShadingContext MakeShadingContext(const LightRig& rig, LightingModel model,
+                                  const glm::mat4& view_from_world) {
+  ShadingContext ctx;
+  ctx.model = model;
+  const glm::mat4 world_from_view = glm::inverse(view_from_world);
+  ctx.eye = glm::vec3(world_from_view[3]);
+  const glm::mat3 rotation(world_from_view);
+  ctx.key_dir = ToWorld(rotation, rig.key.direction_view);
+  ctx.fill_dir = ToWorld(rotation, rig.fill.direction_view);
+  ctx.rim_dir = ToWorld(rotation, rig.rim.direction_view);
+  ctx.key_radiance = rig.key.color * rig.key.intensity;
+  ctx.fill_radiance = rig.fill.color * rig.fill.intensity;
+  ctx.rim_radiance = rig.rim.color * rig.rim.intensity;
+  ctx.ambient = rig.ambient;
+  ctx.specular = rig.specular;
+  ctx.shininess = rig.shininess;
+  return ctx;
+}
+
+glm::vec3 ShadeSurface(const ShadingContext& ctx, const glm::vec3& albedo,
+                       const glm::vec3& normal, const glm::vec3& position) {
+  switch (ctx.model) {
+    case LightingModel::kUnlit:
+      return albedo;
+    case LightingModel::kLambert: {
+      const float n_dot_l = std::max(glm::dot(normal, ctx.key_dir), 0.0f);
+      return albedo * (ctx.ambient + ctx.key_radiance * n_dot_l);
+    }
+    case LightingModel::kBlinnPhong:
+      break;
+  }
+  const glm::vec3 view = glm::normalize(ctx.eye - position);
+  glm::vec3 diffuse = ctx.ambient;
+  glm::vec3 spec(0.0f);
+  const glm::vec3* dirs[3] = {&ctx.key_dir, &ctx.fill_dir, &ctx.rim_dir};
+  const glm::vec3* radiance[3] = {&ctx.key_radiance, &ctx.fill_radiance, &ctx.rim_radiance};
+  for (int i = 0; i < 3; ++i) {
+    const float n_dot_l = glm::dot(normal, *dirs[i]);
+    if (n_dot_l <= 0.0f) continue;
+    diffuse += *radiance[i] * n_dot_l;
+    if (ctx.specular > 0.0f) {
+      const glm::vec3 half = glm::normalize(*dirs[i] + view);
+      const float n_dot_h = glm::dot(normal, half);
+      if (n_dot_h > 0.0f) spec += *radiance[i] * (ctx.specular * std::pow(n_dot_h, ctx.shininess));
+    }
+  }
+  return albedo * diffuse + spec;
+}
+
+glm::vec3 GroundAlbedo(const GroundStyle& style, float grid_spacing, const glm::vec3& position) {
+  if (!(grid_spacing > 0.0f)) return style.color;
+  const float half_width = 0.5f * style.line_width;
+  const float u = position.x / grid_spacing, v = position.z / grid_spacing;
+  const float du = std::abs(u - std::round(u)), dv = std::abs(v - std::round(v));
+  // Soft-edged lines: full line colour inside the width, fading over the same width.
+  const float d = std::min(du, dv);
+  const float line = 1.0f - std::clamp((d - half_width) / std::max(half_width, 1e-6f), 0.0f, 1.0f);
+  return style.color + (style.line_color - style.color) * line;
+}
+
+float ContactShadowFactor(std::span<const ContactShadow> shadows, const glm::vec3& position) {
+  float factor = 1.0f;
+  for (const ContactShadow& s : shadows) {
+    const glm::vec2 d = (glm::vec2(position.x, position.z) - s.centre_xz) / s.radius_xz;
+    const float r2 = glm::dot(d, d);
+    if (r2 < 9.0f) factor *= 1.0f - s.strength * std::exp(-2.0f * r2);
+  }
+  return factor;
+}
+
+ContactShadow ShadowUnder(const deform::Bounds& bounds, float ground_y, float strength) {
+  ContactShadow shadow;
+  if (bounds.empty()) {
+    shadow.strength = 0.0f;
+    return shadow;
+  }
+  const glm::vec3 size = bounds.size();
+  shadow.centre_xz = glm::vec2(bounds.center().x, bounds.center().z);
+  const float footprint = std::max(0.5f * std::max(size.x, size.z), 1e-4f);
+  shadow.radius_xz = glm::max(0.6f * glm::vec2(size.x, size.z), glm::vec2(0.3f * footprint));
+  // Fade with the gap between the object's lowest point and the ground.
+  const float gap = std::max(bounds.min.y - ground_y, 0.0f);
+  shadow.strength = strength / (1.0f + 4.0f * gap / footprint);
+  return shadow;
+}
+
+glm::vec3 BackgroundColor(const Background& background, float t) {
+  return background.top + (background.bottom - background.top) * std::clamp(t, 0.0f, 1.0f);
+}
+
+}  // namespace render
