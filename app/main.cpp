@@ -6,15 +6,23 @@
 
 #include <CLI/CLI.hpp>
 
+#include "app/compare_command.h"
+
 int main(int argc, char** argv) {
   CLI::App app{"patchskin: motion-capture driven layered skinning and software rendering"};
   app.set_version_flag("--version", std::string("patchskin 0.1.0"));
   app.require_subcommand(0, 1);
+  app::CompareCommandOptions compare_options;
+  CLI::App* compare = app::AddCompareCommand(app, &compare_options);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e) == 0 ? 0 : 1;
+    const int code = app.exit(e);
+    if (code == 0) return 0;
+    // compare follows idiff: 1 means "images differ", so its usage errors are 2.
+    return compare->parsed() ? app::kCompareError : 1;
   }
+  if (compare->parsed()) return app::RunCompareCommand(compare_options);
   if (app.get_subcommands().empty()) {
     std::fputs(app.help().c_str(), stdout);
   }
