@@ -1,6 +1,6 @@
 // patchskin: the command line. Parses arguments and dispatches to a subcommand;
-// no algorithm lives here. Exit codes: 0 ok, 1 usage (or a failed comparison),
-// 2 bad input, 3 internal error.
+// no algorithm lives here. Exit codes: 0 ok, 1 usage (or, for compare, images
+// that differ), 2 bad input, 3 internal error.
 
 #include <cstdio>
 #include <exception>
@@ -8,6 +8,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "app/compare_command.h"
 #include "app/inspect_command.h"
 
 int main(int argc, char** argv) {
@@ -17,14 +18,20 @@ int main(int argc, char** argv) {
 
   app::InspectOptions inspect_options;
   CLI::App* inspect = app::AddInspectCommand(app, inspect_options);
+  app::CompareCommandOptions compare_options;
+  CLI::App* compare = app::AddCompareCommand(app, &compare_options);
 
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e) == 0 ? 0 : 1;
+    const int code = app.exit(e);
+    if (code == 0) return 0;
+    // compare follows idiff: 1 means "images differ", so its usage errors are 2.
+    return compare->parsed() ? app::kCompareError : 1;
   }
   try {
     if (inspect->parsed()) return app::RunInspect(inspect_options);
+    if (compare->parsed()) return app::RunCompareCommand(compare_options);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "patchskin: internal error: %s\n", e.what());
     return 3;

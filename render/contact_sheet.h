@@ -1,0 +1,86 @@
+#pragma once
+// Contact sheet: a grid of downscaled frames, each with its frame number written
+// under it, for a quick look at a whole sequence in one picture.
+//
+// Layout (all in pixels; n frames, c = min(columns, n) columns, r = ceil(n / c) rows):
+//   cell      = thumb_width x (thumb_height + label_height)
+//   width     = c * thumb_width + (c + 1) * padding
+//   height    = r * (thumb_height + label_height) + (r + 1) * padding
+// thumb_height keeps the frames' aspect: round(thumb_width * frame_h / frame_w).
+// Frames fill the grid row by row in the order added. Thumbnails are area-averaged
+// in linear light (OpenCV INTER_AREA); labels are drawn with cv::putText.
+//
+// The builder downsizes each frame as it is added, so a long sequence costs one
+// thumbnail per frame, not one frame.
+
+#include <memory>
+#include <span>
+
+#include "mocap/error.h"
+#include "render/image.h"
+
+namespace render {
+
+using mocap::Result;
+using mocap::Status;
+
+struct ContactSheetOptions {
+  int columns = 6;          // >= 1
+  int thumb_width = 192;    // pixels, >= 8
+  int padding = 6;          // pixels between and around cells, >= 0
+  int label_height = 20;    // pixels of label strip under each thumbnail, >= 0 (0: no labels)
+  glm::vec4 background{0.05f, 0.05f, 0.05f, 1.0f};  // linear RGBA
+  glm::vec4 text_color{1.0f, 1.0f, 1.0f, 1.0f};     // linear RGBA
+};
+
+// Sheet size for `num_frames` frames of frame_width x frame_height (see layout).
+struct ContactSheetLayout {
+  int columns = 0;
+  int rows = 0;
+  int thumb_width = 0;
+  int thumb_height = 0;
+  int width = 0;   // whole sheet
+  int height = 0;
+};
+[[nodiscard]] Result<ContactSheetLayout> ComputeContactSheetLayout(
+    int num_frames, int frame_width, int frame_height, const ContactSheetOptions& options);
+
+class ContactSheetBuilder {
+ public:
+  // All frames must be frame_width x frame_height. Errors: kInvalidArgument for
+  // option values out of range, a non-positive count or size, or a sheet over 2^26 pixels.
+  [[nodiscard]] static Result<std::unique_ptr<ContactSheetBuilder>> Create(
+      int num_frames, int frame_width, int frame_height, const ContactSheetOptions& options = {});
+  ~ContactSheetBuilder();
+
+  // Puts `frame` into the next cell, labelled `frame_number`. Errors: wrong size,
+  // more frames than announced.
+  [[nodiscard]] Status Add(const Image& frame, int frame_number);
+
+  // The sheet so far (cells not yet filled show the background).
+  const Image& sheet() const { return sheet_; }
+  const ContactSheetLayout& layout() const { return layout_; }
+  int frames_added() const { return added_; }
+
+ private:
+  ContactSheetBuilder() = default;
+  ContactSheetOptions options_;
+  ContactSheetLayout layout_;
+  int num_frames_ = 0;
+  int frame_width_ = 0;
+  int frame_height_ = 0;
+  int added_ = 0;
+  Image sheet_;
+};
+
+// One frame for MakeContactSheet.
+struct NumberedFrame {
+  const Image* image = nullptr;  // not owned, not null
+  int frame_number = 0;
+};
+
+// Whole sheet in one call (all frames the same size).
+[[nodiscard]] Result<Image> MakeContactSheet(std::span<const NumberedFrame> frames,
+                                             const ContactSheetOptions& options = {});
+
+}  // namespace render
