@@ -10,6 +10,7 @@
 
 #include "app/compare_command.h"
 #include "app/inspect_command.h"
+#include "app/render_command.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"patchskin: motion-capture driven layered skinning and software rendering"};
@@ -18,6 +19,11 @@ int main(int argc, char** argv) {
 
   app::InspectOptions inspect_options;
   CLI::App* inspect = app::AddInspectCommand(app, inspect_options);
+  app::RenderOptions render_options;
+  CLI::App* render = app::AddRenderCommand(app, render_options);
+  app::RenderOptions turntable_options;
+  turntable_options.camera = "turntable";
+  CLI::App* turntable = app::AddTurntableCommand(app, turntable_options);
   app::CompareCommandOptions compare_options;
   CLI::App* compare = app::AddCompareCommand(app, &compare_options);
 
@@ -31,6 +37,8 @@ int main(int argc, char** argv) {
   }
   try {
     if (inspect->parsed()) return app::RunInspect(inspect_options);
+    if (render->parsed()) return app::RunRender(render_options);
+    if (turntable->parsed()) return app::RunRender(turntable_options);
     if (compare->parsed()) return app::RunCompareCommand(compare_options);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "patchskin: internal error: %s\n", e.what());

@@ -17,7 +17,33 @@ std::string LowerExtension(const std::string& path) {
   return ext;
 }
 
+mocap::BvhReadOptions BvhOptions(const MotionSourceOptions& options) {
+  mocap::BvhReadOptions bvh;
+  bvh.scale = options.scale;
+  bvh.convert_to_y_up = options.y_up;
+  bvh.position_mode = options.add_position_to_offset ? mocap::PositionChannelMode::kAddToOffset
+                                                     : mocap::PositionChannelMode::kReplaceOffset;
+  bvh.allow_short_motion = options.allow_short_motion;
+  return bvh;
+}
+
+MotionSource FromBvh(mocap::BvhFile&& file) {
+  MotionSource out;
+  out.format = "bvh";
+  out.skeleton = std::move(file.skeleton);
+  out.motion = std::move(file.motion);
+  out.warnings = std::move(file.warnings);
+  return out;
+}
+
 }  // namespace
+
+mocap::Result<MotionSource> LoadBvhText(std::string_view text, const std::string& name,
+                                        const MotionSourceOptions& options) {
+  mocap::Result<mocap::BvhFile> file = mocap::ParseBvh(text, name, BvhOptions(options));
+  if (!file.ok()) return std::move(file).error();
+  return FromBvh(std::move(*file));
+}
 
 mocap::Result<MotionSource> LoadMotionSource(const std::string& path,
                                              const MotionSourceOptions& options) {
@@ -34,19 +60,9 @@ mocap::Result<MotionSource> LoadMotionSource(const std::string& path,
   const std::string ext = LowerExtension(path);
   MotionSource out;
   if (ext == ".bvh") {
-    mocap::BvhReadOptions bvh;
-    bvh.scale = options.scale;
-    bvh.convert_to_y_up = options.y_up;
-    bvh.position_mode = options.add_position_to_offset ? mocap::PositionChannelMode::kAddToOffset
-                                                       : mocap::PositionChannelMode::kReplaceOffset;
-    bvh.allow_short_motion = options.allow_short_motion;
-    mocap::Result<mocap::BvhFile> file = mocap::ReadBvhFile(path, bvh);
+    mocap::Result<mocap::BvhFile> file = mocap::ReadBvhFile(path, BvhOptions(options));
     if (!file.ok()) return std::move(file).error();
-    out.format = "bvh";
-    out.skeleton = std::move(file->skeleton);
-    out.motion = std::move(file->motion);
-    out.warnings = std::move(file->warnings);
-    return out;
+    return FromBvh(std::move(*file));
   }
   if (ext == ".gltf" || ext == ".glb") {
     mocap::Result<deform::GltfModel> model = deform::ReadGltf(path);

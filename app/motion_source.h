@@ -5,6 +5,7 @@
 
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "deform/gltf_import.h"
@@ -37,5 +38,9 @@ struct MotionSource {
 // an unknown extension, anything the readers report) name the file.
 mocap::Result<MotionSource> LoadMotionSource(const std::string& path,
                                              const MotionSourceOptions& options);
+
+// Parses BVH text held in memory (the built-in demo); `name` labels messages.
+mocap::Result<MotionSource> LoadBvhText(std::string_view text, const std::string& name,
+                                        const MotionSourceOptions& options);
 
 }  // namespace app

@@ -1,0 +1,231 @@
+#include "app/pipeline.h"
+
+#include <algorithm>
+#include <array>
+#include <thread>
+
+#include "app/motion_source.h"
+#include "deform/dqs_job.h"
+#include "deform/skinning_job.h"
+#include "mocap/bvh_reader.h"
+#include "mocap/pose.h"
+#include "mocap/sampling.h"
+
+namespace app {
+namespace {
+
+inline constexpr int kMaxThreads = 64;
+
+// Runs fn(chunk, begin, end) over [0, n) split into `threads` contiguous ranges
+// (chunk = 0..threads-1). The jobs give the same bits for any split, so the
+// thread count never changes the output.
+template <typename Fn>
+void ParallelRanges(int n, int threads, Fn&& fn) {
+  threads = std::clamp(threads, 1, kMaxThreads);
+  if (threads == 1 || n < 4096) {
+    fn(0, 0, n);
+    return;
+  }
+  std::vector<std::thread> workers;
+  const int chunk = (n + threads - 1) / threads;
+  for (int t = 1; t < threads; ++t) {
+    const int begin = std::min(n, t * chunk);
+    const int end = std::min(n, begin + chunk);
+    if (begin < end) workers.emplace_back([&fn, t, begin, end] { fn(t, begin, end); });
+  }
+  fn(0, 0, std::min(n, chunk));
+  for (std::thread& w : workers) w.join();
+}
+
+template <typename T>
+std::span<T> Sub(std::vector<T>& v, int begin, int end, int stride = 1) {
+  return std::span<T>(v).subspan(static_cast<std::size_t>(begin * stride),
+                                 static_cast<std::size_t>((end - begin) * stride));
+}
+template <typename T>
+std::span<const T> Sub(const std::vector<T>& v, int begin, int end, int stride = 1) {
+  return std::span<const T>(v).subspan(static_cast<std::size_t>(begin * stride),
+                                       static_cast<std::size_t>((end - begin) * stride));
+}
+
+mocap::Error JobError(const Character& c, const mocap::JobStatus& s, const char* stage) {
+  return mocap::MakeError(mocap::ErrorCode::kInternal, {c.source, 0, 0, {}},
+                          std::string(stage) + " refused to run: " + s.what);
+}
+
+}  // namespace
+
+const char* GlobalMethodName(GlobalMethod method) {
+  switch (method) {
+    case GlobalMethod::kSsd: return "ssd";
+    case GlobalMethod::kDqs: return "dqs";
+    case GlobalMethod::kSwd: return "swd";
+  }
+  return "?";
+}
+
+mocap::Result<GlobalMethod> ParseGlobalMethod(const std::string& name) {
+  if (name == "ssd" || name == "lbs") return GlobalMethod::kSsd;
+  if (name == "dqs") return GlobalMethod::kDqs;
+  if (name == "swd") return GlobalMethod::kSwd;
+  return mocap::MakeError(mocap::ErrorCode::kInvalidArgument, {"--global", 0, 0, {}},
+                          "expected ssd, dqs or swd, found '" + name + "'");
+}
+
+mocap::Result<Character> MakeCharacter(MotionSource&& source,
+                                       const deform::MannequinOptions& mannequin) {
+  Character c;
+  c.source = source.gltf ? source.gltf->skeleton.info.source_file : source.skeleton.info.source_file;
+  c.skeleton = std::move(source.skeleton);
+  c.motion = std::move(source.motion);
+  c.warnings = std::move(source.warnings);
+  if (c.source.empty()) c.source = "<input>";
+  if (source.gltf) {
+    c.mesh = std::move(source.gltf->mesh);
+    return c;
+  }
+  const auto nj = static_cast<std::size_t>(c.skeleton.num_joints());
+  std::vector<mocap::JointTransform> locals(nj);
+  std::vector<glm::mat4> model(nj);
+  mocap::RestPose(c.skeleton, locals);
+  // A rest pose far lower than the first frame's is not a body pose (limbs
+  // folded or lying flat): build and bind the body at frame 0 instead.
+  const mocap::UpAxis up = c.skeleton.info.up_axis;
+  const float rest_h = mocap::RestHeight(c.skeleton, up);
+  const float first_h = mocap::FirstFrameHeight(c.skeleton, c.motion, up);
+  if (c.motion.num_frames > 0 && first_h > 1.3f * rest_h) {
+    (void)mocap::LocalPoseJob{&c.skeleton, c.motion.frame(0), locals}.Run();
+    c.bound_at_first_frame = true;
+  }
+  const mocap::JobStatus s =
+      mocap::LocalToModelJob{.parents = c.skeleton.parents, .locals = locals, .model_from_joint = model}
+          .Run();
+  if (!s) return JobError(c, s, "local-to-model");
+  mocap::Result<deform::SkinnedMesh> body = deform::BuildMannequin(c.skeleton, model, mannequin);
+  if (!body.ok()) {
+    mocap::Error e = std::move(body).error();
+    if (e.loc.file.empty()) e.loc.file = c.source;
+    return e;
+  }
+  c.mesh = std::move(*body);
+  return c;
+}
+
+struct FramePipeline::Impl {
+  const Character* character = nullptr;
+  GlobalMethod method = GlobalMethod::kSsd;
+  int threads = 1;
+  std::vector<mocap::JointTransform> locals, scratch;
+  std::vector<glm::mat4> model_from_joint;
+  std::vector<glm::mat4> palette;
+  std::vector<deform::DualQuat> dq_palette;
+};
+
+FramePipeline::FramePipeline(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+FramePipeline::FramePipeline(FramePipeline&&) noexcept = default;
+FramePipeline& FramePipeline::operator=(FramePipeline&&) noexcept = default;
+FramePipeline::~FramePipeline() = default;
+
+GlobalMethod FramePipeline::method() const { return impl_->method; }
+
+mocap::Result<FramePipeline> FramePipeline::Create(const Character& character, GlobalMethod method,
+                                                   int threads) {
+  if (method == GlobalMethod::kSwd) {
+    return mocap::MakeError(mocap::ErrorCode::kUnsupported, {character.source, 0, 0, {}},
+                            "--global swd is not available in this build yet");
+  }
+  const mocap::Status weights = deform::CheckSkinWeights(
+      character.mesh.weights, static_cast<int>(character.mesh.skin_joints.size()),
+      character.mesh.bind.num_vertices());
+  if (!weights.ok()) return weights.error();
+  auto impl = std::make_unique<Impl>();
+  impl->character = &character;
+  impl->method = method;
+  impl->threads = threads > 0 ? threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  const auto nj = static_cast<std::size_t>(character.skeleton.num_joints());
+  impl->locals.resize(nj);
+  impl->scratch.resize(nj);
+  impl->model_from_joint.resize(nj);
+  impl->palette.resize(character.mesh.skin_joints.size());
+  impl->dq_palette.resize(character.mesh.skin_joints.size());
+  return FramePipeline(std::move(impl));
+}
+
+mocap::Status FramePipeline::Evaluate(double time_s, DeformedFrame& out) {
+  Impl& m = *impl_;
+  const Character& c = *m.character;
+  const deform::SkinnedMesh& mesh = c.mesh;
+  if (c.motion.num_frames > 0) {
+    const mocap::JobStatus s = mocap::SampleLocalsJob{.skeleton = &c.skeleton, .motion = &c.motion,
+                                                      .time_s = time_s, .scratch = m.scratch,
+                                                      .locals = m.locals}
+                                   .Run();
+    if (!s) return JobError(c, s, "sampling");
+  } else {
+    mocap::RestPose(c.skeleton, m.locals);
+  }
+  mocap::JobStatus s = mocap::LocalToModelJob{.parents = c.skeleton.parents, .locals = m.locals,
+                                              .model_from_root = c.world_from_model,
+                                              .model_from_joint = m.model_from_joint}
+                           .Run();
+  if (!s) return JobError(c, s, "local-to-model");
+  s = deform::BuildSkinningPalette(m.model_from_joint, mesh, m.palette);
+  if (!s) return JobError(c, s, "palette");
+
+  const int nv = mesh.bind.num_vertices();
+  out.positions.resize(static_cast<std::size_t>(nv));
+  out.normals.resize(static_cast<std::size_t>(nv));
+  const int k = mesh.weights.influences;
+  const bool has_normals = !mesh.bind.normals.empty();
+  if (m.method == GlobalMethod::kDqs) {
+    s = deform::BuildDualQuatPalette(m.palette, m.dq_palette);
+    if (!s) return JobError(c, s, "dual quaternion palette");
+  }
+  std::array<mocap::JobStatus, kMaxThreads> results{};
+  ParallelRanges(nv, m.threads, [&](int chunk, int begin, int end) {
+    mocap::JobStatus r;
+    if (m.method == GlobalMethod::kDqs) {
+      r = deform::DqsJob{.palette = m.dq_palette,
+                         .influences = k,
+                         .joint_indices = Sub(mesh.weights.joints, begin, end, k),
+                         .joint_weights = Sub(mesh.weights.weights, begin, end, k),
+                         .rest_positions = Sub(mesh.bind.positions, begin, end),
+                         .rest_normals = has_normals ? Sub(mesh.bind.normals, begin, end)
+                                                     : std::span<const glm::vec3>(),
+                         .positions = Sub(out.positions, begin, end),
+                         .normals = Sub(out.normals, begin, end)}
+              .Run();
+    } else {
+      r = deform::SkinningJob{.model_from_bind = m.palette,
+                              .influences = k,
+                              .joint_indices = Sub(mesh.weights.joints, begin, end, k),
+                              .joint_weights = Sub(mesh.weights.weights, begin, end, k),
+                              .rest_positions = Sub(mesh.bind.positions, begin, end),
+                              .rest_normals = has_normals ? Sub(mesh.bind.normals, begin, end)
+                                                          : std::span<const glm::vec3>(),
+                              .positions = Sub(out.positions, begin, end),
+                              .normals = Sub(out.normals, begin, end)}
+              .Run();
+    }
+    results[static_cast<std::size_t>(chunk)] = r;
+  });
+  for (const mocap::JobStatus& r : results) {
+    if (!r) return JobError(c, r, GlobalMethodName(m.method));
+  }
+  if (has_normals) {
+    for (glm::vec3& n : out.normals) {
+      const float len = glm::length(n);
+      n = len > 0.0f ? n / len : glm::vec3(0.0f, 1.0f, 0.0f);
+    }
+  } else {
+    deform::ComputeVertexNormals(out.positions, mesh.bind.triangles, out.normals);
+  }
+  out.joint_positions.resize(m.model_from_joint.size());
+  for (std::size_t j = 0; j < m.model_from_joint.size(); ++j) {
+    out.joint_positions[j] = glm::vec3(m.model_from_joint[j][3]);
+  }
+  out.bounds = deform::ComputeBounds(out.positions);
+  return mocap::Status::Ok();
+}
+
+}  // namespace app

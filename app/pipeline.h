@@ -1,0 +1,90 @@
+#pragma once
+// The per-frame pipeline: the one place that decides the order of the stages
+// (ALGORITHMS.md section 0, STYLE.md section 3):
+//
+//   SampleLocals(t) -> LocalToModel -> GlobalDeform (SSD | DQS | SWD)
+//     -> [patch layer: PoseSpace dS -> MassSpring dE -> PatchRebuild -> BorderBlend]
+//     -> Normals -> (render)
+//
+// Why this order: every later stage reads the joint matrices; the global
+// deformation must move the skin (and, with patches, the control points)
+// before the local layer adds displacements in the frames the global layer
+// defines; normals come last because every stage before moves vertices.
+// Sampling is by time, not frame index, so --fps resampling and chunked
+// renders evaluate exactly the same poses.
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "deform/mannequin.h"
+#include "deform/mesh.h"
+#include "mocap/error.h"
+#include "mocap/motion.h"
+#include "mocap/skeleton.h"
+
+namespace app {
+
+struct MotionSource;
+
+enum class GlobalMethod { kSsd, kDqs, kSwd };
+const char* GlobalMethodName(GlobalMethod method);
+// "ssd", "dqs", "swd" (also "lbs" for ssd); kInvalidArgument otherwise.
+mocap::Result<GlobalMethod> ParseGlobalMethod(const std::string& name);
+
+// What gets deformed: a skeleton, its motion, and a skinned mesh bound to it
+// (the glTF's own mesh, or a mannequin generated from a BVH skeleton).
+struct Character {
+  std::string source;                  // file name (or "demo"), for messages and metadata
+  mocap::Skeleton skeleton;
+  mocap::Motion motion;
+  deform::SkinnedMesh mesh;
+  glm::mat4 world_from_model{1.0f};    // glTF: node transform of the skinned mesh is ignored
+                                       // (glTF rule), so identity; kept for other sources
+  bool bound_at_first_frame = false;   // BVH: the rest pose was not a body pose, so the
+                                       // mannequin was built and bound at frame 0
+  std::vector<mocap::Warning> warnings;
+};
+
+// Builds a Character from a loaded source: glTF keeps its mesh; BVH gets a
+// mannequin, bound at the rest pose unless the rest pose is much lower than the
+// first frame's pose (rest poses that lie flat, e.g. Bandai Namco's), in which
+// case it is bound at frame 0.
+mocap::Result<Character> MakeCharacter(MotionSource&& source,
+                                       const deform::MannequinOptions& mannequin = {});
+
+// One evaluated frame, in world space.
+struct DeformedFrame {
+  std::vector<glm::vec3> positions;        // #V
+  std::vector<glm::vec3> normals;          // #V unit normals
+  std::vector<glm::vec3> joint_positions;  // #J
+  deform::Bounds bounds;                   // of positions
+};
+
+// Evaluates a Character frame by frame. Owns its scratch buffers (reused
+// between frames); not thread-safe itself, uses `threads` workers inside.
+class FramePipeline {
+ public:
+  FramePipeline(FramePipeline&&) noexcept;
+  FramePipeline& operator=(FramePipeline&&) noexcept;
+  ~FramePipeline();
+
+  // Precomputes what the method needs (palettes, SWD bindings).
+  static mocap::Result<FramePipeline> Create(const Character& character, GlobalMethod method,
+                                             int threads);
+
+  // Deforms the character at `time_s` seconds from the motion's first frame
+  // (clamped to the motion). Never allocates after the first call.
+  mocap::Status Evaluate(double time_s, DeformedFrame& out);
+
+  GlobalMethod method() const;
+
+ private:
+  struct Impl;
+  explicit FramePipeline(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace app

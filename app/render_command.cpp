@@ -1,0 +1,459 @@
+#include "app/render_command.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <sstream>
+#include <vector>
+
+#include "app/demo_data.h"
+#include "app/motion_source.h"
+#include "app/pipeline.h"
+#include "app/progress.h"
+#include "render/async_writer.h"
+#include "render/camera.h"
+#include "render/contact_sheet.h"
+#include "render/image_io.h"
+#include "render/overlay.h"
+#include "render/renderer.h"
+#include "render/video_writer.h"
+
+namespace app {
+namespace {
+
+constexpr int kMaxSheetFrames = 24;
+constexpr float kFovYDeg = 35.0f;
+constexpr int kMaxImageSide = 16384;
+
+mocap::Error ArgError(const std::string& option, const std::string& message) {
+  return mocap::MakeError(mocap::ErrorCode::kInvalidArgument, {option, 0, 0, {}}, message);
+}
+
+mocap::Result<glm::ivec2> ParseSize(const std::string& text) {
+  int w = 0, h = 0;
+  char x = 0, extra = 0;
+  std::istringstream in(text);
+  if (!(in >> w >> x >> h) || (x != 'x' && x != 'X') || (in >> extra)) {
+    return ArgError("--size", "expected WIDTHxHEIGHT such as 1280x720, found '" + text + "'");
+  }
+  if (w < 16 || h < 16 || w > kMaxImageSide || h > kMaxImageSide) {
+    return ArgError("--size", "width and height must be within 16.." + std::to_string(kMaxImageSide) +
+                                  ", found " + text);
+  }
+  return glm::ivec2(w, h);
+}
+
+struct FrameRange {
+  int first = 0;
+  int last = 0;   // inclusive
+  int step = 1;
+};
+
+mocap::Result<FrameRange> ParseFrames(const std::string& text, int num_frames) {
+  FrameRange r{0, num_frames - 1, 1};
+  if (text.empty()) return r;
+  std::vector<std::string> parts;
+  std::stringstream ss(text);
+  for (std::string part; std::getline(ss, part, ':');) parts.push_back(part);
+  if (parts.empty() || parts.size() > 3) {
+    return ArgError("--frames", "expected A:B or A:B:STEP, found '" + text + "'");
+  }
+  auto parse_int = [&](const std::string& s, int fallback) -> std::optional<int> {
+    if (s.empty()) return fallback;
+    std::size_t used = 0;
+    try {
+      const long v = std::stol(s, &used);
+      if (used != s.size() || v < INT32_MIN || v > INT32_MAX) return std::nullopt;
+      return static_cast<int>(v);
+    } catch (...) {
+      return std::nullopt;
+    }
+  };
+  const auto a = parse_int(parts[0], 0);
+  const auto b = parse_int(parts.size() > 1 ? parts[1] : parts[0], num_frames - 1);
+  const auto c = parse_int(parts.size() > 2 ? parts[2] : "", 1);
+  if (!a || !b || !c) return ArgError("--frames", "expected whole numbers in '" + text + "'");
+  r = {*a, *b, *c};
+  if (r.step < 1) return ArgError("--frames", "STEP must be at least 1, found " + std::to_string(r.step));
+  if (r.first < 0 || r.last < r.first || r.last >= num_frames) {
+    return ArgError("--frames", "range " + text + " is outside the motion's frames 0.." +
+                                    std::to_string(num_frames - 1) + " (A <= B, both inclusive)");
+  }
+  return r;
+}
+
+std::vector<std::string> SplitList(const std::string& text) {
+  std::vector<std::string> out;
+  std::stringstream ss(text);
+  for (std::string item; std::getline(ss, item, ',');) {
+    if (!item.empty()) out.push_back(item);
+  }
+  return out;
+}
+
+// Everything about one output frame that the loop needs.
+struct OutputFrame {
+  int number = 0;      // output frame number (names the file)
+  double time_s = 0;   // motion time evaluated
+  int camera = 0;      // turntable camera index, or the follow-camera frame
+};
+
+void AddSkeleton(const DeformedFrame& f, const mocap::Skeleton& s, render::Overlays& o) {
+  render::LineOverlay bones;
+  bones.depth_test = false;
+  render::AppendSkeletonLines(f.joint_positions, s.parents, bones);
+  o.lines.push_back(std::move(bones));
+  render::PointOverlay joints;
+  joints.points = f.joint_positions;
+  joints.depth_test = false;
+  o.points.push_back(std::move(joints));
+}
+
+// Copies the right half of `right` over `left`, and draws a divider.
+void ComposeSplit(const render::Image& right, render::Image& left) {
+  const int mid = left.width / 2;
+  for (int y = 0; y < left.height; ++y) {
+    for (int x = mid; x < left.width; ++x) left.at(x, y) = right.at(x, y);
+    left.at(mid, y) = glm::vec4(1.0f);
+    if (mid > 0) left.at(mid - 1, y) = glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);
+  }
+}
+
+}  // namespace
+
+CLI::App* AddRenderCommand(CLI::App& parent, RenderOptions& o) {
+  CLI::App* cmd = parent.add_subcommand(
+      "render", "Render a capture (BVH on a mannequin) or a glTF animation to image frames");
+  cmd->add_option("input", o.input, "BVH, glTF or GLB file; none = the built-in demo");
+  cmd->add_option("--frames", o.frames, "A:B[:STEP] output frames, inclusive (default all)");
+  cmd->add_option("--fps", o.fps, "Output frame rate; the motion is resampled (default: its own)");
+  cmd->add_option("--size", o.size, "Image size WxH")->capture_default_str();
+  cmd->add_option("--out", o.out,
+                  "Output pattern; #### is the frame number, the extension picks the format "
+                  "(png, exr, tif, jpg). Default out/<name>/frame_####.png");
+  cmd->add_option("--global", o.global, "Global skinning: ssd, dqs or swd")->capture_default_str();
+  cmd->add_option("--camera", o.camera, "follow, fixed or turntable")->capture_default_str();
+  cmd->add_option("--turntable-frames", o.turntable_frames, "Images in a turntable")
+      ->capture_default_str();
+  cmd->add_option("--elevation", o.elevation_deg, "Camera elevation in degrees")
+      ->capture_default_str();
+  cmd->add_option("--overlay", o.overlay, "Comma list: skeleton, wire");
+  cmd->add_option("--split", o.split,
+                  "Left half one method, right half another (LEFT,RIGHT); default ssd,<global>")
+      ->expected(0, 1)
+      ->default_str("");
+  cmd->add_option("--threads", o.threads, "Worker threads (0 = all cores)")->capture_default_str();
+  cmd->add_option("--supersample", o.supersample, "Anti-aliasing samples per axis: 1, 2 or 4")
+      ->capture_default_str();
+  cmd->add_option("--png-compression", o.png_compression, "PNG zlib level 0..9")
+      ->capture_default_str();
+  cmd->add_flag("--no-sheet", o.no_sheet, "Do not write the contact sheet");
+  cmd->add_flag("--no-video", o.no_video, "Do not write the preview video");
+  cmd->add_flag("--quiet", o.quiet, "No progress output");
+  return cmd;
+}
+
+CLI::App* AddTurntableCommand(CLI::App& parent, RenderOptions& o) {
+  CLI::App* cmd = parent.add_subcommand(
+      "turntable", "One frame of the motion, the camera orbiting it (render --camera turntable)");
+  cmd->add_option("input", o.input, "BVH, glTF or GLB file; none = the built-in demo");
+  cmd->add_option("--frames", o.frames, "The motion frame to show (default 0)");
+  cmd->add_option("--turntable-frames", o.turntable_frames, "Images in the orbit")
+      ->capture_default_str();
+  cmd->add_option("--elevation", o.elevation_deg, "Camera elevation in degrees")
+      ->capture_default_str();
+  cmd->add_option("--size", o.size, "Image size WxH")->capture_default_str();
+  cmd->add_option("--out", o.out, "Output pattern (default out/<name>_turntable/frame_####.png)");
+  cmd->add_option("--global", o.global, "Global skinning: ssd, dqs or swd")->capture_default_str();
+  cmd->add_option("--overlay", o.overlay, "Comma list: skeleton, wire");
+  cmd->add_option("--threads", o.threads, "Worker threads (0 = all cores)");
+  cmd->add_option("--supersample", o.supersample, "Anti-aliasing samples per axis: 1, 2 or 4");
+  cmd->add_flag("--no-sheet", o.no_sheet, "Do not write the contact sheet");
+  cmd->add_flag("--no-video", o.no_video, "Do not write the preview video");
+  cmd->add_flag("--quiet", o.quiet, "No progress output");
+  cmd->callback([&o] { o.camera = "turntable"; });
+  return cmd;
+}
+
+namespace {
+
+int Fail(const mocap::Error& e) {
+  std::fprintf(stderr, "%s\n", e.ToString().c_str());
+  return e.code == mocap::ErrorCode::kInternal ? 3 : 2;
+}
+
+}  // namespace
+
+int RunRender(const RenderOptions& o) {
+  // --- Arguments -------------------------------------------------------------
+  const mocap::Result<glm::ivec2> size = ParseSize(o.size);
+  if (!size.ok()) return Fail(size.error());
+  if (o.supersample != 1 && o.supersample != 2 && o.supersample != 4) {
+    return Fail(ArgError("--supersample", "expected 1, 2 or 4, found " + std::to_string(o.supersample)));
+  }
+  if (o.png_compression < 0 || o.png_compression > 9) {
+    return Fail(ArgError("--png-compression", "expected 0..9"));
+  }
+  if (o.camera != "follow" && o.camera != "fixed" && o.camera != "turntable") {
+    return Fail(ArgError("--camera", "expected follow, fixed or turntable, found '" + o.camera + "'"));
+  }
+  if (o.turntable_frames < 1 || o.turntable_frames > 100000) {
+    return Fail(ArgError("--turntable-frames", "expected 1..100000"));
+  }
+  if (o.threads < 0 || o.threads > 256) return Fail(ArgError("--threads", "expected 0..256"));
+  if (!(o.fps >= 0.0) || o.fps > 10000.0) return Fail(ArgError("--fps", "expected 0 < fps <= 10000"));
+  bool overlay_skeleton = false, overlay_wire = false;
+  for (const std::string& item : SplitList(o.overlay)) {
+    if (item == "skeleton") overlay_skeleton = true;
+    else if (item == "wire" || item == "wireframe") overlay_wire = true;
+    else return Fail(ArgError("--overlay", "expected skeleton or wire, found '" + item + "'"));
+  }
+  const mocap::Result<GlobalMethod> method = ParseGlobalMethod(o.global);
+  if (!method.ok()) return Fail(method.error());
+  std::optional<GlobalMethod> split_left, split_right;
+  if (o.split) {
+    std::vector<std::string> pair = SplitList(*o.split);
+    if (pair.empty()) pair = {"ssd", *method == GlobalMethod::kSsd ? "dqs" : o.global};
+    if (pair.size() != 2) return Fail(ArgError("--split", "expected LEFT,RIGHT such as ssd,dqs"));
+    const auto l = ParseGlobalMethod(pair[0]);
+    const auto r = ParseGlobalMethod(pair[1]);
+    if (!l.ok()) return Fail(l.error());
+    if (!r.ok()) return Fail(r.error());
+    split_left = *l;
+    split_right = *r;
+  }
+
+  // --- Input -----------------------------------------------------------------
+  MotionSourceOptions load;
+  load.y_up = true;  // frames are rendered Y-up with the ground at the feet
+  const bool demo = o.input.empty();
+  mocap::Result<MotionSource> src = demo ? LoadBvhText(DemoBvhText(), "demo_walk.bvh", load)
+                                         : LoadMotionSource(o.input, load);
+  if (!src.ok()) return Fail(src.error());
+  if (!o.quiet) {
+    for (const mocap::Warning& w : src->warnings) std::fprintf(stderr, "%s\n", w.ToString().c_str());
+  }
+  const std::string name = demo ? "demo" : std::filesystem::path(o.input).stem().string();
+  mocap::Result<Character> character = MakeCharacter(std::move(*src));
+  if (!character.ok()) return Fail(character.error());
+  const Character& ch = *character;
+
+  const double frame_time = o.fps > 0.0 ? 1.0 / o.fps
+                                        : (ch.motion.frame_time_s > 0 ? ch.motion.frame_time_s : 1.0 / 30.0);
+  const int motion_frames =
+      ch.motion.num_frames > 0
+          ? static_cast<int>(std::floor(ch.motion.duration_s() / frame_time + 1e-9)) + 1
+          : 1;
+  const bool turntable = o.camera == "turntable";
+  mocap::Result<FrameRange> range = ParseFrames(o.frames, motion_frames);
+  if (!range.ok()) return Fail(range.error());
+  std::vector<OutputFrame> frames;
+  if (turntable) {
+    for (int k = 0; k < o.turntable_frames; ++k) frames.push_back({k, range->first * frame_time, k});
+  } else {
+    for (int f = range->first; f <= range->last; f += range->step) frames.push_back({f, f * frame_time, f});
+  }
+
+  std::string pattern = o.out;
+  if (pattern.empty()) pattern = "out/" + name + (turntable ? "_turntable" : "") + "/frame_####.png";
+  if (!render::HasFramePlaceholder(pattern)) {
+    return Fail(ArgError("--out", "the pattern '" + pattern +
+                                      "' needs one frame placeholder such as #### or %04d"));
+  }
+
+  // --- Pipelines ---------------------------------------------------------------
+  const GlobalMethod main_method = split_left ? *split_left : *method;
+  mocap::Result<FramePipeline> pipeline = FramePipeline::Create(ch, main_method, o.threads);
+  if (!pipeline.ok()) return Fail(pipeline.error());
+  std::optional<FramePipeline> right_pipeline;
+  if (split_right) {
+    mocap::Result<FramePipeline> p = FramePipeline::Create(ch, *split_right, o.threads);
+    if (!p.ok()) return Fail(p.error());
+    right_pipeline.emplace(std::move(*p));
+  }
+
+  // --- Framing: a pre-pass over up to 64 frames of the range ------------------
+  DeformedFrame frame, right_frame;
+  deform::Bounds all_bounds;
+  glm::vec3 largest_extent(0.0f);
+  float ground_y = 1e30f;
+  {
+    const int samples = std::min<int>(64, static_cast<int>(frames.size()));
+    for (int i = 0; i < samples; ++i) {
+      const std::size_t k = frames.size() * static_cast<std::size_t>(i) / static_cast<std::size_t>(samples);
+      const mocap::Status s = pipeline->Evaluate(frames[k].time_s, frame);
+      if (!s.ok()) return Fail(s.error());
+      all_bounds.Extend(frame.bounds.min);
+      all_bounds.Extend(frame.bounds.max);
+      largest_extent = glm::max(largest_extent, frame.bounds.size());
+      ground_y = std::min(ground_y, frame.bounds.min.y);
+    }
+  }
+  const float aspect = static_cast<float>(size->x) / static_cast<float>(size->y);
+  const float elevation = glm::radians(o.elevation_deg);
+  // Seen from the character's front-left, slightly above (characters face +Z).
+  const glm::vec3 view_dir = -glm::normalize(glm::vec3(0.45f, 0.0f, 1.0f) * std::cos(elevation) +
+                                             glm::vec3(0.0f, std::sin(elevation), 0.0f));
+  std::vector<render::Camera> turntable_cameras;
+  render::Camera fixed_camera;
+  render::FollowCamera follow;
+  std::vector<glm::vec3> centres;  // follow camera: one per motion frame up to the last output
+  int centre_base = 0;
+  if (turntable) {
+    const mocap::Status s = pipeline->Evaluate(frames.front().time_s, frame);
+    if (!s.ok()) return Fail(s.error());
+    const render::Camera framed = render::FrameBounds(frame.bounds, kFovYDeg, aspect, view_dir);
+    turntable_cameras = render::TurntablePath(frame.bounds.center(),
+                                              glm::length(framed.eye - framed.target),
+                                              o.elevation_deg, o.turntable_frames);
+    for (render::Camera& c : turntable_cameras) {
+      c.fov_y_deg = kFovYDeg;
+      c.aspect = aspect;
+    }
+  } else if (o.camera == "fixed") {
+    fixed_camera = render::FrameBounds(all_bounds, kFovYDeg, aspect, view_dir);
+  } else {
+    deform::Bounds typical;
+    typical.Extend(-0.5f * largest_extent);
+    typical.Extend(0.5f * largest_extent);
+    const render::Camera framed = render::FrameBounds(typical, kFovYDeg, aspect, view_dir);
+    follow.offset = framed.eye - framed.target;
+    follow.fov_y_deg = kFovYDeg;
+    follow.aspect = aspect;
+    follow.near_plane = framed.near_plane;
+    follow.far_plane = framed.far_plane * 4.0f;
+    follow.frame_time_s = static_cast<float>(frame_time);
+    centre_base = std::max(0, range->first - follow.window_frames);
+    // Centres of the body's bounds at every output frame the filter can see.
+    for (int f = centre_base; f <= range->last; ++f) {
+      const mocap::Status s = pipeline->Evaluate(f * frame_time, frame);
+      if (!s.ok()) return Fail(s.error());
+      centres.push_back(frame.bounds.center());
+    }
+  }
+
+  // --- Outputs -------------------------------------------------------------------
+  {
+    const mocap::Result<std::string> first = render::ExpandFramePattern(pattern, frames.front().number);
+    if (!first.ok()) return Fail(first.error());
+    const std::filesystem::path dir = std::filesystem::path(*first).parent_path();
+    std::error_code ec;
+    if (!dir.empty()) std::filesystem::create_directories(dir, ec);
+    if (ec) {
+      return Fail(mocap::MakeError(mocap::ErrorCode::kIo, {dir.string(), 0, 0, {}},
+                                   "cannot create the output folder: " + ec.message()));
+    }
+  }
+  const std::filesystem::path out_dir =
+      std::filesystem::path(*render::ExpandFramePattern(pattern, 0)).parent_path();
+  render::RenderSettings settings;
+  settings.width = size->x;
+  settings.height = size->y;
+  settings.supersample = o.supersample;
+  settings.threads = o.threads;
+  settings.ground_at_scene_min = false;
+  settings.ground_y = ground_y;
+  render::Renderer renderer;
+  render::Renderer right_renderer;
+  render::AsyncImageWriter writer({.num_workers = 2, .max_in_flight = 4});
+  render::WriteOptions write_options;
+  write_options.png_compression = o.png_compression;
+  write_options.source_file = demo ? "demo_walk.bvh (built in)" : o.input;
+
+  const int sheet_count = std::min<int>(kMaxSheetFrames, static_cast<int>(frames.size()));
+  std::unique_ptr<render::ContactSheetBuilder> sheet;
+  if (!o.no_sheet) {
+    auto b = render::ContactSheetBuilder::Create(sheet_count, size->x, size->y);
+    if (!b.ok()) return Fail(b.error());
+    sheet = std::move(*b);
+  }
+  std::unique_ptr<render::VideoWriter> video;
+  if (!o.no_video) {
+    const double video_fps = turntable ? 24.0 : 1.0 / (frame_time * range->step);
+    auto v = render::VideoWriter::Open((out_dir / "preview.mp4").string(), size->x & ~1,
+                                       size->y & ~1, {.fps = video_fps});
+    if (!v.ok()) return Fail(v.error());
+    video = std::move(*v);
+  }
+
+  // --- The frame loop -------------------------------------------------------------
+  Progress progress(demo ? "render demo" : "render " + name, static_cast<int>(frames.size()), o.quiet);
+  render::Image image, right_image;
+  int next_sheet = 0;
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    const OutputFrame& of = frames[i];
+    mocap::Status s = pipeline->Evaluate(of.time_s, frame);
+    if (!s.ok()) return Fail(s.error());
+    render::Camera camera = turntable ? turntable_cameras[static_cast<std::size_t>(of.camera)]
+                            : o.camera == "fixed"
+                                ? fixed_camera
+                                : follow.At(centres, of.camera - centre_base);
+    auto draw = [&](const DeformedFrame& f, render::Renderer& r, const std::string& label,
+                    int label_x, render::Image& into) -> mocap::Status {
+      const deform::Mesh& bind = ch.mesh.bind;
+      render::SceneMesh body{.positions = f.positions, .normals = f.normals,
+                             .triangles = bind.triangles, .vertex_colors = bind.colors};
+      render::Overlays overlays;
+      if (overlay_skeleton) AddSkeleton(f, ch.skeleton, overlays);
+      overlays.wireframe = overlay_wire;
+      overlays.text.push_back({.text = "frame " + std::to_string(of.number),
+                               .origin_px = {10, size->y - 12}});
+      if (!label.empty()) overlays.text.push_back({.text = label, .origin_px = {label_x, 30}});
+      const mocap::JobStatus js = r.Render(camera, {&body, 1}, overlays, settings, into);
+      if (!js) {
+        return mocap::MakeError(mocap::ErrorCode::kInternal, {ch.source, 0, 0, {}},
+                                std::string("renderer refused the frame: ") + js.what);
+      }
+      return mocap::Status::Ok();
+    };
+    if (right_pipeline) {
+      s = right_pipeline->Evaluate(of.time_s, right_frame);
+      if (!s.ok()) return Fail(s.error());
+      s = draw(frame, renderer, GlobalMethodName(main_method), 10, image);
+      if (!s.ok()) return Fail(s.error());
+      s = draw(right_frame, right_renderer, GlobalMethodName(right_pipeline->method()),
+               size->x / 2 + 10, right_image);
+      if (!s.ok()) return Fail(s.error());
+      ComposeSplit(right_image, image);
+    } else {
+      s = draw(frame, renderer, "", 0, image);
+      if (!s.ok()) return Fail(s.error());
+    }
+    if (sheet && next_sheet < sheet_count &&
+        i == frames.size() * static_cast<std::size_t>(next_sheet) / static_cast<std::size_t>(sheet_count)) {
+      s = sheet->Add(image, of.number);
+      if (!s.ok()) return Fail(s.error());
+      ++next_sheet;
+    }
+    if (video) {
+      s = video->AddFrame(image);
+      if (!s.ok()) return Fail(s.error());
+    }
+    const mocap::Result<std::string> path = render::ExpandFramePattern(pattern, of.number);
+    if (!path.ok()) return Fail(path.error());
+    write_options.frame = of.number;
+    s = writer.Submit(image, *path, write_options);
+    if (!s.ok()) return Fail(s.error());
+    progress.Step(of.number);
+  }
+  mocap::Status s = writer.Finish();
+  if (!s.ok()) return Fail(s.error());
+  progress.Finish();
+  std::printf("frames:        %s (%zu)\n", pattern.c_str(), frames.size());
+  if (sheet) {
+    const std::string sheet_path = (out_dir / "contact_sheet.png").string();
+    s = render::WriteImage(sheet->sheet(), sheet_path, {});
+    if (!s.ok()) return Fail(s.error());
+    std::printf("contact sheet: %s\n", sheet_path.c_str());
+  }
+  if (video) {
+    s = video->Close();
+    if (!s.ok()) return Fail(s.error());
+    std::printf("video:         %s (%s)\n", video->path().c_str(), render::VideoCodecName(video->codec()));
+  }
+  return 0;
+}
+
+}  // namespace app

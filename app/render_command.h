@@ -1,0 +1,41 @@
+#pragma once
+// `patchskin render [INPUT]`: renders a capture (BVH, on a generated mannequin)
+// or a glTF character's animation to an image sequence, with a contact sheet
+// and a preview video. Without INPUT it renders the built-in demo (a walk the
+// project generated, samples/data/demo_walk.bvh, compiled into the binary) to
+// out/demo/. `patchskin turntable` is `render --camera turntable`.
+
+#include <optional>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+namespace app {
+
+struct RenderOptions {
+  std::string input;                  // empty = built-in demo
+  std::string frames;                 // "A:B[:STEP]", inclusive, in output frames; empty = all
+  double fps = 0.0;                   // output frame rate; 0 = the capture's own
+  std::string size = "1280x720";      // WxH
+  std::string out;                    // pattern with ####; empty = out/<name>/frame_####.png
+  std::string global = "ssd";         // ssd | dqs | swd
+  std::string camera = "follow";      // follow | fixed | turntable
+  int turntable_frames = 36;          // images of a turntable
+  float elevation_deg = 15.0f;        // camera elevation (turntable and fixed)
+  std::string overlay;                // comma list: skeleton, wire
+  std::optional<std::string> split;   // "LEFT,RIGHT" methods; "" = default pair
+  int threads = 0;                    // 0 = hardware concurrency
+  int supersample = 2;                // 1, 2 or 4 samples per axis
+  int png_compression = 1;            // zlib level for PNG frames
+  bool no_sheet = false;
+  bool no_video = false;
+  bool quiet = false;
+};
+
+CLI::App* AddRenderCommand(CLI::App& parent, RenderOptions& options);
+CLI::App* AddTurntableCommand(CLI::App& parent, RenderOptions& options);
+
+// Runs a render. Exit code: 0 ok, 2 bad input, 3 internal error.
+int RunRender(const RenderOptions& options);
+
+}  // namespace app
