@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <string>
 #include <utility>
 
@@ -106,6 +107,81 @@ mocap::Result<double> CandyWrapperFigure(std::span<const glm::vec3> rest_positio
     minimum = r == 0 ? *ratio : std::min(minimum, *ratio);
   }
   return minimum;
+}
+
+mocap::Result<double> CappedVolume(std::span<const glm::vec3> positions,
+                                   std::span<const glm::uvec3> triangles,
+                                   std::span<const std::vector<std::uint32_t>> caps) {
+  if (triangles.empty()) {
+    return MakeError(ErrorCode::kInvalidArgument, {}, "expected triangles, found none");
+  }
+  // Directed edge -> use count; an edge whose reverse is absent is on the boundary.
+  std::map<std::pair<std::uint32_t, std::uint32_t>, int> edges;
+  double six_volume = 0.0;  // sum of det(a, b, c) = 6 x signed tetrahedron volumes from 0
+  auto add_triangle = [&](const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c) {
+    six_volume += glm::dot(a, glm::cross(b, c));
+  };
+  for (const glm::uvec3& t : triangles) {
+    if (t.x >= positions.size() || t.y >= positions.size() || t.z >= positions.size()) {
+      return MakeError(ErrorCode::kInvalidArgument, {},
+                       "triangle index past the " + std::to_string(positions.size()) +
+                           " positions");
+    }
+    add_triangle(glm::dvec3(positions[t.x]), glm::dvec3(positions[t.y]),
+                 glm::dvec3(positions[t.z]));
+    ++edges[{t.x, t.y}];
+    ++edges[{t.y, t.z}];
+    ++edges[{t.z, t.x}];
+  }
+  std::map<std::uint32_t, std::size_t> cap_of;  // vertex -> cap index
+  std::vector<glm::dvec3> centroids(caps.size(), glm::dvec3(0.0));
+  for (std::size_t c = 0; c < caps.size(); ++c) {
+    for (const std::uint32_t v : caps[c]) {
+      if (v >= positions.size()) {
+        return MakeError(ErrorCode::kInvalidArgument, {},
+                         "cap " + std::to_string(c) + " vertex " + std::to_string(v) +
+                             " is past the positions");
+      }
+      cap_of[v] = c;
+      centroids[c] += glm::dvec3(positions[v]);
+    }
+    if (!caps[c].empty()) centroids[c] /= static_cast<double>(caps[c].size());
+  }
+  for (const auto& [edge, count] : edges) {
+    if (edges.count({edge.second, edge.first}) != 0) continue;  // interior edge
+    const auto from = cap_of.find(edge.first), to = cap_of.find(edge.second);
+    if (from == cap_of.end() || to == cap_of.end() || from->second != to->second) {
+      return MakeError(ErrorCode::kInvalidArgument, {},
+                       "boundary edge " + std::to_string(edge.first) + "-" +
+                           std::to_string(edge.second) + " is not on a cap ring");
+    }
+    // The cap triangle uses the edge reversed, so the closed surface stays consistent.
+    for (int i = 0; i < count; ++i) {
+      add_triangle(centroids[from->second], glm::dvec3(positions[edge.second]),
+                   glm::dvec3(positions[edge.first]));
+    }
+  }
+  return std::abs(six_volume) / 6.0;
+}
+
+mocap::Result<double> VolumeFigure(std::span<const glm::vec3> rest_positions,
+                                   std::span<const glm::vec3> positions,
+                                   std::span<const glm::uvec3> triangles,
+                                   std::span<const std::vector<std::uint32_t>> caps) {
+  if (rest_positions.size() != positions.size()) {
+    return MakeError(ErrorCode::kInvalidArgument, {},
+                     "expected as many deformed as rest positions (" +
+                         std::to_string(rest_positions.size()) + "), found " +
+                         std::to_string(positions.size()));
+  }
+  mocap::Result<double> rest = CappedVolume(rest_positions, triangles, caps);
+  if (!rest) return rest;
+  if (!(*rest > 1e-12)) {
+    return MakeError(ErrorCode::kInvalidArgument, {}, "the section encloses no volume at rest");
+  }
+  mocap::Result<double> current = CappedVolume(positions, triangles, caps);
+  if (!current) return current;
+  return *current / *rest;
 }
 
 std::vector<std::uint32_t> RingNearPlane(std::span<const glm::vec3> rest_positions,

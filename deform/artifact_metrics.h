@@ -61,6 +61,23 @@ mocap::Result<double> CandyWrapperFigure(std::span<const glm::vec3> rest_positio
                                          std::span<const glm::vec3> positions,
                                          std::span<const ArtifactRing> rings);
 
+// Volume enclosed by `triangles` (a section of a closed skin, e.g. a limb between two
+// rings, wound consistently) after closing every boundary loop with a fan from the
+// centroid of the cap ring that holds it (model units cubed, absolute value). Every
+// boundary edge (one used by a single triangle) must have both ends in one ring of
+// `caps`. Errors (kInvalidArgument): index past the positions, an open boundary edge
+// outside the caps, no triangles.
+mocap::Result<double> CappedVolume(std::span<const glm::vec3> positions,
+                                   std::span<const glm::uvec3> triangles,
+                                   std::span<const std::vector<std::uint32_t>> caps);
+
+// Volume figure: CappedVolume(positions) / CappedVolume(rest_positions) over the same
+// triangles and caps (e.g. the limb within a few units of a joint). 1 = volume kept.
+mocap::Result<double> VolumeFigure(std::span<const glm::vec3> rest_positions,
+                                   std::span<const glm::vec3> positions,
+                                   std::span<const glm::uvec3> triangles,
+                                   std::span<const std::vector<std::uint32_t>> caps);
+
 // Vertices within `half_thickness` of `plane` (rest positions, model units): the ring
 // "nearest the rest bisector plane" used for SSD and DQS.
 std::vector<std::uint32_t> RingNearPlane(std::span<const glm::vec3> rest_positions,

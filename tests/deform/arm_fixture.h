@@ -22,14 +22,21 @@
 namespace testfixture {
 
 inline constexpr int kArmBones = 3;
-inline constexpr float kUpperArmLength = 30.0f;
-inline constexpr float kForearmLength = 25.0f;
-inline constexpr float kHandLength = 10.0f;
-inline constexpr float kElbowX = kUpperArmLength;
-inline constexpr float kWristX = kUpperArmLength + kForearmLength;
-inline constexpr float kArmLength = kWristX + kHandLength;
-inline constexpr float kElbowBlendHalfWidth = 5.0f;  // SSD weights blend over x in [25, 35]
-inline constexpr float kWristBlendHalfWidth = 2.0f;  // and over x in [53, 57]
+
+// Dimensions of a 3-bone limb along +x (model units). Lengths are whole numbers so that
+// rings (every 1/per_unit units) fall exactly on the middle and end joints.
+struct LimbShape {
+  float upper_length;       // upper arm / thigh
+  float lower_length;       // forearm / shin
+  float end_length;         // hand / foot
+  float radius_at_root;     // tube radius at x = 0
+  float radius_taper;       // radius loss per unit of x
+  float middle_blend;       // SSD weights blend over x in [J1 - this, J1 + this]
+  float end_blend;          // and over [J2 - this, J2 + this]
+};
+inline constexpr LimbShape kArmShape{30, 25, 10, 4.0f, 0.03f, 5.0f, 2.0f};
+inline constexpr LimbShape kLegShape{45, 42, 15, 7.0f, 0.045f, 7.0f, 3.0f};
+inline constexpr float kArmLength = 65.0f;  // kArmShape's total length
 
 inline float Smooth(float x) {
   const float y = glm::clamp(x, 0.0f, 1.0f);
@@ -37,35 +44,39 @@ inline float Smooth(float x) {
 }
 
 struct Arm {
+  LimbShape shape;
   std::array<glm::vec3, kArmBones + 1> joint_rest;  // J_0..J_3 bind positions
   deform::Mesh mesh;                                // rings of `segments` vertices
   deform::SkinWeights weights;                      // 4 influences over joints 0..2
   std::vector<std::vector<std::uint32_t>> rings;    // vertex indices of each ring
   std::vector<float> ring_x;                        // x of each ring (on the bone axis)
-  int elbow_ring = 0;                               // the ring at x = kElbowX
+  int elbow_ring = 0;                               // the ring at the middle joint J_1
+  float length() const { return shape.upper_length + shape.lower_length + shape.end_length; }
 };
 
-inline float ArmRadius(float x) { return 4.0f - 0.03f * x; }
-
-// `per_five_units` rings per 5 model units (so rings fall exactly on elbow and wrist).
-inline Arm MakeArm(int segments, int per_five_units) {
+// A limb tube with `per_unit` rings per model unit (triangles wound counter-clockwise
+// seen from outside).
+inline Arm MakeLimb(const LimbShape& shape, int segments, int per_unit) {
   Arm arm;
-  arm.joint_rest = {glm::vec3(0.0f), glm::vec3(kElbowX, 0, 0), glm::vec3(kWristX, 0, 0),
-                    glm::vec3(kArmLength, 0, 0)};
-  const int num_rings = 13 * per_five_units + 1;
+  arm.shape = shape;
+  const float j1 = shape.upper_length, j2 = j1 + shape.lower_length;
+  arm.joint_rest = {glm::vec3(0.0f), glm::vec3(j1, 0, 0), glm::vec3(j2, 0, 0),
+                    glm::vec3(arm.length(), 0, 0)};
+  const int num_rings = static_cast<int>(std::lround(arm.length())) * per_unit + 1;
   arm.weights.influences = 4;
   for (int r = 0; r < num_rings; ++r) {
-    const float x = kArmLength * static_cast<float>(r) / static_cast<float>(num_rings - 1);
-    if (r == 6 * per_five_units) arm.elbow_ring = r;
+    const float x = static_cast<float>(r) / static_cast<float>(per_unit);
+    if (r == static_cast<int>(std::lround(j1)) * per_unit) arm.elbow_ring = r;
     arm.ring_x.push_back(x);
     std::vector<std::uint32_t> ring;
-    const float s = Smooth((x - (kElbowX - kElbowBlendHalfWidth)) / (2 * kElbowBlendHalfWidth));
-    const float t = Smooth((x - (kWristX - kWristBlendHalfWidth)) / (2 * kWristBlendHalfWidth));
+    const float s = Smooth((x - (j1 - shape.middle_blend)) / (2 * shape.middle_blend));
+    const float t = Smooth((x - (j2 - shape.end_blend)) / (2 * shape.end_blend));
+    const float radius = shape.radius_at_root - shape.radius_taper * x;
     for (int i = 0; i < segments; ++i) {
       const float angle = 6.2831853f * static_cast<float>(i) / static_cast<float>(segments);
       const glm::vec3 radial(0.0f, std::cos(angle), std::sin(angle));
       ring.push_back(static_cast<std::uint32_t>(arm.mesh.positions.size()));
-      arm.mesh.positions.push_back(glm::vec3(x, 0, 0) + ArmRadius(x) * radial);
+      arm.mesh.positions.push_back(glm::vec3(x, 0, 0) + radius * radial);
       arm.mesh.normals.push_back(radial);
       const std::array<float, 4> w = {1.0f - s, s * (1.0f - t), s * t, 0.0f};
       for (int j = 0; j < 4; ++j) {
@@ -81,12 +92,14 @@ inline Arm MakeArm(int segments, int per_five_units) {
       const auto& b = arm.rings[static_cast<std::size_t>(r + 1)];
       const auto i1 = static_cast<std::size_t>((i + 1) % segments);
       const auto i0 = static_cast<std::size_t>(i);
-      arm.mesh.triangles.emplace_back(a[i0], b[i0], b[i1]);
-      arm.mesh.triangles.emplace_back(a[i0], b[i1], a[i1]);
+      arm.mesh.triangles.emplace_back(a[i0], b[i1], b[i0]);
+      arm.mesh.triangles.emplace_back(a[i0], a[i1], b[i1]);
     }
   }
   return arm;
 }
+
+inline Arm MakeArm(int segments, int per_unit) { return MakeLimb(kArmShape, segments, per_unit); }
 
 // The arm's sweep chain spec: bones 0..2 move with joints 0..2; the elbow spreads its
 // twist downstream (along the forearm), the wrist upstream (forearm pronation).
@@ -199,14 +212,39 @@ inline deform::ArtifactRing ElbowRing(const Arm& arm, const ArmPose& pose,
   return ring;
 }
 
+// The tube's triangles between rings r0 < r1 and those two rings as caps (a closed
+// section for CappedVolume / VolumeFigure).
+struct Section {
+  std::vector<glm::uvec3> triangles;
+  std::vector<std::vector<std::uint32_t>> caps;
+};
+inline Section SectionBetween(const Arm& arm, std::size_t r0, std::size_t r1) {
+  Section section;
+  const std::size_t per_gap = 2 * arm.rings[0].size();  // triangles between two rings
+  section.triangles.assign(arm.mesh.triangles.begin() + static_cast<std::ptrdiff_t>(per_gap * r0),
+                           arm.mesh.triangles.begin() + static_cast<std::ptrdiff_t>(per_gap * r1));
+  section.caps = {arm.rings[r0], arm.rings[r1]};
+  return section;
+}
+
+// The section within `half_length` units of the middle joint.
+inline Section SectionAroundElbow(const Arm& arm, float half_length) {
+  const auto per_unit = static_cast<std::size_t>(arm.elbow_ring) /
+                        static_cast<std::size_t>(std::lround(arm.shape.upper_length));
+  const auto d = static_cast<std::size_t>(std::lround(half_length)) * per_unit;
+  const auto elbow = static_cast<std::size_t>(arm.elbow_ring);
+  return SectionBetween(arm, elbow - d, elbow + d);
+}
+
 // Rings along the forearm (from the start of the SSD elbow blend to the wrist), each
 // projected on the plane through its axis point normal to the bone it lies on.
 inline std::vector<deform::ArtifactRing> ForearmRings(const Arm& arm, const ArmPose& pose) {
   std::vector<deform::ArtifactRing> rings;
   for (std::size_t r = 0; r < arm.rings.size(); ++r) {
     const float x = arm.ring_x[r];
-    if (x < kElbowX - kElbowBlendHalfWidth || x > kWristX) continue;
-    const std::size_t bone = x < kElbowX ? 0 : 1;
+    const float elbow = arm.joint_rest[1].x, wrist = arm.joint_rest[2].x;
+    if (x < elbow - arm.shape.middle_blend || x > wrist) continue;
+    const std::size_t bone = x < elbow ? 0 : 1;
     const glm::vec3 axis(1, 0, 0);
     deform::ArtifactRing ring;
     ring.vertices = arm.rings[r];

@@ -25,9 +25,9 @@ struct ArmSetup {
   std::vector<SweepVertexBinding> bindings;
 };
 
-ArmSetup MakeArmSetup(int segments = 24, int per_five_units = 5) {
+ArmSetup MakeArmSetup(int segments = 24, int per_unit = 1) {
   ArmSetup setup;
-  setup.arm = testfixture::MakeArm(segments, per_five_units);
+  setup.arm = testfixture::MakeArm(segments, per_unit);
   auto chain = deform::BuildSweepChain(testfixture::ArmChainSpec(setup.arm));
   EXPECT_TRUE(chain.ok()) << chain.error().ToString();
   setup.chain = *chain;
