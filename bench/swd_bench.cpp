@@ -67,6 +67,7 @@ void BM_SwdJob(benchmark::State& state) {
                            .bindings = *bindings,
                            .rest_normals = arm.normals,
                            .keep_volume = state.range(0) != 0,
+                           .section_scales = {},
                            .positions = positions,
                            .normals = normals};
   for (auto _ : state) {

@@ -83,6 +83,54 @@ bool Finite(const glm::vec3& v) {
   return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
 }
 
+// Principal direction, within the plane orthogonal to unit `tangent`, of the symmetric
+// second-moment matrix m; any in-plane unit vector when the section is round.
+glm::dvec3 PrincipalInPlane(const glm::dmat3& m, const glm::dvec3& tangent) {
+  const glm::dvec3 helper =
+      std::abs(tangent.x) < 0.9 ? glm::dvec3(1, 0, 0) : glm::dvec3(0, 1, 0);
+  const glm::dvec3 e1 = glm::normalize(glm::cross(tangent, helper));
+  const glm::dvec3 e2 = glm::cross(tangent, e1);
+  const double a = glm::dot(e1, m * e1), b = glm::dot(e1, m * e2), c = glm::dot(e2, m * e2);
+  const double angle = 0.5 * std::atan2(2.0 * b, a - c);  // major axis of [[a b][b c]]
+  return std::cos(angle) * e1 + std::sin(angle) * e2;
+}
+
+constexpr int kSectionBinsPerBone = 64;
+
+int SectionBin(const SweepChain& chain, float u) {
+  const int bins = kSectionBinsPerBone * chain.num_bones();
+  return std::clamp(static_cast<int>(u * kSectionBinsPerBone), 0, bins - 1);
+}
+
+void AssignSectionAxes(std::span<const SweepChain> chains,
+                       std::vector<SweepVertexBinding>& bindings) {
+  std::vector<std::vector<glm::dmat3>> moments(chains.size());
+  for (std::size_t c = 0; c < chains.size(); ++c) {
+    moments[c].assign(static_cast<std::size_t>(kSectionBinsPerBone * chains[c].num_bones()),
+                      glm::dmat3(0.0));
+  }
+  auto accumulate = [&](const SweepBinding& b) {
+    const glm::dvec3 o(b.offset);
+    moments[b.chain][static_cast<std::size_t>(SectionBin(chains[b.chain], b.u))] +=
+        glm::outerProduct(o, o);
+  };
+  for (const SweepVertexBinding& v : bindings) {
+    accumulate(v.primary);
+    if (v.weight < 1.0f) accumulate(v.secondary);
+  }
+  auto assign = [&](SweepBinding& b) {
+    const SweepChain& chain = chains[b.chain];
+    glm::dvec3 tangent;
+    SweepCentre(chain, chain.rest_pose(), static_cast<double>(b.u), &tangent);
+    const glm::dmat3& m = moments[b.chain][static_cast<std::size_t>(SectionBin(chain, b.u))];
+    b.section_axis = glm::vec3(PrincipalInPlane(m, glm::normalize(tangent)));
+  };
+  for (SweepVertexBinding& v : bindings) {
+    assign(v.primary);
+    if (v.weight < 1.0f) assign(v.secondary);
+  }
+}
+
 }  // namespace
 
 double DefaultHalfWidth(double skin_radius, double bend_rad, double length_in,
@@ -359,6 +407,16 @@ T SweepScale(const SweepChain& chain, const BasicSweepPose<T>& pose, T u) {
   return std::sqrt(std::max(T(0), T(1) + gain * T(6) * x * (T(1) - x)));
 }
 
+template <typename T>
+bool SweepRegionAt(const SweepChain& chain, T u, int* joint, T* x) {
+  const Location at = Locate(chain, u);
+  if (!at.in_region) return false;
+  const T start = T(chain.region_start(at.index));
+  *joint = at.index;
+  *x = (u - start) / (T(chain.region_end(at.index)) - start);
+  return true;
+}
+
 SweepBinding BindToSweep(const SweepChain& chain, int chain_index, const glm::dvec3& rest_point) {
   const BasicSweepPose<double>& rest = chain.rest_pose();
   const int num_bones = chain.num_bones();
@@ -483,6 +541,7 @@ mocap::Result<std::vector<SweepVertexBinding>> BindToSweeps(
       }
     }
   }
+  AssignSectionAxes(chains, bindings);
   return bindings;
 }
 
@@ -492,6 +551,7 @@ mocap::Result<std::vector<SweepVertexBinding>> BindToSweeps(
   template Vec3T<T> SweepCentre<T>(const SweepChain&, const BasicSweepPose<T>&, T, Vec3T<T>*); \
   template QuatT<T> SweepFrame<T>(const SweepChain&, const BasicSweepPose<T>&, T);            \
   template T SweepScale<T>(const SweepChain&, const BasicSweepPose<T>&, T);                   \
+  template bool SweepRegionAt<T>(const SweepChain&, T, int*, T*);                             \
   template QuatT<T> TwistQuat<T>(const Vec3T<T>&, T);                                         \
   template T TwistAngle<T>(const QuatT<T>&, const Vec3T<T>&);                                 \
   template QuatT<T> SlerpShort<T>(const QuatT<T>&, const QuatT<T>&, T);

@@ -162,6 +162,11 @@ glm::qua<T, glm::defaultp> SweepFrame(const SweepChain& chain, const BasicSweepP
 template <typename T>
 T SweepScale(const SweepChain& chain, const BasicSweepPose<T>& pose, T u);
 
+// If u lies in the region of an interior joint, sets *joint to it and *x to the region
+// parameter (u - ua)/(ub - ua) in [0,1] and returns true; else returns false.
+template <typename T>
+bool SweepRegionAt(const SweepChain& chain, T u, int* joint, T* x);
+
 // Twist quaternion Tw(axis, angle) = (cos(angle/2), sin(angle/2) axis); axis unit.
 template <typename T>
 glm::qua<T, glm::defaultp> TwistQuat(const glm::vec<3, T, glm::defaultp>& axis, T angle_rad);
@@ -180,6 +185,11 @@ glm::qua<T, glm::defaultp> SlerpShort(const glm::qua<T, glm::defaultp>& q0,
 struct SweepBinding {
   float u = 0.0f;             // sweep parameter in [0, K]
   glm::vec3 offset{0.0f};     // o = p0 - c0(u), bind model space (model units)
+  // First axis e_a of the rest cross-section's ellipse at u (unit, orthogonal to
+  // hat(c0'(u)), bind model space): principal direction of the offsets of the points
+  // bound near u (the columns of E0 are e_a, e_b = hat(c0') x e_a, hat(c0')). Zero when
+  // BindToSweep alone made the binding (then elliptic scaling treats the section as round).
+  glm::vec3 section_axis{0.0f};
   std::uint16_t chain = 0;    // index of the chain in the chain list given to the binder/job
 };
 
@@ -207,7 +217,9 @@ SweepBinding BindToSweep(const SweepChain& chain, int chain_index, const glm::dv
 
 // Binds every rest vertex (#V, bind model space) to the chain whose rest bone segment is
 // nearest; a vertex on a junction's branch with u in [u_start, u_end) is also bound to
-// the trunk. Errors (kInvalidArgument) for empty or oversized chain lists, bad junction
+// the trunk. Then sets every binding's section_axis: the offsets bound to the same chain
+// in u-bins of 1/64 bone give a second-moment matrix sum(o o^T), whose principal
+// direction in the vertex's section plane is e_a (PCA of the vertex ring at u). Errors (kInvalidArgument) for empty or oversized chain lists, bad junction
 // indices or intervals, non-finite positions.
 mocap::Result<std::vector<SweepVertexBinding>> BindToSweeps(
     std::span<const SweepChain> chains, std::span<const SweepJunction> junctions,

@@ -272,6 +272,7 @@ inline std::vector<glm::vec3> SkinSwd(const deform::SweepChain& chain,
       .bindings = bindings,
       .rest_normals = normals != nullptr ? rest_normals : std::span<const glm::vec3>(),
       .keep_volume = keep_volume,
+      .section_scales = {},
       .positions = out,
       .normals = normals != nullptr ? std::span<glm::vec3>(*normals) : std::span<glm::vec3>(),
   };

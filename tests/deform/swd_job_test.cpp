@@ -49,6 +49,7 @@ TEST(SwdJob, Validity) {
                     .bindings = s.bindings,
                     .rest_normals = {},
                     .keep_volume = false,
+                    .section_scales = {},
                     .positions = out,
                     .normals = {}};
   EXPECT_EQ(good.Validate().code, JobStatus::kOk);
@@ -129,6 +130,7 @@ TEST(SwdJob, SubRangesGiveBitIdenticalResults) {
              .bindings = s.bindings,
              .rest_normals = s.arm.mesh.normals,
              .keep_volume = true,
+             .section_scales = {},
              .positions = whole,
              .normals = whole_n};
   ASSERT_TRUE(job.Run());
@@ -225,6 +227,7 @@ TEST(SwdJob, JunctionBlendIsContinuousAcrossTheZoneBoundaries) {
                    .bindings = *bindings,
                    .rest_normals = {},
                    .keep_volume = false,
+                   .section_scales = {},
                    .positions = out,
                    .normals = {}};
   ASSERT_TRUE(job.Run());
@@ -235,6 +238,108 @@ TEST(SwdJob, JunctionBlendIsContinuousAcrossTheZoneBoundaries) {
     worst = std::max(worst, glm::length(out[i] - out[i - 1]) / kSpacing);
   }
   EXPECT_LT(worst, 4.0f);
+}
+
+}  // namespace
+
+namespace {
+
+// A straight 2-bone elliptic tube along +x (y radius 4, z radius 2), rings every unit.
+struct EllipticTube {
+  SweepChain chain;
+  std::vector<glm::vec3> positions;
+  std::vector<float> ring_x;  // #V: x of each vertex's ring
+  std::vector<SweepVertexBinding> bindings;
+};
+
+EllipticTube MakeEllipticTube() {
+  EllipticTube tube;
+  deform::SweepChainSpec spec;
+  spec.joints = {0, 1};
+  spec.rest_points = {glm::vec3(0), glm::vec3(20, 0, 0), glm::vec3(40, 0, 0)};
+  spec.half_widths = {0, 6, 0};
+  tube.chain = *deform::BuildSweepChain(spec);
+  for (int x = 0; x <= 40; ++x) {
+    for (int i = 0; i < 16; ++i) {
+      const float angle = 6.2831853f * static_cast<float>(i) / 16.0f;
+      tube.positions.emplace_back(static_cast<float>(x), 4.0f * std::cos(angle),
+                                  2.0f * std::sin(angle));
+      tube.ring_x.push_back(static_cast<float>(x));
+    }
+  }
+  const std::vector<SweepChain> chains = {tube.chain};
+  tube.bindings = *deform::BindToSweeps(chains, {}, tube.positions);
+  return tube;
+}
+
+std::vector<glm::vec3> RunTube(const EllipticTube& tube,
+                               std::span<const deform::SectionScale> scales) {
+  const std::array<glm::quat, 2> rotations = {glm::quat(1, 0, 0, 0), glm::quat(1, 0, 0, 0)};
+  const std::array<glm::vec3, 2> joints = {glm::vec3(0), glm::vec3(20, 0, 0)};
+  std::vector<glm::vec3> out(tube.positions.size());
+  const SwdJob job{.chains = std::span<const SweepChain>(&tube.chain, 1),
+                   .joint_rotations = rotations,
+                   .joint_positions = joints,
+                   .bindings = tube.bindings,
+                   .rest_normals = {},
+                   .keep_volume = false,
+                   .section_scales = scales,
+                   .positions = out,
+                   .normals = {}};
+  if (!job.Run()) out.clear();
+  return out;
+}
+
+TEST(SwdJob, BindingFindsTheEllipseAxisOfTheSection) {
+  const EllipticTube tube = MakeEllipticTube();
+  for (const SweepVertexBinding& b : tube.bindings) {
+    EXPECT_NEAR(std::abs(b.primary.section_axis.y), 1.0f, kFloatTol) << "u " << b.primary.u;
+  }
+}
+
+TEST(SwdJob, EllipticScalingStretchesTheJointSectionAlongItsAxes) {
+  const EllipticTube tube = MakeEllipticTube();
+  const std::vector<deform::SectionScale> unit = {{.chain = 0, .joint = 1}};
+  const auto plain = RunTube(tube, {});
+  EXPECT_EQ(RunTube(tube, unit), plain);  // unit scales change nothing
+  const std::vector<deform::SectionScale> bulge = {
+      {.chain = 0, .joint = 1, .scale_a = 2.0f, .scale_b = 0.5f}};
+  const auto out = RunTube(tube, bulge);
+  ASSERT_EQ(out.size(), tube.positions.size());
+  for (std::size_t v = 0; v < out.size(); ++v) {
+    int joint = 0;
+    float x = 0.0f;
+    const glm::vec3& p0 = tube.positions[v];
+    if (!deform::SweepRegionAt(tube.chain, tube.bindings[v].primary.u, &joint, &x)) {
+      EXPECT_NEAR(glm::length(out[v] - p0), 0.0f, 1e-4f) << "outside the region, x " << p0.x;
+      continue;
+    }
+    const float bump = 4.0f * x * (1.0f - x);
+    const glm::vec3 expected(p0.x, p0.y * (1.0f + bump), p0.z * (1.0f - 0.5f * bump));
+    EXPECT_NEAR(glm::length(out[v] - expected), 0.0f, 1e-4f) << "x " << p0.x;
+  }
+}
+
+TEST(SwdJob, RejectsSectionScalesOutsideInteriorJoints) {
+  const EllipticTube tube = MakeEllipticTube();
+  for (const deform::SectionScale bad :
+       {deform::SectionScale{.chain = 0, .joint = 0}, deform::SectionScale{.chain = 0, .joint = 2},
+        deform::SectionScale{.chain = 1, .joint = 1},
+        deform::SectionScale{.chain = 0, .joint = 1, .scale_a = -1.0f}}) {
+    const std::array<glm::quat, 2> rotations = {glm::quat(1, 0, 0, 0), glm::quat(1, 0, 0, 0)};
+    const std::array<glm::vec3, 2> joints = {glm::vec3(0), glm::vec3(20, 0, 0)};
+    std::vector<glm::vec3> out(tube.positions.size());
+    const SwdJob job{.chains = std::span<const SweepChain>(&tube.chain, 1),
+                     .joint_rotations = rotations,
+                     .joint_positions = joints,
+                     .bindings = tube.bindings,
+                     .rest_normals = {},
+                     .keep_volume = false,
+                     .section_scales = std::span<const deform::SectionScale>(&bad, 1),
+                     .positions = out,
+                     .normals = {}};
+    EXPECT_EQ(job.Validate().code, JobStatus::kOutOfRange);
+  }
 }
 
 }  // namespace
