@@ -208,6 +208,12 @@ struct SweepJunction {
   int trunk = 0;          // index of the trunk chain
   float u_start = 0.0f;   // junction zone start on the branch (u units)
   float u_end = 1.0f;     // junction zone end, > u_start
+  // Width (model units) of a seam fade at the boundary where the trunk becomes the
+  // nearest chain [ours]: om is multiplied by sm((d_trunk - d_branch) / seam_band), so
+  // it is 0 on both sides of that boundary. 0 (the default) keeps the plain rule, which
+  // leaves a jump there when the branch starts part-way along the trunk (a clavicle on
+  // the chest); a band of about the branch's first bone length removes it.
+  float seam_band = 0.0f;
 };
 
 // Binds one rest point to one chain: roots of g(u) = dot(p0 - c0(u), hat(c0'(u))),

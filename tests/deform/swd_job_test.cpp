@@ -1,6 +1,7 @@
 #include "deform/swd_job.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <cstring>
 #include <vector>
 
@@ -340,6 +341,79 @@ TEST(SwdJob, RejectsSectionScalesOutsideInteriorJoints) {
                      .normals = {}};
     EXPECT_EQ(job.Validate().code, JobStatus::kOutOfRange);
   }
+}
+
+}  // namespace
+
+namespace {
+
+// Worst ratio of deformed to rest spacing along a line of points crossing the boundary
+// between a trunk (pelvis-chest-neck, up +y) and a clavicle branch that starts part-way
+// up it (at the neck base), with the clavicle raised.
+float WorstStretchNearMidTrunkJunction(float seam_band) {
+  deform::SweepChainSpec trunk_spec;
+  trunk_spec.joints = {0, 1, 2};
+  trunk_spec.rest_points = {glm::vec3(0), glm::vec3(0, 20, 0), glm::vec3(0, 40, 0),
+                            glm::vec3(0, 52, 0)};
+  trunk_spec.half_widths = {0, 5, 4, 0};
+  deform::SweepChainSpec branch_spec;
+  branch_spec.joints = {3, 4};
+  branch_spec.rest_points = {glm::vec3(0, 40, 0), glm::vec3(12, 40, 0), glm::vec3(37, 40, 0)};
+  branch_spec.half_widths = {0, 4, 0};
+  const std::vector<SweepChain> chains = {*deform::BuildSweepChain(branch_spec),
+                                          *deform::BuildSweepChain(trunk_spec)};
+  const std::vector<deform::SweepJunction> junctions = {
+      {.branch = 0, .trunk = 1, .u_start = 0.0f, .u_end = 1.0f, .seam_band = seam_band}};
+  std::vector<glm::vec3> points;
+  constexpr float kSpacing = 0.02f;
+  for (float x = -3.0f; x <= 16.0f; x += kSpacing) points.emplace_back(x, 44.5f, 1.0f);
+  const auto bindings = deform::BindToSweeps(chains, junctions, points);
+  if (!bindings.ok()) return -1.0f;
+  // Skeleton: 0 pelvis, 1 chest, 2 neck (0,40,0), 3 clavicle (0,40,0), 4 shoulder (12,40,0).
+  const std::array<glm::vec3, 5> rest_joints = {glm::vec3(0), glm::vec3(0, 20, 0),
+                                                glm::vec3(0, 40, 0), glm::vec3(0, 40, 0),
+                                                glm::vec3(12, 40, 0)};
+  const std::array<int, 5> parents = {-1, 0, 1, 1, 3};
+  const glm::quat chest = glm::angleAxis(0.1f, glm::vec3(0, 0, 1));
+  const glm::quat clavicle = chest * glm::angleAxis(0.6f, glm::vec3(0, 0, 1));
+  const std::array<glm::quat, 5> rotations = {
+      glm::quat(1, 0, 0, 0), chest, chest, clavicle,
+      clavicle * glm::angleAxis(0.8f, glm::vec3(0, 0, 1))};
+  std::array<glm::vec3, 5> joints{};
+  for (std::size_t j = 0; j < 5; ++j) {
+    const int parent = parents[j];
+    joints[j] = parent < 0 ? rest_joints[j]
+                           : joints[static_cast<std::size_t>(parent)] +
+                                 rotations[static_cast<std::size_t>(parent)] *
+                                     (rest_joints[j] - rest_joints[static_cast<std::size_t>(parent)]);
+  }
+  std::vector<glm::vec3> out(points.size());
+  const SwdJob job{.chains = chains,
+                   .joint_rotations = rotations,
+                   .joint_positions = joints,
+                   .bindings = *bindings,
+                   .rest_normals = {},
+                   .keep_volume = false,
+                   .section_scales = {},
+                   .positions = out,
+                   .normals = {}};
+  if (!job.Run()) return -1.0f;
+  float worst = 0.0f;
+  for (std::size_t i = 1; i < out.size(); ++i) {
+    worst = std::max(worst, glm::length(out[i] - out[i - 1]) / kSpacing);
+  }
+  return worst;
+}
+
+TEST(SwdJob, SeamBandRemovesTheJumpWhereTheTrunkBecomesNearest) {
+  const float plain = WorstStretchNearMidTrunkJunction(0.0f);
+  const float banded = WorstStretchNearMidTrunkJunction(12.0f);
+  ASSERT_GT(plain, 0.0f);
+  ASSERT_GT(banded, 0.0f);
+  std::printf("worst spacing stretch across the junction seam: plain %.2f, seam band %.2f\n",
+              double(plain), double(banded));
+  EXPECT_GT(plain, 20.0f) << "the plain rule should tear at the nearest-chain boundary";
+  EXPECT_LT(banded, 4.0f);
 }
 
 }  // namespace
