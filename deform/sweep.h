@@ -186,9 +186,10 @@ struct SweepBinding {
   float u = 0.0f;             // sweep parameter in [0, K]
   glm::vec3 offset{0.0f};     // o = p0 - c0(u), bind model space (model units)
   // First axis e_a of the rest cross-section's ellipse at u (unit, orthogonal to
-  // hat(c0'(u)), bind model space): principal direction of the offsets of the points
-  // bound near u (the columns of E0 are e_a, e_b = hat(c0') x e_a, hat(c0')). Zero when
-  // BindToSweep alone made the binding (then elliptic scaling treats the section as round).
+  // hat(c0'(u)), bind model space): principal direction, in the section plane, of the
+  // offsets bound in the same joint region (the columns of E0 are e_a,
+  // e_b = hat(c0') x e_a, hat(c0')). Zero between regions, where no elliptic scaling
+  // applies, and when BindToSweep alone made the binding (then the section counts as round).
   glm::vec3 section_axis{0.0f};
   std::uint16_t chain = 0;    // index of the chain in the chain list given to the binder/job
 };
@@ -223,9 +224,11 @@ SweepBinding BindToSweep(const SweepChain& chain, int chain_index, const glm::dv
 
 // Binds every rest vertex (#V, bind model space) to the chain whose rest bone segment is
 // nearest; a vertex on a junction's branch with u in [u_start, u_end) is also bound to
-// the trunk. Then sets every binding's section_axis: the offsets bound to the same chain
-// in u-bins of 1/64 bone give a second-moment matrix sum(o o^T), whose principal
-// direction in the vertex's section plane is e_a (PCA of the vertex ring at u). Errors (kInvalidArgument) for empty or oversized chain lists, bad junction
+// the trunk. Then sets the section_axis of every binding inside a joint region: the
+// offsets bound in that region give a second-moment matrix sum(o o^T), whose principal
+// direction in the vertex's section plane is e_a. (The spec's E0(u) is the PCA of the
+// ring at u; pooling over the region keeps e_a continuous in u and defined for nearly
+// round rings, and equals it when the region's rings are alike.) Errors (kInvalidArgument) for empty or oversized chain lists, bad junction
 // indices or intervals, non-finite positions.
 mocap::Result<std::vector<SweepVertexBinding>> BindToSweeps(
     std::span<const SweepChain> chains, std::span<const SweepJunction> junctions,

@@ -52,24 +52,25 @@ glm::dvec3 PrincipalInPlane(const glm::dmat3& m, const glm::dvec3& tangent) {
   return std::cos(angle) * e1 + std::sin(angle) * e2;
 }
 
-constexpr int kSectionBinsPerBone = 64;
-
+// The joint region holding u (its interior joint index), or -1 between regions. Section
+// axes are pooled per region rather than per ring: a nearly round ring has no stable
+// principal direction, and the axis must vary continuously along u for the skin to.
 int SectionBin(const SweepChain& chain, float u) {
-  const int bins = kSectionBinsPerBone * chain.num_bones();
-  return std::clamp(static_cast<int>(u * kSectionBinsPerBone), 0, bins - 1);
+  int joint = -1;
+  float x = 0.0f;
+  return SweepRegionAt(chain, u, &joint, &x) ? joint : -1;
 }
 
 void AssignSectionAxes(std::span<const SweepChain> chains,
                        std::vector<SweepVertexBinding>& bindings) {
   std::vector<std::vector<glm::dmat3>> moments(chains.size());
   for (std::size_t c = 0; c < chains.size(); ++c) {
-    moments[c].assign(static_cast<std::size_t>(kSectionBinsPerBone * chains[c].num_bones()),
-                      glm::dmat3(0.0));
+    moments[c].assign(static_cast<std::size_t>(chains[c].num_bones() + 1), glm::dmat3(0.0));
   }
   auto accumulate = [&](const SweepBinding& b) {
     const glm::dvec3 o(b.offset);
-    moments[b.chain][static_cast<std::size_t>(SectionBin(chains[b.chain], b.u))] +=
-        glm::outerProduct(o, o);
+    const int bin = SectionBin(chains[b.chain], b.u);
+    if (bin >= 0) moments[b.chain][static_cast<std::size_t>(bin)] += glm::outerProduct(o, o);
   };
   for (const SweepVertexBinding& v : bindings) {
     accumulate(v.primary);
@@ -77,9 +78,11 @@ void AssignSectionAxes(std::span<const SweepChain> chains,
   }
   auto assign = [&](SweepBinding& b) {
     const SweepChain& chain = chains[b.chain];
+    const int bin = SectionBin(chain, b.u);
+    if (bin < 0) return;  // between regions: no elliptic scaling applies
     glm::dvec3 tangent;
     SweepCentre(chain, chain.rest_pose(), static_cast<double>(b.u), &tangent);
-    const glm::dmat3& m = moments[b.chain][static_cast<std::size_t>(SectionBin(chain, b.u))];
+    const glm::dmat3& m = moments[b.chain][static_cast<std::size_t>(bin)];
     b.section_axis = glm::vec3(PrincipalInPlane(m, glm::normalize(tangent)));
   };
   for (SweepVertexBinding& v : bindings) {
