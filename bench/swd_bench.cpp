@@ -1,7 +1,8 @@
 // SWD throughput on a ~20k-vertex arm: a tube of 417 rings x 48 vertices around a
 // 3-bone chain (upper arm 30, forearm 25, hand 10 units), elbow bent 100 degrees and
 // the hand pronated 60 degrees. Reports vertices per second for the per-frame job
-// (with normals, with and without volume keeping) and for the one-off binding.
+// (with normals; plain, volume keeping, volume keeping + elliptic bulge) and for the
+// one-off binding.
 
 #include <array>
 #include <cmath>
@@ -61,13 +62,18 @@ void BM_SwdJob(benchmark::State& state) {
   const std::array<glm::vec3, 3> joints = {glm::vec3(0), elbow,
                                            elbow + bend * glm::vec3(25, 0, 0)};
   std::vector<glm::vec3> positions(arm.positions.size()), normals(arm.positions.size());
+  // Mode 2 adds a biceps-like elliptic bulge in the elbow region.
+  const std::array<deform::SectionScale, 1> bulge = {
+      deform::SectionScale{.chain = 0, .joint = 1, .scale_a = 1.3f, .scale_b = 0.9f}};
   const deform::SwdJob job{.chains = chains,
                            .joint_rotations = rotations,
                            .joint_positions = joints,
                            .bindings = *bindings,
                            .rest_normals = arm.normals,
                            .keep_volume = state.range(0) != 0,
-                           .section_scales = {},
+                           .section_scales = state.range(0) == 2
+                                                 ? std::span<const deform::SectionScale>(bulge)
+                                                 : std::span<const deform::SectionScale>(),
                            .positions = positions,
                            .normals = normals};
   for (auto _ : state) {
@@ -79,7 +85,8 @@ void BM_SwdJob(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(positions.size()));
   state.counters["vertices"] = static_cast<double>(positions.size());
 }
-BENCHMARK(BM_SwdJob)->ArgName("keep_volume")->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
+// mode 0: plain; 1: keep_volume; 2: keep_volume + elliptic bulge at the elbow.
+BENCHMARK(BM_SwdJob)->ArgName("mode")->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMicrosecond);
 
 void BM_SwdBind(benchmark::State& state) {
   const BenchArm arm = MakeBenchArm();
