@@ -426,3 +426,34 @@ TEST(SwdJob, SeamBandRemovesTheJumpWhereTheTrunkBecomesNearest) {
 }
 
 }  // namespace
+
+namespace {
+
+// No tears anywhere along the limb: under a strong combined pose (elbow bent 150 deg,
+// forearm twisted 90, hand pronated 60 and bent) no mesh edge stretches more than 2x.
+TEST(SwdJob, CombinedPoseStretchesNoEdgeMuch) {
+  const ArmSetup s = MakeArmSetup(24, 2);
+  const glm::quat bend = glm::angleAxis(glm::radians(150.0f), glm::vec3(0, 0, 1));
+  const glm::quat forearm = bend * glm::angleAxis(glm::radians(90.0f), glm::vec3(1, 0, 0));
+  const glm::quat hand = forearm * glm::angleAxis(glm::radians(60.0f), glm::vec3(1, 0, 0)) *
+                         glm::angleAxis(glm::radians(40.0f), glm::vec3(0, 1, 0));
+  const auto pose = testfixture::MakePose(s.arm, {glm::quat(1, 0, 0, 0), forearm, hand},
+                                          s.arm.joint_rest[0]);
+  for (const bool keep_volume : {false, true}) {
+    const auto out = testfixture::SkinSwd(s.chain, s.bindings, pose, keep_volume);
+    ASSERT_EQ(out.size(), s.arm.mesh.positions.size());
+    float worst = 0.0f;
+    for (const glm::uvec3& t : s.arm.mesh.triangles) {
+      for (int e = 0; e < 3; ++e) {
+        const unsigned a = t[e], b = t[(e + 1) % 3];
+        const float rest = glm::length(s.arm.mesh.positions[a] - s.arm.mesh.positions[b]);
+        worst = std::max(worst, glm::length(out[a] - out[b]) / rest);
+      }
+    }
+    std::printf("combined pose, keep_volume %d: worst edge stretch %.3f\n", int(keep_volume),
+                double(worst));
+    EXPECT_LT(worst, 2.0f) << "keep_volume " << keep_volume;
+  }
+}
+
+}  // namespace
