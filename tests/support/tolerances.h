@@ -112,5 +112,12 @@ inline constexpr float kJpegFlatTol = 3.0f / 255.0f;
 inline constexpr double kVideoFlatTol8 = 6.0;
 // PSNR in dB (a log of a computed ratio).
 inline constexpr double kPsnrTolDb = 1e-3;
+// SWD: bind-pose rebuild error relative to the mesh size (ALGORITHMS.md 2.3 asks 1e-5).
+inline constexpr float kSwdRebuildRelTol = 1e-5f;
+// Area ratios of vertex rings compared with closed forms (float positions, double areas).
+inline constexpr double kAreaRatioTol = 1e-4;
+// Sweep centre-curve continuity: a step of kCurveStep in u moves c by about speed * step.
+inline constexpr double kCurveStep = 1e-7;
+inline constexpr double kCurveDirectionTol = 1e-5;  // radians between tangent directions
 
 }  // namespace testsupport
