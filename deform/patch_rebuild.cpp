@@ -1,0 +1,207 @@
+// PatchRebuildJob (ALGORITHMS.md 3.6): p = s(u,v) + d n(u,v) from the stored
+// basis values and a 4x4 block of control points.
+//
+// The per-record arithmetic is one template, instantiated for float (scalar
+// path) and for 8-lane GCC vectors compiled with AVX. Both perform the same
+// IEEE operations in the same order (no FMA: -ffp-contract=off and no "fma"
+// target), so every record's result is bit-identical whichever path, batch
+// or thread computed it.
+
+#include <cmath>
+#include <cstring>
+
+#include <immintrin.h>
+
+#include "deform/patch_binding.h"
+
+// The 8-lane helpers pass vectors by value, but all of them are internal and
+// always inlined into AVX functions, so no call crosses the ABI GCC warns about.
+#pragma GCC diagnostic ignored "-Wpsabi"
+
+namespace deform {
+namespace {
+
+typedef float V8 __attribute__((vector_size(32)));
+
+template <typename V>
+[[gnu::always_inline]] inline V Splat(float x) {
+  if constexpr (sizeof(V) == sizeof(float)) {
+    return x;
+  } else {
+    return V{x, x, x, x, x, x, x, x};
+  }
+}
+
+// Derivatives of the four cubic basis functions of span k at u, from the
+// span's knot constants t (layout in MakeSpanTable, patch_binding.cpp):
+// degree-1 and degree-2 values, then N'_{i,3} = 3/(u_{i+3}-u_i) N_{i,2} - ...
+template <typename V>
+[[gnu::always_inline]] inline void DerivBasis(const V& u, const float* t, V* out) {
+  const V a = Splat<V>(t[2]) - u;            // u_{k+1} - u
+  const V b = u - Splat<V>(t[1]);            // u - u_k
+  const V c = u - Splat<V>(t[0]);            // u - u_{k-1}
+  const V e = Splat<V>(t[3]) - u;            // u_{k+2} - u
+  const V n1a = a * Splat<V>(t[4]);          // N_{k-1,1}
+  const V n1b = b * Splat<V>(t[4]);          // N_{k,1}
+  const V n20 = (a * Splat<V>(t[5])) * n1a;  // N_{k-2,2}
+  const V n21 = (c * Splat<V>(t[5])) * n1a + (e * Splat<V>(t[6])) * n1b;  // N_{k-1,2}
+  const V n22 = (b * Splat<V>(t[6])) * n1b;  // N_{k,2}
+  const V c0 = Splat<V>(t[7]) * n20;
+  const V c1 = Splat<V>(t[8]) * n21;
+  const V c2 = Splat<V>(t[9]) * n22;
+  out[0] = -c0;
+  out[1] = c0 - c1;
+  out[2] = c1 - c2;
+  out[3] = c2;
+}
+
+// Inputs of one record (or 8 records sharing a span).
+template <typename V>
+struct RecordIn {
+  V u, v, d, nu0, nu1, nu2, nv0, nv1, nv2;
+};
+
+// Surface point s and unnormalized normal c = cross(s_u, s_v).
+template <typename V>
+struct RecordOut {
+  V sx, sy, sz, cx, cy, cz, len2;
+};
+
+template <typename V>
+[[gnu::always_inline]] inline void EvaluateRecord(const RecordIn<V>& in, const float* tu,
+                                                  const float* tv, const glm::vec3* q, int stride,
+                                                  RecordOut<V>& out) {
+  const V one = Splat<V>(1.0f);
+  const V nu[4] = {in.nu0, in.nu1, in.nu2, ((one - in.nu0) - in.nu1) - in.nu2};
+  const V nv[4] = {in.nv0, in.nv1, in.nv2, ((one - in.nv0) - in.nv1) - in.nv2};
+  V dnu[4], dnv[4];
+  DerivBasis(in.u, tu, dnu);
+  DerivBasis(in.v, tv, dnv);
+  V s[3] = {Splat<V>(0.0f), Splat<V>(0.0f), Splat<V>(0.0f)};
+  V su[3] = {s[0], s[0], s[0]};
+  V sv[3] = {s[0], s[0], s[0]};
+  for (int a = 0; a < 4; ++a) {
+    const glm::vec3* row = q + a * stride;
+    for (int k = 0; k < 3; ++k) {
+      V r = nv[0] * Splat<V>(row[0][k]);     // sum_b Nv[b] Q[a][b]
+      V rv = dnv[0] * Splat<V>(row[0][k]);   // sum_b Nv'[b] Q[a][b]
+      for (int b = 1; b < 4; ++b) {
+        const V qb = Splat<V>(row[b][k]);
+        r = r + nv[b] * qb;
+        rv = rv + dnv[b] * qb;
+      }
+      s[k] = s[k] + nu[a] * r;
+      su[k] = su[k] + dnu[a] * r;
+      sv[k] = sv[k] + nu[a] * rv;
+    }
+  }
+  out.sx = s[0];
+  out.sy = s[1];
+  out.sz = s[2];
+  out.cx = su[1] * sv[2] - su[2] * sv[1];
+  out.cy = su[2] * sv[0] - su[0] * sv[2];
+  out.cz = su[0] * sv[1] - su[1] * sv[0];
+  out.len2 = (out.cx * out.cx + out.cy * out.cy) + out.cz * out.cz;
+}
+
+// Squared length below which the normal is taken as zero (degenerate patch).
+constexpr float kTinyLen2 = 1e-30f;
+
+void RunOne(const PatchRebuildJob& job, size_t i) {
+  const PatchBindingView& b = job.bindings;
+  const int i0 = b.first[i] & 0xff, j0 = b.first[i] >> 8;
+  const RecordIn<float> in{b.u[i],   b.v[i],   b.d[i],   b.nu0[i], b.nu1[i],
+                           b.nu2[i], b.nv0[i], b.nv1[i], b.nv2[i]};
+  RecordOut<float> out;
+  EvaluateRecord(in, &b.span_table_u[static_cast<size_t>(i0) * kSpanTableStride],
+                 &b.span_table_v[static_cast<size_t>(j0) * kSpanTableStride],
+                 &job.control[static_cast<size_t>(i0) * b.num_v + j0], b.num_v, out);
+  const float len2 = out.len2 > kTinyLen2 ? out.len2 : kTinyLen2;
+  const float scale = b.sigma / std::sqrt(len2);
+  const float nx = out.cx * scale, ny = out.cy * scale, nz = out.cz * scale;
+  job.positions[i] = glm::vec3(out.sx + in.d * nx, out.sy + in.d * ny, out.sz + in.d * nz);
+  if (!job.normals.empty()) job.normals[i] = glm::vec3(nx, ny, nz);
+}
+
+[[gnu::target("avx")]] V8 Load8(const float* p) {
+  V8 v;
+  std::memcpy(&v, p, sizeof(v));
+  return v;
+}
+
+// Eight consecutive records that share one span.
+[[gnu::target("avx")]] void RunEight(const PatchRebuildJob& job, size_t i) {
+  const PatchBindingView& b = job.bindings;
+  const int i0 = b.first[i] & 0xff, j0 = b.first[i] >> 8;
+  const RecordIn<V8> in{Load8(&b.u[i]),   Load8(&b.v[i]),   Load8(&b.d[i]),
+                        Load8(&b.nu0[i]), Load8(&b.nu1[i]), Load8(&b.nu2[i]),
+                        Load8(&b.nv0[i]), Load8(&b.nv1[i]), Load8(&b.nv2[i])};
+  RecordOut<V8> out;
+  EvaluateRecord(in, &b.span_table_u[static_cast<size_t>(i0) * kSpanTableStride],
+                 &b.span_table_v[static_cast<size_t>(j0) * kSpanTableStride],
+                 &job.control[static_cast<size_t>(i0) * b.num_v + j0], b.num_v, out);
+  const V8 tiny = Splat<V8>(kTinyLen2);
+  const V8 len2 = out.len2 > tiny ? out.len2 : tiny;
+  const V8 scale = Splat<V8>(b.sigma) / V8(_mm256_sqrt_ps(__m256(len2)));
+  const V8 nx = out.cx * scale, ny = out.cy * scale, nz = out.cz * scale;
+  const V8 px = out.sx + in.d * nx, py = out.sy + in.d * ny, pz = out.sz + in.d * nz;
+  glm::vec3* pos = &job.positions[i];
+  for (int l = 0; l < 8; ++l) pos[l] = glm::vec3(px[l], py[l], pz[l]);
+  if (!job.normals.empty()) {
+    glm::vec3* nrm = &job.normals[i];
+    for (int l = 0; l < 8; ++l) nrm[l] = glm::vec3(nx[l], ny[l], nz[l]);
+  }
+}
+
+}  // namespace
+
+mocap::JobStatus PatchRebuildJob::Validate() const {
+  using mocap::JobStatus;
+  const PatchBindingView& b = bindings;
+  if (b.num_u < 4 || b.num_v < 4 || b.num_u > 256 || b.num_v > 256) {
+    return {JobStatus::kOutOfRange, "control grid must be 4..256 points each way"};
+  }
+  if (control.size() != static_cast<size_t>(b.num_u) * static_cast<size_t>(b.num_v)) {
+    return {JobStatus::kSizeMismatch, "control must hold num_u x num_v points"};
+  }
+  if (b.span_table_u.size() != static_cast<size_t>(b.num_u - 3) * kSpanTableStride ||
+      b.span_table_v.size() != static_cast<size_t>(b.num_v - 3) * kSpanTableStride) {
+    return {JobStatus::kSizeMismatch, "span tables must hold (M-3) and (N-3) entries"};
+  }
+  const size_t n = b.size();
+  if (b.u.size() != n || b.v.size() != n || b.nu0.size() != n || b.nu1.size() != n ||
+      b.nu2.size() != n || b.nv0.size() != n || b.nv1.size() != n || b.nv2.size() != n ||
+      b.first.size() != n) {
+    return {JobStatus::kSizeMismatch, "binding record arrays differ in length"};
+  }
+  if (positions.size() != n) return {JobStatus::kSizeMismatch, "positions must hold #B points"};
+  if (!normals.empty() && normals.size() != n) {
+    return {JobStatus::kSizeMismatch, "normals must be empty or hold #B normals"};
+  }
+  if (b.sigma != 1.0f && b.sigma != -1.0f) return {JobStatus::kOutOfRange, "sigma must be +1 or -1"};
+  return mocap::kJobOk;
+}
+
+mocap::JobStatus PatchRebuildJob::Run() const {
+  if (const mocap::JobStatus st = Validate(); !st) return st;
+  const size_t n = bindings.size();
+  const bool simd = allow_simd && __builtin_cpu_supports("avx");
+  const std::uint16_t* first = bindings.first.data();
+  size_t i = 0;
+  while (i < n) {
+    if (simd && i + 8 <= n) {
+      bool same = true;
+      for (int l = 1; l < 8; ++l) same = same && first[i + static_cast<size_t>(l)] == first[i];
+      if (same) {
+        RunEight(*this, i);
+        i += 8;
+        continue;
+      }
+    }
+    RunOne(*this, i);
+    ++i;
+  }
+  return mocap::kJobOk;
+}
+
+}  // namespace deform
