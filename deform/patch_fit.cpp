@@ -114,26 +114,47 @@ mocap::Status CheckOneToOne(const RegionParametrization& param, const std::vecto
   return mocap::Status::Ok();
 }
 
-// Area-weighted normal sum and per-vertex area weights (area/3 per corner).
-glm::dvec3 AreaWeights(std::span<const glm::vec3> positions, std::span<const int> region,
-                       const std::vector<glm::ivec3>& tris, std::vector<double>& weights) {
-  weights.assign(region.size(), 0.0);
-  glm::dvec3 normal(0.0);
+// Area-weighted moments of the region: the normal sum, the centroid and the
+// covariance integrated exactly over the triangles (for a triangle a,b,c
+// about the centroid: A/12 (aa^T + bb^T + cc^T + ss^T), s = a+b+c), so the
+// triangulation's diagonal direction does not tilt the axes. Without
+// triangles, the vertices count equally.
+struct RegionMoments {
+  glm::dvec3 normal_sum{0.0};
+  glm::dvec3 centroid{0.0};
+  glm::dmat3 covariance{0.0};
+};
+
+RegionMoments Moments(std::span<const glm::vec3> positions, std::span<const int> region,
+                      const std::vector<glm::ivec3>& tris) {
+  RegionMoments m;
+  auto pos = [&](int r) { return D(positions[static_cast<size_t>(region[static_cast<size_t>(r)])]); };
+  double area = 0.0;
   for (const glm::ivec3& t : tris) {
-    const glm::dvec3 a = D(positions[static_cast<size_t>(region[static_cast<size_t>(t.x)])]);
-    const glm::dvec3 b = D(positions[static_cast<size_t>(region[static_cast<size_t>(t.y)])]);
-    const glm::dvec3 c = D(positions[static_cast<size_t>(region[static_cast<size_t>(t.z)])]);
-    const glm::dvec3 n = glm::cross(b - a, c - a);
-    normal += n;
-    const double area3 = 0.5 * glm::length(n) / 3.0;
-    weights[static_cast<size_t>(t.x)] += area3;
-    weights[static_cast<size_t>(t.y)] += area3;
-    weights[static_cast<size_t>(t.z)] += area3;
+    const glm::dvec3 n = glm::cross(pos(t.y) - pos(t.x), pos(t.z) - pos(t.x));
+    m.normal_sum += n;
+    const double a = 0.5 * glm::length(n);
+    area += a;
+    m.centroid += a * (pos(t.x) + pos(t.y) + pos(t.z)) / 3.0;
   }
-  double total = 0.0;
-  for (double w : weights) total += w;
-  if (!(total > 0.0)) std::fill(weights.begin(), weights.end(), 1.0);
-  return normal;
+  if (area > 0.0) {
+    m.centroid /= area;
+    for (const glm::ivec3& t : tris) {
+      const glm::dvec3 a = pos(t.x) - m.centroid, b = pos(t.y) - m.centroid, c = pos(t.z) - m.centroid;
+      const double ar = 0.5 * glm::length(glm::cross(b - a, c - a));
+      const glm::dvec3 s = a + b + c;
+      m.covariance += (ar / (12.0 * area)) * (glm::outerProduct(a, a) + glm::outerProduct(b, b) +
+                                               glm::outerProduct(c, c) + glm::outerProduct(s, s));
+    }
+    return m;
+  }
+  for (size_t r = 0; r < region.size(); ++r) m.centroid += pos(static_cast<int>(r));
+  m.centroid /= static_cast<double>(region.size());
+  for (size_t r = 0; r < region.size(); ++r) {
+    const glm::dvec3 d = pos(static_cast<int>(r)) - m.centroid;
+    m.covariance += glm::outerProduct(d, d) / static_cast<double>(region.size());
+  }
+  return m;
 }
 
 // Small dense LU with partial pivoting, factored once, solved for many
@@ -296,6 +317,41 @@ std::vector<double> ChordParameters(const std::vector<glm::dvec3>& pts, int coun
   return out;
 }
 
+// Squared 2D distance from x to triangle abc and the barycentric weights of
+// the closest point (0 and x's own weights when x is inside).
+double ClosestInTriangle(const glm::dvec2& x, const glm::dvec2& a, const glm::dvec2& b,
+                         const glm::dvec2& c, double w[3]) {
+  const double det = (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
+  if (det > 0.0) {
+    const double wb = ((x.x - a.x) * (c.y - a.y) - (x.y - a.y) * (c.x - a.x)) / det;
+    const double wc = ((b.x - a.x) * (x.y - a.y) - (b.y - a.y) * (x.x - a.x)) / det;
+    const double wa = 1.0 - wb - wc;
+    if (wa >= 0.0 && wb >= 0.0 && wc >= 0.0) {
+      w[0] = wa;
+      w[1] = wb;
+      w[2] = wc;
+      return 0.0;
+    }
+  }
+  double best = 1e300;
+  const glm::dvec2 pts[3] = {a, b, c};
+  for (int e = 0; e < 3; ++e) {
+    const glm::dvec2 p = pts[e], q = pts[(e + 1) % 3];
+    const glm::dvec2 pq = q - p;
+    const double len2 = glm::dot(pq, pq);
+    const double t = len2 > 0.0 ? std::clamp(glm::dot(x - p, pq) / len2, 0.0, 1.0) : 0.0;
+    const glm::dvec2 y = p + t * pq;
+    const double d2 = glm::dot(x - y, x - y);
+    if (d2 < best) {
+      best = d2;
+      w[e] = 1.0 - t;
+      w[(e + 1) % 3] = t;
+      w[(e + 2) % 3] = 0.0;
+    }
+  }
+  return best;
+}
+
 mocap::Status CheckParameterList(std::span<const double> xs, const char* what) {
   if (xs.size() < 2) return ArgError(std::string(what) + ": expected at least 2 sample parameters");
   for (size_t i = 0; i < xs.size(); ++i) {
@@ -324,20 +380,9 @@ mocap::Result<RegionParametrization> ParametrizePlane(std::span<const glm::vec3>
   param.kind = RegionParametrization::Kind::kPlane;
   param.region.assign(region.begin(), region.end());
   param.region_triangles = static_cast<int>(tris.size());
-  std::vector<double> w;
-  const glm::dvec3 normal_sum = AreaWeights(positions, region, tris, w);
-  double wsum = 0.0;
-  glm::dvec3 c(0.0);
-  for (size_t r = 0; r < region.size(); ++r) {
-    c += w[r] * D(positions[static_cast<size_t>(region[r])]);
-    wsum += w[r];
-  }
-  c /= wsum;
-  glm::dmat3 cov(0.0);
-  for (size_t r = 0; r < region.size(); ++r) {
-    const glm::dvec3 d = D(positions[static_cast<size_t>(region[r])]) - c;
-    cov += (w[r] / wsum) * glm::outerProduct(d, d);
-  }
+  const RegionMoments mom = Moments(positions, region, tris);
+  const glm::dvec3 normal_sum = mom.normal_sum, c = mom.centroid;
+  const glm::dmat3 cov = mom.covariance;
   glm::dvec3 vals;
   glm::dmat3 vecs;
   SymmetricEigen(cov, vals, vecs);
@@ -377,16 +422,9 @@ mocap::Result<RegionParametrization> ParametrizeCylinder(
   param.kind = RegionParametrization::Kind::kCylinder;
   param.region.assign(region.begin(), region.end());
   param.region_triangles = static_cast<int>(tris.size());
-  std::vector<double> w;
-  const glm::dvec3 normal_sum = AreaWeights(positions, region, tris, w);
+  const RegionMoments mom = Moments(positions, region, tris);
+  const glm::dvec3 normal_sum = mom.normal_sum, c = mom.centroid;
   const glm::dvec3 a = glm::normalize(axis_direction);
-  glm::dvec3 c(0.0);
-  double wsum = 0.0;
-  for (size_t r = 0; r < region.size(); ++r) {
-    c += w[r] * D(positions[static_cast<size_t>(region[r])]);
-    wsum += w[r];
-  }
-  c /= wsum;
   glm::dvec3 radial = c - axis_origin;
   radial -= glm::dot(radial, a) * a;
   if (!(glm::length(radial) > 1e-12)) {
@@ -441,23 +479,27 @@ mocap::Result<PatchSamples> SampleRegion(std::span<const glm::vec3> positions,
     for (int l = 0; l < out.num_t; ++l) {
       const glm::dvec2 x(us[static_cast<size_t>(k)], vs[static_cast<size_t>(l)]);
       bool found = false;
-      if (mode == SampleMode::kBarycentric) {
-        constexpr double kInside = -1e-9;  // accept points on edges
+      if (mode == SampleMode::kBarycentric && !tris.empty()) {
+        // The containing triangle, or else the nearest point of the layout
+        // (samples on the border of a non-rectangular layout stay on the
+        // region's edge instead of jumping to a vertex).
+        double best_d2 = 1e300;
+        glm::dvec3 best_point(0.0);
         for (const glm::ivec3& t : tris) {
           const glm::dvec2 a = param.uv[static_cast<size_t>(t.x)], b = param.uv[static_cast<size_t>(t.y)],
                            c = param.uv[static_cast<size_t>(t.z)];
-          const double det = (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
-          if (!(det > 0.0)) continue;
-          const double wb = ((x.x - a.x) * (c.y - a.y) - (x.y - a.y) * (c.x - a.x)) / det;
-          const double wc = ((b.x - a.x) * (x.y - a.y) - (b.y - a.y) * (x.x - a.x)) / det;
-          const double wa = 1.0 - wb - wc;
-          if (wa < kInside || wb < kInside || wc < kInside) continue;
-          auto pos = [&](int r) { return D(positions[static_cast<size_t>(param.region[static_cast<size_t>(r)])]); };
-          out.points.push_back(wa * pos(t.x) + wb * pos(t.y) + wc * pos(t.z));
-          out.vertex.push_back(-1);
-          found = true;
-          break;
+          double w[3] = {1.0, 0.0, 0.0};
+          const double d2 = ClosestInTriangle(x, a, b, c, w);
+          if (d2 < best_d2) {
+            best_d2 = d2;
+            auto pos = [&](int r) { return D(positions[static_cast<size_t>(param.region[static_cast<size_t>(r)])]); };
+            best_point = w[0] * pos(t.x) + w[1] * pos(t.y) + w[2] * pos(t.z);
+            if (d2 == 0.0) break;
+          }
         }
+        out.points.push_back(best_point);
+        out.vertex.push_back(-1);
+        found = true;
       }
       if (found) continue;
       size_t best = 0;

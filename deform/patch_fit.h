@@ -67,7 +67,8 @@ std::vector<double> UniformParameters(int count);
 // How a sample point is taken from the mesh (3.3).
 enum class SampleMode {
   kNearestVertex,  // the region vertex whose (u,v) is nearest [paper]
-  kBarycentric,    // the exact mesh point at (u,v) in the 2D layout; nearest vertex outside it
+  kBarycentric,    // the exact mesh point at (u,v) in the 2D layout; outside the layout,
+                   // the mesh point at the nearest layout point (on its border)
 };
 
 // S x T sample points on the region and their parameters.
