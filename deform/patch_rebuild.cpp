@@ -7,6 +7,7 @@
 // target), so every record's result is bit-identical whichever path, batch
 // or thread computed it.
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 
@@ -28,7 +29,7 @@ template <typename V>
   if constexpr (sizeof(V) == sizeof(float)) {
     return x;
   } else {
-    return V{x, x, x, x, x, x, x, x};
+    return x - V{};  // vector - scalar broadcasts; x - (+0) is x, even for -0
   }
 }
 
@@ -80,11 +81,14 @@ template <typename V>
   V s[3] = {Splat<V>(0.0f), Splat<V>(0.0f), Splat<V>(0.0f)};
   V su[3] = {s[0], s[0], s[0]};
   V sv[3] = {s[0], s[0], s[0]};
+#pragma GCC unroll 4
   for (int a = 0; a < 4; ++a) {
     const glm::vec3* row = q + a * stride;
+#pragma GCC unroll 3
     for (int k = 0; k < 3; ++k) {
       V r = nv[0] * Splat<V>(row[0][k]);     // sum_b Nv[b] Q[a][b]
       V rv = dnv[0] * Splat<V>(row[0][k]);   // sum_b Nv'[b] Q[a][b]
+#pragma GCC unroll 3
       for (int b = 1; b < 4; ++b) {
         const V qb = Splat<V>(row[b][k]);
         r = r + nv[b] * qb;
@@ -123,19 +127,46 @@ void RunOne(const PatchRebuildJob& job, size_t i) {
   if (!job.normals.empty()) job.normals[i] = glm::vec3(nx, ny, nz);
 }
 
-[[gnu::target("avx")]] V8 Load8(const float* p) {
+[[gnu::target("avx")]] inline V8 Load8(const float* p) {
   V8 v;
   std::memcpy(&v, p, sizeof(v));
   return v;
 }
 
-// Eight consecutive records that share one span.
-[[gnu::target("avx")]] void RunEight(const PatchRebuildJob& job, size_t i) {
+// Lanes of a short run: records i .. i+count-1, the last one repeated.
+[[gnu::target("avx")]] inline V8 LoadPadded(std::span<const float> a, size_t i, size_t count) {
+  alignas(32) float tmp[8];
+  for (size_t l = 0; l < 8; ++l) tmp[l] = a[i + (l < count ? l : count - 1)];
+  return Load8(tmp);
+}
+
+// Writes 8 points given as x, y, z lanes to 8 consecutive glm::vec3 (24
+// floats) with a shuffle transpose instead of 24 lane extracts.
+[[gnu::target("avx")]] inline void StoreAos8(const V8& x, const V8& y, const V8& z, float* out) {
+  const __m256 rxy = _mm256_shuffle_ps(__m256(x), __m256(y), _MM_SHUFFLE(2, 0, 2, 0));  // x0 x2 y0 y2
+  const __m256 ryz = _mm256_shuffle_ps(__m256(y), __m256(z), _MM_SHUFFLE(3, 1, 3, 1));  // y1 y3 z1 z3
+  const __m256 rzx = _mm256_shuffle_ps(__m256(z), __m256(x), _MM_SHUFFLE(3, 1, 2, 0));  // z0 z2 x1 x3
+  const __m256 r03 = _mm256_shuffle_ps(rxy, rzx, _MM_SHUFFLE(2, 0, 2, 0));  // x0 y0 z0 x1
+  const __m256 r14 = _mm256_shuffle_ps(ryz, rxy, _MM_SHUFFLE(3, 1, 2, 0));  // y1 z1 x2 y2
+  const __m256 r25 = _mm256_shuffle_ps(rzx, ryz, _MM_SHUFFLE(3, 1, 3, 1));  // z2 x3 y3 z3
+  _mm256_storeu_ps(out, _mm256_permute2f128_ps(r03, r14, 0x20));
+  _mm256_storeu_ps(out + 8, _mm256_permute2f128_ps(r25, r03, 0x30));
+  _mm256_storeu_ps(out + 16, _mm256_permute2f128_ps(r14, r25, 0x31));
+}
+
+// `count` (1..8) consecutive records that share one span, in 8 lanes.
+[[gnu::target("avx")]] void RunBatch(const PatchRebuildJob& job, size_t i, size_t count) {
   const PatchBindingView& b = job.bindings;
   const int i0 = b.first[i] & 0xff, j0 = b.first[i] >> 8;
-  const RecordIn<V8> in{Load8(&b.u[i]),   Load8(&b.v[i]),   Load8(&b.d[i]),
-                        Load8(&b.nu0[i]), Load8(&b.nu1[i]), Load8(&b.nu2[i]),
-                        Load8(&b.nv0[i]), Load8(&b.nv1[i]), Load8(&b.nv2[i])};
+  RecordIn<V8> in;
+  if (count == 8) {
+    in = {Load8(&b.u[i]),   Load8(&b.v[i]),   Load8(&b.d[i]),   Load8(&b.nu0[i]), Load8(&b.nu1[i]),
+          Load8(&b.nu2[i]), Load8(&b.nv0[i]), Load8(&b.nv1[i]), Load8(&b.nv2[i])};
+  } else {
+    in = {LoadPadded(b.u, i, count),   LoadPadded(b.v, i, count),   LoadPadded(b.d, i, count),
+          LoadPadded(b.nu0, i, count), LoadPadded(b.nu1, i, count), LoadPadded(b.nu2, i, count),
+          LoadPadded(b.nv0, i, count), LoadPadded(b.nv1, i, count), LoadPadded(b.nv2, i, count)};
+  }
   RecordOut<V8> out;
   EvaluateRecord(in, &b.span_table_u[static_cast<size_t>(i0) * kSpanTableStride],
                  &b.span_table_v[static_cast<size_t>(j0) * kSpanTableStride],
@@ -145,13 +176,23 @@ void RunOne(const PatchRebuildJob& job, size_t i) {
   const V8 scale = Splat<V8>(b.sigma) / V8(_mm256_sqrt_ps(__m256(len2)));
   const V8 nx = out.cx * scale, ny = out.cy * scale, nz = out.cz * scale;
   const V8 px = out.sx + in.d * nx, py = out.sy + in.d * ny, pz = out.sz + in.d * nz;
-  glm::vec3* pos = &job.positions[i];
-  for (int l = 0; l < 8; ++l) pos[l] = glm::vec3(px[l], py[l], pz[l]);
-  if (!job.normals.empty()) {
-    glm::vec3* nrm = &job.normals[i];
-    for (int l = 0; l < 8; ++l) nrm[l] = glm::vec3(nx[l], ny[l], nz[l]);
+  const bool normals = !job.normals.empty();
+  if (count == 8) {
+    StoreAos8(px, py, pz, &job.positions[i].x);
+    if (normals) StoreAos8(nx, ny, nz, &job.normals[i].x);
+    return;
+  }
+  glm::vec3 tmp[8];
+  StoreAos8(px, py, pz, &tmp[0].x);
+  for (size_t l = 0; l < count; ++l) job.positions[i + l] = tmp[l];
+  if (normals) {
+    StoreAos8(nx, ny, nz, &tmp[0].x);
+    for (size_t l = 0; l < count; ++l) job.normals[i + l] = tmp[l];
   }
 }
+
+// Runs shorter than this go through the scalar path (same results, less work).
+constexpr size_t kMinBatch = 3;
 
 }  // namespace
 
@@ -189,17 +230,19 @@ mocap::JobStatus PatchRebuildJob::Run() const {
   const std::uint16_t* first = bindings.first.data();
   size_t i = 0;
   while (i < n) {
-    if (simd && i + 8 <= n) {
-      bool same = true;
-      for (int l = 1; l < 8; ++l) same = same && first[i + static_cast<size_t>(l)] == first[i];
-      if (same) {
-        RunEight(*this, i);
-        i += 8;
-        continue;
-      }
+    size_t end = i + 1;  // the run of records sharing i's span
+    while (end < n && first[end] == first[i]) ++end;
+    const size_t run = end - i;
+    if (!simd || run < kMinBatch) {
+      for (size_t k = i; k < end; ++k) RunOne(*this, k);
+    } else if (run < 8) {
+      RunBatch(*this, i, run);
+    } else {
+      // Full batches, the last one overlapping the previous so that no lane
+      // is wasted; overlapped records are recomputed to identical values.
+      for (size_t k = i; k < end; k += 8) RunBatch(*this, std::min(k, end - 8), 8);
     }
-    RunOne(*this, i);
-    ++i;
+    i = end;
   }
   return mocap::kJobOk;
 }
