@@ -12,19 +12,24 @@ using mocap::ErrorCode;
 using mocap::MakeError;
 
 // Knot constants of every span of one direction, kSpanTableStride floats per
-// span k (row k-3): u_{k-1}, u_k, u_{k+1}, u_{k+2}, 1/(u_{k+1}-u_k),
-// 1/(u_{k+1}-u_{k-1}), 1/(u_{k+2}-u_k), 3/(u_{k+1}-u_{k-2}), 3/(u_{k+2}-u_{k-1}),
-// 3/(u_{k+3}-u_k). Every denominator contains the span itself, so it is
-// positive for the non-empty spans records use; empty spans get zeros.
+// span k (row k-3): u_{k-1}, u_k, u_{k+1}, u_{k+2}, then with
+// r1 = 1/(u_{k+1}-u_k), r2a = 1/(u_{k+1}-u_{k-1}), r2b = 1/(u_{k+2}-u_k):
+// 3 r1 r2a/(u_{k+1}-u_{k-2}), 3 r1 r2a/(u_{k+2}-u_{k-1}), 3 r1 r2b/(u_{k+2}-u_{k-1}),
+// 3 r1 r2b/(u_{k+3}-u_k) (used by DerivBasis in patch_rebuild.cpp). Every
+// denominator contains the span itself, so it is positive for the non-empty
+// spans records use; empty spans get zeros.
 std::vector<float> MakeSpanTable(const std::vector<double>& U, int num_control) {
   std::vector<float> table(static_cast<size_t>(num_control - 3) * kSpanTableStride, 0.0f);
   for (int k = 3; k < num_control; ++k) {
     auto kn = [&](int i) { return U[static_cast<size_t>(i)]; };
     if (!(kn(k + 1) > kn(k))) continue;
-    const double vals[kSpanTableStride] = {
-        kn(k - 1), kn(k), kn(k + 1), kn(k + 2),
-        1.0 / (kn(k + 1) - kn(k)), 1.0 / (kn(k + 1) - kn(k - 1)), 1.0 / (kn(k + 2) - kn(k)),
-        3.0 / (kn(k + 1) - kn(k - 2)), 3.0 / (kn(k + 2) - kn(k - 1)), 3.0 / (kn(k + 3) - kn(k))};
+    const double r1 = 1.0 / (kn(k + 1) - kn(k));
+    const double r2a = 1.0 / (kn(k + 1) - kn(k - 1)), r2b = 1.0 / (kn(k + 2) - kn(k));
+    const double g0 = 3.0 / (kn(k + 1) - kn(k - 2)), g1 = 3.0 / (kn(k + 2) - kn(k - 1));
+    const double g2 = 3.0 / (kn(k + 3) - kn(k));
+    const double vals[kSpanTableStride] = {kn(k - 1),      kn(k),          kn(k + 1),
+                                           kn(k + 2),      g0 * r1 * r2a,  g1 * r1 * r2a,
+                                           g1 * r1 * r2b,  g2 * r1 * r2b};
     for (int c = 0; c < kSpanTableStride; ++c) {
       table[static_cast<size_t>(k - 3) * kSpanTableStride + static_cast<size_t>(c)] =
           static_cast<float>(vals[c]);

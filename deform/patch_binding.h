@@ -15,7 +15,7 @@
 // plus the mesh vertex index (4 bytes, used by the caller to scatter results,
 // not by the rebuild): 42 bytes in all, under the paper's 44. The normal's
 // derivative basis values are recomputed from u, v and a per-span table of
-// knot constants (10 floats per span and direction, shared by all vertices).
+// knot constants (8 floats per span and direction, shared by all vertices).
 // Records are sorted by span so runs of 8 vertices share one 4x4 block of
 // control points; the rebuild evaluates them 8 at a time with AVX when the
 // CPU has it, with exactly the scalar path's operations (no FMA), so results
@@ -33,7 +33,7 @@
 namespace deform {
 
 // Floats per span in PatchBinding::span_table_u / _v (see patch_binding.cpp).
-inline constexpr int kSpanTableStride = 10;
+inline constexpr int kSpanTableStride = 8;
 
 // Settings of the orthogonal projection (3.5). Defaults are the spec's.
 struct ProjectionOptions {

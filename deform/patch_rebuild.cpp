@@ -34,22 +34,20 @@ template <typename V>
 }
 
 // Derivatives of the four cubic basis functions of span k at u, from the
-// span's knot constants t (layout in MakeSpanTable, patch_binding.cpp):
-// degree-1 and degree-2 values, then N'_{i,3} = 3/(u_{i+3}-u_i) N_{i,2} - ...
+// span's constants t (layout in MakeSpanTable, patch_binding.cpp). With
+// a = u_{k+1}-u, b = u-u_k, c = u-u_{k-1}, e = u_{k+2}-u the degree-2 values
+// are N_{k-2,2} = a^2 r1 r2a, N_{k-1,2} = ac r1 r2a + be r1 r2b,
+// N_{k,2} = b^2 r1 r2b, and N'_{i,3} = 3/(u_{i+3}-u_i) N_{i,2} - 3/(u_{i+4}-u_{i+1}) N_{i+1,2};
+// the constant products are folded into t[4..7] (8 multiplies per direction).
 template <typename V>
 [[gnu::always_inline]] inline void DerivBasis(const V& u, const float* t, V* out) {
-  const V a = Splat<V>(t[2]) - u;            // u_{k+1} - u
-  const V b = u - Splat<V>(t[1]);            // u - u_k
-  const V c = u - Splat<V>(t[0]);            // u - u_{k-1}
-  const V e = Splat<V>(t[3]) - u;            // u_{k+2} - u
-  const V n1a = a * Splat<V>(t[4]);          // N_{k-1,1}
-  const V n1b = b * Splat<V>(t[4]);          // N_{k,1}
-  const V n20 = (a * Splat<V>(t[5])) * n1a;  // N_{k-2,2}
-  const V n21 = (c * Splat<V>(t[5])) * n1a + (e * Splat<V>(t[6])) * n1b;  // N_{k-1,2}
-  const V n22 = (b * Splat<V>(t[6])) * n1b;  // N_{k,2}
-  const V c0 = Splat<V>(t[7]) * n20;
-  const V c1 = Splat<V>(t[8]) * n21;
-  const V c2 = Splat<V>(t[9]) * n22;
+  const V a = Splat<V>(t[2]) - u;                                      // u_{k+1} - u
+  const V b = u - Splat<V>(t[1]);                                      // u - u_k
+  const V c = u - Splat<V>(t[0]);                                      // u - u_{k-1}
+  const V e = Splat<V>(t[3]) - u;                                      // u_{k+2} - u
+  const V c0 = (a * a) * Splat<V>(t[4]);                               // 3/(u_{k+1}-u_{k-2}) N_{k-2,2}
+  const V c1 = (a * c) * Splat<V>(t[5]) + (b * e) * Splat<V>(t[6]);  // 3/(u_{k+2}-u_{k-1}) N_{k-1,2}
+  const V c2 = (b * b) * Splat<V>(t[7]);                               // 3/(u_{k+3}-u_k) N_{k,2}
   out[0] = -c0;
   out[1] = c0 - c1;
   out[2] = c1 - c2;
