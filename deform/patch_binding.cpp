@@ -38,6 +38,53 @@ std::vector<float> MakeSpanTable(const std::vector<double>& U, int num_control) 
   return table;
 }
 
+// One bound vertex before it is packed into the structure of arrays.
+struct BindingRecord {
+  int vertex;
+  double u, v, d;
+};
+
+// Packs records: spans, basis values, span tables, sorted by span (stable,
+// so records of one span keep their order).
+PatchBinding MakeBinding(const BSplineSurface& surface, const std::vector<BindingRecord>& records) {
+  const auto& ku = surface.knots_u();
+  const auto& kv = surface.knots_v();
+  std::vector<std::uint16_t> first(records.size());
+  for (size_t r = 0; r < records.size(); ++r) {
+    const int k = FindSpan(ku, surface.num_u(), 3, records[r].u);
+    const int l = FindSpan(kv, surface.num_v(), 3, records[r].v);
+    first[r] = static_cast<std::uint16_t>((k - 3) | ((l - 3) << 8));
+  }
+  std::vector<size_t> order(records.size());
+  for (size_t r = 0; r < order.size(); ++r) order[r] = r;
+  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return first[a] < first[b]; });
+  PatchBinding b;
+  b.num_u = surface.num_u();
+  b.num_v = surface.num_v();
+  b.sigma = static_cast<float>(surface.sigma());
+  b.span_table_u = MakeSpanTable(ku, b.num_u);
+  b.span_table_v = MakeSpanTable(kv, b.num_v);
+  for (size_t r : order) {
+    const BindingRecord& rec = records[r];
+    const int k = (first[r] & 0xff) + 3, l = (first[r] >> 8) + 3;
+    double nu[4], nv[4];
+    BasisFuns(ku, k, 3, rec.u, nu);
+    BasisFuns(kv, l, 3, rec.v, nv);
+    b.vertex.push_back(rec.vertex);
+    b.u.push_back(static_cast<float>(rec.u));
+    b.v.push_back(static_cast<float>(rec.v));
+    b.d.push_back(static_cast<float>(rec.d));
+    b.nu0.push_back(static_cast<float>(nu[0]));
+    b.nu1.push_back(static_cast<float>(nu[1]));
+    b.nu2.push_back(static_cast<float>(nu[2]));
+    b.nv0.push_back(static_cast<float>(nv[0]));
+    b.nv1.push_back(static_cast<float>(nv[1]));
+    b.nv2.push_back(static_cast<float>(nv[2]));
+    b.first.push_back(first[r]);
+  }
+  return b;
+}
+
 struct Eval {
   SurfaceDerivs sd;
   glm::dvec3 r{0.0};
@@ -178,6 +225,20 @@ PatchBindingView PatchBinding::view() const {
                           .nv0 = nv0, .nv1 = nv1, .nv2 = nv2, .first = first};
 }
 
+mocap::Result<PatchBinding> RefreshBinding(const PatchBinding& binding,
+                                           const BSplineSurface& refined) {
+  if (refined.degree_u() != 3 || refined.degree_v() != 3 || refined.num_u() > 256 ||
+      refined.num_v() > 256) {
+    return MakeError(ErrorCode::kUnsupported, {}, "refresh binding: expected a bicubic patch of at most 256 x 256");
+  }
+  std::vector<BindingRecord> recs;
+  recs.reserve(binding.size());
+  for (size_t i = 0; i < binding.size(); ++i) {
+    recs.push_back({binding.vertex[i], binding.u[i], binding.v[i], binding.d[i]});
+  }
+  return MakeBinding(refined, recs);
+}
+
 std::vector<glm::vec3> ControlPointsAsFloat(const BSplineSurface& surface) {
   std::vector<glm::vec3> out;
   out.reserve(surface.control().size());
@@ -214,7 +275,6 @@ mocap::Result<BindResult> BindPatch(const BSplineSurface& surface,
   struct Record {
     int vertex;
     Projection proj;
-    std::uint16_t first;
   };
   std::vector<Record> records;
   for (size_t r = 0; r < region.size(); ++r) {
@@ -229,37 +289,16 @@ mocap::Result<BindResult> BindPatch(const BSplineSurface& surface,
       report.far_vertices.push_back(region[r]);
       continue;
     }
-    const int k = FindSpan(surface.knots_u(), surface.num_u(), 3, proj.u);
-    const int l = FindSpan(surface.knots_v(), surface.num_v(), 3, proj.v);
-    records.push_back({region[r], proj, static_cast<std::uint16_t>((k - 3) | ((l - 3) << 8))});
+    records.push_back({region[r], proj});
     report.max_abs_d = std::max(report.max_abs_d, std::abs(proj.d));
   }
-  // Sort by span so that runs of records share one block of control points.
-  std::stable_sort(records.begin(), records.end(),
-                   [](const Record& a, const Record& b) { return a.first < b.first; });
-  PatchBinding& b = result.binding;
-  b.num_u = surface.num_u();
-  b.num_v = surface.num_v();
-  b.sigma = static_cast<float>(surface.sigma());
-  b.span_table_u = MakeSpanTable(surface.knots_u(), b.num_u);
-  b.span_table_v = MakeSpanTable(surface.knots_v(), b.num_v);
+  std::vector<BindingRecord> recs;
+  recs.reserve(records.size());
   for (const Record& rec : records) {
-    const int k = (rec.first & 0xff) + 3, l = (rec.first >> 8) + 3;
-    double nu[4], nv[4];
-    BasisFuns(surface.knots_u(), k, 3, rec.proj.u, nu);
-    BasisFuns(surface.knots_v(), l, 3, rec.proj.v, nv);
-    b.vertex.push_back(rec.vertex);
-    b.u.push_back(static_cast<float>(rec.proj.u));
-    b.v.push_back(static_cast<float>(rec.proj.v));
-    b.d.push_back(static_cast<float>(rec.proj.d));
-    b.nu0.push_back(static_cast<float>(nu[0]));
-    b.nu1.push_back(static_cast<float>(nu[1]));
-    b.nu2.push_back(static_cast<float>(nu[2]));
-    b.nv0.push_back(static_cast<float>(nv[0]));
-    b.nv1.push_back(static_cast<float>(nv[1]));
-    b.nv2.push_back(static_cast<float>(nv[2]));
-    b.first.push_back(rec.first);
+    recs.push_back({rec.vertex, rec.proj.u, rec.proj.v, rec.proj.d});
   }
+  PatchBinding& b = result.binding;
+  b = MakeBinding(surface, recs);
   report.bound = static_cast<int>(b.size());
   // Rest check (3.5): rebuilding from the fitted control points gives p back.
   const std::vector<glm::vec3> control = ControlPointsAsFloat(surface);

@@ -132,6 +132,14 @@ mocap::Result<BindResult> BindPatch(const BSplineSurface& surface,
                                     std::span<const glm::dvec2> region_uv,
                                     const ProjectionOptions& options = {});
 
+// After knot insertion or refinement (ALGORITHMS.md 7) the surface is the
+// same, so every record's (u, v, d) stays valid: this recomputes only the
+// spans, basis values and span tables for `refined` and re-sorts the records
+// by span (vertex order may change; read PatchBinding::vertex). Fails on a
+// non-bicubic surface.
+mocap::Result<PatchBinding> RefreshBinding(const PatchBinding& binding,
+                                           const BSplineSurface& refined);
+
 // Float copy of a surface's control points (#M x #N row-major) for the rebuild.
 std::vector<glm::vec3> ControlPointsAsFloat(const BSplineSurface& surface);
 

@@ -191,6 +191,29 @@ TEST(PatchRebuildJob, SplitRangesAreBitIdentical) {
   EXPECT_EQ(std::memcmp(whole_n.data(), split_n.data(), n * sizeof(glm::vec3)), 0);
 }
 
+TEST(PatchBinding, RefreshAfterKnotRefinementKeepsTheRebuild) {
+  const deform::Mesh tube = testsupport::MakeTube(30, 20, 1.5f, 200.0f, 6.0f);
+  const Fitted f = FitTube(tube, 6, 5);
+  auto bound = deform::BindPatch(f.surface, tube.positions, f.param.region, f.param.uv);
+  ASSERT_TRUE(bound.ok());
+  const std::vector<glm::vec3> before = Rebuild(bound->binding, deform::ControlPointsAsFloat(f.surface));
+  BSplineSurface refined = f.surface;
+  ASSERT_TRUE(refined.RefineU(refined.SpanMidpointsU()).ok());
+  ASSERT_TRUE(refined.InsertKnotV(0.3).ok());
+  auto fresh = deform::RefreshBinding(bound->binding, refined);
+  ASSERT_TRUE(fresh.ok());
+  ASSERT_EQ(fresh->size(), bound->binding.size());
+  EXPECT_EQ(fresh->num_u, refined.num_u());
+  const std::vector<glm::vec3> after = Rebuild(*fresh, deform::ControlPointsAsFloat(refined));
+  // Records may be reordered by span: match them by vertex.
+  std::vector<glm::vec3> by_vertex(tube.positions.size());
+  for (size_t i = 0; i < before.size(); ++i) by_vertex[bound->binding.vertex[i]] = before[i];
+  for (size_t i = 0; i < after.size(); ++i) {
+    EXPECT_LT(glm::length(after[i] - by_vertex[fresh->vertex[i]]),
+              kRebuildRelTol * bound->report.patch_diagonal);
+  }
+}
+
 TEST(PatchRebuildJob, Validity) {
   const deform::Mesh cap = testsupport::MakeSphereCap(10, 3.0f, 1.5f);
   const std::vector<int> region = testsupport::AllVertices(cap);
