@@ -209,6 +209,27 @@ TEST(PatchFit, NonUniformAndHandPickedSampling) {
   EXPECT_LT(fit->max_error, kDoubleTol);
 }
 
+TEST(PatchFit, LargerGridByRefiningASampleResolutionFit) {
+  // The paper's 9x10 grid from 6x6 samples (3.4): interpolate at 6x6, then
+  // insert knots; the surface, and so the fit error, stay the same.
+  const PatchSamples samples = RandomSamples(6, 6, 8);
+  auto fit = deform::FitSurface(samples, {.num_u = 6, .num_v = 6});
+  ASSERT_TRUE(fit.ok());
+  deform::BSplineSurface grid = fit->surface;
+  const double extra_u[] = {0.2, 0.5, 0.8};
+  const double extra_v[] = {0.15, 0.4, 0.6, 0.85};
+  ASSERT_TRUE(grid.RefineU(extra_u).ok());
+  ASSERT_TRUE(grid.RefineV(extra_v).ok());
+  EXPECT_EQ(grid.num_u(), 9);
+  EXPECT_EQ(grid.num_v(), 10);
+  for (int k = 0; k < 6; ++k) {
+    for (int l = 0; l < 6; ++l) {
+      EXPECT_LT(glm::length(grid.Evaluate(samples.us[k], samples.vs[l]) - samples.points[k * 6 + l]),
+                testsupport::kKnotInsertionTol);
+    }
+  }
+}
+
 TEST(PatchFit, RejectsBadInput) {
   const deform::Mesh sheet = testsupport::MakeBumpySheet(4, 4, 1.0f, 0.0f);
   const std::vector<int> bad_region = {0, 1, 99};
