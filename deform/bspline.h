@@ -125,7 +125,8 @@ class BSplineSurface {
   mocap::Result<KnotInsertionMap> InsertKnotU(double ub);
   mocap::Result<KnotInsertionMap> InsertKnotV(double vb);
   // Inserts every knot of `knots` (each in (0,1), any order) one at a time;
-  // returns the composed map.
+  // returns the composed map. On failure the knots inserted before the bad
+  // one stay inserted (the surface is still unchanged).
   mocap::Result<KnotInsertionMap> RefineU(std::span<const double> knots);
   mocap::Result<KnotInsertionMap> RefineV(std::span<const double> knots);
   // Midpoints of every non-empty knot span along u (resp. v), for refinement.

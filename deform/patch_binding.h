@@ -88,16 +88,20 @@ struct PatchBindingView {
   PatchBindingView Slice(size_t begin, size_t end) const;
 };
 
-// The bound vertices of one patch: records sorted by span, then vertex.
+// The bound vertices of one patch (#B records), sorted by span so that runs
+// share a 4x4 block of control points; view() gives the job's input.
 struct PatchBinding {
-  int num_u = 0;
-  int num_v = 0;
-  float sigma = 1.0f;
-  std::vector<float> span_table_u;
-  std::vector<float> span_table_v;
-  std::vector<int> vertex;  // #B mesh vertex index of each record
-  std::vector<float> u, v, d, nu0, nu1, nu2, nv0, nv1, nv2;
-  std::vector<std::uint16_t> first;
+  int num_u = 0;                    // M, control points along u of the bound surface
+  int num_v = 0;                    // N, control points along v
+  float sigma = 1.0f;               // the surface's normal sign, +1 or -1
+  std::vector<float> span_table_u;  // (M-3) x kSpanTableStride knot constants (per patch)
+  std::vector<float> span_table_v;  // (N-3) x kSpanTableStride
+  std::vector<int> vertex;          // #B mesh vertex index of each record (for the caller)
+  std::vector<float> u, v;          // #B projection parameters in [0,1]
+  std::vector<float> d;             // #B signed distance along n(u,v), model units
+  std::vector<float> nu0, nu1, nu2; // #B N_{k-3..k-1}(u); N_k(u) = 1 - their sum
+  std::vector<float> nv0, nv1, nv2; // #B N_{l-3..l-1}(v); N_l(v) = 1 - their sum
+  std::vector<std::uint16_t> first; // #B (k-3) | (l-3) << 8: the block's first row/column
 
   size_t size() const { return vertex.size(); }
   PatchBindingView view() const;
@@ -146,7 +150,9 @@ std::vector<glm::vec3> ControlPointsAsFloat(const BSplineSurface& surface);
 // Rebuilds bound vertices from control points by equation (3). Reads the
 // records in `bindings`; writes #B positions and, optionally, #B unit normals
 // n(u,v) of the patch surface (not the mesh normals). Never allocates; the
-// result of a record does not depend on how the records are split.
+// result of a record does not depend on how the records are split. Records
+// must come from BindPatch / RefreshBinding for a grid of this size: like
+// every job, Validate() checks sizes and does not read the span indices.
 struct PatchRebuildJob {
   // Inputs.
   std::span<const glm::vec3> control{};  // #M x #N control points Q (row-major, model space)
