@@ -119,5 +119,15 @@ inline constexpr double kAreaRatioTol = 1e-4;
 // Sweep centre-curve continuity: a step of kCurveStep in u moves c by about speed * step.
 inline constexpr double kCurveStep = 1e-7;
 inline constexpr double kCurveDirectionTol = 1e-5;  // radians between tangent directions
+// B-spline identities in double (partition of unity, Cox-de Boor agreement).
+inline constexpr double kSplineTol = 1e-12;
+// Central finite differences of B-spline derivatives (step 1e-6 in parameter).
+inline constexpr double kFiniteDiffTol = 1e-5;
+// Knot insertion and refinement keep the surface (ALGORITHMS.md 7).
+inline constexpr double kKnotInsertionTol = 1e-6;
+// Rest rebuild of bound vertices, relative to the patch size (ALGORITHMS.md 3.5).
+inline constexpr double kRebuildRelTol = 1e-4;
+// Projection recovering known (u,v,d) (Newton stops at 1e-7 x diagonal).
+inline constexpr double kProjectionTol = 1e-6;
 
 }  // namespace testsupport
