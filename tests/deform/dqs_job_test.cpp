@@ -162,9 +162,9 @@ TEST(DqsJob, KeepsMoreCrossSectionThanSsdAtA90DegreeBend) {
   RecordProperty("dqs_area_ratio", std::to_string(dqs));
   std::printf("mid-ring area / rest area at a 90 degree bend: SSD %.4f, DQS %.4f\n", ssd, dqs);
   // SSD halves the bend: the ring shrinks by cos(45 deg) in the bend plane.
-  EXPECT_NEAR(ssd, std::cos(std::numbers::pi_v<float> / 4.0f), testsupport::kAreaRatioTol);
+  EXPECT_NEAR(ssd, std::cos(std::numbers::pi_v<float> / 4.0f), testsupport::kPolygonAreaRatioTol);
   // DQS rotates the ring rigidly by 45 degrees: its projection keeps the area.
-  EXPECT_NEAR(dqs, 1.0f, testsupport::kAreaRatioTol);
+  EXPECT_NEAR(dqs, 1.0f, testsupport::kPolygonAreaRatioTol);
 }
 
 }  // namespace

@@ -90,7 +90,7 @@ inline constexpr float kMinTriangleAreaFraction = 1e-9f;
 // skeleton's joint-and-end-site height (head and foot soles add thickness).
 inline constexpr float kMannequinHeightTolFraction = 0.25f;
 // Cross-section area ratios of a 64-gon ring (polygon vs analytic shrink).
-inline constexpr float kAreaRatioTol = 0.01f;
+inline constexpr float kPolygonAreaRatioTol = 0.01f;
 // Rendered colour against an analytic value where only float round-off and
 // 1/256-pixel vertex snapping differ (perspective-correct interpolation).
 inline constexpr float kRenderTol = 2e-3f;
@@ -114,7 +114,7 @@ inline constexpr double kVideoFlatTol8 = 6.0;
 inline constexpr double kPsnrTolDb = 1e-3;
 // SWD: bind-pose rebuild error relative to the mesh size (ALGORITHMS.md 2.3 asks 1e-5).
 inline constexpr float kSwdRebuildRelTol = 1e-5f;
-// Area ratios of vertex rings compared with closed forms (float positions, double areas).
+// Area ratios of vertex rings (SWD fixtures) compared with closed forms (float positions, double areas).
 inline constexpr double kAreaRatioTol = 1e-4;
 // Sweep centre-curve continuity: a step of kCurveStep in u moves c by about speed * step.
 inline constexpr double kCurveStep = 1e-7;
