@@ -1,6 +1,7 @@
 #include "mocap/bvh_reader.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <fstream>
 #include <limits>
@@ -14,6 +15,14 @@ namespace {
 
 inline bool IsBlank(char c) { return c == ' ' || c == '\t' || c == '\f' || c == '\v'; }
 inline bool IsLineEnd(char c) { return c == '\n' || c == '\r'; }
+
+enum ByteClass : unsigned char { kOther, kBlank, kLineEnd };
+constexpr auto kByteClass = [] {
+  std::array<ByteClass, 256> table{};
+  for (const char c : {' ', '\t', '\f', '\v'}) table[static_cast<unsigned char>(c)] = kBlank;
+  for (const char c : {'\n', '\r'}) table[static_cast<unsigned char>(c)] = kLineEnd;
+  return table;
+}();
 
 // Reads the frame data: one pass over the buffer, writing straight into the
 // preallocated array. Line numbers are counted as we go; columns are computed
@@ -108,22 +117,31 @@ class MotionParser {
   }
 
   // Parses one data line starting at a non-blank byte; leaves p_ at its line end.
+  // The hot loop of the reader: works on local pointers (so they stay in
+  // registers) and classifies bytes with one table lookup.
   Status ParseLine(long long frame, int num_channels, float* out) {
+    const char* p = p_;
+    const char* const end = end_;
     int count = 0;
     for (;;) {
-      const char* token = p_;
-      if (count == num_channels) return TooMany(frame, num_channels, token);
+      if (count == num_channels) [[unlikely]] {
+        p_ = p;
+        return TooMany(frame, num_channels, p);
+      }
       const char* next = nullptr;
-      const internal::NumberStatus s = internal::ParseBvhNumber(p_, end_, out[count], &next);
-      if (s != internal::NumberStatus::kOk || (next != end_ && !IsBlank(*next) && !IsLineEnd(*next))) {
-        return BadNumber(frame, count, s, token);
+      const internal::NumberStatus s = internal::ParseBvhNumber(p, end, out[count], &next);
+      if (s != internal::NumberStatus::kOk || (next != end && kByteClass[static_cast<unsigned char>(*next)] == kOther))
+          [[unlikely]] {
+        p_ = p;
+        return BadNumber(frame, count, s, p);
       }
       ++count;
-      p_ = next;
-      while (p_ != end_ && IsBlank(*p_)) ++p_;
-      if (p_ == end_ || IsLineEnd(*p_)) break;
+      p = next;
+      while (p != end && kByteClass[static_cast<unsigned char>(*p)] == kBlank) ++p;
+      if (p == end || kByteClass[static_cast<unsigned char>(*p)] == kLineEnd) break;
     }
-    if (count != num_channels) {
+    p_ = p;
+    if (count != num_channels) [[unlikely]] {
       return MakeError(ErrorCode::kCountMismatch, Loc(p_),
                        "expected " + std::to_string(num_channels) + " values in frame " + std::to_string(frame) +
                            ", found " + std::to_string(count));
@@ -309,6 +327,8 @@ Result<BvhFile> ParseBvh(std::string_view text, const std::string& file_name, co
     return MakeError(ErrorCode::kInvalidArgument, FileLoc{file_name, 0, 0, {}},
                      "scale must be finite and >= 0 (0 = automatic), got " + std::to_string(options.scale));
   }
+  // Windows tools sometimes write a UTF-8 byte order mark; it is not part of the grammar.
+  if (text.size() >= 3 && text.compare(0, 3, "\xEF\xBB\xBF") == 0) text.remove_prefix(3);
   Result<BvhDocument> document = ParseBvhHierarchy(text, file_name, {options.max_depth, options.max_joints});
   if (!document) return std::move(document).error();
   BvhFile file;

@@ -3,7 +3,9 @@
 
 #include "mocap/bvh_reader.h"
 
+#include <algorithm>
 #include <cstdlib>
+#include <random>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -340,6 +342,50 @@ TEST(BvhReader, JointAndDepthLimitsAreOptions) {
   ASSERT_FALSE(depth.ok());
   EXPECT_EQ(depth.error().code, ErrorCode::kLimitExceeded);
   EXPECT_EQ(depth.error().loc.line, 6);
+}
+
+TEST(BvhReader, SkipsUtf8ByteOrderMark) {
+  std::string text(kSmall);
+  text.insert(0, "\xEF\xBB\xBF");
+  ExpectSameAsSmall(MustParse(text));
+}
+
+// Random byte edits and truncations never crash: each gives a file or an error
+// with a location inside the text.
+TEST(BvhReader, MutatedInputsGiveAResultOrALocatedError) {
+  const std::string base = kSmall;
+  std::mt19937 rng(42);
+  const char kBytes[] = "{}:.-+eE0123456789 \t\r\nXZrotationOFFSETJOINTEnd";
+  int failures = 0;
+  for (int trial = 0; trial < 3000; ++trial) {
+    std::string text = base;
+    const int edits = 1 + static_cast<int>(rng() % 4);
+    for (int e = 0; e < edits; ++e) {
+      const std::size_t at = rng() % text.size();
+      switch (rng() % 3) {
+        case 0: text[at] = kBytes[rng() % (sizeof(kBytes) - 1)]; break;
+        case 1: {  // delete up to 8 bytes (not erase(): GCC 12 warns falsely with -Wrestrict)
+          std::string cut = text.substr(0, at);
+          cut.append(text, std::min(text.size(), at + 1 + rng() % 8), std::string::npos);
+          text.swap(cut);
+          break;
+        }
+        default: text.resize(at); break;
+      }
+      if (text.empty()) text.push_back('H');
+    }
+    auto result = ParseBvh(text, "fuzz.bvh");
+    if (result.ok()) {
+      EXPECT_TRUE(result->skeleton.Check().ok());
+      EXPECT_EQ(result->motion.values.size(),
+                static_cast<std::size_t>(result->motion.num_frames) * static_cast<std::size_t>(result->motion.num_channels));
+      continue;
+    }
+    ++failures;
+    EXPECT_GE(result.error().loc.line, 1) << result.error().ToString();
+    EXPECT_GE(result.error().loc.column, 1) << result.error().ToString();
+  }
+  EXPECT_GT(failures, 1000);  // most edits break the file
 }
 
 TEST(BvhReader, MissingFileIsAnIoError) {
