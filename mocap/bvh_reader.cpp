@@ -2,9 +2,15 @@
 
 #include <algorithm>
 #include <array>
+#include <cerrno>
 #include <cmath>
-#include <fstream>
+#include <cstring>
 #include <limits>
+
+#include <fcntl.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include "mocap/internal/bvh_number.h"
 #include "mocap/pose.h"
@@ -364,17 +370,54 @@ Result<BvhFile> ParseBvh(std::string_view text, const std::string& file_name, co
   return file;
 }
 
-Result<BvhFile> ReadBvhFile(const std::string& path, const BvhReadOptions& options) {
-  std::ifstream in(path, std::ios::binary | std::ios::ate);
-  if (!in) return MakeError(ErrorCode::kIo, FileLoc{path, 0, 0, {}}, "cannot open the file for reading");
-  const std::streamoff size = in.tellg();
-  if (size < 0) return MakeError(ErrorCode::kIo, FileLoc{path, 0, 0, {}}, "cannot determine the file size");
-  std::string text(static_cast<std::size_t>(size), '\0');
-  in.seekg(0);
-  if (!in.read(text.data(), size)) {
-    return MakeError(ErrorCode::kIo, FileLoc{path, 0, 0, {}}, "cannot read the file");
+namespace {
+
+// A read-only view of a whole file: mmap'd, so the parser reads the page cache
+// directly instead of a copy (the copy costs about a quarter of the parse time
+// on an 80 MB file).
+class MappedFile {
+ public:
+  MappedFile() = default;
+  MappedFile(const MappedFile&) = delete;
+  MappedFile& operator=(const MappedFile&) = delete;
+  ~MappedFile() {
+    if (data_ != nullptr) munmap(data_, size_);
+    if (fd_ >= 0) close(fd_);
   }
-  return ParseBvh(text, path, options);
+
+  Status Open(const std::string& path) {
+    const FileLoc loc{path, 0, 0, {}};
+    fd_ = open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd_ < 0) return MakeError(ErrorCode::kIo, loc, std::string("cannot open the file: ") + std::strerror(errno));
+    struct stat info {};
+    if (fstat(fd_, &info) != 0 || !S_ISREG(info.st_mode)) {
+      return MakeError(ErrorCode::kIo, loc, "not a regular file");
+    }
+    size_ = static_cast<std::size_t>(info.st_size);
+    if (size_ == 0) return Status::Ok();
+    void* data = mmap(nullptr, size_, PROT_READ, MAP_PRIVATE, fd_, 0);
+    if (data == MAP_FAILED) return MakeError(ErrorCode::kIo, loc, std::string("cannot map the file: ") + std::strerror(errno));
+    data_ = data;
+    madvise(data_, size_, MADV_SEQUENTIAL);
+    return Status::Ok();
+  }
+
+  std::string_view text() const {
+    return data_ == nullptr ? std::string_view() : std::string_view(static_cast<const char*>(data_), size_);
+  }
+
+ private:
+  int fd_ = -1;
+  void* data_ = nullptr;
+  std::size_t size_ = 0;
+};
+
+}  // namespace
+
+Result<BvhFile> ReadBvhFile(const std::string& path, const BvhReadOptions& options) {
+  MappedFile file;
+  if (Status s = file.Open(path); !s) return s.error();
+  return ParseBvh(file.text(), path, options);
 }
 
 }  // namespace mocap

@@ -82,7 +82,8 @@ struct BvhFile {
 [[nodiscard]] Result<BvhFile> ParseBvh(std::string_view text, const std::string& file_name_for_messages,
                                        const BvhReadOptions& options = {});
 
-// Reads `path` into memory and parses it (kIo when it cannot be read).
+// Maps `path` into memory (mmap, read-only) and parses it; kIo when it cannot
+// be opened, is not a regular file or cannot be mapped.
 [[nodiscard]] Result<BvhFile> ReadBvhFile(const std::string& path, const BvhReadOptions& options = {});
 
 // Detection helpers (rules above), exposed for tests and `inspect`.

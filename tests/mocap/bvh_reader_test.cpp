@@ -393,6 +393,9 @@ TEST(BvhReader, MissingFileIsAnIoError) {
   ASSERT_FALSE(result.ok());
   EXPECT_EQ(result.error().code, ErrorCode::kIo);
   EXPECT_EQ(result.error().loc.file, "/nonexistent/walk.bvh");
+  auto folder = mocap::ReadBvhFile(testsupport::TestDataPath("bvh").string());
+  ASSERT_FALSE(folder.ok());
+  EXPECT_EQ(folder.error().code, ErrorCode::kIo);
 }
 
 // Real captures: counts from shared/data/SOURCES.md, values of the first and
