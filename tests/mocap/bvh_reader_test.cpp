@@ -5,8 +5,8 @@
 
 #include <algorithm>
 #include <cstdlib>
-#include <random>
 #include <fstream>
+#include <random>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -56,7 +56,8 @@ BvhFile MustParse(const std::string& text, const BvhReadOptions& options = {}) {
 }
 
 std::string Replace(std::string text, const std::string& from, const std::string& to) {
-  for (std::size_t at = text.find(from); at != std::string::npos; at = text.find(from, at + to.size())) {
+  for (std::size_t at = text.find(from); at != std::string::npos;
+       at = text.find(from, at + to.size())) {
     text.replace(at, from.size(), to);
   }
   return text;
@@ -67,7 +68,8 @@ void ExpectSameAsSmall(const BvhFile& file) {
   EXPECT_EQ(file.skeleton.names, ref.skeleton.names);
   EXPECT_EQ(file.skeleton.parents, ref.skeleton.parents);
   ASSERT_EQ(file.motion.values.size(), ref.motion.values.size());
-  for (std::size_t i = 0; i < ref.motion.values.size(); ++i) EXPECT_EQ(file.motion.values[i], ref.motion.values[i]);
+  for (std::size_t i = 0; i < ref.motion.values.size(); ++i)
+    EXPECT_EQ(file.motion.values[i], ref.motion.values[i]);
 }
 
 TEST(BvhReader, ReadsSmallFile) {
@@ -109,7 +111,8 @@ TEST(BvhReader, LineEndsAndBlanksDoNotMatter) {
   ExpectSameAsSmall(MustParse(Replace(kSmall, "\n", "\r\n")));
   ExpectSameAsSmall(MustParse(Replace(kSmall, "\n", "\r")));
   ExpectSameAsSmall(MustParse(Replace(Replace(kSmall, "\n", " \t\n\n"), " ", "\t ")));
-  ExpectSameAsSmall(MustParse(std::string(kSmall).substr(0, std::string(kSmall).size() - 1)));  // no final LF
+  ExpectSameAsSmall(
+      MustParse(std::string(kSmall).substr(0, std::string(kSmall).size() - 1)));  // no final LF
 }
 
 TEST(BvhReader, CrOnlyFileCountsLines) {
@@ -161,7 +164,8 @@ TEST(BvhReader, DuplicateNamesAreMadeUniqueWithAWarning) {
 }
 
 TEST(BvhReader, OneAndTwoRotationChannelsAndAnyOrder) {
-  std::string text = Replace(kSmall, "CHANNELS 3 Zrotation Yrotation Xrotation", "CHANNELS 1 Yrotation");
+  std::string text =
+      Replace(kSmall, "CHANNELS 3 Zrotation Yrotation Xrotation", "CHANNELS 1 Yrotation");
   text = Replace(text, "CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation",
                  "CHANNELS 4 Xrotation Zposition Yrotation Xposition");
   text = Replace(text, "0.5 90 -1 10 20 30 1 2 3", "1 2 3 4 5");
@@ -175,7 +179,8 @@ TEST(BvhReader, OneAndTwoRotationChannelsAndAnyOrder) {
 }
 
 TEST(BvhReader, ExponentsSignsAndLeadingDots) {
-  const BvhFile file = MustParse(Replace(kSmall, "0.5 90 -1 10 20 30 1 2 3", "+.5 9E1 -1e0 1.0e+1 +2e1 3e1 .1 -.2 -0"));
+  const BvhFile file = MustParse(
+      Replace(kSmall, "0.5 90 -1 10 20 30 1 2 3", "+.5 9E1 -1e0 1.0e+1 +2e1 3e1 .1 -.2 -0"));
   const auto f = file.motion.frame(0);
   EXPECT_EQ(f[0], 0.5f);
   EXPECT_EQ(f[1], 90.0f);
@@ -190,7 +195,8 @@ TEST(BvhReader, FramesHeaderVariants) {
   ExpectSameAsSmall(MustParse(Replace(kSmall, "Frames: 2", "Frames:\t2")));
   ExpectSameAsSmall(MustParse(Replace(kSmall, "Frames: 2", "Frames:2")));
   ExpectSameAsSmall(MustParse(Replace(kSmall, "Frames: 2", "Frames : 2")));
-  const BvhFile glued = MustParse(Replace(kSmall, "Frame Time: 0.0333333", "Frame Time:\t.0083333"));
+  const BvhFile glued =
+      MustParse(Replace(kSmall, "Frame Time: 0.0333333", "Frame Time:\t.0083333"));
   EXPECT_EQ(glued.motion.frame_time_s, 0.0083333);
   EXPECT_EQ(mocap::NominalFps(glued.motion.frame_time_s), 120.0);
 }
@@ -205,7 +211,8 @@ TEST(BvhReader, MissingFrameTimeGetsDefaultAndWarning) {
 
 TEST(BvhReader, SeveralRoots) {
   const std::string second =
-      "ROOT Prop\n{\n OFFSET 7 8 9\n CHANNELS 3 Xposition Yposition Zposition\n End Site\n {\n OFFSET 0 1 0\n }\n}\n"
+      "ROOT Prop\n{\n OFFSET 7 8 9\n CHANNELS 3 Xposition Yposition Zposition\n End Site\n {\n "
+      "OFFSET 0 1 0\n }\n}\n"
       "MOTION";
   std::string text = Replace(kSmall, "MOTION", second);
   text = Replace(text, "30 1 2 3\n", "30 1 2 3 10 11 12\n");
@@ -253,7 +260,8 @@ TEST(BvhReader, ZeroFramesAndZeroChannels) {
 
 // The root's local translation in both modes, with a non-zero root OFFSET.
 TEST(BvhReader, PositionChannelModes) {
-  for (const auto mode : {mocap::PositionChannelMode::kReplaceOffset, mocap::PositionChannelMode::kAddToOffset}) {
+  for (const auto mode :
+       {mocap::PositionChannelMode::kReplaceOffset, mocap::PositionChannelMode::kAddToOffset}) {
     BvhReadOptions options;
     options.position_mode = mode;
     const BvhFile file = MustParse(kSmall, options);
@@ -317,12 +325,15 @@ TEST(BvhReader, ZUpIsDetectedAndConvertedToTheSamePoses) {
     std::vector<mocap::JointTransform> a(2), b(2);
     std::vector<glm::mat4> ma(2), mb(2);
     ASSERT_TRUE((mocap::LocalPoseJob{&y_up.skeleton, y_up.motion.frame(f), a}.Run().ok()));
-    ASSERT_TRUE((mocap::LocalPoseJob{&converted.skeleton, converted.motion.frame(f), b}.Run().ok()));
+    ASSERT_TRUE(
+        (mocap::LocalPoseJob{&converted.skeleton, converted.motion.frame(f), b}.Run().ok()));
     ASSERT_TRUE((mocap::LocalToModelJob{y_up.skeleton.parents, a, glm::mat4(1.0f), ma}.Run().ok()));
-    ASSERT_TRUE((mocap::LocalToModelJob{converted.skeleton.parents, b, glm::mat4(1.0f), mb}.Run().ok()));
+    ASSERT_TRUE(
+        (mocap::LocalToModelJob{converted.skeleton.parents, b, glm::mat4(1.0f), mb}.Run().ok()));
     for (int j = 0; j < 2; ++j) {
       for (int c = 0; c < 4; ++c) {
-        for (int r = 0; r < 4; ++r) EXPECT_NEAR(ma[j][c][r], mb[j][c][r], testsupport::kPositionTol);
+        for (int r = 0; r < 4; ++r)
+          EXPECT_NEAR(ma[j][c][r], mb[j][c][r], testsupport::kPositionTol);
       }
     }
   }
@@ -363,14 +374,18 @@ TEST(BvhReader, MutatedInputsGiveAResultOrALocatedError) {
     for (int e = 0; e < edits; ++e) {
       const std::size_t at = rng() % text.size();
       switch (rng() % 3) {
-        case 0: text[at] = kBytes[rng() % (sizeof(kBytes) - 1)]; break;
+        case 0:
+          text[at] = kBytes[rng() % (sizeof(kBytes) - 1)];
+          break;
         case 1: {  // delete up to 8 bytes (not erase(): GCC 12 warns falsely with -Wrestrict)
           std::string cut = text.substr(0, at);
           cut.append(text, std::min(text.size(), at + 1 + rng() % 8), std::string::npos);
           text.swap(cut);
           break;
         }
-        default: text.resize(at); break;
+        default:
+          text.resize(at);
+          break;
       }
       if (text.empty()) text.push_back('H');
     }
@@ -378,7 +393,8 @@ TEST(BvhReader, MutatedInputsGiveAResultOrALocatedError) {
     if (result.ok()) {
       EXPECT_TRUE(result->skeleton.Check().ok());
       EXPECT_EQ(result->motion.values.size(),
-                static_cast<std::size_t>(result->motion.num_frames) * static_cast<std::size_t>(result->motion.num_channels));
+                static_cast<std::size_t>(result->motion.num_frames) *
+                    static_cast<std::size_t>(result->motion.num_channels));
       continue;
     }
     ++failures;
@@ -449,19 +465,21 @@ TEST_P(SharedBvh, LoadsWithDocumentedCountsAndValues) {
     const std::vector<float> expected = SplitLine(data[static_cast<std::size_t>(f)]);
     const auto got = file.motion.frame(f);
     ASSERT_EQ(expected.size(), got.size());
-    for (std::size_t k = 0; k < got.size(); ++k) EXPECT_EQ(got[k], expected[k]) << "frame " << f << " value " << k;
+    for (std::size_t k = 0; k < got.size(); ++k)
+      EXPECT_EQ(got[k], expected[k]) << "frame " << f << " value " << k;
   }
 }
 
 INSTANTIATE_TEST_SUITE_P(
     SharedData, SharedBvh,
-    testing::Values(SharedCase{"bvh/cmu_cgspeed/01_01.bvh", 31, 7, 2752, 120, "unknown"},
-                    SharedCase{"bvh/cmu_cgspeed/01_03.bvh", 31, 7, 4511, 120, "unknown"},
-                    SharedCase{"bvh/bandai_namco/dataset-1_walk_normal_001.bvh", 22, 5, 195, 30, "cm"},
-                    SharedCase{"bvh/bandai_namco/dataset-2_run_active_034.bvh", 22, 5, 75, 30, "cm"},
-                    SharedCase{"bvh/lafan1_resolved/Geno_bind.bvh", 75, 21, 2, 60, "cm"},
-                    SharedCase{"bvh/lafan1_resolved/Geno_stance.bvh", 75, 21, 2, 60, "cm"},
-                    SharedCase{"bvh/bvh_python/test_mocapbank.bvh", 19, 5, 455, 30, "cm"},
-                    SharedCase{"bvh/bvh_python/test_freebvh.bvh", 55, 15, 69, 30, "cm"}));
+    testing::Values(
+        SharedCase{"bvh/cmu_cgspeed/01_01.bvh", 31, 7, 2752, 120, "unknown"},
+        SharedCase{"bvh/cmu_cgspeed/01_03.bvh", 31, 7, 4511, 120, "unknown"},
+        SharedCase{"bvh/bandai_namco/dataset-1_walk_normal_001.bvh", 22, 5, 195, 30, "cm"},
+        SharedCase{"bvh/bandai_namco/dataset-2_run_active_034.bvh", 22, 5, 75, 30, "cm"},
+        SharedCase{"bvh/lafan1_resolved/Geno_bind.bvh", 75, 21, 2, 60, "cm"},
+        SharedCase{"bvh/lafan1_resolved/Geno_stance.bvh", 75, 21, 2, 60, "cm"},
+        SharedCase{"bvh/bvh_python/test_mocapbank.bvh", 19, 5, 455, 30, "cm"},
+        SharedCase{"bvh/bvh_python/test_freebvh.bvh", 55, 15, 69, 30, "cm"}));
 
 }  // namespace

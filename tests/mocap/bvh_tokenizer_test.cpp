@@ -90,7 +90,8 @@ TEST(BvhKeyword, ComparesWithoutCase) {
 
 TEST(BvhDocument, KeepsFileLocationsAndMotionStart) {
   const std::string text =
-      "HIERARCHY\nROOT Hips\n{\n OFFSET 0 0 0\n CHANNELS 1 Zrotation\n End Site\n {\n  OFFSET 0 1 0\n }\n}\n"
+      "HIERARCHY\nROOT Hips\n{\n OFFSET 0 0 0\n CHANNELS 1 Zrotation\n End Site\n {\n  OFFSET 0 1 "
+      "0\n }\n}\n"
       "MOTION\nFrames: 1\nFrame Time: 0.5\n7\n";
   auto doc = mocap::ParseBvhHierarchy(text, "d.bvh");
   ASSERT_TRUE(doc.ok()) << doc.error().ToString();
