@@ -45,8 +45,7 @@ std::string_view AfterColon(std::string_view token) {
 
 class HierarchyParser {
  public:
-  HierarchyParser(std::string_view text, const std::string& file_name,
-                  const BvhParseLimits& limits)
+  HierarchyParser(std::string_view text, const std::string& file_name, const BvhParseLimits& limits)
       : tok_(text), limits_(limits) {
     doc_.file_name = file_name;
   }
@@ -54,8 +53,8 @@ class HierarchyParser {
   Result<BvhDocument> Run() {
     BvhToken t = tok_.Next();
     if (!BvhKeywordEquals(t.text, "HIERARCHY")) {
-      return Fail(ErrorCode::kSyntax, t, "expected 'HIERARCHY' at the start of the file, found " +
-                                             Found(t));
+      return Fail(ErrorCode::kSyntax, t,
+                  "expected 'HIERARCHY' at the start of the file, found " + Found(t));
     }
     for (;;) {
       t = tok_.Next();
@@ -64,9 +63,10 @@ class HierarchyParser {
       } else if (BvhKeywordEquals(t.text, "MOTION") && !doc_.joints.empty()) {
         break;
       } else {
-        return Fail(ErrorCode::kSyntax, t,
-                    std::string(doc_.joints.empty() ? "expected 'ROOT'" : "expected 'ROOT' or 'MOTION'") +
-                        ", found " + Found(t));
+        return Fail(
+            ErrorCode::kSyntax, t,
+            std::string(doc_.joints.empty() ? "expected 'ROOT'" : "expected 'ROOT' or 'MOTION'") +
+                ", found " + Found(t));
       }
     }
     if (Status s = ParseMotionHeader(); !s) return s.error();
@@ -87,10 +87,12 @@ class HierarchyParser {
     const char* end = t.text.data() + t.text.size();
     const internal::NumberStatus s = internal::ParseBvhNumber(t.text.data(), end, *value, &next);
     if (s == internal::NumberStatus::kNonFinite) {
-      return Fail(ErrorCode::kNonFinite, t, std::string("expected a finite ") + what + ", found " + Found(t));
+      return Fail(ErrorCode::kNonFinite, t,
+                  std::string("expected a finite ") + what + ", found " + Found(t));
     }
     if (s != internal::NumberStatus::kOk || next != end) {
-      return Fail(ErrorCode::kBadNumber, t, std::string("expected ") + what + ", found " + Found(t));
+      return Fail(ErrorCode::kBadNumber, t,
+                  std::string("expected ") + what + ", found " + Found(t));
     }
     return Status::Ok();
   }
@@ -157,7 +159,8 @@ class HierarchyParser {
                   "expected a channel count from 0 to 6, found " + Found(count_tok));
     }
     if (joint->num_channels > 0) {
-      return Fail(ErrorCode::kBadChannel, keyword, "second CHANNELS line for joint '" + joint->name + "'");
+      return Fail(ErrorCode::kBadChannel, keyword,
+                  "second CHANNELS line for joint '" + joint->name + "'");
     }
     for (int i = 0; i < count; ++i) {
       const BvhToken t = tok_.Next();
@@ -165,7 +168,8 @@ class HierarchyParser {
       if (!ParseChannelName(t.text, &type)) {
         return Fail(ErrorCode::kBadChannel, t,
                     "expected a channel name (Xposition ... Zrotation), channel " +
-                        std::to_string(i + 1) + " of " + std::to_string(count) + ", found " + Found(t));
+                        std::to_string(i + 1) + " of " + std::to_string(count) + ", found " +
+                        Found(t));
       }
       for (int k = 0; k < i; ++k) {
         if (joint->channels[k] == type) {
@@ -223,11 +227,13 @@ class HierarchyParser {
       const BvhToken t = tok_.Next();
       if (t.text == "}") {
         if (!top.has_offset) {
-          return Fail(ErrorCode::kSyntax, t, "expected 'OFFSET' in joint '" + joint.name + "', found '}'");
+          return Fail(ErrorCode::kSyntax, t,
+                      "expected 'OFFSET' in joint '" + joint.name + "', found '}'");
         }
         stack.pop_back();
       } else if (BvhKeywordEquals(t.text, "OFFSET")) {
-        if (top.has_offset) return Fail(ErrorCode::kSyntax, t, "second OFFSET in joint '" + joint.name + "'");
+        if (top.has_offset)
+          return Fail(ErrorCode::kSyntax, t, "second OFFSET in joint '" + joint.name + "'");
         if (Status s = ParseOffset(&joint.offset); !s) return s;
         top.has_offset = true;
       } else if (BvhKeywordEquals(t.text, "CHANNELS")) {
@@ -279,18 +285,21 @@ class HierarchyParser {
     long long frames = -1;
     const char* end = value_text.data() + value_text.size();
     const auto r = std::from_chars(value_text.data(), end, frames);
-    if (value_text.empty() || r.ptr != end || (r.ec != std::errc() && r.ec != std::errc::result_out_of_range)) {
-      return Fail(ErrorCode::kBadNumber, value_tok, "expected a frame count after 'Frames:', found " +
-                                                        (value_text.empty() ? std::string("end of file")
-                                                                            : "'" + std::string(value_text) + "'"));
+    if (value_text.empty() || r.ptr != end ||
+        (r.ec != std::errc() && r.ec != std::errc::result_out_of_range)) {
+      return Fail(ErrorCode::kBadNumber, value_tok,
+                  "expected a frame count after 'Frames:', found " +
+                      (value_text.empty() ? std::string("end of file")
+                                          : "'" + std::string(value_text) + "'"));
     }
     if (r.ec == std::errc::result_out_of_range || frames > INT_MAX) {
       return Fail(ErrorCode::kLimitExceeded, value_tok,
-                  "declared frame count " + std::string(value_text) + " is larger than the limit of " +
-                      std::to_string(INT_MAX));
+                  "declared frame count " + std::string(value_text) +
+                      " is larger than the limit of " + std::to_string(INT_MAX));
     }
     if (frames < 0) {
-      return Fail(ErrorCode::kBadNumber, value_tok, "expected a frame count of 0 or more, found " + std::to_string(frames));
+      return Fail(ErrorCode::kBadNumber, value_tok,
+                  "expected a frame count of 0 or more, found " + std::to_string(frames));
     }
     doc_.declared_frames = frames;
 
@@ -300,7 +309,8 @@ class HierarchyParser {
       const BvhToken time_kw = tok_.Next();
       if (!BvhKeywordEquals(time_kw.text.substr(0, 5), "Time:") &&
           !(BvhKeywordEquals(time_kw.text, "Time") && tok_.Peek().text.substr(0, 1) == ":")) {
-        return Fail(ErrorCode::kSyntax, time_kw, "expected 'Time:' after 'Frame', found " + Found(time_kw));
+        return Fail(ErrorCode::kSyntax, time_kw,
+                    "expected 'Time:' after 'Frame', found " + Found(time_kw));
       }
       BvhToken time_value = time_kw;
       std::string_view text = AfterColon(time_kw.text);
@@ -318,15 +328,19 @@ class HierarchyParser {
       double seconds = 0.0;
       const char* next = nullptr;
       const char* text_end = text.data() + text.size();
-      const internal::NumberStatus s = internal::ParseBvhNumber(text.data(), text_end, seconds, &next);
+      const internal::NumberStatus s =
+          internal::ParseBvhNumber(text.data(), text_end, seconds, &next);
       if (text.empty() || s == internal::NumberStatus::kBadNumber || next != text_end) {
-        return Fail(ErrorCode::kBadNumber, time_value, "expected a frame time in seconds, found " +
-                                                           (text.empty() ? std::string("end of file")
-                                                                         : "'" + std::string(text) + "'"));
+        return Fail(
+            ErrorCode::kBadNumber, time_value,
+            "expected a frame time in seconds, found " +
+                (text.empty() ? std::string("end of file") : "'" + std::string(text) + "'"));
       }
       if (s == internal::NumberStatus::kNonFinite || !(seconds > 0.0)) {
-        return Fail(s == internal::NumberStatus::kNonFinite ? ErrorCode::kNonFinite : ErrorCode::kBadNumber,
-                    time_value, "expected a positive, finite frame time, found '" + std::string(text) + "'");
+        return Fail(
+            s == internal::NumberStatus::kNonFinite ? ErrorCode::kNonFinite : ErrorCode::kBadNumber,
+            time_value,
+            "expected a positive, finite frame time, found '" + std::string(text) + "'");
       }
       doc_.frame_time_s = seconds;
       doc_.has_frame_time = true;
@@ -382,8 +396,9 @@ Result<Skeleton> BuildBvhSkeleton(const BvhDocument& document, PositionChannelMo
         }
       }
       if (warnings != nullptr) {
-        warnings->push_back(Warning{FileLoc{document.file_name, j.line, j.column, {}},
-                                    "duplicate joint name '" + j.name + "' renamed to '" + name + "'"});
+        warnings->push_back(
+            Warning{FileLoc{document.file_name, j.line, j.column, {}},
+                    "duplicate joint name '" + j.name + "' renamed to '" + name + "'"});
       }
     }
     skeleton.names.push_back(std::move(name));
@@ -392,7 +407,8 @@ Result<Skeleton> BuildBvhSkeleton(const BvhDocument& document, PositionChannelMo
     JointChannels channels;
     channels.first = j.num_channels > 0 ? first : 0;
     channels.count = static_cast<std::uint8_t>(j.num_channels);
-    for (int c = 0; c < j.num_channels; ++c) channels.types[static_cast<std::size_t>(c)] = j.channels[c];
+    for (int c = 0; c < j.num_channels; ++c)
+      channels.types[static_cast<std::size_t>(c)] = j.channels[c];
     first += static_cast<std::uint32_t>(j.num_channels);
     skeleton.channels.push_back(channels);
   }

@@ -46,36 +46,36 @@ inline constexpr double kDefaultBvhFrameTimeS = 1.0 / 30.0;
 inline constexpr int kDefaultBvhMaxDepth = 256;
 
 struct BvhJoint {
-  std::string name;                     // as written (trimmed)
-  int parent = kNoParent;               // index into BvhDocument::joints, or kNoParent
-  glm::vec3 offset{0.0f};               // OFFSET, file units, in the parent's frame
-  int num_channels = 0;                 // 0..6
-  ChannelType channels[6]{};            // in file order; the rotation order is the Euler order
-  int line = 0;                         // location of the joint's name in the file
+  std::string name;           // as written (trimmed)
+  int parent = kNoParent;     // index into BvhDocument::joints, or kNoParent
+  glm::vec3 offset{0.0f};     // OFFSET, file units, in the parent's frame
+  int num_channels = 0;       // 0..6
+  ChannelType channels[6]{};  // in file order; the rotation order is the Euler order
+  int line = 0;               // location of the joint's name in the file
   int column = 0;
 };
 
 struct BvhEndSite {
-  std::string name;                     // the name written after "End Site", or "End Site"
-  int parent = kNoParent;               // index into BvhDocument::joints
-  glm::vec3 offset{0.0f};               // OFFSET, file units
-  int line = 0;                         // location of the "End" keyword
+  std::string name;        // the name written after "End Site", or "End Site"
+  int parent = kNoParent;  // index into BvhDocument::joints
+  glm::vec3 offset{0.0f};  // OFFSET, file units
+  int line = 0;            // location of the "End" keyword
   int column = 0;
 };
 
 struct BvhDocument {
-  std::string file_name;                // for messages, as given by the caller
-  std::vector<BvhJoint> joints;         // #J in file order (parents before children)
-  std::vector<BvhEndSite> end_sites;    // in file order
-  int num_channels = 0;                 // sum of the joints' channel counts
-  long long declared_frames = 0;        // the "Frames:" value, >= 0, not yet trusted
-  int frames_line = 0;                  // location of the "Frames:" value
+  std::string file_name;              // for messages, as given by the caller
+  std::vector<BvhJoint> joints;       // #J in file order (parents before children)
+  std::vector<BvhEndSite> end_sites;  // in file order
+  int num_channels = 0;               // sum of the joints' channel counts
+  long long declared_frames = 0;      // the "Frames:" value, >= 0, not yet trusted
+  int frames_line = 0;                // location of the "Frames:" value
   int frames_column = 0;
   double frame_time_s = kDefaultBvhFrameTimeS;  // > 0, as written (or the default)
-  bool has_frame_time = false;          // false when the file had no "Frame Time:" line
-  std::size_t motion_offset = 0;        // byte offset just after the MOTION header
-  int motion_line = 1;                  // line number at motion_offset
-  std::size_t motion_line_start = 0;    // byte offset of the start of that line
+  bool has_frame_time = false;                  // false when the file had no "Frame Time:" line
+  std::size_t motion_offset = 0;                // byte offset just after the MOTION header
+  int motion_line = 1;                          // line number at motion_offset
+  std::size_t motion_line_start = 0;            // byte offset of the start of that line
   std::vector<Warning> warnings;
 };
 

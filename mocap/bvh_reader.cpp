@@ -1,9 +1,16 @@
 #include "mocap/bvh_reader.h"
 
 #include <algorithm>
+#include <array>
+#include <cerrno>
 #include <cmath>
-#include <fstream>
+#include <cstring>
 #include <limits>
+
+#include <fcntl.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include "mocap/internal/bvh_number.h"
 #include "mocap/pose.h"
@@ -14,6 +21,14 @@ namespace {
 
 inline bool IsBlank(char c) { return c == ' ' || c == '\t' || c == '\f' || c == '\v'; }
 inline bool IsLineEnd(char c) { return c == '\n' || c == '\r'; }
+
+enum ByteClass : unsigned char { kOther, kBlank, kLineEnd };
+constexpr auto kByteClass = [] {
+  std::array<ByteClass, 256> table{};
+  for (const char c : {' ', '\t', '\f', '\v'}) table[static_cast<unsigned char>(c)] = kBlank;
+  for (const char c : {'\n', '\r'}) table[static_cast<unsigned char>(c)] = kLineEnd;
+  return table;
+}();
 
 // Reads the frame data: one pass over the buffer, writing straight into the
 // preallocated array. Line numbers are counted as we go; columns are computed
@@ -65,10 +80,12 @@ class MotionParser {
       SkipSpace();
       if (p_ != end_) {
         std::vector<float> scratch(static_cast<std::size_t>(num_channels));
-        if (Status s = ParseLine(static_cast<long long>(frames) + 1, num_channels, scratch.data()); !s) return s;
+        if (Status s = ParseLine(static_cast<long long>(frames) + 1, num_channels, scratch.data());
+            !s)
+          return s;
       }
-      const std::string counts = "'Frames:' declares " + std::to_string(declared) + " frames but the file holds " +
-                                 std::to_string(frames);
+      const std::string counts = "'Frames:' declares " + std::to_string(declared) +
+                                 " frames but the file holds " + std::to_string(frames);
       if (!options.allow_short_motion) {
         return MakeError(ErrorCode::kCountMismatch, Loc(p_), counts);
       }
@@ -108,25 +125,34 @@ class MotionParser {
   }
 
   // Parses one data line starting at a non-blank byte; leaves p_ at its line end.
+  // The hot loop of the reader: works on local pointers (so they stay in
+  // registers) and classifies bytes with one table lookup.
   Status ParseLine(long long frame, int num_channels, float* out) {
+    const char* p = p_;
+    const char* const end = end_;
     int count = 0;
     for (;;) {
-      const char* token = p_;
-      if (count == num_channels) return TooMany(frame, num_channels, token);
+      if (count == num_channels) [[unlikely]] {
+        p_ = p;
+        return TooMany(frame, num_channels, p);
+      }
       const char* next = nullptr;
-      const internal::NumberStatus s = internal::ParseBvhNumber(p_, end_, out[count], &next);
-      if (s != internal::NumberStatus::kOk || (next != end_ && !IsBlank(*next) && !IsLineEnd(*next))) {
-        return BadNumber(frame, count, s, token);
+      const internal::NumberStatus s = internal::ParseBvhNumber(p, end, out[count], &next);
+      if (s != internal::NumberStatus::kOk ||
+          (next != end && kByteClass[static_cast<unsigned char>(*next)] == kOther)) [[unlikely]] {
+        p_ = p;
+        return BadNumber(frame, count, s, p);
       }
       ++count;
-      p_ = next;
-      while (p_ != end_ && IsBlank(*p_)) ++p_;
-      if (p_ == end_ || IsLineEnd(*p_)) break;
+      p = next;
+      while (p != end && kByteClass[static_cast<unsigned char>(*p)] == kBlank) ++p;
+      if (p == end || kByteClass[static_cast<unsigned char>(*p)] == kLineEnd) break;
     }
-    if (count != num_channels) {
+    p_ = p;
+    if (count != num_channels) [[unlikely]] {
       return MakeError(ErrorCode::kCountMismatch, Loc(p_),
-                       "expected " + std::to_string(num_channels) + " values in frame " + std::to_string(frame) +
-                           ", found " + std::to_string(count));
+                       "expected " + std::to_string(num_channels) + " values in frame " +
+                           std::to_string(frame) + ", found " + std::to_string(count));
     }
     return Status::Ok();
   }
@@ -141,8 +167,8 @@ class MotionParser {
       while (q != end_ && !IsBlank(*q) && !IsLineEnd(*q)) ++q;
     }
     return MakeError(ErrorCode::kCountMismatch, Loc(extra),
-                     "expected " + std::to_string(num_channels) + " values in frame " + std::to_string(frame) +
-                         ", found " + std::to_string(count));
+                     "expected " + std::to_string(num_channels) + " values in frame " +
+                         std::to_string(frame) + ", found " + std::to_string(count));
   }
 
   Error BadNumber(long long frame, int index, internal::NumberStatus s, const char* token) {
@@ -151,9 +177,9 @@ class MotionParser {
     const std::string found(token, static_cast<std::size_t>(q - token));
     const bool non_finite = s == internal::NumberStatus::kNonFinite;
     return MakeError(non_finite ? ErrorCode::kNonFinite : ErrorCode::kBadNumber, Loc(token),
-                     std::string(non_finite ? "expected a finite number" : "expected a number") + " for value " +
-                         std::to_string(index + 1) + " of frame " + std::to_string(frame) + ", found '" + found +
-                         "'");
+                     std::string(non_finite ? "expected a finite number" : "expected a number") +
+                         " for value " + std::to_string(index + 1) + " of frame " +
+                         std::to_string(frame) + ", found '" + found + "'");
   }
 
   void WarnExtraLines(std::vector<Warning>* warnings, long long declared) {
@@ -164,7 +190,8 @@ class MotionParser {
       while (p_ != end_ && !IsLineEnd(*p_)) ++p_;
       SkipSpace();
     }
-    warnings->push_back(Warning{first, std::to_string(extra) + " data line(s) after the " + std::to_string(declared) +
+    warnings->push_back(Warning{first, std::to_string(extra) + " data line(s) after the " +
+                                           std::to_string(declared) +
                                            " frames 'Frames:' declares; ignored"});
   }
 
@@ -195,7 +222,8 @@ UpAxis DetectBvhUpAxis(const Skeleton& skeleton) {
     const JointChannels& c = skeleton.channels[js];
     for (int k = 0; k < c.count; ++k) {
       const ChannelType t = c.types[static_cast<std::size_t>(k)];
-      has_position |= t == ChannelType::kXPosition || t == ChannelType::kYPosition || t == ChannelType::kZPosition;
+      has_position |= t == ChannelType::kXPosition || t == ChannelType::kYPosition ||
+                      t == ChannelType::kZPosition;
     }
     if (has_position) continue;
     vote(skeleton.rest_translations[js], &y_votes, &z_votes);
@@ -208,7 +236,8 @@ UpAxis DetectBvhUpAxis(const Skeleton& skeleton) {
   if (!any) {
     for (int j = 0; j < skeleton.num_joints(); ++j) {
       const std::size_t js = static_cast<std::size_t>(j);
-      if (skeleton.parents[js] != kNoParent) vote(skeleton.rest_translations[js], &y_votes, &z_votes);
+      if (skeleton.parents[js] != kNoParent)
+        vote(skeleton.rest_translations[js], &y_votes, &z_votes);
     }
   }
   return z_votes > y_votes ? UpAxis::kZ : UpAxis::kY;
@@ -221,7 +250,8 @@ float RestHeight(const Skeleton& skeleton, UpAxis up) {
   float hi = std::numeric_limits<float>::lowest();
   for (std::size_t j = 0; j < model.size(); ++j) {
     const int p = skeleton.parents[j];
-    model[j] = skeleton.rest_translations[j] + (p == kNoParent ? glm::vec3(0.0f) : model[static_cast<std::size_t>(p)]);
+    model[j] = skeleton.rest_translations[j] +
+               (p == kNoParent ? glm::vec3(0.0f) : model[static_cast<std::size_t>(p)]);
     lo = std::min(lo, model[j][axis]);
     hi = std::max(hi, model[j][axis]);
   }
@@ -269,7 +299,8 @@ void ScaleSkeletonAndMotion(float factor, Skeleton* skeleton, Motion* motion) {
   for (const JointChannels& c : skeleton->channels) {
     for (int k = 0; k < c.count; ++k) {
       const ChannelType t = c.types[static_cast<std::size_t>(k)];
-      if (t == ChannelType::kXPosition || t == ChannelType::kYPosition || t == ChannelType::kZPosition) {
+      if (t == ChannelType::kXPosition || t == ChannelType::kYPosition ||
+          t == ChannelType::kZPosition) {
         columns.push_back(static_cast<int>(c.first) + k);
       }
     }
@@ -289,11 +320,22 @@ void ConvertZUpToYUp(Skeleton* skeleton, Motion* motion) {
       ChannelType& t = c.types[static_cast<std::size_t>(k)];
       const int column = static_cast<int>(c.first) + k;
       switch (t) {
-        case ChannelType::kYPosition: t = ChannelType::kZPosition; negate.push_back(column); break;
-        case ChannelType::kZPosition: t = ChannelType::kYPosition; break;
-        case ChannelType::kYRotation: t = ChannelType::kZRotation; negate.push_back(column); break;
-        case ChannelType::kZRotation: t = ChannelType::kYRotation; break;
-        default: break;
+        case ChannelType::kYPosition:
+          t = ChannelType::kZPosition;
+          negate.push_back(column);
+          break;
+        case ChannelType::kZPosition:
+          t = ChannelType::kYPosition;
+          break;
+        case ChannelType::kYRotation:
+          t = ChannelType::kZRotation;
+          negate.push_back(column);
+          break;
+        case ChannelType::kZRotation:
+          t = ChannelType::kYRotation;
+          break;
+        default:
+          break;
       }
     }
   }
@@ -304,19 +346,25 @@ void ConvertZUpToYUp(Skeleton* skeleton, Motion* motion) {
   skeleton->info.up_axis = UpAxis::kY;
 }
 
-Result<BvhFile> ParseBvh(std::string_view text, const std::string& file_name, const BvhReadOptions& options) {
+Result<BvhFile> ParseBvh(std::string_view text, const std::string& file_name,
+                         const BvhReadOptions& options) {
   if (!(options.scale >= 0.0f) || !std::isfinite(options.scale)) {
-    return MakeError(ErrorCode::kInvalidArgument, FileLoc{file_name, 0, 0, {}},
-                     "scale must be finite and >= 0 (0 = automatic), got " + std::to_string(options.scale));
+    return MakeError(
+        ErrorCode::kInvalidArgument, FileLoc{file_name, 0, 0, {}},
+        "scale must be finite and >= 0 (0 = automatic), got " + std::to_string(options.scale));
   }
-  Result<BvhDocument> document = ParseBvhHierarchy(text, file_name, {options.max_depth, options.max_joints});
+  // Windows tools sometimes write a UTF-8 byte order mark; it is not part of the grammar.
+  if (text.size() >= 3 && text.compare(0, 3, "\xEF\xBB\xBF") == 0) text.remove_prefix(3);
+  Result<BvhDocument> document =
+      ParseBvhHierarchy(text, file_name, {options.max_depth, options.max_joints});
   if (!document) return std::move(document).error();
   BvhFile file;
   file.warnings = std::move(document->warnings);
   Result<Skeleton> skeleton = BuildBvhSkeleton(*document, options.position_mode, &file.warnings);
   if (!skeleton) return std::move(skeleton).error();
   file.skeleton = std::move(skeleton).value();
-  if (Status s = MotionParser(text, *document).Run(options, &file.motion, &file.warnings); !s) return s.error();
+  if (Status s = MotionParser(text, *document).Run(options, &file.motion, &file.warnings); !s)
+    return s.error();
 
   SkeletonInfo& info = file.skeleton.info;
   info.up_axis = options.up_axis.has_value() ? *options.up_axis : DetectBvhUpAxis(file.skeleton);
@@ -332,29 +380,73 @@ Result<BvhFile> ParseBvh(std::string_view text, const std::string& file_name, co
             : info.detected_units == std::string("inch") ? 0.0254f
                                                          : 1.0f;
     if (info.detected_units == std::string("unknown")) {
-      file.warnings.push_back(Warning{FileLoc{file_name, 0, 0, {}},
-                                      "units not recognised from a rest height of " + std::to_string(raw_height) +
-                                          "; automatic scale left at 1"});
+      file.warnings.push_back(
+          Warning{FileLoc{file_name, 0, 0, {}}, "units not recognised from a rest height of " +
+                                                    std::to_string(raw_height) +
+                                                    "; automatic scale left at 1"});
     }
   }
   if (scale != 1.0f) ScaleSkeletonAndMotion(scale, &file.skeleton, &file.motion);
   info.scale_applied = scale;
   info.rest_height = raw_height * scale;
-  if (options.convert_to_y_up && info.up_axis == UpAxis::kZ) ConvertZUpToYUp(&file.skeleton, &file.motion);
+  if (options.convert_to_y_up && info.up_axis == UpAxis::kZ)
+    ConvertZUpToYUp(&file.skeleton, &file.motion);
   return file;
 }
 
-Result<BvhFile> ReadBvhFile(const std::string& path, const BvhReadOptions& options) {
-  std::ifstream in(path, std::ios::binary | std::ios::ate);
-  if (!in) return MakeError(ErrorCode::kIo, FileLoc{path, 0, 0, {}}, "cannot open the file for reading");
-  const std::streamoff size = in.tellg();
-  if (size < 0) return MakeError(ErrorCode::kIo, FileLoc{path, 0, 0, {}}, "cannot determine the file size");
-  std::string text(static_cast<std::size_t>(size), '\0');
-  in.seekg(0);
-  if (!in.read(text.data(), size)) {
-    return MakeError(ErrorCode::kIo, FileLoc{path, 0, 0, {}}, "cannot read the file");
+namespace {
+
+// A read-only view of a whole file: mmap'd, so the parser reads the page cache
+// directly instead of a copy (the copy costs about a quarter of the parse time
+// on an 80 MB file).
+class MappedFile {
+ public:
+  MappedFile() = default;
+  MappedFile(const MappedFile&) = delete;
+  MappedFile& operator=(const MappedFile&) = delete;
+  ~MappedFile() {
+    if (data_ != nullptr) munmap(data_, size_);
+    if (fd_ >= 0) close(fd_);
   }
-  return ParseBvh(text, path, options);
+
+  Status Open(const std::string& path) {
+    const FileLoc loc{path, 0, 0, {}};
+    fd_ = open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd_ < 0)
+      return MakeError(ErrorCode::kIo, loc,
+                       std::string("cannot open the file: ") + std::strerror(errno));
+    struct stat info {};
+    if (fstat(fd_, &info) != 0 || !S_ISREG(info.st_mode)) {
+      return MakeError(ErrorCode::kIo, loc, "not a regular file");
+    }
+    size_ = static_cast<std::size_t>(info.st_size);
+    if (size_ == 0) return Status::Ok();
+    void* data = mmap(nullptr, size_, PROT_READ, MAP_PRIVATE, fd_, 0);
+    if (data == MAP_FAILED)
+      return MakeError(ErrorCode::kIo, loc,
+                       std::string("cannot map the file: ") + std::strerror(errno));
+    data_ = data;
+    madvise(data_, size_, MADV_SEQUENTIAL);
+    return Status::Ok();
+  }
+
+  std::string_view text() const {
+    return data_ == nullptr ? std::string_view()
+                            : std::string_view(static_cast<const char*>(data_), size_);
+  }
+
+ private:
+  int fd_ = -1;
+  void* data_ = nullptr;
+  std::size_t size_ = 0;
+};
+
+}  // namespace
+
+Result<BvhFile> ReadBvhFile(const std::string& path, const BvhReadOptions& options) {
+  MappedFile file;
+  if (Status s = file.Open(path); !s) return s.error();
+  return ParseBvh(file.text(), path, options);
 }
 
 }  // namespace mocap

@@ -79,11 +79,14 @@ struct BvhFile {
 };
 
 // Parses a whole BVH text. `file_name_for_messages` only labels errors and warnings.
-[[nodiscard]] Result<BvhFile> ParseBvh(std::string_view text, const std::string& file_name_for_messages,
+[[nodiscard]] Result<BvhFile> ParseBvh(std::string_view text,
+                                       const std::string& file_name_for_messages,
                                        const BvhReadOptions& options = {});
 
-// Reads `path` into memory and parses it (kIo when it cannot be read).
-[[nodiscard]] Result<BvhFile> ReadBvhFile(const std::string& path, const BvhReadOptions& options = {});
+// Maps `path` into memory (mmap, read-only) and parses it; kIo when it cannot
+// be opened, is not a regular file or cannot be mapped.
+[[nodiscard]] Result<BvhFile> ReadBvhFile(const std::string& path,
+                                          const BvhReadOptions& options = {});
 
 // Detection helpers (rules above), exposed for tests and `inspect`.
 UpAxis DetectBvhUpAxis(const Skeleton& skeleton);

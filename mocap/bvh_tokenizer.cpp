@@ -4,9 +4,7 @@ namespace mocap {
 
 namespace {
 
-bool IsTokenEnd(char c) {
-  return IsBvhBlank(c) || c == '\n' || c == '\r' || c == '{' || c == '}';
-}
+bool IsTokenEnd(char c) { return IsBvhBlank(c) || c == '\n' || c == '\r' || c == '{' || c == '}'; }
 
 char ToLowerAscii(char c) { return (c >= 'A' && c <= 'Z') ? static_cast<char>(c - 'A' + 'a') : c; }
 

@@ -17,10 +17,10 @@
 namespace mocap {
 
 struct BvhToken {
-  std::string_view text;    // empty at end of input
-  int line = 0;             // 1-based line of the first character
-  int column = 0;           // 1-based column of the first character
-  std::size_t offset = 0;   // byte offset of the first character in the input
+  std::string_view text;   // empty at end of input
+  int line = 0;            // 1-based line of the first character
+  int column = 0;          // 1-based column of the first character
+  std::size_t offset = 0;  // byte offset of the first character in the input
 
   bool empty() const { return text.empty(); }
 };

@@ -25,13 +25,17 @@ void AppendVec(std::string* out, const glm::vec3& v) {
   }
 }
 
-bool IsBvhChannel(ChannelType t) { return static_cast<int>(t) <= static_cast<int>(ChannelType::kZRotation); }
+bool IsBvhChannel(ChannelType t) {
+  return static_cast<int>(t) <= static_cast<int>(ChannelType::kZRotation);
+}
 
 Status CheckName(const std::string& name, const char* what) {
   const bool bad = name.empty() || name.find_first_of("{}\r\n") != std::string::npos ||
-                   name.front() == ' ' || name.front() == '\t' || name.back() == ' ' || name.back() == '\t';
+                   name.front() == ' ' || name.front() == '\t' || name.back() == ' ' ||
+                   name.back() == '\t';
   if (bad) {
-    return MakeError(ErrorCode::kUnsupported, {}, std::string(what) + " name '" + name + "' cannot be written to BVH");
+    return MakeError(ErrorCode::kUnsupported, {},
+                     std::string(what) + " name '" + name + "' cannot be written to BVH");
   }
   return Status::Ok();
 }
@@ -42,8 +46,10 @@ Result<std::string> FormatBvh(const Skeleton& skeleton, const Motion& motion) {
   if (Status s = skeleton.Check(); !s) return s.error();
   const int n = skeleton.num_joints();
   if (motion.num_channels != skeleton.num_channels || motion.num_frames < 0 ||
-      motion.values.size() != static_cast<std::size_t>(motion.num_frames) * static_cast<std::size_t>(motion.num_channels)) {
-    return MakeError(ErrorCode::kInvalidArgument, {}, "motion size does not match the skeleton's channels");
+      motion.values.size() != static_cast<std::size_t>(motion.num_frames) *
+                                  static_cast<std::size_t>(motion.num_channels)) {
+    return MakeError(ErrorCode::kInvalidArgument, {},
+                     "motion size does not match the skeleton's channels");
   }
   if (n == 0) return MakeError(ErrorCode::kInvalidArgument, {}, "skeleton has no joints");
   std::vector<std::vector<int>> children(static_cast<std::size_t>(n));
@@ -52,12 +58,15 @@ Result<std::string> FormatBvh(const Skeleton& skeleton, const Motion& motion) {
     const std::size_t js = static_cast<std::size_t>(j);
     if (Status s = CheckName(skeleton.names[js], "joint"); !s) return s.error();
     const JointChannels& c = skeleton.channels[js];
-    if (c.count > 6) return MakeError(ErrorCode::kUnsupported, {}, "joint '" + skeleton.names[js] + "' has more than 6 channels");
+    if (c.count > 6)
+      return MakeError(ErrorCode::kUnsupported, {},
+                       "joint '" + skeleton.names[js] + "' has more than 6 channels");
     for (int k = 0; k < c.count; ++k) {
       if (!IsBvhChannel(c.types[static_cast<std::size_t>(k)])) {
         return MakeError(ErrorCode::kUnsupported, {},
                          "joint '" + skeleton.names[js] + "' has a " +
-                             ChannelTypeName(c.types[static_cast<std::size_t>(k)]) + " channel, which BVH cannot hold");
+                             ChannelTypeName(c.types[static_cast<std::size_t>(k)]) +
+                             " channel, which BVH cannot hold");
       }
     }
     const int p = skeleton.parents[js];
@@ -65,7 +74,8 @@ Result<std::string> FormatBvh(const Skeleton& skeleton, const Motion& motion) {
   }
   for (std::size_t e = 0; e < skeleton.end_sites.size(); ++e) {
     if (Status s = CheckName(skeleton.end_sites[e].name, "end site"); !s) return s.error();
-    end_sites[static_cast<std::size_t>(skeleton.end_sites[e].parent)].push_back(static_cast<int>(e));
+    end_sites[static_cast<std::size_t>(skeleton.end_sites[e].parent)].push_back(
+        static_cast<int>(e));
   }
 
   std::string out;
@@ -90,7 +100,8 @@ Result<std::string> FormatBvh(const Skeleton& skeleton, const Motion& motion) {
     }
     const std::size_t js = static_cast<std::size_t>(item);
     const std::string indent(static_cast<std::size_t>(depth), '\t');
-    out += indent + (skeleton.parents[js] == kNoParent ? "ROOT " : "JOINT ") + skeleton.names[js] + "\n";
+    out += indent + (skeleton.parents[js] == kNoParent ? "ROOT " : "JOINT ") + skeleton.names[js] +
+           "\n";
     out += indent + "{\n" + indent + "\tOFFSET";
     AppendVec(&out, skeleton.rest_translations[js]);
     const JointChannels& c = skeleton.channels[js];
@@ -133,7 +144,8 @@ Status WriteBvhFile(const std::string& path, const Skeleton& skeleton, const Mot
   const std::string temp = path + ".tmp";
   {
     std::ofstream out(temp, std::ios::binary | std::ios::trunc);
-    if (!out || !out.write(text->data(), static_cast<std::streamsize>(text->size())) || !out.flush()) {
+    if (!out || !out.write(text->data(), static_cast<std::streamsize>(text->size())) ||
+        !out.flush()) {
       std::error_code ignored;
       std::filesystem::remove(temp, ignored);
       return MakeError(ErrorCode::kIo, FileLoc{temp, 0, 0, {}}, "cannot write the file");
@@ -143,7 +155,8 @@ Status WriteBvhFile(const std::string& path, const Skeleton& skeleton, const Mot
   std::filesystem::rename(temp, path, ec);
   if (ec) {
     std::filesystem::remove(temp, ec);
-    return MakeError(ErrorCode::kIo, FileLoc{path, 0, 0, {}}, "cannot rename the temporary file into place");
+    return MakeError(ErrorCode::kIo, FileLoc{path, 0, 0, {}},
+                     "cannot rename the temporary file into place");
   }
   return Status::Ok();
 }

@@ -29,6 +29,7 @@ namespace mocap {
 
 // Writes FormatBvh's text to `path`: first to "<path>.tmp", then renamed over
 // `path`, so a reader never sees a half-written file. kIo on failure.
-[[nodiscard]] Status WriteBvhFile(const std::string& path, const Skeleton& skeleton, const Motion& motion);
+[[nodiscard]] Status WriteBvhFile(const std::string& path, const Skeleton& skeleton,
+                                  const Motion& motion);
 
 }  // namespace mocap

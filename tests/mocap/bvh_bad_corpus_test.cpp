@@ -84,8 +84,10 @@ TEST_P(BvhBadCorpus, FailsWithDocumentedCodeAndLocation) {
   EXPECT_EQ(e.loc.file, path);
   EXPECT_FALSE(e.message.empty());
   // The formatted message starts "path:line:col: error: ".
-  EXPECT_EQ(e.ToString().rfind(path + ":" + std::to_string(c.line) + ":" + std::to_string(c.column) + ": error: ", 0),
-            0u)
+  EXPECT_EQ(
+      e.ToString().rfind(
+          path + ":" + std::to_string(c.line) + ":" + std::to_string(c.column) + ": error: ", 0),
+      0u)
       << e.ToString();
 }
 
@@ -102,20 +104,22 @@ TEST(BvhBadCorpusIndex, FolderTableAndReadmeAgree) {
   for (const BadCase& c : kCases) in_table.insert(c.file);
   EXPECT_GE(in_table.size(), 30u);
   std::set<std::string> in_folder;
-  for (const auto& entry : std::filesystem::directory_iterator(testsupport::TestDataPath("bvh/bad"))) {
+  for (const auto& entry :
+       std::filesystem::directory_iterator(testsupport::TestDataPath("bvh/bad"))) {
     if (entry.path().extension() == ".bvh") in_folder.insert(entry.path().filename().string());
   }
   EXPECT_EQ(in_table, in_folder);
   std::ifstream readme(testsupport::TestDataPath("bvh/bad/README.md"));
   ASSERT_TRUE(readme.good());
-  const std::string text((std::istreambuf_iterator<char>(readme)), std::istreambuf_iterator<char>());
+  const std::string text((std::istreambuf_iterator<char>(readme)),
+                         std::istreambuf_iterator<char>());
   for (const BadCase& c : kCases) {
     const std::string row = std::string("| `") + c.file + "` |";
     const std::size_t at = text.find(row);
     ASSERT_NE(at, std::string::npos) << c.file << " has no README row";
     const std::string line = text.substr(at, text.find('\n', at) - at);
-    const std::string tail = " | " + std::string(mocap::ErrorCodeName(c.code)) + " | " + std::to_string(c.line) +
-                             ":" + std::to_string(c.column) + " |";
+    const std::string tail = " | " + std::string(mocap::ErrorCodeName(c.code)) + " | " +
+                             std::to_string(c.line) + ":" + std::to_string(c.column) + " |";
     EXPECT_EQ(line.substr(line.size() - tail.size()), tail) << line;
   }
 }
@@ -126,7 +130,8 @@ TEST(BvhBadCorpusIndex, FolderTableAndReadmeAgree) {
 TEST(BvhBadCorpusIndex, HugeDeclaredCountLoadsWhatIsThereWhenAllowed) {
   mocap::BvhReadOptions options;
   options.allow_short_motion = true;
-  auto result = mocap::ReadBvhFile(testsupport::TestDataPath("bvh/bad/frames_huge_declared.bvh").string(), options);
+  auto result = mocap::ReadBvhFile(
+      testsupport::TestDataPath("bvh/bad/frames_huge_declared.bvh").string(), options);
   ASSERT_TRUE(result.ok()) << result.error().ToString();
   EXPECT_EQ(result->motion.num_frames, 3);
   EXPECT_LE(result->motion.values.capacity(), 9u * 32u);

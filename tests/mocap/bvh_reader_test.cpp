@@ -3,8 +3,10 @@
 
 #include "mocap/bvh_reader.h"
 
+#include <algorithm>
 #include <cstdlib>
 #include <fstream>
+#include <random>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -54,7 +56,8 @@ BvhFile MustParse(const std::string& text, const BvhReadOptions& options = {}) {
 }
 
 std::string Replace(std::string text, const std::string& from, const std::string& to) {
-  for (std::size_t at = text.find(from); at != std::string::npos; at = text.find(from, at + to.size())) {
+  for (std::size_t at = text.find(from); at != std::string::npos;
+       at = text.find(from, at + to.size())) {
     text.replace(at, from.size(), to);
   }
   return text;
@@ -65,7 +68,8 @@ void ExpectSameAsSmall(const BvhFile& file) {
   EXPECT_EQ(file.skeleton.names, ref.skeleton.names);
   EXPECT_EQ(file.skeleton.parents, ref.skeleton.parents);
   ASSERT_EQ(file.motion.values.size(), ref.motion.values.size());
-  for (std::size_t i = 0; i < ref.motion.values.size(); ++i) EXPECT_EQ(file.motion.values[i], ref.motion.values[i]);
+  for (std::size_t i = 0; i < ref.motion.values.size(); ++i)
+    EXPECT_EQ(file.motion.values[i], ref.motion.values[i]);
 }
 
 TEST(BvhReader, ReadsSmallFile) {
@@ -107,7 +111,8 @@ TEST(BvhReader, LineEndsAndBlanksDoNotMatter) {
   ExpectSameAsSmall(MustParse(Replace(kSmall, "\n", "\r\n")));
   ExpectSameAsSmall(MustParse(Replace(kSmall, "\n", "\r")));
   ExpectSameAsSmall(MustParse(Replace(Replace(kSmall, "\n", " \t\n\n"), " ", "\t ")));
-  ExpectSameAsSmall(MustParse(std::string(kSmall).substr(0, std::string(kSmall).size() - 1)));  // no final LF
+  ExpectSameAsSmall(
+      MustParse(std::string(kSmall).substr(0, std::string(kSmall).size() - 1)));  // no final LF
 }
 
 TEST(BvhReader, CrOnlyFileCountsLines) {
@@ -159,7 +164,8 @@ TEST(BvhReader, DuplicateNamesAreMadeUniqueWithAWarning) {
 }
 
 TEST(BvhReader, OneAndTwoRotationChannelsAndAnyOrder) {
-  std::string text = Replace(kSmall, "CHANNELS 3 Zrotation Yrotation Xrotation", "CHANNELS 1 Yrotation");
+  std::string text =
+      Replace(kSmall, "CHANNELS 3 Zrotation Yrotation Xrotation", "CHANNELS 1 Yrotation");
   text = Replace(text, "CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation",
                  "CHANNELS 4 Xrotation Zposition Yrotation Xposition");
   text = Replace(text, "0.5 90 -1 10 20 30 1 2 3", "1 2 3 4 5");
@@ -173,7 +179,8 @@ TEST(BvhReader, OneAndTwoRotationChannelsAndAnyOrder) {
 }
 
 TEST(BvhReader, ExponentsSignsAndLeadingDots) {
-  const BvhFile file = MustParse(Replace(kSmall, "0.5 90 -1 10 20 30 1 2 3", "+.5 9E1 -1e0 1.0e+1 +2e1 3e1 .1 -.2 -0"));
+  const BvhFile file = MustParse(
+      Replace(kSmall, "0.5 90 -1 10 20 30 1 2 3", "+.5 9E1 -1e0 1.0e+1 +2e1 3e1 .1 -.2 -0"));
   const auto f = file.motion.frame(0);
   EXPECT_EQ(f[0], 0.5f);
   EXPECT_EQ(f[1], 90.0f);
@@ -188,7 +195,8 @@ TEST(BvhReader, FramesHeaderVariants) {
   ExpectSameAsSmall(MustParse(Replace(kSmall, "Frames: 2", "Frames:\t2")));
   ExpectSameAsSmall(MustParse(Replace(kSmall, "Frames: 2", "Frames:2")));
   ExpectSameAsSmall(MustParse(Replace(kSmall, "Frames: 2", "Frames : 2")));
-  const BvhFile glued = MustParse(Replace(kSmall, "Frame Time: 0.0333333", "Frame Time:\t.0083333"));
+  const BvhFile glued =
+      MustParse(Replace(kSmall, "Frame Time: 0.0333333", "Frame Time:\t.0083333"));
   EXPECT_EQ(glued.motion.frame_time_s, 0.0083333);
   EXPECT_EQ(mocap::NominalFps(glued.motion.frame_time_s), 120.0);
 }
@@ -203,7 +211,8 @@ TEST(BvhReader, MissingFrameTimeGetsDefaultAndWarning) {
 
 TEST(BvhReader, SeveralRoots) {
   const std::string second =
-      "ROOT Prop\n{\n OFFSET 7 8 9\n CHANNELS 3 Xposition Yposition Zposition\n End Site\n {\n OFFSET 0 1 0\n }\n}\n"
+      "ROOT Prop\n{\n OFFSET 7 8 9\n CHANNELS 3 Xposition Yposition Zposition\n End Site\n {\n "
+      "OFFSET 0 1 0\n }\n}\n"
       "MOTION";
   std::string text = Replace(kSmall, "MOTION", second);
   text = Replace(text, "30 1 2 3\n", "30 1 2 3 10 11 12\n");
@@ -251,7 +260,8 @@ TEST(BvhReader, ZeroFramesAndZeroChannels) {
 
 // The root's local translation in both modes, with a non-zero root OFFSET.
 TEST(BvhReader, PositionChannelModes) {
-  for (const auto mode : {mocap::PositionChannelMode::kReplaceOffset, mocap::PositionChannelMode::kAddToOffset}) {
+  for (const auto mode :
+       {mocap::PositionChannelMode::kReplaceOffset, mocap::PositionChannelMode::kAddToOffset}) {
     BvhReadOptions options;
     options.position_mode = mode;
     const BvhFile file = MustParse(kSmall, options);
@@ -315,12 +325,15 @@ TEST(BvhReader, ZUpIsDetectedAndConvertedToTheSamePoses) {
     std::vector<mocap::JointTransform> a(2), b(2);
     std::vector<glm::mat4> ma(2), mb(2);
     ASSERT_TRUE((mocap::LocalPoseJob{&y_up.skeleton, y_up.motion.frame(f), a}.Run().ok()));
-    ASSERT_TRUE((mocap::LocalPoseJob{&converted.skeleton, converted.motion.frame(f), b}.Run().ok()));
+    ASSERT_TRUE(
+        (mocap::LocalPoseJob{&converted.skeleton, converted.motion.frame(f), b}.Run().ok()));
     ASSERT_TRUE((mocap::LocalToModelJob{y_up.skeleton.parents, a, glm::mat4(1.0f), ma}.Run().ok()));
-    ASSERT_TRUE((mocap::LocalToModelJob{converted.skeleton.parents, b, glm::mat4(1.0f), mb}.Run().ok()));
+    ASSERT_TRUE(
+        (mocap::LocalToModelJob{converted.skeleton.parents, b, glm::mat4(1.0f), mb}.Run().ok()));
     for (int j = 0; j < 2; ++j) {
       for (int c = 0; c < 4; ++c) {
-        for (int r = 0; r < 4; ++r) EXPECT_NEAR(ma[j][c][r], mb[j][c][r], testsupport::kPositionTol);
+        for (int r = 0; r < 4; ++r)
+          EXPECT_NEAR(ma[j][c][r], mb[j][c][r], testsupport::kPositionTol);
       }
     }
   }
@@ -342,11 +355,63 @@ TEST(BvhReader, JointAndDepthLimitsAreOptions) {
   EXPECT_EQ(depth.error().loc.line, 6);
 }
 
+TEST(BvhReader, SkipsUtf8ByteOrderMark) {
+  std::string text(kSmall);
+  text.insert(0, "\xEF\xBB\xBF");
+  ExpectSameAsSmall(MustParse(text));
+}
+
+// Random byte edits and truncations never crash: each gives a file or an error
+// with a location inside the text.
+TEST(BvhReader, MutatedInputsGiveAResultOrALocatedError) {
+  const std::string base = kSmall;
+  std::mt19937 rng(42);
+  const char kBytes[] = "{}:.-+eE0123456789 \t\r\nXZrotationOFFSETJOINTEnd";
+  int failures = 0;
+  for (int trial = 0; trial < 3000; ++trial) {
+    std::string text = base;
+    const int edits = 1 + static_cast<int>(rng() % 4);
+    for (int e = 0; e < edits; ++e) {
+      const std::size_t at = rng() % text.size();
+      switch (rng() % 3) {
+        case 0:
+          text[at] = kBytes[rng() % (sizeof(kBytes) - 1)];
+          break;
+        case 1: {  // delete up to 8 bytes (not erase(): GCC 12 warns falsely with -Wrestrict)
+          std::string cut = text.substr(0, at);
+          cut.append(text, std::min(text.size(), at + 1 + rng() % 8), std::string::npos);
+          text.swap(cut);
+          break;
+        }
+        default:
+          text.resize(at);
+          break;
+      }
+      if (text.empty()) text.push_back('H');
+    }
+    auto result = ParseBvh(text, "fuzz.bvh");
+    if (result.ok()) {
+      EXPECT_TRUE(result->skeleton.Check().ok());
+      EXPECT_EQ(result->motion.values.size(),
+                static_cast<std::size_t>(result->motion.num_frames) *
+                    static_cast<std::size_t>(result->motion.num_channels));
+      continue;
+    }
+    ++failures;
+    EXPECT_GE(result.error().loc.line, 1) << result.error().ToString();
+    EXPECT_GE(result.error().loc.column, 1) << result.error().ToString();
+  }
+  EXPECT_GT(failures, 1000);  // most edits break the file
+}
+
 TEST(BvhReader, MissingFileIsAnIoError) {
   auto result = mocap::ReadBvhFile("/nonexistent/walk.bvh");
   ASSERT_FALSE(result.ok());
   EXPECT_EQ(result.error().code, ErrorCode::kIo);
   EXPECT_EQ(result.error().loc.file, "/nonexistent/walk.bvh");
+  auto folder = mocap::ReadBvhFile(testsupport::TestDataPath("bvh").string());
+  ASSERT_FALSE(folder.ok());
+  EXPECT_EQ(folder.error().code, ErrorCode::kIo);
 }
 
 // Real captures: counts from shared/data/SOURCES.md, values of the first and
@@ -400,19 +465,21 @@ TEST_P(SharedBvh, LoadsWithDocumentedCountsAndValues) {
     const std::vector<float> expected = SplitLine(data[static_cast<std::size_t>(f)]);
     const auto got = file.motion.frame(f);
     ASSERT_EQ(expected.size(), got.size());
-    for (std::size_t k = 0; k < got.size(); ++k) EXPECT_EQ(got[k], expected[k]) << "frame " << f << " value " << k;
+    for (std::size_t k = 0; k < got.size(); ++k)
+      EXPECT_EQ(got[k], expected[k]) << "frame " << f << " value " << k;
   }
 }
 
 INSTANTIATE_TEST_SUITE_P(
     SharedData, SharedBvh,
-    testing::Values(SharedCase{"bvh/cmu_cgspeed/01_01.bvh", 31, 7, 2752, 120, "unknown"},
-                    SharedCase{"bvh/cmu_cgspeed/01_03.bvh", 31, 7, 4511, 120, "unknown"},
-                    SharedCase{"bvh/bandai_namco/dataset-1_walk_normal_001.bvh", 22, 5, 195, 30, "cm"},
-                    SharedCase{"bvh/bandai_namco/dataset-2_run_active_034.bvh", 22, 5, 75, 30, "cm"},
-                    SharedCase{"bvh/lafan1_resolved/Geno_bind.bvh", 75, 21, 2, 60, "cm"},
-                    SharedCase{"bvh/lafan1_resolved/Geno_stance.bvh", 75, 21, 2, 60, "cm"},
-                    SharedCase{"bvh/bvh_python/test_mocapbank.bvh", 19, 5, 455, 30, "cm"},
-                    SharedCase{"bvh/bvh_python/test_freebvh.bvh", 55, 15, 69, 30, "cm"}));
+    testing::Values(
+        SharedCase{"bvh/cmu_cgspeed/01_01.bvh", 31, 7, 2752, 120, "unknown"},
+        SharedCase{"bvh/cmu_cgspeed/01_03.bvh", 31, 7, 4511, 120, "unknown"},
+        SharedCase{"bvh/bandai_namco/dataset-1_walk_normal_001.bvh", 22, 5, 195, 30, "cm"},
+        SharedCase{"bvh/bandai_namco/dataset-2_run_active_034.bvh", 22, 5, 75, 30, "cm"},
+        SharedCase{"bvh/lafan1_resolved/Geno_bind.bvh", 75, 21, 2, 60, "cm"},
+        SharedCase{"bvh/lafan1_resolved/Geno_stance.bvh", 75, 21, 2, 60, "cm"},
+        SharedCase{"bvh/bvh_python/test_mocapbank.bvh", 19, 5, 455, 30, "cm"},
+        SharedCase{"bvh/bvh_python/test_freebvh.bvh", 55, 15, 69, 30, "cm"}));
 
 }  // namespace

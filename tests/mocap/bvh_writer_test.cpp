@@ -50,9 +50,11 @@ BvhFile RoundTrip(const BvhFile& file) {
 }
 
 constexpr const char* kTwoRoots =
-    "HIERARCHY\nROOT Hips\n{\n OFFSET 1 2 3\n CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation\n"
+    "HIERARCHY\nROOT Hips\n{\n OFFSET 1 2 3\n CHANNELS 6 Xposition Yposition Zposition Zrotation "
+    "Xrotation Yrotation\n"
     " JOINT Left Leg:1\n {\n  OFFSET 0.1 -40.25 1e-7\n  CHANNELS 2 Xrotation Zrotation\n"
-    "  End Site Toe\n  {\n   OFFSET 0 -3 1\n  }\n }\n JOINT Spine\n {\n  OFFSET 0 10 0\n  CHANNELS 0\n"
+    "  End Site Toe\n  {\n   OFFSET 0 -3 1\n  }\n }\n JOINT Spine\n {\n  OFFSET 0 10 0\n  CHANNELS "
+    "0\n"
     "  End Site\n  {\n   OFFSET 0 5 0\n  }\n }\n}\n"
     "ROOT Prop\n{\n OFFSET 0 0 0\n CHANNELS 1 Yrotation\n}\n"
     "MOTION\nFrames: 2\nFrame Time: 0.0083333\n"
@@ -135,14 +137,16 @@ TEST(BvhWriter, WritesFileAtomically) {
   auto back = mocap::ReadBvhFile(path.string());
   ASSERT_TRUE(back.ok()) << back.error().ToString();
   ExpectSame(*file, *back);
-  const mocap::Status bad = mocap::WriteBvhFile("/nonexistent/dir/x.bvh", file->skeleton, file->motion);
+  const mocap::Status bad =
+      mocap::WriteBvhFile("/nonexistent/dir/x.bvh", file->skeleton, file->motion);
   ASSERT_FALSE(bad.ok());
   EXPECT_EQ(bad.error().code, mocap::ErrorCode::kIo);
 }
 
 TEST(BvhWriter, RealCapturesRoundTrip) {
-  for (const char* name : {"bvh/cmu_cgspeed/01_01.bvh", "bvh/bandai_namco/dataset-1_walk_normal_001.bvh",
-                           "bvh/lafan1_resolved/Geno_bind.bvh", "bvh/bvh_python/test_mocapbank.bvh"}) {
+  for (const char* name :
+       {"bvh/cmu_cgspeed/01_01.bvh", "bvh/bandai_namco/dataset-1_walk_normal_001.bvh",
+        "bvh/lafan1_resolved/Geno_bind.bvh", "bvh/bvh_python/test_mocapbank.bvh"}) {
     const auto path = testsupport::SharedDataPath(name);
     PATCHSKIN_REQUIRE_SHARED_FILE(path);
     auto file = mocap::ReadBvhFile(path.string());
