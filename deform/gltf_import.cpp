@@ -451,7 +451,9 @@ mocap::Status Converter::ReadPrimitive(int mesh, int prim, int skin, bool& compu
   auto positions = Floats(*pos_view, false);
   if (!positions.ok()) return std::move(positions).error();
   part.positions.resize(num_vertices);
-  std::memcpy(part.positions.data(), positions->data(), positions->size() * sizeof(float));
+  for (std::size_t v = 0; v < num_vertices; ++v) {
+    part.positions[v] = glm::vec3((*positions)[3 * v], (*positions)[3 * v + 1], (*positions)[3 * v + 2]);
+  }
 
   const std::uint64_t num_skin_joints = m_.skins[static_cast<std::size_t>(skin)].joints.size();
   const int sets = attribute("JOINTS_1") >= 0 || attribute("WEIGHTS_1") >= 0 ? 2 : 1;
