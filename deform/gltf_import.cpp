@@ -17,6 +17,7 @@
 
 #include <tiny_gltf.h>
 
+#include "deform/internal/gltf_build.h"
 #include "deform/internal/gltf_files.h"
 
 namespace deform {
@@ -288,7 +289,8 @@ Result<mocap::JointTransform> NodeTransform(const tinygltf::Node& n, const std::
                                             const Converter& cv, bool& dropped_shear) {
   mocap::JointTransform t;
   auto finite = [](const std::vector<double>& v) {
-    return std::all_of(v.begin(), v.end(), [](double x) { return std::isfinite(x); });
+    // Finite after conversion to float too: runtime math is in float.
+    return std::all_of(v.begin(), v.end(), [](double x) { return std::abs(x) <= std::numeric_limits<float>::max(); });
   };
   if (!n.matrix.empty()) {
     if (n.matrix.size() != 16 || !finite(n.matrix)) {
@@ -297,22 +299,7 @@ Result<mocap::JointTransform> NodeTransform(const tinygltf::Node& n, const std::
     glm::dmat4 m;
     for (int c = 0; c < 4; ++c)
       for (int r = 0; r < 4; ++r) m[c][r] = n.matrix[static_cast<std::size_t>(c * 4 + r)];
-    glm::dvec3 s(glm::length(glm::dvec3(m[0])), glm::length(glm::dvec3(m[1])), glm::length(glm::dvec3(m[2])));
-    if (glm::determinant(glm::dmat3(m)) < 0.0) s.x = -s.x;
-    glm::dmat3 r(1.0);
-    if (s.x != 0.0 && s.y != 0.0 && s.z != 0.0) r = glm::dmat3(glm::dvec3(m[0]) / s.x, glm::dvec3(m[1]) / s.y, glm::dvec3(m[2]) / s.z);
-    t.translation = glm::vec3(glm::dvec3(m[3]));
-    t.rotation = glm::normalize(glm::quat(glm::quat_cast(r)));
-    t.scale = glm::vec3(s);
-    const glm::dmat4 back(t.ToMatrix());
-    double err = 0.0, mag = 1.0;
-    for (int c = 0; c < 4; ++c)
-      for (int rr = 0; rr < 4; ++rr) {
-        err = std::max(err, std::abs(back[c][rr] - m[c][rr]));
-        mag = std::max(mag, std::abs(m[c][rr]));
-      }
-    dropped_shear = err > 1e-4 * mag;
-    return t;
+    return internal::DecomposeMatrix(m, &dropped_shear);
   }
   if (!finite(n.translation) || !finite(n.rotation) || !finite(n.scale)) {
     return cv.Fail(ErrorCode::kNonFinite, at, "non-finite translation, rotation or scale");
@@ -359,7 +346,6 @@ mocap::Status Converter::BuildSkeleton(int skin) {
   std::vector<int> stack;
   for (int r = num_nodes - 1; r >= 0; --r)
     if (parent[static_cast<std::size_t>(r)] == -1 && needed[static_cast<std::size_t>(r)]) stack.push_back(r);
-  bool dropped_shear_any = false;
   while (!stack.empty()) {
     const int n = stack.back();
     stack.pop_back();
@@ -372,7 +358,6 @@ mocap::Status Converter::BuildSkeleton(int skin) {
     if (!rest.ok()) return std::move(rest).error();
     if (dropped_shear) {
       Warn(Indexed("nodes", n) + ".matrix", "shear dropped when decomposing into translation, rotation, scale");
-      dropped_shear_any = true;
     }
     std::string name = node.name.empty() ? "node_" + std::to_string(n) : node.name;
     if (sk.FindJoint(name) >= 0) name += "_" + std::to_string(n);  // names must be unique
@@ -387,8 +372,6 @@ mocap::Status Converter::BuildSkeleton(int skin) {
     for (auto it = node.children.rbegin(); it != node.children.rend(); ++it)
       if (needed[static_cast<std::size_t>(*it)]) stack.push_back(*it);
   }
-  (void)dropped_shear_any;
-  sk.channels.assign(joint_node_.size(), {});
   sk.info.source_file = path_;
   sk.info.detected_units = "m";
   for (int j : s.joints) out_.mesh.skin_joints.push_back(node_joint_[static_cast<std::size_t>(j)]);
@@ -491,18 +474,7 @@ mocap::Status Converter::ReadPrimitive(int mesh, int prim, int skin, bool& compu
       }
     }
   }
-  int unweighted = 0;
-  for (std::size_t v = 0; v < num_vertices; ++v) {
-    float* w = part.weights.data() + v * static_cast<std::size_t>(part.influences);
-    double sum = 0.0;
-    for (int k = 0; k < part.influences; ++k) sum += w[k];
-    if (sum <= 1e-12) {
-      w[0] = 1.0f;  // bind to the first listed joint rather than collapse to the origin
-      ++unweighted;
-      continue;
-    }
-    for (int k = 0; k < part.influences; ++k) w[k] = static_cast<float>(w[k] / sum);
-  }
+  const int unweighted = internal::NormalizeWeightRows(part.weights, part.influences);
   if (unweighted > 0) {
     Warn(at + ".attributes.WEIGHTS_0",
          std::to_string(unweighted) + " vertices have zero total weight; bound to their first joint");
@@ -697,23 +669,7 @@ mocap::Status Converter::ReadAnimations() {
     }
     out_.animations.push_back(std::move(anim));
   }
-  using mocap::ChannelType;
-  static constexpr ChannelType kTypes[3][4] = {
-      {ChannelType::kXPosition, ChannelType::kYPosition, ChannelType::kZPosition, ChannelType::kZPosition},
-      {ChannelType::kQuatX, ChannelType::kQuatY, ChannelType::kQuatZ, ChannelType::kQuatW},
-      {ChannelType::kXScale, ChannelType::kYScale, ChannelType::kZScale, ChannelType::kZScale}};
-  int next = 0;
-  for (std::size_t j = 0; j < driven.size(); ++j) {
-    mocap::JointChannels& ch = sk.channels[j];
-    ch.first = static_cast<std::uint32_t>(next);
-    for (int path = 0; path < 3; ++path) {
-      if (!driven[j][static_cast<std::size_t>(path)]) continue;
-      const int width = path == 1 ? 4 : 3;
-      for (int i = 0; i < width; ++i) ch.types[ch.count++] = kTypes[path][i];
-    }
-    next += ch.count;
-  }
-  sk.num_channels = next;
+  internal::AssignChannelLayout(driven, sk);
   return mocap::Status::Ok();
 }
 
@@ -739,18 +695,7 @@ Result<GltfModel> Converter::Run(const GltfReadOptions& options, std::vector<moc
     e.loc.file = path_;
     return e;
   }
-  // Rest height: extent of the joint origins along +Y in the rest pose.
-  std::vector<mocap::JointTransform> locals(static_cast<std::size_t>(out_.skeleton.num_joints()));
-  std::vector<glm::mat4> model_from_joint(locals.size());
-  mocap::RestPose(out_.skeleton, locals);
-  (void)mocap::LocalToModelJob{.parents = out_.skeleton.parents, .locals = locals, .model_from_joint = model_from_joint}.Run();
-  float lo = 0.0f, hi = 0.0f;
-  for (std::size_t j = 0; j < model_from_joint.size(); ++j) {
-    const float y = model_from_joint[j][3].y;
-    lo = j == 0 ? y : std::min(lo, y);
-    hi = j == 0 ? y : std::max(hi, y);
-  }
-  out_.skeleton.info.rest_height = hi - lo;
+  out_.skeleton.info.rest_height = internal::RestHeight(out_.skeleton);
   return std::move(out_);
 }
 
