@@ -43,10 +43,10 @@ enum class GltfPath : std::uint8_t {
 
 // One animated property of one joint: keys of a glTF channel + sampler.
 struct GltfChannel {
-  int joint = 0;                                   // skeleton joint index
+  int joint = 0;  // skeleton joint index
   GltfPath path = GltfPath::kTranslation;
   GltfInterpolation interpolation = GltfInterpolation::kLinear;
-  std::vector<float> times_s;                      // #K key times, non-decreasing, seconds
+  std::vector<float> times_s;  // #K key times, non-decreasing, seconds
   // #K x width floats (width 3 or 4 by path) for kLinear / kStep. For
   // kCubicSpline #K x 3 x width: per key the in-tangent, the value, then the
   // out-tangent, as stored in the file. Rotation keys of kLinear/kStep are unit.
@@ -57,9 +57,9 @@ struct GltfChannel {
 };
 
 struct GltfAnimation {
-  std::string name;                  // the file's name, or "animation_<index>"
-  double duration_s = 0.0;           // last key time over all channels (glTF time starts at 0)
-  std::vector<GltfChannel> channels; // channels on nodes outside the skeleton are dropped (warning)
+  std::string name;                   // the file's name, or "animation_<index>"
+  double duration_s = 0.0;            // last key time over all channels (glTF time starts at 0)
+  std::vector<GltfChannel> channels;  // channels on nodes outside the skeleton are dropped (warning)
 };
 
 struct GltfModel {

@@ -2,9 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <vector>
-
 #include <glm/gtc/quaternion.hpp>
+#include <vector>
 
 namespace deform::internal {
 
@@ -76,7 +75,8 @@ float RestHeight(const mocap::Skeleton& skeleton) {
   std::vector<mocap::JointTransform> locals(n);
   std::vector<glm::mat4> model_from_joint(n);
   mocap::RestPose(skeleton, locals);
-  if (!mocap::LocalToModelJob{.parents = skeleton.parents, .locals = locals, .model_from_joint = model_from_joint}
+  if (!mocap::LocalToModelJob{
+          .parents = skeleton.parents, .locals = locals, .model_from_joint = model_from_joint}
            .Run()) {
     return 0.0f;
   }

@@ -4,9 +4,8 @@
 // normalization and the rest height.
 
 #include <array>
-#include <span>
-
 #include <glm/glm.hpp>
+#include <span>
 
 #include "mocap/pose.h"
 #include "mocap/skeleton.h"

@@ -3,13 +3,13 @@
 // past-the-end, huge), and the GLB form is cut at many lengths. Each load must
 // either succeed with a consistent model or return an error naming the file.
 
+#include <gtest/gtest.h>
+
 #include <cstdint>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
-
-#include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
 
 #include "deform/gltf_import.h"
 #include "support/data_paths.h"
@@ -22,7 +22,8 @@ std::string ReadText(const std::string& path) {
 }
 
 // A loaded model must be internally consistent, or the error must name the file.
-void ExpectSane(const mocap::Result<deform::GltfModel>& model, const std::string& path, const std::string& what) {
+void ExpectSane(const mocap::Result<deform::GltfModel>& model, const std::string& path,
+                const std::string& what) {
   if (!model.ok()) {
     EXPECT_EQ(model.error().loc.file, path) << what;
     EXPECT_FALSE(model.error().message.empty()) << what;
