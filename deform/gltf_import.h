@@ -78,10 +78,12 @@ struct GltfModel {
   // is its inverse bind matrix (identity when the file gives none).
   SkinnedMesh mesh;
   // Rest-pose model_from_node of the (first) skinned mesh node, through all its
-  // ancestors. Skinning ignores it (glTF rule) but exporters such as
-  // COLLADA2GLTF bake it into the inverse bind matrices, so in the rest pose
+  // ancestors. Skinning ignores it (glTF rule). Most exporters bake it into the
+  // inverse bind matrices, so that in the rest pose
   //   model_from_joint[skin_joints[s]] * joint_from_bind[s] == model_from_bind
-  // for every skin joint s: the rest pose reproduces the unskinned placement.
+  // for every skin joint s (CesiumMan; identity for SimpleSkin). Not
+  // guaranteed: the early RiggedSimple export in ../shared/data leaves its
+  // "Armature" node out of the bind matrices. Informational only.
   glm::mat4 model_from_bind{1.0f};
   std::vector<GltfAnimation> animations;  // in file order
   std::vector<mocap::Warning> warnings;   // tinygltf's warnings and ours

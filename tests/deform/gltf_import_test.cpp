@@ -186,6 +186,21 @@ INSTANTIATE_TEST_SUITE_P(SharedData, RealGltf, testing::ValuesIn(kRealModels),
                            return name;
                          });
 
+// Not only the table above: any model added to the shared folder must load.
+TEST(ReadGltf, EveryFileOfTheSharedFolderLoads) {
+  const auto folder = testsupport::SharedDataPath("gltf");
+  PATCHSKIN_REQUIRE_SHARED_FILE(folder);
+  int loaded = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(folder)) {
+    const std::string ext = entry.path().extension().string();
+    if (ext != ".gltf" && ext != ".glb") continue;
+    auto model = ReadGltf(entry.path().string());
+    EXPECT_TRUE(model.ok()) << model.error().ToString();
+    ++loaded;
+  }
+  EXPECT_GE(loaded, 3);
+}
+
 TEST(ReadGltf, CesiumManJointsSitBelowZUpAndArmature) {
   const auto path = testsupport::SharedDataPath("gltf/CesiumMan.glb");
   PATCHSKIN_REQUIRE_SHARED_FILE(path);
