@@ -230,6 +230,7 @@ constexpr BadFile kBadFiles[] = {
     {"joint_past_skin.gltf", mocap::ErrorCode::kCountMismatch, "accessors[1]"},
     {"node_cycle.gltf", mocap::ErrorCode::kSyntax, "nodes"},
     {"truncated.glb", mocap::ErrorCode::kCountMismatch, "glb header.length"},
+    {"broken_json.gltf", mocap::ErrorCode::kSyntax, ""},
 };
 
 class BadGltf : public testing::TestWithParam<BadFile> {};
@@ -242,6 +243,9 @@ TEST_P(BadGltf, GivesExpectedError) {
       << model.error().ToString();
   EXPECT_EQ(model.error().loc.file, path);
   EXPECT_EQ(model.error().loc.field_path, GetParam().field) << model.error().ToString();
+  if (std::string(GetParam().field).empty()) {  // a whole-file error comes from tinygltf
+    EXPECT_EQ(model.error().message.rfind("tinygltf: ", 0), 0u) << model.error().ToString();
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(BadFiles, BadGltf, testing::ValuesIn(kBadFiles),
