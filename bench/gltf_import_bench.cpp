@@ -4,11 +4,11 @@
 // Run: build/bench/bench/gltf_import_bench [--benchmark_filter=...]
 // The model comes from PATCHSKIN_GLTF_BENCH_FILE or ../shared/data/gltf/CesiumMan.glb.
 
+#include <benchmark/benchmark.h>
+
 #include <cstdlib>
 #include <string>
 #include <vector>
-
-#include <benchmark/benchmark.h>
 
 #include "deform/gltf_import.h"
 

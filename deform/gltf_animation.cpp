@@ -43,9 +43,10 @@ glm::dvec4 Evaluate(const GltfChannel& channel, double t) {
   if (n == 1 || t <= times.front()) return read(0, value_offset);
   if (t >= times.back()) return read(n - 1, value_offset);
   // First key strictly after t: segment [k, k+1] with times[k] <= t < times[k+1].
-  const std::size_t k1 = static_cast<std::size_t>(
-      std::upper_bound(times.begin(), times.end(), static_cast<float>(t),
-                       [](float a, float b) { return a < b; }) - times.begin());
+  const std::size_t k1 =
+      static_cast<std::size_t>(std::upper_bound(times.begin(), times.end(), static_cast<float>(t),
+                                                [](float a, float b) { return a < b; }) -
+                               times.begin());
   const std::size_t k = k1 - 1;
   const double t0 = times[k];
   const double dt = static_cast<double>(times[k1]) - t0;
@@ -59,12 +60,12 @@ glm::dvec4 Evaluate(const GltfChannel& channel, double t) {
   }
   const double s2 = s * s;
   const double s3 = s2 * s;
-  const glm::dvec4 v0 = read(k, w);          // value at k
-  const glm::dvec4 b0 = read(k, 2 * w);      // out-tangent at k
-  const glm::dvec4 a1 = read(k1, 0);         // in-tangent at k+1
-  const glm::dvec4 v1 = read(k1, w);         // value at k+1
-  glm::dvec4 p = (2 * s3 - 3 * s2 + 1) * v0 + (s3 - 2 * s2 + s) * dt * b0 +
-                 (-2 * s3 + 3 * s2) * v1 + (s3 - s2) * dt * a1;
+  const glm::dvec4 v0 = read(k, w);      // value at k
+  const glm::dvec4 b0 = read(k, 2 * w);  // out-tangent at k
+  const glm::dvec4 a1 = read(k1, 0);     // in-tangent at k+1
+  const glm::dvec4 v1 = read(k1, w);     // value at k+1
+  glm::dvec4 p = (2 * s3 - 3 * s2 + 1) * v0 + (s3 - 2 * s2 + s) * dt * b0 + (-2 * s3 + 3 * s2) * v1 +
+                 (s3 - s2) * dt * a1;
   if (rotation) {
     const double len = glm::length(p);
     p = len > 0.0 ? p / len : glm::dvec4(0.0, 0.0, 0.0, 1.0);
@@ -83,8 +84,12 @@ void SampleGltfAnimation(const GltfModel& model, int animation, double t_s,
     const glm::dvec4 v = Evaluate(channel, t_s);
     mocap::JointTransform& out = locals[static_cast<std::size_t>(channel.joint)];
     switch (channel.path) {
-      case GltfPath::kTranslation: out.translation = glm::vec3(glm::dvec3(v)); break;
-      case GltfPath::kScale: out.scale = glm::vec3(glm::dvec3(v)); break;
+      case GltfPath::kTranslation:
+        out.translation = glm::vec3(glm::dvec3(v));
+        break;
+      case GltfPath::kScale:
+        out.scale = glm::vec3(glm::dvec3(v));
+        break;
       case GltfPath::kRotation:
         out.rotation = glm::normalize(glm::quat(static_cast<float>(v.w), static_cast<float>(v.x),
                                                 static_cast<float>(v.y), static_cast<float>(v.z)));
@@ -119,8 +124,7 @@ double DetectFrameTime(const GltfAnimation& animation) {
   return 1.0 / 30.0;
 }
 
-mocap::Result<mocap::Motion> AnimationToMotion(const GltfModel& model, int animation,
-                                               double frame_time_s) {
+mocap::Result<mocap::Motion> AnimationToMotion(const GltfModel& model, int animation, double frame_time_s) {
   using mocap::ErrorCode;
   const mocap::FileLoc loc{model.skeleton.info.source_file, 0, 0, {}};
   if (animation < 0 || animation >= static_cast<int>(model.animations.size())) {
@@ -159,17 +163,38 @@ mocap::Result<mocap::Motion> AnimationToMotion(const GltfModel& model, int anima
       for (std::size_t c = 0; c < ch.count; ++c) {
         float value = 0.0f;
         switch (ch.types[c]) {
-          case mocap::ChannelType::kXPosition: value = l.translation.x; break;
-          case mocap::ChannelType::kYPosition: value = l.translation.y; break;
-          case mocap::ChannelType::kZPosition: value = l.translation.z; break;
-          case mocap::ChannelType::kQuatX: value = l.rotation.x; break;
-          case mocap::ChannelType::kQuatY: value = l.rotation.y; break;
-          case mocap::ChannelType::kQuatZ: value = l.rotation.z; break;
-          case mocap::ChannelType::kQuatW: value = l.rotation.w; break;
-          case mocap::ChannelType::kXScale: value = l.scale.x; break;
-          case mocap::ChannelType::kYScale: value = l.scale.y; break;
-          case mocap::ChannelType::kZScale: value = l.scale.z; break;
-          default: break;  // Euler channels never appear in an imported glTF skeleton
+          case mocap::ChannelType::kXPosition:
+            value = l.translation.x;
+            break;
+          case mocap::ChannelType::kYPosition:
+            value = l.translation.y;
+            break;
+          case mocap::ChannelType::kZPosition:
+            value = l.translation.z;
+            break;
+          case mocap::ChannelType::kQuatX:
+            value = l.rotation.x;
+            break;
+          case mocap::ChannelType::kQuatY:
+            value = l.rotation.y;
+            break;
+          case mocap::ChannelType::kQuatZ:
+            value = l.rotation.z;
+            break;
+          case mocap::ChannelType::kQuatW:
+            value = l.rotation.w;
+            break;
+          case mocap::ChannelType::kXScale:
+            value = l.scale.x;
+            break;
+          case mocap::ChannelType::kYScale:
+            value = l.scale.y;
+            break;
+          case mocap::ChannelType::kZScale:
+            value = l.scale.z;
+            break;
+          default:
+            break;  // Euler channels never appear in an imported glTF skeleton
         }
         row[ch.first + c] = value;
       }

@@ -8,6 +8,8 @@
 
 #include "deform/gltf_import.h"
 
+#include <tiny_gltf.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -15,18 +17,20 @@
 #include <fstream>
 #include <sstream>
 
-#include <tiny_gltf.h>
-
+#include "deform/internal/gltf_accessor.h"
+#include "deform/internal/gltf_build.h"
 #include "deform/internal/gltf_files.h"
 
 namespace deform {
 namespace {
 
 namespace fs = std::filesystem;
-using mocap::ErrorCode;
-using mocap::Result;
+using internal::AccessorView;
+using internal::ComponentBytes;
 using internal::InsideFolder;
 using internal::ReadFileBounded;
+using mocap::ErrorCode;
+using mocap::Result;
 
 // ---------------------------------------------------------------------------
 // Files and URIs.
@@ -72,8 +76,8 @@ bool RefuseWrite(std::string* err, const std::string&, const std::vector<unsigne
 }
 
 // Textures are not used: keep image bytes undecoded.
-bool SkipImage(tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*,
-               int, void*) {
+bool SkipImage(tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int,
+               void*) {
   return true;
 }
 
@@ -95,36 +99,20 @@ std::string FirstLines(const std::string& text) {
 // ---------------------------------------------------------------------------
 // Accessors.
 
-// A checked view of an accessor: every element lies inside its buffer.
-struct AccessorView {
-  int index = -1;
-  const unsigned char* data = nullptr;  // first element
-  std::size_t stride = 0;               // bytes between elements
-  std::size_t count = 0;
-  int components = 0;                   // 1 (SCALAR) .. 16 (MAT4)
-  int component_type = 0;               // TINYGLTF_COMPONENT_TYPE_*
-};
-
-int ComponentBytes(int type) {
-  switch (type) {
-    case TINYGLTF_COMPONENT_TYPE_BYTE:
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return 1;
-    case TINYGLTF_COMPONENT_TYPE_SHORT:
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return 2;
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
-    case TINYGLTF_COMPONENT_TYPE_FLOAT: return 4;
-    default: return 0;
-  }
-}
-
 const char* TypeName(int type) {
   switch (type) {
-    case TINYGLTF_TYPE_SCALAR: return "SCALAR";
-    case TINYGLTF_TYPE_VEC2: return "VEC2";
-    case TINYGLTF_TYPE_VEC3: return "VEC3";
-    case TINYGLTF_TYPE_VEC4: return "VEC4";
-    case TINYGLTF_TYPE_MAT4: return "MAT4";
-    default: return "other";
+    case TINYGLTF_TYPE_SCALAR:
+      return "SCALAR";
+    case TINYGLTF_TYPE_VEC2:
+      return "VEC2";
+    case TINYGLTF_TYPE_VEC3:
+      return "VEC3";
+    case TINYGLTF_TYPE_VEC4:
+      return "VEC4";
+    case TINYGLTF_TYPE_MAT4:
+      return "MAT4";
+    default:
+      return "other";
   }
 }
 
@@ -142,12 +130,14 @@ class Converter {
   Result<AccessorView> View(int index, const std::string& user, int type,
                             std::initializer_list<int> component_types) const {
     if (index < 0 || index >= static_cast<int>(m_.accessors.size())) {
-      return Fail(ErrorCode::kNotFound, user, "accessor index " + std::to_string(index) + " out of range (" +
-                                                  std::to_string(m_.accessors.size()) + " accessors)");
+      return Fail(ErrorCode::kNotFound, user,
+                  "accessor index " + std::to_string(index) + " out of range (" +
+                      std::to_string(m_.accessors.size()) + " accessors)");
     }
     const tinygltf::Accessor& a = m_.accessors[static_cast<std::size_t>(index)];
     const std::string at = Indexed("accessors", index);
-    if (a.sparse.isSparse) return Fail(ErrorCode::kUnsupported, at + ".sparse", "sparse accessors are not supported");
+    if (a.sparse.isSparse)
+      return Fail(ErrorCode::kUnsupported, at + ".sparse", "sparse accessors are not supported");
     if (a.type != type) {
       return Fail(ErrorCode::kUnsupported, at + ".type",
                   std::string("expected ") + TypeName(type) + " for " + user + ", found " + TypeName(a.type));
@@ -163,13 +153,15 @@ class Converter {
     const tinygltf::BufferView& bv = m_.bufferViews[static_cast<std::size_t>(a.bufferView)];
     const std::string bv_at = Indexed("bufferViews", a.bufferView);
     if (bv.buffer < 0 || bv.buffer >= static_cast<int>(m_.buffers.size())) {
-      return Fail(ErrorCode::kNotFound, bv_at + ".buffer", "buffer " + std::to_string(bv.buffer) + " out of range");
+      return Fail(ErrorCode::kNotFound, bv_at + ".buffer",
+                  "buffer " + std::to_string(bv.buffer) + " out of range");
     }
     const std::vector<unsigned char>& buffer = m_.buffers[static_cast<std::size_t>(bv.buffer)].data;
     if (bv.byteOffset > buffer.size() || bv.byteLength > buffer.size() - bv.byteOffset) {
       return Fail(ErrorCode::kCountMismatch, bv_at + ".byteLength",
-                  "view of " + std::to_string(bv.byteLength) + " bytes at offset " + std::to_string(bv.byteOffset) +
-                      " runs past the " + std::to_string(buffer.size()) + " bytes of its buffer");
+                  "view of " + std::to_string(bv.byteLength) + " bytes at offset " +
+                      std::to_string(bv.byteOffset) + " runs past the " + std::to_string(buffer.size()) +
+                      " bytes of its buffer");
     }
     const int components = tinygltf::GetNumComponentsInType(static_cast<std::uint32_t>(a.type));
     const std::size_t element = static_cast<std::size_t>(components * ComponentBytes(a.componentType));
@@ -179,9 +171,9 @@ class Converter {
                   "stride " + std::to_string(stride) + " must be in " + std::to_string(element) + "..252");
     }
     const std::size_t available = bv.byteLength;
-    const bool fits = a.byteOffset <= available && (a.count == 0 || (a.count - 1 <= available / stride &&
-                                                                     (a.count - 1) * stride + element <=
-                                                                         available - a.byteOffset));
+    const bool fits = a.byteOffset <= available &&
+                      (a.count == 0 || (a.count - 1 <= available / stride &&
+                                        (a.count - 1) * stride + element <= available - a.byteOffset));
     if (!fits) {
       return Fail(ErrorCode::kCountMismatch, at + ".count",
                   std::to_string(a.count) + " elements of " + std::to_string(element) + " bytes at offset " +
@@ -198,59 +190,12 @@ class Converter {
     return v;
   }
 
-  // Component c of element i as a double; integer types are normalized to
-  // [0,1] / [-1,1] when `normalize` (glTF's normalized-integer rule).
-  static double Component(const AccessorView& v, std::size_t i, int c, bool normalize) {
-    const unsigned char* p = v.data + i * v.stride +
-                             static_cast<std::size_t>(c * ComponentBytes(v.component_type));
-    switch (v.component_type) {
-      case TINYGLTF_COMPONENT_TYPE_FLOAT: { float f; std::memcpy(&f, p, 4); return f; }
-      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return normalize ? p[0] / 255.0 : p[0];
-      case TINYGLTF_COMPONENT_TYPE_BYTE: {
-        const auto x = static_cast<signed char>(p[0]);
-        return normalize ? std::max(x / 127.0, -1.0) : x;
-      }
-      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
-        std::uint16_t x; std::memcpy(&x, p, 2); return normalize ? x / 65535.0 : x;
-      }
-      case TINYGLTF_COMPONENT_TYPE_SHORT: {
-        std::int16_t x; std::memcpy(&x, p, 2); return normalize ? std::max(x / 32767.0, -1.0) : x;
-      }
-      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: { std::uint32_t x; std::memcpy(&x, p, 4); return x; }
-      default: return 0.0;
-    }
-  }
-
-  // All components as floats, rejecting NaN and infinity.
   Result<std::vector<float>> Floats(const AccessorView& v, bool normalize) const {
-    std::vector<float> out(v.count * static_cast<std::size_t>(v.components));
-    for (std::size_t i = 0; i < v.count; ++i) {
-      for (int c = 0; c < v.components; ++c) {
-        const double x = Component(v, i, c, normalize);
-        if (!std::isfinite(x)) {
-          return Fail(ErrorCode::kNonFinite, Indexed("accessors", v.index),
-                      "non-finite value at element " + std::to_string(i) + ", component " + std::to_string(c));
-        }
-        out[i * static_cast<std::size_t>(v.components) + static_cast<std::size_t>(c)] = static_cast<float>(x);
-      }
-    }
-    return out;
+    return internal::ReadFloats(v, normalize, path_);
   }
-
-  // All components as unsigned integers below `limit`; `what` names them in errors.
-  Result<std::vector<std::uint32_t>> Uints(const AccessorView& v, std::uint64_t limit, const std::string& what) const {
-    std::vector<std::uint32_t> out(v.count * static_cast<std::size_t>(v.components));
-    for (std::size_t i = 0; i < out.size(); ++i) {
-      const std::size_t e = i / static_cast<std::size_t>(v.components);
-      const auto x = static_cast<std::uint32_t>(Component(v, e, static_cast<int>(i % static_cast<std::size_t>(v.components)), false));
-      if (x >= limit) {
-        return Fail(ErrorCode::kCountMismatch, Indexed("accessors", v.index),
-                    what + " " + std::to_string(x) + " at element " + std::to_string(e) + " past the " +
-                        std::to_string(limit) + " " + (what == "joint index" ? "joints of the skin" : "vertices"));
-      }
-      out[i] = x;
-    }
-    return out;
+  Result<std::vector<std::uint32_t>> Uints(const AccessorView& v, std::uint64_t limit,
+                                           const std::string& what) const {
+    return internal::ReadUints(v, limit, what, path_);
   }
 
   Result<GltfModel> Run(const GltfReadOptions& options, std::vector<mocap::Warning> warnings);
@@ -288,7 +233,9 @@ Result<mocap::JointTransform> NodeTransform(const tinygltf::Node& n, const std::
                                             const Converter& cv, bool& dropped_shear) {
   mocap::JointTransform t;
   auto finite = [](const std::vector<double>& v) {
-    return std::all_of(v.begin(), v.end(), [](double x) { return std::isfinite(x); });
+    // Finite after conversion to float too: runtime math is in float.
+    return std::all_of(v.begin(), v.end(),
+                       [](double x) { return std::abs(x) <= std::numeric_limits<float>::max(); });
   };
   if (!n.matrix.empty()) {
     if (n.matrix.size() != 16 || !finite(n.matrix)) {
@@ -297,27 +244,13 @@ Result<mocap::JointTransform> NodeTransform(const tinygltf::Node& n, const std::
     glm::dmat4 m;
     for (int c = 0; c < 4; ++c)
       for (int r = 0; r < 4; ++r) m[c][r] = n.matrix[static_cast<std::size_t>(c * 4 + r)];
-    glm::dvec3 s(glm::length(glm::dvec3(m[0])), glm::length(glm::dvec3(m[1])), glm::length(glm::dvec3(m[2])));
-    if (glm::determinant(glm::dmat3(m)) < 0.0) s.x = -s.x;
-    glm::dmat3 r(1.0);
-    if (s.x != 0.0 && s.y != 0.0 && s.z != 0.0) r = glm::dmat3(glm::dvec3(m[0]) / s.x, glm::dvec3(m[1]) / s.y, glm::dvec3(m[2]) / s.z);
-    t.translation = glm::vec3(glm::dvec3(m[3]));
-    t.rotation = glm::normalize(glm::quat(glm::quat_cast(r)));
-    t.scale = glm::vec3(s);
-    const glm::dmat4 back(t.ToMatrix());
-    double err = 0.0, mag = 1.0;
-    for (int c = 0; c < 4; ++c)
-      for (int rr = 0; rr < 4; ++rr) {
-        err = std::max(err, std::abs(back[c][rr] - m[c][rr]));
-        mag = std::max(mag, std::abs(m[c][rr]));
-      }
-    dropped_shear = err > 1e-4 * mag;
-    return t;
+    return internal::DecomposeMatrix(m, &dropped_shear);
   }
   if (!finite(n.translation) || !finite(n.rotation) || !finite(n.scale)) {
     return cv.Fail(ErrorCode::kNonFinite, at, "non-finite translation, rotation or scale");
   }
-  if (n.translation.size() == 3) t.translation = glm::vec3(glm::dvec3(n.translation[0], n.translation[1], n.translation[2]));
+  if (n.translation.size() == 3)
+    t.translation = glm::vec3(glm::dvec3(n.translation[0], n.translation[1], n.translation[2]));
   if (n.scale.size() == 3) t.scale = glm::vec3(glm::dvec3(n.scale[0], n.scale[1], n.scale[2]));
   if (n.rotation.size() == 4) {
     const glm::dquat q(n.rotation[3], n.rotation[0], n.rotation[1], n.rotation[2]);
@@ -333,9 +266,11 @@ mocap::Status Converter::BuildSkeleton(int skin) {
   for (int n = 0; n < num_nodes; ++n) {
     for (int c : m_.nodes[static_cast<std::size_t>(n)].children) {
       const std::string at = Indexed("nodes", n) + ".children";
-      if (c < 0 || c >= num_nodes) return Fail(ErrorCode::kNotFound, at, "child " + std::to_string(c) + " out of range");
+      if (c < 0 || c >= num_nodes)
+        return Fail(ErrorCode::kNotFound, at, "child " + std::to_string(c) + " out of range");
       if (c == n || parent[static_cast<std::size_t>(c)] != -1) {
-        return Fail(ErrorCode::kSyntax, at, "node " + std::to_string(c) + " has more than one parent (or is its own)");
+        return Fail(ErrorCode::kSyntax, at,
+                    "node " + std::to_string(c) + " has more than one parent (or is its own)");
       }
       parent[static_cast<std::size_t>(c)] = n;
     }
@@ -359,20 +294,20 @@ mocap::Status Converter::BuildSkeleton(int skin) {
   std::vector<int> stack;
   for (int r = num_nodes - 1; r >= 0; --r)
     if (parent[static_cast<std::size_t>(r)] == -1 && needed[static_cast<std::size_t>(r)]) stack.push_back(r);
-  bool dropped_shear_any = false;
   while (!stack.empty()) {
     const int n = stack.back();
     stack.pop_back();
     if (static_cast<int>(joint_node_.size()) >= mocap::kMaxJoints) {
-      return Fail(ErrorCode::kLimitExceeded, "nodes", "more than " + std::to_string(mocap::kMaxJoints) + " joints");
+      return Fail(ErrorCode::kLimitExceeded, "nodes",
+                  "more than " + std::to_string(mocap::kMaxJoints) + " joints");
     }
     const tinygltf::Node& node = m_.nodes[static_cast<std::size_t>(n)];
     bool dropped_shear = false;
     auto rest = NodeTransform(node, Indexed("nodes", n), *this, dropped_shear);
     if (!rest.ok()) return std::move(rest).error();
     if (dropped_shear) {
-      Warn(Indexed("nodes", n) + ".matrix", "shear dropped when decomposing into translation, rotation, scale");
-      dropped_shear_any = true;
+      Warn(Indexed("nodes", n) + ".matrix",
+           "shear dropped when decomposing into translation, rotation, scale");
     }
     std::string name = node.name.empty() ? "node_" + std::to_string(n) : node.name;
     if (sk.FindJoint(name) >= 0) name += "_" + std::to_string(n);  // names must be unique
@@ -380,15 +315,14 @@ mocap::Status Converter::BuildSkeleton(int skin) {
     node_joint_[static_cast<std::size_t>(n)] = static_cast<int>(joint_node_.size());
     joint_node_.push_back(n);
     const int p = parent[static_cast<std::size_t>(n)];
-    sk.parents.push_back(static_cast<std::int16_t>(p == -1 ? mocap::kNoParent : node_joint_[static_cast<std::size_t>(p)]));
+    sk.parents.push_back(
+        static_cast<std::int16_t>(p == -1 ? mocap::kNoParent : node_joint_[static_cast<std::size_t>(p)]));
     sk.rest_translations.push_back(rest->translation);
     sk.rest_rotations.push_back(rest->rotation);
     sk.rest_scales.push_back(rest->scale);
     for (auto it = node.children.rbegin(); it != node.children.rend(); ++it)
       if (needed[static_cast<std::size_t>(*it)]) stack.push_back(*it);
   }
-  (void)dropped_shear_any;
-  sk.channels.assign(joint_node_.size(), {});
   sk.info.source_file = path_;
   sk.info.detected_units = "m";
   for (int j : s.joints) out_.mesh.skin_joints.push_back(node_joint_[static_cast<std::size_t>(j)]);
@@ -412,12 +346,14 @@ mocap::Status Converter::ReadSkin(int skin) {
   if (!values.ok()) return std::move(values).error();
   for (std::size_t k = 0; k < n; ++k)
     for (int c = 0; c < 4; ++c)
-      for (int r = 0; r < 4; ++r) out_.mesh.joint_from_bind[k][c][r] = (*values)[k * 16 + static_cast<std::size_t>(c * 4 + r)];
+      for (int r = 0; r < 4; ++r)
+        out_.mesh.joint_from_bind[k][c][r] = (*values)[k * 16 + static_cast<std::size_t>(c * 4 + r)];
   return mocap::Status::Ok();
 }
 
 mocap::Status Converter::ReadPrimitive(int mesh, int prim, int skin, bool& computed_normals) {
-  const tinygltf::Primitive& p = m_.meshes[static_cast<std::size_t>(mesh)].primitives[static_cast<std::size_t>(prim)];
+  const tinygltf::Primitive& p =
+      m_.meshes[static_cast<std::size_t>(mesh)].primitives[static_cast<std::size_t>(prim)];
   const std::string at = Indexed("meshes", mesh) + ".primitives[" + std::to_string(prim) + "]";
   if (p.mode != TINYGLTF_MODE_TRIANGLES) {
     Warn(at + ".mode", "only triangle lists are imported; primitive skipped");
@@ -430,11 +366,13 @@ mocap::Status Converter::ReadPrimitive(int mesh, int prim, int skin, bool& compu
   };
   const int position_index = attribute("POSITION");
   if (position_index < 0) return Fail(ErrorCode::kNotFound, at + ".attributes.POSITION", "missing");
-  auto pos_view = View(position_index, at + ".attributes.POSITION", TINYGLTF_TYPE_VEC3, {TINYGLTF_COMPONENT_TYPE_FLOAT});
+  auto pos_view =
+      View(position_index, at + ".attributes.POSITION", TINYGLTF_TYPE_VEC3, {TINYGLTF_COMPONENT_TYPE_FLOAT});
   if (!pos_view.ok()) return std::move(pos_view).error();
   const std::size_t num_vertices = pos_view->count;
   if (num_vertices >= std::numeric_limits<std::uint32_t>::max()) {
-    return Fail(ErrorCode::kLimitExceeded, Indexed("accessors", position_index) + ".count", "too many vertices");
+    return Fail(ErrorCode::kLimitExceeded, Indexed("accessors", position_index) + ".count",
+                "too many vertices");
   }
   // An attribute accessor with exactly one element per vertex.
   auto vertex_view = [&](int index, const std::string& name, int type,
@@ -442,8 +380,8 @@ mocap::Status Converter::ReadPrimitive(int mesh, int prim, int skin, bool& compu
     auto v = View(index, at + ".attributes." + name, type, types);
     if (v.ok() && v->count != num_vertices) {
       return Fail(ErrorCode::kCountMismatch, Indexed("accessors", index) + ".count",
-                  "expected " + std::to_string(num_vertices) + " (the POSITION count) for " + name + ", found " +
-                      std::to_string(v->count));
+                  "expected " + std::to_string(num_vertices) + " (the POSITION count) for " + name +
+                      ", found " + std::to_string(v->count));
     }
     return v;
   };
@@ -451,7 +389,9 @@ mocap::Status Converter::ReadPrimitive(int mesh, int prim, int skin, bool& compu
   auto positions = Floats(*pos_view, false);
   if (!positions.ok()) return std::move(positions).error();
   part.positions.resize(num_vertices);
-  std::memcpy(part.positions.data(), positions->data(), positions->size() * sizeof(float));
+  for (std::size_t v = 0; v < num_vertices; ++v) {
+    part.positions[v] = glm::vec3((*positions)[3 * v], (*positions)[3 * v + 1], (*positions)[3 * v + 2]);
+  }
 
   const std::uint64_t num_skin_joints = m_.skins[static_cast<std::size_t>(skin)].joints.size();
   const int sets = attribute("JOINTS_1") >= 0 || attribute("WEIGHTS_1") >= 0 ? 2 : 1;
@@ -463,8 +403,10 @@ mocap::Status Converter::ReadPrimitive(int mesh, int prim, int skin, bool& compu
     const std::string wname = "WEIGHTS_" + std::to_string(set);
     const int ji = attribute(jname.c_str());
     const int wi = attribute(wname.c_str());
-    if (ji < 0) return Fail(ErrorCode::kNotFound, at + ".attributes." + jname, "missing (needed by a skinned mesh)");
-    if (wi < 0) return Fail(ErrorCode::kNotFound, at + ".attributes." + wname, "missing (needed by a skinned mesh)");
+    if (ji < 0)
+      return Fail(ErrorCode::kNotFound, at + ".attributes." + jname, "missing (needed by a skinned mesh)");
+    if (wi < 0)
+      return Fail(ErrorCode::kNotFound, at + ".attributes." + wname, "missing (needed by a skinned mesh)");
     auto jv = vertex_view(ji, jname, TINYGLTF_TYPE_VEC4,
                           {TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT});
     if (!jv.ok()) return std::move(jv).error();
@@ -483,24 +425,14 @@ mocap::Status Converter::ReadPrimitive(int mesh, int prim, int skin, bool& compu
           return Fail(ErrorCode::kBadNumber, Indexed("accessors", wi),
                       "negative weight " + std::to_string(w) + " at vertex " + std::to_string(v));
         }
-        const std::size_t slot = v * static_cast<std::size_t>(part.influences) + static_cast<std::size_t>(set * 4) + k;
+        const std::size_t slot =
+            v * static_cast<std::size_t>(part.influences) + static_cast<std::size_t>(set * 4) + k;
         part.joints[slot] = (*joints)[v * 4 + k];
         part.weights[slot] = std::max(w, 0.0f);
       }
     }
   }
-  int unweighted = 0;
-  for (std::size_t v = 0; v < num_vertices; ++v) {
-    float* w = part.weights.data() + v * static_cast<std::size_t>(part.influences);
-    double sum = 0.0;
-    for (int k = 0; k < part.influences; ++k) sum += w[k];
-    if (sum <= 1e-12) {
-      w[0] = 1.0f;  // bind to the first listed joint rather than collapse to the origin
-      ++unweighted;
-      continue;
-    }
-    for (int k = 0; k < part.influences; ++k) w[k] = static_cast<float>(w[k] / sum);
-  }
+  const int unweighted = internal::NormalizeWeightRows(part.weights, part.influences);
   if (unweighted > 0) {
     Warn(at + ".attributes.WEIGHTS_0",
          std::to_string(unweighted) + " vertices have zero total weight; bound to their first joint");
@@ -521,11 +453,13 @@ mocap::Status Converter::ReadPrimitive(int mesh, int prim, int skin, bool& compu
     for (std::size_t i = 0; i < num_vertices; ++i) indices[i] = static_cast<std::uint32_t>(i);
   }
   if (indices.size() % 3 != 0) {
-    return Fail(ErrorCode::kCountMismatch,
-                index_accessor >= 0 ? Indexed("accessors", index_accessor) + ".count" : at + ".attributes.POSITION",
-                "a triangle list needs a multiple of 3 indices, found " + std::to_string(indices.size()));
+    return Fail(
+        ErrorCode::kCountMismatch,
+        index_accessor >= 0 ? Indexed("accessors", index_accessor) + ".count" : at + ".attributes.POSITION",
+        "a triangle list needs a multiple of 3 indices, found " + std::to_string(indices.size()));
   }
-  for (std::size_t i = 0; i < indices.size(); i += 3) part.triangles.emplace_back(indices[i], indices[i + 1], indices[i + 2]);
+  for (std::size_t i = 0; i < indices.size(); i += 3)
+    part.triangles.emplace_back(indices[i], indices[i + 1], indices[i + 2]);
 
   const int normal_index = attribute("NORMAL");
   part.normals.resize(num_vertices);
@@ -552,9 +486,11 @@ Result<glm::mat4> Converter::RestWorld(int node) const {
   glm::mat4 world(1.0f);
   int steps = 0;
   for (int n = node; n != -1; n = parent_[static_cast<std::size_t>(n)]) {
-    if (++steps > static_cast<int>(m_.nodes.size())) return Fail(ErrorCode::kSyntax, "nodes", "the node hierarchy has a cycle");
+    if (++steps > static_cast<int>(m_.nodes.size()))
+      return Fail(ErrorCode::kSyntax, "nodes", "the node hierarchy has a cycle");
     bool dropped_shear = false;
-    auto local = NodeTransform(m_.nodes[static_cast<std::size_t>(n)], Indexed("nodes", n), *this, dropped_shear);
+    auto local =
+        NodeTransform(m_.nodes[static_cast<std::size_t>(n)], Indexed("nodes", n), *this, dropped_shear);
     if (!local.ok()) return std::move(local).error();
     world = local->ToMatrix() * world;
   }
@@ -593,7 +529,8 @@ mocap::Status Converter::ReadMeshes(int skin) {
     }
   }
   if (parts_.empty()) {
-    return Fail(ErrorCode::kNotFound, Indexed("skins", skin), "no triangle primitive of a node uses this skin");
+    return Fail(ErrorCode::kNotFound, Indexed("skins", skin),
+                "no triangle primitive of a node uses this skin");
   }
   if (computed_normals) Warn("", "some primitives have no NORMAL; normals were computed");
   int influences = 4;
@@ -612,7 +549,8 @@ mocap::Status Converter::ReadMeshes(int skin) {
       for (int k = 0; k < influences; ++k) {
         const bool present = k < part.influences;
         const std::size_t src = v * static_cast<std::size_t>(part.influences) + static_cast<std::size_t>(k);
-        mesh.weights.joints.push_back(present ? static_cast<std::uint16_t>(part.joints[src]) : std::uint16_t{0});
+        mesh.weights.joints.push_back(present ? static_cast<std::uint16_t>(part.joints[src])
+                                              : std::uint16_t{0});
         mesh.weights.weights.push_back(present ? part.weights[src] : 0.0f);
       }
     }
@@ -633,36 +571,54 @@ mocap::Status Converter::ReadAnimations() {
       const tinygltf::AnimationChannel& ch = src.channels[c];
       const std::string cat = at + ".channels[" + std::to_string(c) + "]";
       if (ch.sampler < 0 || ch.sampler >= static_cast<int>(src.samplers.size())) {
-        return Fail(ErrorCode::kNotFound, cat + ".sampler", "sampler " + std::to_string(ch.sampler) + " out of range");
+        return Fail(ErrorCode::kNotFound, cat + ".sampler",
+                    "sampler " + std::to_string(ch.sampler) + " out of range");
       }
       if (ch.target_node < 0 || ch.target_node >= static_cast<int>(m_.nodes.size())) {
-        return Fail(ErrorCode::kNotFound, cat + ".target.node", "node " + std::to_string(ch.target_node) + " out of range");
+        return Fail(ErrorCode::kNotFound, cat + ".target.node",
+                    "node " + std::to_string(ch.target_node) + " out of range");
       }
       GltfChannel out;
-      if (ch.target_path == "translation") out.path = GltfPath::kTranslation;
-      else if (ch.target_path == "rotation") out.path = GltfPath::kRotation;
-      else if (ch.target_path == "scale") out.path = GltfPath::kScale;
-      else { Warn(cat + ".target.path", "'" + ch.target_path + "' is not imported"); continue; }
+      if (ch.target_path == "translation")
+        out.path = GltfPath::kTranslation;
+      else if (ch.target_path == "rotation")
+        out.path = GltfPath::kRotation;
+      else if (ch.target_path == "scale")
+        out.path = GltfPath::kScale;
+      else {
+        Warn(cat + ".target.path", "'" + ch.target_path + "' is not imported");
+        continue;
+      }
       out.joint = node_joint_[static_cast<std::size_t>(ch.target_node)];
-      if (out.joint < 0) { Warn(cat + ".target.node", "node is not part of the skeleton; channel ignored"); continue; }
+      if (out.joint < 0) {
+        Warn(cat + ".target.node", "node is not part of the skeleton; channel ignored");
+        continue;
+      }
       const tinygltf::AnimationSampler& s = src.samplers[static_cast<std::size_t>(ch.sampler)];
       const std::string sat = at + ".samplers[" + std::to_string(ch.sampler) + "]";
-      if (s.interpolation == "LINEAR" || s.interpolation.empty()) out.interpolation = GltfInterpolation::kLinear;
-      else if (s.interpolation == "STEP") out.interpolation = GltfInterpolation::kStep;
-      else if (s.interpolation == "CUBICSPLINE") out.interpolation = GltfInterpolation::kCubicSpline;
-      else return Fail(ErrorCode::kUnsupported, sat + ".interpolation", "unknown interpolation '" + s.interpolation + "'");
+      if (s.interpolation == "LINEAR" || s.interpolation.empty())
+        out.interpolation = GltfInterpolation::kLinear;
+      else if (s.interpolation == "STEP")
+        out.interpolation = GltfInterpolation::kStep;
+      else if (s.interpolation == "CUBICSPLINE")
+        out.interpolation = GltfInterpolation::kCubicSpline;
+      else
+        return Fail(ErrorCode::kUnsupported, sat + ".interpolation",
+                    "unknown interpolation '" + s.interpolation + "'");
       auto in_view = View(s.input, sat + ".input", TINYGLTF_TYPE_SCALAR, {TINYGLTF_COMPONENT_TYPE_FLOAT});
       if (!in_view.ok()) return std::move(in_view).error();
       const bool rotation = out.path == GltfPath::kRotation;
-      auto out_view = rotation ? View(s.output, sat + ".output", TINYGLTF_TYPE_VEC4,
-                                      {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_BYTE,
-                                       TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_SHORT,
-                                       TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT})
-                               : View(s.output, sat + ".output", TINYGLTF_TYPE_VEC3, {TINYGLTF_COMPONENT_TYPE_FLOAT});
+      auto out_view =
+          rotation ? View(s.output, sat + ".output", TINYGLTF_TYPE_VEC4,
+                          {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_BYTE,
+                           TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_SHORT,
+                           TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT})
+                   : View(s.output, sat + ".output", TINYGLTF_TYPE_VEC3, {TINYGLTF_COMPONENT_TYPE_FLOAT});
       if (!out_view.ok()) return std::move(out_view).error();
       const std::size_t keys = in_view->count;
       const std::size_t per_key = out.interpolation == GltfInterpolation::kCubicSpline ? 3 : 1;
-      if (keys == 0) return Fail(ErrorCode::kCountMismatch, Indexed("accessors", s.input) + ".count", "no keys");
+      if (keys == 0)
+        return Fail(ErrorCode::kCountMismatch, Indexed("accessors", s.input) + ".count", "no keys");
       if (out_view->count != keys * per_key) {
         return Fail(ErrorCode::kCountMismatch, Indexed("accessors", s.output) + ".count",
                     "expected " + std::to_string(keys * per_key) + " outputs for " + std::to_string(keys) +
@@ -685,7 +641,9 @@ mocap::Status Converter::ReadAnimations() {
         for (std::size_t k = 0; k < keys; ++k) {
           float* q = out.values.data() + k * 4;
           const float len = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
-          if (len < 1e-6f) return Fail(ErrorCode::kBadNumber, Indexed("accessors", s.output), "zero quaternion at key " + std::to_string(k));
+          if (len < 1e-6f)
+            return Fail(ErrorCode::kBadNumber, Indexed("accessors", s.output),
+                        "zero quaternion at key " + std::to_string(k));
           for (int i = 0; i < 4; ++i) q[i] /= len;
         }
       }
@@ -695,23 +653,7 @@ mocap::Status Converter::ReadAnimations() {
     }
     out_.animations.push_back(std::move(anim));
   }
-  using mocap::ChannelType;
-  static constexpr ChannelType kTypes[3][4] = {
-      {ChannelType::kXPosition, ChannelType::kYPosition, ChannelType::kZPosition, ChannelType::kZPosition},
-      {ChannelType::kQuatX, ChannelType::kQuatY, ChannelType::kQuatZ, ChannelType::kQuatW},
-      {ChannelType::kXScale, ChannelType::kYScale, ChannelType::kZScale, ChannelType::kZScale}};
-  int next = 0;
-  for (std::size_t j = 0; j < driven.size(); ++j) {
-    mocap::JointChannels& ch = sk.channels[j];
-    ch.first = static_cast<std::uint32_t>(next);
-    for (int path = 0; path < 3; ++path) {
-      if (!driven[j][static_cast<std::size_t>(path)]) continue;
-      const int width = path == 1 ? 4 : 3;
-      for (int i = 0; i < width; ++i) ch.types[ch.count++] = kTypes[path][i];
-    }
-    next += ch.count;
-  }
-  sk.num_channels = next;
+  internal::AssignChannelLayout(driven, sk);
   return mocap::Status::Ok();
 }
 
@@ -719,13 +661,15 @@ Result<GltfModel> Converter::Run(const GltfReadOptions& options, std::vector<moc
   out_.warnings = std::move(warnings);
   for (const std::string& ext : m_.extensionsRequired) {
     if (ext.rfind("KHR_materials_", 0) != 0 && ext.rfind("KHR_texture_", 0) != 0) {
-      return Fail(ErrorCode::kUnsupported, "extensionsRequired", "required extension '" + ext + "' is not supported");
+      return Fail(ErrorCode::kUnsupported, "extensionsRequired",
+                  "required extension '" + ext + "' is not supported");
     }
   }
   if (m_.skins.empty()) return Fail(ErrorCode::kNotFound, "skins", "the file has no skin");
   if (options.skin < 0 || options.skin >= static_cast<int>(m_.skins.size())) {
-    return Fail(ErrorCode::kInvalidArgument, "skins", "skin " + std::to_string(options.skin) + " requested, the file has " +
-                                                          std::to_string(m_.skins.size()));
+    return Fail(ErrorCode::kInvalidArgument, "skins",
+                "skin " + std::to_string(options.skin) + " requested, the file has " +
+                    std::to_string(m_.skins.size()));
   }
   if (auto st = BuildSkeleton(options.skin); !st) return st.error();
   if (auto st = ReadSkin(options.skin); !st) return st.error();
@@ -737,27 +681,17 @@ Result<GltfModel> Converter::Run(const GltfReadOptions& options, std::vector<moc
     e.loc.file = path_;
     return e;
   }
-  // Rest height: extent of the joint origins along +Y in the rest pose.
-  std::vector<mocap::JointTransform> locals(static_cast<std::size_t>(out_.skeleton.num_joints()));
-  std::vector<glm::mat4> model_from_joint(locals.size());
-  mocap::RestPose(out_.skeleton, locals);
-  (void)mocap::LocalToModelJob{.parents = out_.skeleton.parents, .locals = locals, .model_from_joint = model_from_joint}.Run();
-  float lo = 0.0f, hi = 0.0f;
-  for (std::size_t j = 0; j < model_from_joint.size(); ++j) {
-    const float y = model_from_joint[j][3].y;
-    lo = j == 0 ? y : std::min(lo, y);
-    hi = j == 0 ? y : std::max(hi, y);
-  }
-  out_.skeleton.info.rest_height = hi - lo;
+  out_.skeleton.info.rest_height = internal::RestHeight(out_.skeleton);
   return std::move(out_);
 }
 
-Result<GltfModel> ConvertGltf(const tinygltf::Model& model, const std::string& path, const GltfReadOptions& options,
-                              std::vector<mocap::Warning> warnings) {
+Result<GltfModel> ConvertGltf(const tinygltf::Model& model, const std::string& path,
+                              const GltfReadOptions& options, std::vector<mocap::Warning> warnings) {
   try {
     return Converter(model, path).Run(options, std::move(warnings));
   } catch (const std::exception& e) {
-    return mocap::MakeError(ErrorCode::kInternal, mocap::FileLoc{path, 0, 0, {}}, std::string("unexpected exception: ") + e.what());
+    return mocap::MakeError(ErrorCode::kInternal, mocap::FileLoc{path, 0, 0, {}},
+                            std::string("unexpected exception: ") + e.what());
   }
 }
 }  // namespace
@@ -777,7 +711,8 @@ Result<GltfModel> ReadGltf(const std::string& path, const GltfReadOptions& optio
   }
   if (mocap::Status uris = internal::CheckUris(path, json_text); !uris) return uris.error();
   if (data.size() > std::numeric_limits<unsigned int>::max()) {
-    return mocap::MakeError(ErrorCode::kLimitExceeded, mocap::FileLoc{path, 0, 0, {}}, "file larger than 4 GiB");
+    return mocap::MakeError(ErrorCode::kLimitExceeded, mocap::FileLoc{path, 0, 0, {}},
+                            "file larger than 4 GiB");
   }
 
   FsContext fs_context;
@@ -803,14 +738,15 @@ Result<GltfModel> ReadGltf(const std::string& path, const GltfReadOptions& optio
                                           static_cast<unsigned int>(json_text.size()), base_dir);
     }
   } catch (const std::exception& e) {
-    return mocap::MakeError(ErrorCode::kSyntax, mocap::FileLoc{path, 0, 0, {}}, std::string("tinygltf: ") + e.what());
+    return mocap::MakeError(ErrorCode::kSyntax, mocap::FileLoc{path, 0, 0, {}},
+                            std::string("tinygltf: ") + e.what());
   }
   std::vector<mocap::Warning> warnings;
   AddLines(path, warn, warnings);
   if (!fs_context.rejected.empty()) {
-    return mocap::MakeError(ErrorCode::kUnsupported, mocap::FileLoc{path, 0, 0, {}},
-                            "refused to read '" + fs_context.rejected +
-                                "': it resolves outside the model's folder");
+    return mocap::MakeError(
+        ErrorCode::kUnsupported, mocap::FileLoc{path, 0, 0, {}},
+        "refused to read '" + fs_context.rejected + "': it resolves outside the model's folder");
   }
   if (!loaded) {
     return mocap::MakeError(ErrorCode::kSyntax, mocap::FileLoc{path, 0, 0, {}},

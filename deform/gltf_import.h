@@ -43,10 +43,10 @@ enum class GltfPath : std::uint8_t {
 
 // One animated property of one joint: keys of a glTF channel + sampler.
 struct GltfChannel {
-  int joint = 0;                                   // skeleton joint index
+  int joint = 0;  // skeleton joint index
   GltfPath path = GltfPath::kTranslation;
   GltfInterpolation interpolation = GltfInterpolation::kLinear;
-  std::vector<float> times_s;                      // #K key times, non-decreasing, seconds
+  std::vector<float> times_s;  // #K key times, non-decreasing, seconds
   // #K x width floats (width 3 or 4 by path) for kLinear / kStep. For
   // kCubicSpline #K x 3 x width: per key the in-tangent, the value, then the
   // out-tangent, as stored in the file. Rotation keys of kLinear/kStep are unit.
@@ -57,9 +57,9 @@ struct GltfChannel {
 };
 
 struct GltfAnimation {
-  std::string name;                  // the file's name, or "animation_<index>"
-  double duration_s = 0.0;           // last key time over all channels (glTF time starts at 0)
-  std::vector<GltfChannel> channels; // channels on nodes outside the skeleton are dropped (warning)
+  std::string name;                   // the file's name, or "animation_<index>"
+  double duration_s = 0.0;            // last key time over all channels (glTF time starts at 0)
+  std::vector<GltfChannel> channels;  // channels on nodes outside the skeleton are dropped (warning)
 };
 
 struct GltfModel {
@@ -78,10 +78,12 @@ struct GltfModel {
   // is its inverse bind matrix (identity when the file gives none).
   SkinnedMesh mesh;
   // Rest-pose model_from_node of the (first) skinned mesh node, through all its
-  // ancestors. Skinning ignores it (glTF rule) but exporters such as
-  // COLLADA2GLTF bake it into the inverse bind matrices, so in the rest pose
+  // ancestors. Skinning ignores it (glTF rule). Most exporters bake it into the
+  // inverse bind matrices, so that in the rest pose
   //   model_from_joint[skin_joints[s]] * joint_from_bind[s] == model_from_bind
-  // for every skin joint s: the rest pose reproduces the unskinned placement.
+  // for every skin joint s (CesiumMan; identity for SimpleSkin). Not
+  // guaranteed: the early RiggedSimple export in ../shared/data leaves its
+  // "Armature" node out of the bind matrices. Informational only.
   glm::mat4 model_from_bind{1.0f};
   std::vector<GltfAnimation> animations;  // in file order
   std::vector<mocap::Warning> warnings;   // tinygltf's warnings and ours

@@ -3,7 +3,6 @@
 #include <cctype>
 #include <cstdint>
 #include <fstream>
-
 #include <nlohmann/json.hpp>
 
 namespace deform::internal {
@@ -15,11 +14,13 @@ using mocap::Result;
 Result<std::vector<unsigned char>> ReadFileBounded(const std::string& path, std::size_t max_bytes) {
   std::error_code ec;
   const auto size = fs::file_size(path, ec);
-  if (ec) return mocap::MakeError(ErrorCode::kIo, mocap::FileLoc{path, 0, 0, {}}, "cannot open file: " + ec.message());
+  if (ec)
+    return mocap::MakeError(ErrorCode::kIo, mocap::FileLoc{path, 0, 0, {}},
+                            "cannot open file: " + ec.message());
   if (size > max_bytes) {
-    return mocap::MakeError(ErrorCode::kLimitExceeded, mocap::FileLoc{path, 0, 0, {}},
-                            "file has " + std::to_string(size) + " bytes, more than the limit of " +
-                                std::to_string(max_bytes));
+    return mocap::MakeError(
+        ErrorCode::kLimitExceeded, mocap::FileLoc{path, 0, 0, {}},
+        "file has " + std::to_string(size) + " bytes, more than the limit of " + std::to_string(max_bytes));
   }
   std::ifstream in(path, std::ios::binary);
   if (!in) return mocap::MakeError(ErrorCode::kIo, mocap::FileLoc{path, 0, 0, {}}, "cannot open file");
@@ -99,8 +100,8 @@ Result<std::string> GlbJson(const std::string& path, const std::vector<unsigned 
                             "expected GLB version 2, found " + std::to_string(version));
   }
   if (length != bytes.size()) {
-    return fail("glb header.length", "header declares " + std::to_string(length) +
-                                         " bytes, file has " + std::to_string(bytes.size()) +
+    return fail("glb header.length", "header declares " + std::to_string(length) + " bytes, file has " +
+                                         std::to_string(bytes.size()) +
                                          (length > bytes.size() ? " (truncated file)" : ""));
   }
   const std::uint32_t json_length = ReadU32(bytes.data() + 12);
@@ -109,16 +110,16 @@ Result<std::string> GlbJson(const std::string& path, const std::vector<unsigned 
                             "expected the JSON chunk first");
   }
   if (json_length > bytes.size() - 20) {
-    return fail("glb chunks[0].length", "JSON chunk of " + std::to_string(json_length) +
-                                            " bytes runs past the end of the file");
+    return fail("glb chunks[0].length",
+                "JSON chunk of " + std::to_string(json_length) + " bytes runs past the end of the file");
   }
   std::size_t next = 20 + static_cast<std::size_t>(json_length);
   if (next < bytes.size()) {
     if (bytes.size() - next < 8) return fail("glb chunks[1]", "truncated chunk header");
     const std::uint32_t bin_length = ReadU32(bytes.data() + next);
     if (bin_length > bytes.size() - next - 8) {
-      return fail("glb chunks[1].length", "BIN chunk of " + std::to_string(bin_length) +
-                                              " bytes runs past the end of the file");
+      return fail("glb chunks[1].length",
+                  "BIN chunk of " + std::to_string(bin_length) + " bytes runs past the end of the file");
     }
   }
   return std::string(reinterpret_cast<const char*>(bytes.data()) + 20, json_length);
@@ -137,15 +138,13 @@ mocap::Status CheckUris(const std::string& path, const std::string& json_text) {
       const std::string uri = item["uri"].get<std::string>();
       const std::string problem = UriProblem(uri);
       if (!problem.empty()) {
-        return mocap::MakeError(
-            ErrorCode::kUnsupported,
-            {path, 0, 0, std::string(array) + "[" + std::to_string(i) + "].uri"},
-            "URI '" + uri.substr(0, 200) + "' " + problem);
+        return mocap::MakeError(ErrorCode::kUnsupported,
+                                {path, 0, 0, std::string(array) + "[" + std::to_string(i) + "].uri"},
+                                "URI '" + uri.substr(0, 200) + "' " + problem);
       }
     }
   }
   return mocap::Status::Ok();
 }
-
 
 }  // namespace deform::internal

@@ -3,14 +3,14 @@
 // node matrices, computed normals, 8 influences, external buffers and
 // symlinks out of the folder, AnimationToMotion's frame layout.
 
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <glm/gtc/matrix_transform.hpp>
 #include <string>
 #include <vector>
-
-#include <glm/gtc/matrix_transform.hpp>
-#include <gtest/gtest.h>
 
 #include "deform/gltf_import.h"
 #include "mocap/pose.h"
@@ -30,18 +30,21 @@ using testsupport::kFloatTol;
 // (joint, rest translation (0,1,0)); node 2 holds the mesh. Vertex 2 follows the tip.
 GltfWriter TwoJointTriangle(bool with_normals = true) {
   GltfWriter w;
-  const int positions = w.Accessor(std::vector<float>{0, 0, 0, 1, 0, 0, 0, 1, 0}, GltfWriter::kFloat, "VEC3", 3);
+  const int positions =
+      w.Accessor(std::vector<float>{0, 0, 0, 1, 0, 0, 0, 1, 0}, GltfWriter::kFloat, "VEC3", 3);
   const int joints = w.Accessor(std::vector<std::uint16_t>{0, 1, 0, 0, 0, 1, 0, 0, 1, 0, 0, 0},
                                 GltfWriter::kUnsignedShort, "VEC4", 3);
   const int weights = w.Accessor(std::vector<float>{0.5f, 0.5f, 0, 0, 0.25f, 0.25f, 0, 0, 1, 0, 0, 0},
                                  GltfWriter::kFloat, "VEC4", 3);
-  const int indices = w.Accessor(std::vector<std::uint16_t>{0, 1, 2, 0}, GltfWriter::kUnsignedShort, "SCALAR", 3);
-  const int ibms = w.Accessor(std::vector<float>{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1,  //
+  const int indices =
+      w.Accessor(std::vector<std::uint16_t>{0, 1, 2, 0}, GltfWriter::kUnsignedShort, "SCALAR", 3);
+  const int ibms = w.Accessor(std::vector<float>{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0,  0, 1,  //
                                                  1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, -1, 0, 1},
                               GltfWriter::kFloat, "MAT4", 2);
   nlohmann::json attributes = {{"POSITION", positions}, {"JOINTS_0", joints}, {"WEIGHTS_0", weights}};
   if (with_normals) {
-    attributes["NORMAL"] = w.Accessor(std::vector<float>{0, 0, 1, 0, 0, 1, 0, 0, 1}, GltfWriter::kFloat, "VEC3", 3);
+    attributes["NORMAL"] =
+        w.Accessor(std::vector<float>{0, 0, 1, 0, 0, 1, 0, 0, 1}, GltfWriter::kFloat, "VEC3", 3);
   }
   w.doc["scenes"] = {{{"nodes", {0, 2}}}};
   w.doc["nodes"] = {{{"name", "root"}, {"children", {1}}},
@@ -96,8 +99,8 @@ TEST(GltfAnimation, StepHoldsTheEarlierKey) {
 }
 
 // Hermite basis written out independently of the importer.
-glm::vec3 Hermite(const glm::vec3& v0, const glm::vec3& out0, const glm::vec3& in1, const glm::vec3& v1, float dt,
-                  float s) {
+glm::vec3 Hermite(const glm::vec3& v0, const glm::vec3& out0, const glm::vec3& in1, const glm::vec3& v1,
+                  float dt, float s) {
   const float h00 = 2 * s * s * s - 3 * s * s + 1;
   const float h10 = s * s * s - 2 * s * s + s;
   const float h01 = -2 * s * s * s + 3 * s * s;
@@ -131,9 +134,8 @@ TEST(GltfAnimation, CubicSplineFollowsHermiteWithScaledTangents) {
 TEST(GltfAnimation, CubicSplineRotationIsNormalized) {
   GltfWriter w = TwoJointTriangle();
   const float c = std::cos(0.5f), s = std::sin(0.5f);  // 1 rad about Z
-  AddChannel(w, 1, "rotation", "CUBICSPLINE", {0, 1},
-             {0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0.3f, 0,  //
-              0, 0, 0.2f, 0, 0, 0, s, c, 0, 0, 0, 0});
+  AddChannel(w, 1, "rotation", "CUBICSPLINE", {0, 1}, {0, 0, 0,    0, 0, 0, 0, 1, 0, 0, 0.3f, 0,  //
+                                                       0, 0, 0.2f, 0, 0, 0, s, c, 0, 0, 0,    0});
   const GltfModel model = Load(w, "cubic_rotation.gltf");
   const glm::quat q = SampleJoint(model, model.skeleton.FindJoint("tip"), 0.5).rotation;
   EXPECT_NEAR(glm::length(q), 1.0f, kFloatTol);
@@ -174,12 +176,19 @@ TEST(GltfAnimation, MotionMatchesExactSamplingOnGeneratedClip) {
   std::vector<glm::mat4> ma(n), mb(n);
   for (int f = 0; f < motion->num_frames; ++f) {
     deform::SampleGltfAnimation(model, 0, f * 0.25, a);
-    ASSERT_TRUE((mocap::LocalPoseJob{.skeleton = &model.skeleton, .frame_values = motion->frame(f), .locals = b}.Run()));
-    ASSERT_TRUE((mocap::LocalToModelJob{.parents = model.skeleton.parents, .locals = a, .model_from_joint = ma}.Run()));
-    ASSERT_TRUE((mocap::LocalToModelJob{.parents = model.skeleton.parents, .locals = b, .model_from_joint = mb}.Run()));
+    ASSERT_TRUE(
+        (mocap::LocalPoseJob{.skeleton = &model.skeleton, .frame_values = motion->frame(f), .locals = b}
+             .Run()));
+    ASSERT_TRUE(
+        (mocap::LocalToModelJob{.parents = model.skeleton.parents, .locals = a, .model_from_joint = ma}
+             .Run()));
+    ASSERT_TRUE(
+        (mocap::LocalToModelJob{.parents = model.skeleton.parents, .locals = b, .model_from_joint = mb}
+             .Run()));
     const auto va = testsupport::ReferenceSkin(model.mesh, ma);
     const auto vb = testsupport::ReferenceSkin(model.mesh, mb);
-    for (std::size_t v = 0; v < va.size(); ++v) EXPECT_NEAR(glm::distance(va[v], vb[v]), 0.0, testsupport::kSkinnedVertexTol);
+    for (std::size_t v = 0; v < va.size(); ++v)
+      EXPECT_NEAR(glm::distance(va[v], vb[v]), 0.0, testsupport::kSkinnedVertexTol);
     // Vertex 2 rides only the tip: bind (0,1,0) -> tip translation.
     const glm::vec3 tip = a[1].translation;
     EXPECT_NEAR(glm::distance(va[2], glm::dvec3(tip)), 0.0, testsupport::kSkinnedVertexTol) << "frame " << f;
@@ -215,7 +224,8 @@ TEST(GltfImport, NodeMatrixIsDecomposedAndNormalsComputed) {
 TEST(GltfImport, EightInfluencesAreNormalized) {
   GltfWriter w = TwoJointTriangle();
   const int joints1 = w.Accessor(std::vector<std::uint16_t>(12, 1), GltfWriter::kUnsignedShort, "VEC4", 3);
-  const int weights1 = w.Accessor(std::vector<float>{1, 0, 0, 0, 0.5f, 0, 0, 0, 0, 0, 0, 1}, GltfWriter::kFloat, "VEC4", 3);
+  const int weights1 =
+      w.Accessor(std::vector<float>{1, 0, 0, 0, 0.5f, 0, 0, 0, 0, 0, 0, 1}, GltfWriter::kFloat, "VEC4", 3);
   auto& attributes = w.doc["meshes"][0]["primitives"][0]["attributes"];
   attributes["JOINTS_1"] = joints1;
   attributes["WEIGHTS_1"] = weights1;
@@ -281,7 +291,8 @@ TEST(GltfImport, RejectsSymlinkLeavingTheFolder) {
   auto model = deform::ReadGltf(path);
   ASSERT_FALSE(model.ok());
   EXPECT_EQ(model.error().code, mocap::ErrorCode::kUnsupported) << model.error().ToString();
-  EXPECT_NE(model.error().message.find("outside the model's folder"), std::string::npos) << model.error().ToString();
+  EXPECT_NE(model.error().message.find("outside the model's folder"), std::string::npos)
+      << model.error().ToString();
 }
 
 }  // namespace

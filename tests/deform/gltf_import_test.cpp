@@ -4,12 +4,12 @@
 
 #include "deform/gltf_import.h"
 
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <filesystem>
 #include <string>
 #include <vector>
-
-#include <gtest/gtest.h>
 
 #include "mocap/pose.h"
 #include "support/data_paths.h"
@@ -96,8 +96,9 @@ TEST_P(RealGltf, InverseBindTimesRestPoseIsIdentity) {
   std::vector<mocap::JointTransform> locals(n);
   std::vector<glm::mat4> model_from_joint(n);
   mocap::RestPose(model.skeleton, locals);
-  ASSERT_TRUE((mocap::LocalToModelJob{.parents = model.skeleton.parents, .locals = locals,
-                                      .model_from_joint = model_from_joint}.Run()));
+  ASSERT_TRUE((mocap::LocalToModelJob{
+      .parents = model.skeleton.parents, .locals = locals, .model_from_joint = model_from_joint}
+                   .Run()));
   glm::mat4 bind_frame(1.0f);
   const std::string frame = GetParam().bind_frame;
   if (frame == "mesh") {
@@ -157,17 +158,22 @@ TEST_P(RealGltf, MotionAndExactSamplingSkinAlike) {
   std::vector<glm::mat4> exact_m(n), motion_m(n);
   double max_moved = 0.0;
   for (int f = 0; f < motion->num_frames; f += 7) {
-    deform::SampleGltfAnimation(model, 0, std::min(f * motion->frame_time_s, model.animations[0].duration_s), exact);
-    ASSERT_TRUE((mocap::LocalPoseJob{.skeleton = &model.skeleton, .frame_values = motion->frame(f),
-                                    .locals = from_motion}.Run()));
-    ASSERT_TRUE((mocap::LocalToModelJob{.parents = model.skeleton.parents, .locals = exact,
-                                       .model_from_joint = exact_m}.Run()));
-    ASSERT_TRUE((mocap::LocalToModelJob{.parents = model.skeleton.parents, .locals = from_motion,
-                                       .model_from_joint = motion_m}.Run()));
+    deform::SampleGltfAnimation(model, 0, std::min(f * motion->frame_time_s, model.animations[0].duration_s),
+                                exact);
+    ASSERT_TRUE((mocap::LocalPoseJob{
+        .skeleton = &model.skeleton, .frame_values = motion->frame(f), .locals = from_motion}
+                     .Run()));
+    ASSERT_TRUE((mocap::LocalToModelJob{
+        .parents = model.skeleton.parents, .locals = exact, .model_from_joint = exact_m}
+                     .Run()));
+    ASSERT_TRUE((mocap::LocalToModelJob{
+        .parents = model.skeleton.parents, .locals = from_motion, .model_from_joint = motion_m}
+                     .Run()));
     const auto a = testsupport::ReferenceSkin(model.mesh, exact_m);
     const auto b = testsupport::ReferenceSkin(model.mesh, motion_m);
     for (std::size_t v = 0; v < a.size(); ++v) {
-      ASSERT_NEAR(glm::distance(a[v], b[v]), 0.0, testsupport::kSkinnedVertexTol) << "frame " << f << " vertex " << v;
+      ASSERT_NEAR(glm::distance(a[v], b[v]), 0.0, testsupport::kSkinnedVertexTol)
+          << "frame " << f << " vertex " << v;
       max_moved = std::max(max_moved, glm::distance(a[v], glm::dvec3(model.mesh.bind.positions[v])));
     }
   }
@@ -179,6 +185,21 @@ INSTANTIATE_TEST_SUITE_P(SharedData, RealGltf, testing::ValuesIn(kRealModels),
                            std::string name = std::filesystem::path(p.param.file).stem().string();
                            return name;
                          });
+
+// Not only the table above: any model added to the shared folder must load.
+TEST(ReadGltf, EveryFileOfTheSharedFolderLoads) {
+  const auto folder = testsupport::SharedDataPath("gltf");
+  PATCHSKIN_REQUIRE_SHARED_FILE(folder);
+  int loaded = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(folder)) {
+    const std::string ext = entry.path().extension().string();
+    if (ext != ".gltf" && ext != ".glb") continue;
+    auto model = ReadGltf(entry.path().string());
+    EXPECT_TRUE(model.ok()) << model.error().ToString();
+    ++loaded;
+  }
+  EXPECT_GE(loaded, 3);
+}
 
 TEST(ReadGltf, CesiumManJointsSitBelowZUpAndArmature) {
   const auto path = testsupport::SharedDataPath("gltf/CesiumMan.glb");
@@ -209,6 +230,7 @@ constexpr BadFile kBadFiles[] = {
     {"joint_past_skin.gltf", mocap::ErrorCode::kCountMismatch, "accessors[1]"},
     {"node_cycle.gltf", mocap::ErrorCode::kSyntax, "nodes"},
     {"truncated.glb", mocap::ErrorCode::kCountMismatch, "glb header.length"},
+    {"broken_json.gltf", mocap::ErrorCode::kSyntax, ""},
 };
 
 class BadGltf : public testing::TestWithParam<BadFile> {};
@@ -221,6 +243,9 @@ TEST_P(BadGltf, GivesExpectedError) {
       << model.error().ToString();
   EXPECT_EQ(model.error().loc.file, path);
   EXPECT_EQ(model.error().loc.field_path, GetParam().field) << model.error().ToString();
+  if (std::string(GetParam().field).empty()) {  // a whole-file error comes from tinygltf
+    EXPECT_EQ(model.error().message.rfind("tinygltf: ", 0), 0u) << model.error().ToString();
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(BadFiles, BadGltf, testing::ValuesIn(kBadFiles),

@@ -7,10 +7,9 @@
 #include <cstdint>
 #include <cstring>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 namespace testsupport {
 
@@ -57,8 +56,7 @@ class GltfWriter {
   // Writes the document with its buffer embedded; returns the path.
   std::string Write(const std::string& path) {
     doc["buffers"] = nlohmann::json::array(
-        {{{"byteLength", bytes_.size()},
-          {"uri", "data:application/octet-stream;base64," + Base64(bytes_)}}});
+        {{{"byteLength", bytes_.size()}, {"uri", "data:application/octet-stream;base64," + Base64(bytes_)}}});
     std::ofstream(path) << doc.dump(1);
     return path;
   }

@@ -3,10 +3,9 @@
 // of the deform jobs, to check imported data:
 //   v' = sum_i w_i * model_from_joint[skin_joints[j_i]] * joint_from_bind[j_i] * v
 
+#include <glm/glm.hpp>
 #include <span>
 #include <vector>
-
-#include <glm/glm.hpp>
 
 #include "deform/mesh.h"
 

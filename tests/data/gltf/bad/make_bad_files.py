@@ -93,6 +93,10 @@ def main():
     d["nodes"][1]["children"] = [0]
     write("node_cycle.gltf", d)
 
+    # JSON cut mid-object: tinygltf's own parse error must come through.
+    with open("broken_json.gltf", "w") as f:
+        f.write(json.dumps(doc)[:200])
+
     # A valid GLB, then cut short in its BIN chunk.
     d = copy.deepcopy(doc)
     del d["buffers"][0]["uri"]
