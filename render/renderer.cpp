@@ -152,8 +152,8 @@ mocap::JobStatus Renderer::Render(const Camera& camera, std::span<const SceneMes
 
   scratch_.resize(static_cast<std::size_t>(threads));
   for (TileScratch& s : scratch_) {
-    s.depth.resize(kTileSize * kTileSize);
-    s.ids.resize(kTileSize * kTileSize);
+    s.depth.resize(kTileBufferSize);
+    s.ids.resize(kTileBufferSize);
     s.accum.resize(kTileSize * kTileSize);
     s.nearest.resize(kTileSize * kTileSize);
   }
