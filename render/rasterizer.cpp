@@ -7,6 +7,7 @@
 #include <emmintrin.h>
 #endif
 
+#include "mocap/check.h"
 #include "render/internal/parallel.h"
 
 namespace render {
@@ -292,6 +293,7 @@ bool Rasterizer::Setup(std::span<const ClipMesh> meshes, const RasterSettings& s
 
 void Rasterizer::RasterizeTile(int tile, std::span<float> depth,
                                std::span<std::uint32_t> ids) const {
+  PATCHSKIN_CHECK(depth.size() >= kTileBufferSize && ids.size() >= kTileBufferSize);
   std::fill(depth.begin(), depth.begin() + kTileSize * kTileSize, 0.0f);
   std::fill(ids.begin(), ids.begin() + kTileSize * kTileSize, kNoTriangle);
   const int x0 = (tile % tiles_x_) * kTileSize, y0 = (tile / tiles_x_) * kTileSize;
@@ -333,6 +335,39 @@ void Rasterizer::RasterizeTile(int tile, std::span<float> depth,
         float* d = depth.data() + static_cast<std::size_t>(sy - y0) * kTileSize +
                    static_cast<std::size_t>(bx0 - x0);
         std::uint32_t* out = ids.data() + (d - depth.data());
+#if defined(__SSE2__)
+        // Four samples per step; lanes past the bounds are masked off (they
+        // may read and rewrite, unchanged, the next row or the buffer padding).
+        __m128i e0 = _mm_setr_epi32(row32[0], row32[0] + sx32[0], row32[0] + 2 * sx32[0], row32[0] + 3 * sx32[0]);
+        __m128i e1 = _mm_setr_epi32(row32[1], row32[1] + sx32[1], row32[1] + 2 * sx32[1], row32[1] + 3 * sx32[1]);
+        __m128i e2 = _mm_setr_epi32(row32[2], row32[2] + sx32[2], row32[2] + 2 * sx32[2], row32[2] + 3 * sx32[2]);
+        const __m128i step0 = _mm_set1_epi32(4 * sx32[0]), step1 = _mm_set1_epi32(4 * sx32[1]),
+                      step2 = _mm_set1_epi32(4 * sx32[2]);
+        const __m128 zz0 = _mm_set1_ps(z0), zz1 = _mm_set1_ps(z1), zz2 = _mm_set1_ps(z2);
+        const __m128i count = _mm_set1_epi32(n), minus_one = _mm_set1_epi32(-1);
+        const __m128i id4 = _mm_set1_epi32(static_cast<int>(id));
+        __m128i lane = _mm_setr_epi32(0, 1, 2, 3);
+        const __m128i four = _mm_set1_epi32(4);
+        for (int i = 0; i < n; i += 4) {
+          const __m128 z = _mm_add_ps(_mm_add_ps(_mm_mul_ps(_mm_cvtepi32_ps(e0), zz0),
+                                                 _mm_mul_ps(_mm_cvtepi32_ps(e1), zz1)),
+                                      _mm_mul_ps(_mm_cvtepi32_ps(e2), zz2));
+          const __m128i inside = _mm_and_si128(
+              _mm_cmpgt_epi32(_mm_or_si128(_mm_or_si128(e0, e1), e2), minus_one),
+              _mm_cmplt_epi32(lane, count));
+          const __m128 old_z = _mm_loadu_ps(d + i);
+          const __m128 pass = _mm_and_ps(_mm_castsi128_ps(inside), _mm_cmpgt_ps(z, old_z));
+          _mm_storeu_ps(d + i, _mm_or_ps(_mm_and_ps(pass, z), _mm_andnot_ps(pass, old_z)));
+          const __m128i old_id = _mm_loadu_si128(reinterpret_cast<const __m128i*>(out + i));
+          const __m128i pass_i = _mm_castps_si128(pass);
+          _mm_storeu_si128(reinterpret_cast<__m128i*>(out + i),
+                           _mm_or_si128(_mm_and_si128(pass_i, id4), _mm_andnot_si128(pass_i, old_id)));
+          e0 = _mm_add_epi32(e0, step0);
+          e1 = _mm_add_epi32(e1, step1);
+          e2 = _mm_add_epi32(e2, step2);
+          lane = _mm_add_epi32(lane, four);
+        }
+#else
         std::int32_t e0 = row32[0], e1 = row32[1], e2 = row32[2];
         for (int i = 0; i < n; ++i) {
           const float z = static_cast<float>(e0) * z0 + static_cast<float>(e1) * z1 +
@@ -344,6 +379,7 @@ void Rasterizer::RasterizeTile(int tile, std::span<float> depth,
           e1 += sx32[1];
           e2 += sx32[2];
         }
+#endif
         row32[0] += sy32[0];
         row32[1] += sy32[1];
         row32[2] += sy32[2];

@@ -28,6 +28,9 @@ namespace render {
 inline constexpr int kSubpixelBits = 8;                 // fixed-point fraction bits
 inline constexpr int kSubpixelScale = 1 << kSubpixelBits;
 inline constexpr int kTileSize = 64;                    // tile side, samples
+// Size of the per-tile buffers RasterizeTile writes: kTileSize^2 samples plus
+// padding for its 4-wide loop (the padding holds no data).
+inline constexpr int kTileBufferSize = kTileSize * kTileSize + 4;
 inline constexpr std::uint32_t kNoTriangle = 0xffffffffu;  // empty visibility-buffer entry
 
 // One triangle list in homogeneous clip space.
@@ -90,8 +93,8 @@ class Rasterizer {
   }
 
   // Rasterizes tile `tile` (row-major over tiles_x() x tiles_y()) into
-  // kTileSize x kTileSize buffers, row-major over the tile with row stride
-  // kTileSize: `depth` gets the largest 1/w seen (0 = empty) and `ids` the id of
+  // buffers of kTileBufferSize entries (row-major over the tile, row stride
+  // kTileSize): `depth` gets the largest 1/w seen (0 = empty) and `ids` the id of
   // the nearest triangle (kNoTriangle = empty). Ties keep the earlier triangle.
   void RasterizeTile(int tile, std::span<float> depth, std::span<std::uint32_t> ids) const;
 

@@ -152,8 +152,8 @@ mocap::JobStatus Renderer::Render(const Camera& camera, std::span<const SceneMes
 
   scratch_.resize(static_cast<std::size_t>(threads));
   for (TileScratch& s : scratch_) {
-    s.depth.resize(kTileSize * kTileSize);
-    s.ids.resize(kTileSize * kTileSize);
+    s.depth.resize(kTileBufferSize);
+    s.ids.resize(kTileBufferSize);
     s.accum.resize(kTileSize * kTileSize);
     s.nearest.resize(kTileSize * kTileSize);
   }
@@ -205,7 +205,7 @@ class Renderer::SampleShader {
     if (t.ground) {
       const float inv = 1.0f / (w0 + w1 + w2);
       const glm::vec3 p = (w0 * inv) * t.p[0] + (w1 * inv) * t.p[1] + (w2 * inv) * t.p[2];
-      const glm::vec3 albedo = GroundAlbedo(settings_.ground_style, r_.grid_spacing_, p);
+      const glm::vec3 albedo = GroundAlbedo(settings_.ground_style, r_.grid_spacing_, p, ctx.eye);
       const float shadow = ContactShadowFactor(r_.shadows_, p);
       if (model == LightingModel::kUnlit) return albedo * shadow;
       return albedo * (ctx.ambient + ctx.key_radiance * std::max(ctx.key_dir.y, 0.0f) +

@@ -61,14 +61,18 @@ glm::vec3 ShadeSurface(const ShadingContext& ctx, const glm::vec3& albedo,
   return albedo * diffuse + spec;
 }
 
-glm::vec3 GroundAlbedo(const GroundStyle& style, float grid_spacing, const glm::vec3& position) {
+glm::vec3 GroundAlbedo(const GroundStyle& style, float grid_spacing, const glm::vec3& position,
+                       const glm::vec3& eye) {
   if (!(grid_spacing > 0.0f)) return style.color;
   const float half_width = 0.5f * style.line_width;
   const float u = position.x / grid_spacing, v = position.z / grid_spacing;
   const float du = std::abs(u - std::round(u)), dv = std::abs(v - std::round(v));
   // Soft-edged lines: full line colour inside the width, fading over the same width.
   const float d = std::min(du, dv);
-  const float line = 1.0f - std::clamp((d - half_width) / std::max(half_width, 1e-6f), 0.0f, 1.0f);
+  float line = 1.0f - std::clamp((d - half_width) / std::max(half_width, 1e-6f), 0.0f, 1.0f);
+  const float distance = glm::length(position - eye) / grid_spacing;
+  const float fade_start = std::max(style.fade_start, 1e-3f);
+  line *= 1.0f - std::clamp((distance - fade_start) / fade_start, 0.0f, 1.0f);
   return style.color + (style.line_color - style.color) * line;
 }
 

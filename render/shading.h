@@ -47,6 +47,7 @@ struct GroundStyle {
   float grid_spacing = 0.0f;       // world units between lines; 0 = 1/4 of the scene height
   float line_width = 0.03f;        // line width as a fraction of grid_spacing
   float shadow_strength = 0.6f;    // darkening at the centre of the contact shadow, 0..1
+  float fade_start = 12.0f;        // grid spacings from the eye where lines start to fade, > 0
 };
 
 struct Background {
@@ -83,8 +84,11 @@ ShadingContext MakeShadingContext(const LightRig& rig, LightingModel model,
 glm::vec3 ShadeSurface(const ShadingContext& ctx, const glm::vec3& albedo,
                        const glm::vec3& normal, const glm::vec3& position);
 
-// Ground albedo at world point `position` (grid lines blended in), before lighting.
-glm::vec3 GroundAlbedo(const GroundStyle& style, float grid_spacing, const glm::vec3& position);
+// Ground albedo at world point `position` (grid lines blended in), before
+// lighting. Lines fade out between style.fade_start and 2 * style.fade_start
+// grid spacings from `eye`, where they would be thinner than a pixel and alias.
+glm::vec3 GroundAlbedo(const GroundStyle& style, float grid_spacing, const glm::vec3& position,
+                       const glm::vec3& eye);
 
 // Multiplier in [1 - max strength, 1] from the contact shadows at `position`.
 float ContactShadowFactor(std::span<const ContactShadow> shadows, const glm::vec3& position);

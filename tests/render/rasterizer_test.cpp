@@ -4,6 +4,7 @@
 
 #include "render/rasterizer.h"
 
+#include <cmath>
 #include <cstring>
 #include <vector>
 
@@ -143,6 +144,21 @@ TEST(RasterizerTest, ClosedMeshCoversSilhouetteOnceWithCullingTwiceWithout) {
     }
   }
   EXPECT_GT(inside, 2000);
+  // The tiled z-buffer pass covers exactly the samples the fill rule assigns.
+  render::RenderSettings s;
+  s.width = w;
+  s.height = h;
+  s.ground = false;
+  s.cull_back_faces = true;
+  s.lighting = render::LightingModel::kUnlit;
+  const render::SceneMesh scene_mesh{.positions = sphere.positions, .triangles = sphere.triangles};
+  const render::Image image = render::Render(cam, {&scene_mesh, 1}, {}, s);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y * w + x);
+      ASSERT_EQ(std::isfinite(image.depth[i]), front[i] == 1) << x << "," << y;
+    }
+  }
 }
 
 // Renders unlit geometry on a transparent background, no ground.

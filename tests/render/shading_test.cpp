@@ -123,8 +123,12 @@ TEST(ShadingTest, GroundShowsGridContactShadowAndBackgroundGradient) {
   const glm::vec3 top = render::BackgroundColor(s.background, 0.5f / static_cast<float>(h * s.supersample));
   EXPECT_EQ(glm::vec3(image.at(0, 0)), top);
   // Grid lines: a point on a line gets the line colour.
-  EXPECT_EQ(render::GroundAlbedo(s.ground_style, 1.0f, {2.0f, 0.0f, 0.37f}), s.ground_style.line_color);
-  EXPECT_EQ(render::GroundAlbedo(s.ground_style, 1.0f, {2.5f, 0.0f, 0.37f}), s.ground_style.color);
+  render::GroundStyle style;
+  const glm::vec3 eye(2.0f, 1.0f, 0.0f);
+  EXPECT_EQ(render::GroundAlbedo(style, 1.0f, {2.0f, 0.0f, 0.37f}, eye), style.line_color);
+  EXPECT_EQ(render::GroundAlbedo(style, 1.0f, {2.5f, 0.0f, 0.37f}, eye), style.color);
+  // Far away (beyond twice fade_start spacings) the lines have faded out.
+  EXPECT_EQ(render::GroundAlbedo(style, 1.0f, {2.0f, 0.0f, 30.37f}, eye), style.color);
 }
 
 TEST(ShadingTest, TriangleColorsTintRegionsAndFlatShadingIsConstantPerFace) {
