@@ -65,9 +65,6 @@ inline constexpr float kJumpAccelTolCmPerS2 = 2.0f;
 // peak, so at most g (h/2)^2 / 2 = 0.009 cm below it, plus round-off.
 inline constexpr float kJumpApexTolCm = 0.02f;
 
-}  // namespace testsupport
-
-namespace testsupport {
 
 // Inverse bind matrix x rest-pose joint matrix vs identity: the files store
 // both in float after an exporter's own float products.
@@ -76,9 +73,6 @@ inline constexpr float kBindIdentityTol = 1e-4f;
 // with a double reference: float round-off over a ~20-joint chain.
 inline constexpr double kSkinnedVertexTol = 1e-4;
 
-}  // namespace testsupport
-
-namespace testsupport {
 
 // Skinning with a rigid palette: positions of order 1..10 after one blended
 // 3x4 transform (edge lengths, rigid-map comparisons).
@@ -129,5 +123,9 @@ inline constexpr double kKnotInsertionTol = 1e-6;
 inline constexpr double kRebuildRelTol = 1e-4;
 // Projection recovering known (u,v,d) (Newton stops at 1e-7 x diagonal).
 inline constexpr double kProjectionTol = 1e-6;
+
+// `inspect` world positions (float chains, printed with 6+ digits) against a
+// double-precision reference, relative to the figure's largest coordinate.
+inline constexpr double kInspectRelTol = 2e-5;
 
 }  // namespace testsupport
