@@ -1,9 +1,13 @@
 #!/usr/bin/env bash
-# Sets up, builds the patchskin command (Release) and runs the built-in demo.
+# Sets up, builds the patchskin command (Release) and runs the built-in demo:
+# frames, a contact sheet and a preview video under out/demo/.
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 bash "$root/scripts/setup.sh"
-cmake -S "$root" -B "$root/build/release" -DCMAKE_BUILD_TYPE=Release -DPATCHSKIN_BUILD_TESTS=OFF \
+cmake -S "$root" -B "$root/build/demo" -DCMAKE_BUILD_TYPE=Release -DPATCHSKIN_BUILD_TESTS=OFF \
   -DPATCHSKIN_BUILD_SAMPLES=OFF >/dev/null
-cmake --build "$root/build/release" --target patchskin -j 2
-"$root/build/release/app/patchskin" "$@"
+cmake --build "$root/build/demo" --target patchskin -j 2
+# No arguments: the built-in demo (a walk on the mannequin) to out/demo/ under
+# the current directory. Any arguments are passed to patchskin instead.
+if [ $# -eq 0 ]; then set -- render; fi
+"$root/build/demo/app/patchskin" "$@"
