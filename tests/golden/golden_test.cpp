@@ -2,9 +2,11 @@
 // tests/golden/ref/<name>.png (see tests/support/golden.h). Rows loosen the
 // default thresholds (OIIO's 0.004 / 0.02 % / 0.012) only with a written reason.
 //
-// Until the rasterizer lands, the one case draws a procedural test card (gradient,
-// anti-aliased disc, translucent square, triangle) in plain float arithmetic, which
-// proves the harness end to end. Run: ctest -L golden; update: GOLDEN_UPDATE=1.
+// The procedural test card (gradient, anti-aliased disc, translucent square,
+// triangle, in plain float arithmetic) proves the harness itself; the render
+// cases draw a lit sphere, a tessellated torus with every overlay, and an
+// 8-frame turntable through render::Renderer. Run: ctest -L golden; update:
+// GOLDEN_UPDATE=1.
 
 #include <functional>
 #include <ostream>
@@ -13,7 +15,12 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <numbers>
+
+#include "render/camera.h"
 #include "render/image.h"
+#include "render/renderer.h"
 #include "support/golden.h"
 
 namespace {
@@ -70,6 +77,126 @@ render::Image TestCard(int w, int h) {
   return img;
 }
 
+// A closed triangle mesh with unit normals, built in the test.
+struct TestMesh {
+  std::vector<glm::vec3> positions;
+  std::vector<glm::vec3> normals;
+  std::vector<glm::uvec3> triangles;
+};
+
+// Torus around +Y: ring radius R, tube radius r, nu x nv quads (nu around the ring).
+TestMesh Torus(float big_r, float small_r, int nu, int nv, glm::vec3 centre) {
+  TestMesh m;
+  const float two_pi = 2.0f * std::numbers::pi_v<float>;
+  for (int i = 0; i < nu; ++i) {
+    const float a = two_pi * static_cast<float>(i) / static_cast<float>(nu);
+    const glm::vec3 radial(std::cos(a), 0.0f, std::sin(a));
+    for (int j = 0; j < nv; ++j) {
+      const float b = two_pi * static_cast<float>(j) / static_cast<float>(nv);
+      const glm::vec3 n = std::cos(b) * radial + std::sin(b) * glm::vec3(0.0f, 1.0f, 0.0f);
+      m.positions.push_back(centre + big_r * radial + small_r * n);
+      m.normals.push_back(n);
+    }
+  }
+  auto id = [&](int i, int j) {
+    return static_cast<unsigned>(((i + nu) % nu) * nv + (j + nv) % nv);
+  };
+  for (int i = 0; i < nu; ++i) {
+    for (int j = 0; j < nv; ++j) {  // counter-clockwise seen from outside
+      m.triangles.emplace_back(id(i, j), id(i, j + 1), id(i + 1, j));
+      m.triangles.emplace_back(id(i + 1, j), id(i, j + 1), id(i + 1, j + 1));
+    }
+  }
+  return m;
+}
+
+// UV sphere: `rings` latitude bands, `segments` longitudes.
+TestMesh Sphere(float radius, int rings, int segments, glm::vec3 centre) {
+  TestMesh m;
+  const float pi = std::numbers::pi_v<float>;
+  for (int i = 0; i <= rings; ++i) {
+    const float theta = pi * static_cast<float>(i) / static_cast<float>(rings);
+    for (int j = 0; j < segments; ++j) {
+      const float phi = 2.0f * pi * static_cast<float>(j) / static_cast<float>(segments);
+      const glm::vec3 n(std::sin(theta) * std::cos(phi), std::cos(theta),
+                        std::sin(theta) * std::sin(phi));
+      m.positions.push_back(centre + radius * n);
+      m.normals.push_back(n);
+    }
+  }
+  auto id = [&](int i, int j) { return static_cast<unsigned>(i * segments + (j + segments) % segments); };
+  for (int i = 0; i < rings; ++i) {
+    for (int j = 0; j < segments; ++j) {
+      if (i > 0) m.triangles.emplace_back(id(i, j), id(i, j + 1), id(i + 1, j));
+      if (i + 1 < rings) m.triangles.emplace_back(id(i + 1, j), id(i, j + 1), id(i + 1, j + 1));
+    }
+  }
+  return m;
+}
+
+render::SceneMesh Scene(const TestMesh& m, glm::vec3 color) {
+  return {.positions = m.positions, .normals = m.normals, .triangles = m.triangles,
+          .base_color = color};
+}
+
+render::RenderSettings SmallSettings(int w, int h) {
+  render::RenderSettings s;
+  s.width = w;
+  s.height = h;
+  s.supersample = 2;
+  s.threads = 2;
+  return s;
+}
+
+render::Camera LookAt(glm::vec3 eye, glm::vec3 target, float aspect) {
+  render::Camera c;
+  c.eye = eye;
+  c.target = target;
+  c.fov_y_deg = 35.0f;
+  c.aspect = aspect;
+  c.near_plane = 0.1f;
+  c.far_plane = 100.0f;
+  return c;
+}
+
+render::Image LitSphere() {
+  const TestMesh sphere = Sphere(1.0f, 48, 96, glm::vec3(0.0f, 1.0f, 0.0f));
+  const render::SceneMesh mesh = Scene(sphere, glm::vec3(0.8f, 0.35f, 0.25f));
+  return render::Render(LookAt({2.5f, 2.2f, 4.5f}, {0.0f, 0.9f, 0.0f}, 1.0f), {&mesh, 1}, {},
+                        SmallSettings(192, 192));
+}
+
+render::Image TorusWithOverlays() {
+  const TestMesh torus = Torus(1.0f, 0.35f, 40, 16, glm::vec3(0.0f, 0.6f, 0.0f));
+  const render::SceneMesh mesh = Scene(torus, glm::vec3(0.3f, 0.55f, 0.8f));
+  render::Overlays o;
+  o.wireframe = true;
+  render::LineOverlay bones;  // a little "skeleton" through the hole, partly hidden
+  bones.endpoints = {{-1.6f, 0.6f, 0.0f}, {0.0f, 0.6f, 0.0f}, {0.0f, 0.6f, 0.0f},
+                     {0.0f, 1.8f, 0.0f}, {0.0f, 0.6f, 0.0f}, {1.6f, 0.6f, 0.0f}};
+  o.lines.push_back(bones);
+  render::PointOverlay joints;
+  joints.points = {{-1.6f, 0.6f, 0.0f}, {0.0f, 0.6f, 0.0f}, {0.0f, 1.8f, 0.0f}, {1.6f, 0.6f, 0.0f}};
+  o.points.push_back(joints);
+  o.text.push_back({.text = "frame 7", .origin_px = {8, 184}, .scale = 0.5});
+  return render::Render(LookAt({0.0f, 2.8f, 4.2f}, {0.0f, 0.6f, 0.0f}, 256.0f / 192.0f), {&mesh, 1},
+                        o, SmallSettings(256, 192));
+}
+
+// An asymmetric scene, so every orbit position looks different: a torus, a
+// green ball on +X and a red ball on +Z.
+render::Image TurntableFrame(int k) {
+  static const TestMesh torus = Torus(0.8f, 0.3f, 36, 14, glm::vec3(0.0f, 0.9f, 0.0f));
+  static const TestMesh ball_x = Sphere(0.35f, 16, 32, glm::vec3(1.1f, 0.35f, 0.0f));
+  static const TestMesh ball_z = Sphere(0.25f, 16, 32, glm::vec3(0.0f, 0.25f, 1.2f));
+  const render::SceneMesh meshes[3] = {Scene(torus, glm::vec3(0.85f, 0.75f, 0.3f)),
+                                       Scene(ball_x, glm::vec3(0.2f, 0.6f, 0.3f)),
+                                       Scene(ball_z, glm::vec3(0.8f, 0.15f, 0.1f))};
+  render::Camera c = render::TurntablePath({0.0f, 0.55f, 0.0f}, 4.5f, 25.0f, 8)[static_cast<std::size_t>(k)];
+  c.aspect = 1.0f;
+  return render::Render(c, meshes, {}, SmallSettings(128, 128));
+}
+
 struct GoldenCase {
   std::string name;
   std::function<render::Image()> render;
@@ -79,6 +206,16 @@ struct GoldenCase {
 const std::vector<GoldenCase>& Cases() {
   static const std::vector<GoldenCase> cases = {
       {"synthetic_test_card", [] { return TestCard(160, 96); }, {}},
+      {"lit_sphere", LitSphere, {}},
+      {"torus_overlays", TorusWithOverlays, {}},
+      {"turntable_0", [] { return TurntableFrame(0); }, {}},
+      {"turntable_1", [] { return TurntableFrame(1); }, {}},
+      {"turntable_2", [] { return TurntableFrame(2); }, {}},
+      {"turntable_3", [] { return TurntableFrame(3); }, {}},
+      {"turntable_4", [] { return TurntableFrame(4); }, {}},
+      {"turntable_5", [] { return TurntableFrame(5); }, {}},
+      {"turntable_6", [] { return TurntableFrame(6); }, {}},
+      {"turntable_7", [] { return TurntableFrame(7); }, {}},
   };
   return cases;
 }
