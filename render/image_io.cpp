@@ -181,6 +181,7 @@ Encoded Encode(const Image& image, ImageFormat format, const WriteOptions& o) {
   }
   if (format == ImageFormat::kPng) {
     e.spec.attribute("png:compressionLevel", o.png_compression);
+    e.spec.attribute("png:filter", static_cast<int>(o.png_filter));
     e.spec.attribute("compression", "zip:" + std::to_string(std::max(o.png_compression, 1)));
   } else if (format == ImageFormat::kJpeg) {
     e.spec.attribute("compression", "jpeg:" + std::to_string(o.jpeg_quality));

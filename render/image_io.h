@@ -48,14 +48,31 @@ std::uint8_t LinearToSrgb8(float linear);
 // Uses a 256-entry table computed once (thread-safe).
 float Srgb8ToLinear(std::uint8_t code);
 
-// PNG zlib levels. Level 6 (zlib's and OIIO's default) costs ~60 ms per 1280x720
-// frame; level 1 ~20 ms with files ~20% larger, the better trade for previews.
+// PNG zlib levels. CPU time per 1280x720 frame (bench/image_io_bench.cpp, shaded
+// test frame): level 6 + adaptive filter 89 ms / 104 kB; level 6 + no filter 33 ms /
+// 109 kB; level 1 + no filter 26 ms / 183 kB, the preview default. Golden
+// references use 9 (small files in git).
 inline constexpr int kPngCompressionPreview = 1;
 inline constexpr int kPngCompressionDefault = 6;
+
+// PNG row filters (libpng's flags). kNone skips filtering: on rendered frames
+// (flat and smoothly shaded areas) it costs about half the time of kAdaptive at
+// level 1 and a third at level 6, for files 5-15% larger; kAdaptive is libpng's
+// default (tries all five per row).
+enum class PngFilter : int {
+  kNone = 0x08,
+  kSub = 0x10,
+  kUp = 0x20,
+  kAverage = 0x40,
+  kPaeth = 0x80,
+  kAdaptive = 0xF8,
+};
 
 struct WriteOptions {
   // PNG zlib level, 0 (none) .. 9 (smallest, slowest).
   int png_compression = kPngCompressionPreview;
+  // PNG row filter (see PngFilter).
+  PngFilter png_filter = PngFilter::kNone;
   // JPEG quality 1..100.
   int jpeg_quality = 90;
   // TIFF sample depth, 8 or 16.

@@ -130,6 +130,21 @@ TEST(WriteImage, PngCompressionLevelChangesSizeNotPixels) {
   EXPECT_EQ(a->rgba, b->rgba);
 }
 
+TEST(WriteImage, PngFilterChangesBytesNotPixels) {
+  const fs::path dir = FreshDir("png_filters");
+  const Image src = TestPattern(64, 64);
+  WriteOptions none, adaptive;
+  none.png_filter = PngFilter::kNone;
+  adaptive.png_filter = PngFilter::kAdaptive;
+  ASSERT_TRUE(WriteImage(src, (dir / "none.png").string(), none));
+  ASSERT_TRUE(WriteImage(src, (dir / "adaptive.png").string(), adaptive));
+  EXPECT_NE(fs::file_size(dir / "none.png"), fs::file_size(dir / "adaptive.png"));
+  auto a = ReadImage((dir / "none.png").string());
+  auto b = ReadImage((dir / "adaptive.png").string());
+  ASSERT_TRUE(a.ok() && b.ok());
+  EXPECT_EQ(a->rgba, b->rgba);
+}
+
 TEST(WriteImage, ExrKeepsHalfPrecisionAndDepth) {
   const fs::path dir = FreshDir("exr");
   Image src = TestPattern(16, 8);
