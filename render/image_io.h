@@ -107,15 +107,16 @@ struct ReadInfo {
   std::string format_name;    // OpenImageIO's format name, e.g. "png", "openexr"
 };
 
-// Largest image ReadImage accepts, in pixels (guards allocations from a bad header).
-inline constexpr std::int64_t kMaxReadPixels = std::int64_t{1} << 27;
+// Largest image ReadImage accepts, in pixels x file channels (guards allocations
+// from a bad header: the decode buffer is 4 bytes per sample, so at most 1 GiB).
+inline constexpr std::int64_t kMaxReadSamples = std::int64_t{1} << 28;
 
 // Reads any file OpenImageIO reads into a linear RGBA Image. Integer-sample files
 // are taken as sRGB-encoded and converted to linear (alpha is not converted);
 // float/half files are taken as linear. 1 channel -> grey, 2 -> grey + alpha,
 // 3 -> alpha 1. A channel named "Z" (EXR) fills Image::depth.
 // Errors: kIo (missing/unreadable), kUnsupported (0 or > 64 channels, volumes),
-// kLimitExceeded (more than kMaxReadPixels pixels).
+// kLimitExceeded (more than kMaxReadSamples samples).
 [[nodiscard]] Result<Image> ReadImage(const std::string& path, ReadInfo* info = nullptr);
 
 // Expands the frame placeholder in an output pattern: a run of '#' becomes the
