@@ -35,6 +35,7 @@ Status AsyncImageWriter::Submit(Image image, std::string path, WriteOptions opti
   if (first_error_) return *first_error_;
   queue_.push_back(Job{std::move(image), std::move(path), std::move(options), next_sequence_++});
   ++in_flight_;
+  peak_in_flight_ = std::max(peak_in_flight_, in_flight_);
   work_ready_.notify_one();
   return Status::Ok();
 }
@@ -59,6 +60,11 @@ Status AsyncImageWriter::Finish() {
 std::int64_t AsyncImageWriter::frames_written() const {
   std::lock_guard<std::mutex> lock(mutex_);
   return frames_written_;
+}
+
+int AsyncImageWriter::peak_in_flight() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return peak_in_flight_;
 }
 
 void AsyncImageWriter::WorkerLoop() {

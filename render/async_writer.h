@@ -54,6 +54,8 @@ class AsyncImageWriter {
 
   // Frames written successfully so far (thread-safe).
   std::int64_t frames_written() const;
+  // Most frames that were queued or encoding at once (<= max_in_flight; thread-safe).
+  int peak_in_flight() const;
 
  private:
   struct Job {
@@ -70,6 +72,7 @@ class AsyncImageWriter {
   std::condition_variable slot_free_;   // in_flight_ dropped
   std::deque<Job> queue_;
   int in_flight_ = 0;                   // queued + encoding
+  int peak_in_flight_ = 0;
   bool stopping_ = false;
   bool finished_ = false;
   std::optional<mocap::Error> first_error_;

@@ -181,6 +181,7 @@ Encoded Encode(const Image& image, ImageFormat format, const WriteOptions& o) {
   }
   if (format == ImageFormat::kPng) {
     e.spec.attribute("png:compressionLevel", o.png_compression);
+    e.spec.attribute("png:filter", static_cast<int>(o.png_filter));
     e.spec.attribute("compression", "zip:" + std::to_string(std::max(o.png_compression, 1)));
   } else if (format == ImageFormat::kJpeg) {
     e.spec.attribute("compression", "jpeg:" + std::to_string(o.jpeg_quality));
@@ -322,10 +323,12 @@ Result<Image> ReadImage(const std::string& path, ReadInfo* info) {
   }
   if (spec.depth > 1) return MakeError(ErrorCode::kUnsupported, loc, "volume images are not read");
   const std::int64_t pixels = std::int64_t{spec.width} * spec.height;
-  if (spec.width <= 0 || spec.height <= 0 || pixels > kMaxReadPixels) {
+  if (spec.width <= 0 || spec.height <= 0 || pixels * spec.nchannels > kMaxReadSamples) {
     return MakeError(ErrorCode::kLimitExceeded, loc,
-                     "expected 1.." + std::to_string(kMaxReadPixels) + " pixels, found " +
-                         std::to_string(spec.width) + "x" + std::to_string(spec.height));
+                     "expected at most " + std::to_string(kMaxReadSamples) +
+                         " samples (pixels x channels), found " + std::to_string(spec.width) +
+                         "x" + std::to_string(spec.height) + "x" +
+                         std::to_string(spec.nchannels));
   }
   const bool integer = spec.format.basetype != OIIO::TypeDesc::FLOAT &&
                        spec.format.basetype != OIIO::TypeDesc::HALF &&

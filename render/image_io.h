@@ -48,14 +48,31 @@ std::uint8_t LinearToSrgb8(float linear);
 // Uses a 256-entry table computed once (thread-safe).
 float Srgb8ToLinear(std::uint8_t code);
 
-// PNG zlib levels. Level 6 (zlib's and OIIO's default) costs ~60 ms per 1280x720
-// frame; level 1 ~20 ms with files ~20% larger, the better trade for previews.
+// PNG zlib levels. CPU time per 1280x720 frame (bench/image_io_bench.cpp, shaded
+// test frame): level 6 + adaptive filter 89 ms / 104 kB; level 6 + no filter 33 ms /
+// 109 kB; level 1 + no filter 26 ms / 183 kB, the preview default. Golden
+// references use 9 (small files in git).
 inline constexpr int kPngCompressionPreview = 1;
 inline constexpr int kPngCompressionDefault = 6;
+
+// PNG row filters (libpng's flags). kNone skips filtering: on rendered frames
+// (flat and smoothly shaded areas) it costs about half the time of kAdaptive at
+// level 1 and a third at level 6, for files 5-15% larger; kAdaptive is libpng's
+// default (tries all five per row).
+enum class PngFilter : int {
+  kNone = 0x08,
+  kSub = 0x10,
+  kUp = 0x20,
+  kAverage = 0x40,
+  kPaeth = 0x80,
+  kAdaptive = 0xF8,
+};
 
 struct WriteOptions {
   // PNG zlib level, 0 (none) .. 9 (smallest, slowest).
   int png_compression = kPngCompressionPreview;
+  // PNG row filter (see PngFilter).
+  PngFilter png_filter = PngFilter::kNone;
   // JPEG quality 1..100.
   int jpeg_quality = 90;
   // TIFF sample depth, 8 or 16.
@@ -90,15 +107,16 @@ struct ReadInfo {
   std::string format_name;    // OpenImageIO's format name, e.g. "png", "openexr"
 };
 
-// Largest image ReadImage accepts, in pixels (guards allocations from a bad header).
-inline constexpr std::int64_t kMaxReadPixels = std::int64_t{1} << 27;
+// Largest image ReadImage accepts, in pixels x file channels (guards allocations
+// from a bad header: the decode buffer is 4 bytes per sample, so at most 1 GiB).
+inline constexpr std::int64_t kMaxReadSamples = std::int64_t{1} << 28;
 
 // Reads any file OpenImageIO reads into a linear RGBA Image. Integer-sample files
 // are taken as sRGB-encoded and converted to linear (alpha is not converted);
 // float/half files are taken as linear. 1 channel -> grey, 2 -> grey + alpha,
 // 3 -> alpha 1. A channel named "Z" (EXR) fills Image::depth.
 // Errors: kIo (missing/unreadable), kUnsupported (0 or > 64 channels, volumes),
-// kLimitExceeded (more than kMaxReadPixels pixels).
+// kLimitExceeded (more than kMaxReadSamples samples).
 [[nodiscard]] Result<Image> ReadImage(const std::string& path, ReadInfo* info = nullptr);
 
 // Expands the frame placeholder in an output pattern: a run of '#' becomes the

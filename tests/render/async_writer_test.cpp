@@ -52,6 +52,8 @@ TEST(AsyncImageWriter, WritesTheSameBytesAsWriteImage) {
     }
     ASSERT_TRUE(writer.Finish());
     EXPECT_EQ(writer.frames_written(), kFrames);
+    EXPECT_LE(writer.peak_in_flight(), 3) << "memory stays bounded";
+    EXPECT_GE(writer.peak_in_flight(), 1);
   }
   for (int f = 0; f < kFrames; ++f) {
     o.frame = f;
@@ -59,6 +61,17 @@ TEST(AsyncImageWriter, WritesTheSameBytesAsWriteImage) {
     ASSERT_TRUE(WriteImage(Frame(f), sync.string(), o));
     EXPECT_EQ(Bytes(dir / ("async_" + std::to_string(f) + ".png")), Bytes(sync)) << f;
   }
+}
+
+TEST(AsyncImageWriter, RaisesTooSmallLimits) {
+  const fs::path dir = FreshDir("limits");
+  AsyncImageWriter writer({.num_workers = 0, .max_in_flight = 0});
+  for (int f = 0; f < 4; ++f) {
+    ASSERT_TRUE(writer.Submit(Frame(f), *ExpandFramePattern((dir / "f#.png").string(), f)));
+  }
+  ASSERT_TRUE(writer.Finish());
+  EXPECT_EQ(writer.frames_written(), 4);
+  EXPECT_EQ(writer.peak_in_flight(), 1) << "one worker, one frame in flight";
 }
 
 TEST(AsyncImageWriter, ReportsAFailedFrameOnFinish) {

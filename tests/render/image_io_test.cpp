@@ -130,6 +130,21 @@ TEST(WriteImage, PngCompressionLevelChangesSizeNotPixels) {
   EXPECT_EQ(a->rgba, b->rgba);
 }
 
+TEST(WriteImage, PngFilterChangesBytesNotPixels) {
+  const fs::path dir = FreshDir("png_filters");
+  const Image src = TestPattern(64, 64);
+  WriteOptions none, adaptive;
+  none.png_filter = PngFilter::kNone;
+  adaptive.png_filter = PngFilter::kAdaptive;
+  ASSERT_TRUE(WriteImage(src, (dir / "none.png").string(), none));
+  ASSERT_TRUE(WriteImage(src, (dir / "adaptive.png").string(), adaptive));
+  EXPECT_NE(fs::file_size(dir / "none.png"), fs::file_size(dir / "adaptive.png"));
+  auto a = ReadImage((dir / "none.png").string());
+  auto b = ReadImage((dir / "adaptive.png").string());
+  ASSERT_TRUE(a.ok() && b.ok());
+  EXPECT_EQ(a->rgba, b->rgba);
+}
+
 TEST(WriteImage, ExrKeepsHalfPrecisionAndDepth) {
   const fs::path dir = FreshDir("exr");
   Image src = TestPattern(16, 8);
@@ -285,6 +300,37 @@ TEST(ReadImage, ReportsMissingAndCorruptFiles) {
   auto junk = ReadImage((dir / "junk.png").string());
   ASSERT_FALSE(junk.ok());
   EXPECT_EQ(junk.error().code, mocap::ErrorCode::kIo);
+}
+
+// CRC-32 as PNG chunks use it (ISO 3309, reflected polynomial 0xEDB88320).
+std::uint32_t Crc32(const std::string& bytes) {
+  std::uint32_t crc = 0xFFFFFFFFu;
+  for (unsigned char b : bytes) {
+    crc ^= b;
+    for (int k = 0; k < 8; ++k) crc = (crc >> 1) ^ (0xEDB88320u & (0u - (crc & 1u)));
+  }
+  return ~crc;
+}
+
+std::string BigEndian(std::uint32_t v) {
+  return {static_cast<char>(v >> 24), static_cast<char>(v >> 16), static_cast<char>(v >> 8),
+          static_cast<char>(v)};
+}
+
+TEST(ReadImage, RefusesHugeDimensionsBeforeAllocating) {
+  // A valid PNG header announcing 100000 x 100000 RGBA pixels, and no pixel data.
+  const fs::path dir = FreshDir("read_huge");
+  std::string ihdr = "IHDR" + BigEndian(100000) + BigEndian(100000);
+  ihdr += std::string{'\x08', '\x06', '\0', '\0', '\0'};  // 8-bit RGBA
+  std::string png = "\x89PNG\r\n\x1a\n";
+  png += BigEndian(13) + ihdr + BigEndian(Crc32(ihdr));
+  png += BigEndian(0) + "IDAT" + BigEndian(Crc32("IDAT"));  // libpng stops reading here
+  png += BigEndian(0) + "IEND" + BigEndian(Crc32("IEND"));
+  std::ofstream(dir / "huge.png", std::ios::binary) << png;
+  auto r = ReadImage((dir / "huge.png").string());
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.error().code, mocap::ErrorCode::kLimitExceeded) << r.error().ToString();
+  EXPECT_NE(r.error().message.find("100000x100000x4"), std::string::npos);
 }
 
 TEST(ExpandFramePattern, PadsHashesAndPrintfForms) {
