@@ -193,6 +193,10 @@ Encoded Encode(const Image& image, ImageFormat format, const WriteOptions& o) {
   // writers would divide it by alpha once more.
   e.spec.attribute("oiio:UnassociatedAlpha", 1);
   e.spec.attribute("Software", kSoftware);
+  // The EXR and TIFF writers stamp the current time when DateTime is unset, so
+  // the same frame written twice would differ; a fixed stamp keeps output a
+  // function of the inputs alone.
+  e.spec.attribute("DateTime", "1970:01:01 00:00:00");
   // A string: PNG text chunks hold only strings, and all formats should agree.
   if (o.frame >= 0) e.spec.attribute("patchskin:frame", std::to_string(o.frame));
   if (!o.source_file.empty()) e.spec.attribute("patchskin:source", o.source_file);

@@ -4,15 +4,19 @@
 
 #include <unistd.h>
 
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <thread>
 
 #include <OpenImageIO/imageio.h>
+
 #include <gtest/gtest.h>
 
 #include "support/data_paths.h"
+#include "support/run_process.h"
 #include "support/tolerances.h"
 
 namespace render {
@@ -165,6 +169,21 @@ TEST(WriteImage, ExrKeepsHalfPrecisionAndDepth) {
       ASSERT_NEAR(back->rgba[i][c], v, std::fabs(v) * testsupport::kHalfRelTol + testsupport::kHalfAbsTol) << i << " " << c;
     }
     ASSERT_EQ(back->depth[i], src.depth[i]) << "depth is stored as float";
+  }
+}
+
+// Same image, same bytes, whenever it is written: the EXR and TIFF writers
+// would otherwise stamp the current time (the writes are a second apart).
+TEST(WriteImage, SameImageGivesSameBytesAcrossTime) {
+  const fs::path dir = FreshDir("same_bytes");
+  const Image src = TestPattern(16, 8);
+  for (const char* ext : {".exr", ".tif", ".png"}) {
+    const std::string a = (dir / (std::string("a") + ext)).string();
+    const std::string b = (dir / (std::string("b") + ext)).string();
+    ASSERT_TRUE(WriteImage(src, a));
+    std::this_thread::sleep_for(std::chrono::milliseconds(1100));
+    ASSERT_TRUE(WriteImage(src, b));
+    EXPECT_EQ(testsupport::ReadWholeFile(a), testsupport::ReadWholeFile(b)) << ext;
   }
 }
 
