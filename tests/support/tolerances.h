@@ -130,4 +130,14 @@ inline constexpr double kRebuildRelTol = 1e-4;
 // Projection recovering known (u,v,d) (Newton stops at 1e-7 x diagonal).
 inline constexpr double kProjectionTol = 1e-6;
 
+// Pose-space RBF evaluated in float against the examples it was fitted to
+// (weights solved in double, displacements of order 1 model unit).
+inline constexpr float kRbfExactTol = 1e-4f;
+// Direct manipulation: a solved constraint lands on its target (double, relative to the patch size).
+inline constexpr double kConstraintRelTol = 1e-9;
+// A vertex edit measured on the float rebuild (PatchRebuildJob), relative to the patch size.
+inline constexpr double kVertexEditRelTol = 1e-5;
+// Rotations compared component-wise (polar factor, blended frames; float quaternions).
+inline constexpr float kRotationTol = 1e-5f;
+
 }  // namespace testsupport
