@@ -69,6 +69,28 @@ std::string ExampleLabel(const PoseExample& e, size_t index) {
 
 }  // namespace
 
+std::vector<PoseFeatureJoint> InfluencingJoints(const mocap::Skeleton& skeleton,
+                                                std::span<const int> skin_joints, int influences,
+                                                std::span<const std::uint16_t> joint_indices,
+                                                std::span<const float> joint_weights,
+                                                float min_weight) {
+  std::vector<std::uint8_t> used(static_cast<size_t>(skeleton.num_joints()), 0);
+  const size_t n = std::min(joint_indices.size(), joint_weights.size());
+  for (size_t k = 0; influences > 0 && k < n; ++k) {
+    if (!(joint_weights[k] >= min_weight) || joint_indices[k] >= skin_joints.size()) continue;
+    const int joint = skin_joints[joint_indices[k]];
+    if (joint >= 0 && joint < skeleton.num_joints()) used[static_cast<size_t>(joint)] = 1;
+  }
+  std::vector<PoseFeatureJoint> out;
+  for (int j = 0; j < skeleton.num_joints(); ++j) {
+    if (used[static_cast<size_t>(j)] != 0 &&
+        skeleton.parents[static_cast<size_t>(j)] != mocap::kNoParent) {
+      out.push_back({.joint = j});
+    }
+  }
+  return out;
+}
+
 int PoseFeatureDimension(const mocap::Skeleton& skeleton, const PoseFeatureSpec& spec) {
   int dim = 0;
   for (const PoseFeatureJoint& j : spec.joints) {

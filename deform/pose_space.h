@@ -59,6 +59,18 @@ struct PoseFeatureSpec {
   std::vector<PoseFeatureJoint> joints{};  // in the order their features are concatenated
 };
 
+// The default joints of a patch (5.1): the skeleton joints whose skin joints
+// carry at least `min_weight` of some control point's weight, minus roots,
+// in increasing joint order, each with weight 1. `skin_joints` maps skin
+// joint -> skeleton joint (SkinnedMesh::skin_joints); joint_indices and
+// joint_weights are #C x influences control-point weights (3.7). Indices out
+// of range are skipped (they were checked by CheckSkinWeights).
+std::vector<PoseFeatureJoint> InfluencingJoints(const mocap::Skeleton& skeleton,
+                                                std::span<const int> skin_joints, int influences,
+                                                std::span<const std::uint16_t> joint_indices,
+                                                std::span<const float> joint_weights,
+                                                float min_weight = 0.01f);
+
 // Number of features of `spec` on `skeleton`: 3 per joint, except kEuler which
 // has one per rotation channel of the joint.
 int PoseFeatureDimension(const mocap::Skeleton& skeleton, const PoseFeatureSpec& spec);

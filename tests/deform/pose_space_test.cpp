@@ -331,6 +331,18 @@ TEST(PoseFeatures, SpecChecks) {
   EXPECT_TRUE(deform::CheckPoseFeatureSpec(s, {.joints = {{.joint = 1, .weight = 2.0f}}}).ok());
 }
 
+TEST(PoseFeatures, InfluencingJointsSkipRootsAndLightWeights) {
+  const mocap::Skeleton s = ElbowSkeleton();
+  const std::vector<int> skin_joints = {1, 0};  // skin joint 0 -> elbow, 1 -> root
+  const std::vector<std::uint16_t> joints = {0, 1, 1, 0};
+  const std::vector<float> weights = {0.6f, 0.4f, 1.0f, 0.0f};
+  const auto found = deform::InfluencingJoints(s, skin_joints, 2, joints, weights);
+  ASSERT_EQ(found.size(), 1u);
+  EXPECT_EQ(found[0].joint, 1);
+  const std::vector<float> light = {0.0f, 1.0f, 1.0f, 0.0f};
+  EXPECT_TRUE(deform::InfluencingJoints(s, skin_joints, 2, joints, light).empty());
+}
+
 TEST(PoseFeatures, FromMotionFrame) {
   const mocap::Skeleton s = ElbowSkeleton();
   mocap::Motion motion{.num_frames = 2, .num_channels = 3, .values = {0, 0, 0, 30, 0, 0}};
