@@ -127,5 +127,14 @@ inline constexpr double kProjectionTol = 1e-6;
 // `inspect` world positions (float chains, printed with 6+ digits) against a
 // double-precision reference, relative to the figure's largest coordinate.
 inline constexpr double kInspectRelTol = 2e-5;
+// Pose-space RBF evaluated in float against the examples it was fitted to
+// (weights solved in double, displacements of order 1 model unit).
+inline constexpr float kRbfExactTol = 1e-4f;
+// Direct manipulation: a solved constraint lands on its target (double, relative to the patch size).
+inline constexpr double kConstraintRelTol = 1e-9;
+// A vertex edit measured on the float rebuild (PatchRebuildJob), relative to the patch size.
+inline constexpr double kVertexEditRelTol = 1e-5;
+// Rotations compared component-wise (polar factor, blended frames; float quaternions).
+inline constexpr float kRotationTol = 1e-5f;
 
 }  // namespace testsupport
