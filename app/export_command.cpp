@@ -59,7 +59,8 @@ mocap::Status CreateFolder(const std::filesystem::path& dir) {
 
 }  // namespace
 
-std::string CameraJson(const render::Camera& camera, glm::ivec2 size, int frame, double time_s) {
+std::string CameraJson(const render::Camera& camera, glm::ivec2 size, float ground_y, int frame,
+                       double time_s) {
   nlohmann::ordered_json j;
   j["frame"] = frame;
   j["time_s"] = time_s;
@@ -72,6 +73,7 @@ std::string CameraJson(const render::Camera& camera, glm::ivec2 size, int frame,
   j["eye"] = Vec3(camera.eye);
   j["target"] = Vec3(camera.target);
   j["up"] = Vec3(camera.up);
+  j["ground_y"] = ground_y;
   j["view"] = ColumnMajor(camera.ViewFromWorld());
   j["projection"] = ColumnMajor(camera.ClipFromView());
   return j.dump(2) + "\n";
@@ -198,7 +200,8 @@ int RunExport(const ExportOptions& o) {
       char file[32];
       std::snprintf(file, sizeof(file), "camera_%04d.json", of.number);
       s = deform::WriteFileAtomic((out_dir / file).string(),
-                                  CameraJson(cameras->At(of), *size, of.number, of.time_s));
+                                  CameraJson(cameras->At(of), *size, cameras->ground_y(),
+                                             of.number, of.time_s));
       if (!s.ok()) return Fail(s.error());
     }
     progress.Step(of.number);

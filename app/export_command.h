@@ -45,9 +45,11 @@ int RunExport(const ExportOptions& options);
 // The camera JSON of one frame (one object, keys in this order):
 //   frame, time_s, width, height, aspect, fov_y_deg, near, far,
 //   eye [x,y,z], target [x,y,z], up [x,y,z] (world space),
+//   ground_y (world Y of the ground plane render draws under the body),
 //   view: world->view matrix, projection: view->clip matrix (OpenGL clip
 //   space, depth -1..1), both 16 numbers in column-major order (element
 //   (row r, column c) at index 4c + r, as glm and glTF store matrices).
-std::string CameraJson(const render::Camera& camera, glm::ivec2 size, int frame, double time_s);
+std::string CameraJson(const render::Camera& camera, glm::ivec2 size, float ground_y, int frame,
+                       double time_s);
 
 }  // namespace app
