@@ -1,5 +1,6 @@
 #include "app/export_command.h"
 
+#include <cctype>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
