@@ -9,6 +9,7 @@
 #include <CLI/CLI.hpp>
 
 #include "app/compare_command.h"
+#include "app/export_command.h"
 #include "app/inspect_command.h"
 #include "app/render_command.h"
 
@@ -24,6 +25,8 @@ int main(int argc, char** argv) {
   app::RenderOptions turntable_options;
   turntable_options.camera = "turntable";
   CLI::App* turntable = app::AddTurntableCommand(app, turntable_options);
+  app::ExportOptions export_options;
+  CLI::App* export_cmd = app::AddExportCommand(app, export_options);
   app::CompareCommandOptions compare_options;
   CLI::App* compare = app::AddCompareCommand(app, &compare_options);
 
@@ -40,6 +43,7 @@ int main(int argc, char** argv) {
     if (render->parsed()) return app::RunRender(render_options);
     if (turntable->parsed()) return app::RunRender(turntable_options);
     if (compare->parsed()) return app::RunCompareCommand(compare_options);
+    if (export_cmd->parsed()) return app::RunExport(export_options);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "patchskin: internal error: %s\n", e.what());
     return 3;

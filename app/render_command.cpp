@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "app/demo_data.h"
+#include "app/frame_plan.h"
 #include "app/motion_source.h"
 #include "app/pipeline.h"
 #include "app/progress.h"
@@ -24,65 +25,6 @@ namespace app {
 namespace {
 
 constexpr int kMaxSheetFrames = 24;
-constexpr float kFovYDeg = 35.0f;
-constexpr int kMaxImageSide = 16384;
-
-mocap::Error ArgError(const std::string& option, const std::string& message) {
-  return mocap::MakeError(mocap::ErrorCode::kInvalidArgument, {option, 0, 0, {}}, message);
-}
-
-mocap::Result<glm::ivec2> ParseSize(const std::string& text) {
-  int w = 0, h = 0;
-  char x = 0, extra = 0;
-  std::istringstream in(text);
-  if (!(in >> w >> x >> h) || (x != 'x' && x != 'X') || (in >> extra)) {
-    return ArgError("--size", "expected WIDTHxHEIGHT such as 1280x720, found '" + text + "'");
-  }
-  if (w < 16 || h < 16 || w > kMaxImageSide || h > kMaxImageSide) {
-    return ArgError("--size", "width and height must be within 16.." + std::to_string(kMaxImageSide) +
-                                  ", found " + text);
-  }
-  return glm::ivec2(w, h);
-}
-
-struct FrameRange {
-  int first = 0;
-  int last = 0;   // inclusive
-  int step = 1;
-};
-
-mocap::Result<FrameRange> ParseFrames(const std::string& text, int num_frames) {
-  FrameRange r{0, num_frames - 1, 1};
-  if (text.empty()) return r;
-  std::vector<std::string> parts;
-  std::stringstream ss(text);
-  for (std::string part; std::getline(ss, part, ':');) parts.push_back(part);
-  if (parts.empty() || parts.size() > 3) {
-    return ArgError("--frames", "expected A:B or A:B:STEP, found '" + text + "'");
-  }
-  auto parse_int = [&](const std::string& s, int fallback) -> std::optional<int> {
-    if (s.empty()) return fallback;
-    std::size_t used = 0;
-    try {
-      const long v = std::stol(s, &used);
-      if (used != s.size() || v < INT32_MIN || v > INT32_MAX) return std::nullopt;
-      return static_cast<int>(v);
-    } catch (...) {
-      return std::nullopt;
-    }
-  };
-  const auto a = parse_int(parts[0], 0);
-  const auto b = parse_int(parts.size() > 1 ? parts[1] : parts[0], num_frames - 1);
-  const auto c = parse_int(parts.size() > 2 ? parts[2] : "", 1);
-  if (!a || !b || !c) return ArgError("--frames", "expected whole numbers in '" + text + "'");
-  r = {*a, *b, *c};
-  if (r.step < 1) return ArgError("--frames", "STEP must be at least 1, found " + std::to_string(r.step));
-  if (r.first < 0 || r.last < r.first || r.last >= num_frames) {
-    return ArgError("--frames", "range " + text + " is outside the motion's frames 0.." +
-                                    std::to_string(num_frames - 1) + " (A <= B, both inclusive)");
-  }
-  return r;
-}
 
 std::vector<std::string> SplitList(const std::string& text) {
   std::vector<std::string> out;
@@ -92,13 +34,6 @@ std::vector<std::string> SplitList(const std::string& text) {
   }
   return out;
 }
-
-// Everything about one output frame that the loop needs.
-struct OutputFrame {
-  int number = 0;      // output frame number (names the file)
-  double time_s = 0;   // motion time evaluated
-  int camera = 0;      // turntable camera index, or the follow-camera frame
-};
 
 void AddSkeleton(const DeformedFrame& f, const mocap::Skeleton& s, render::Overlays& o) {
   render::LineOverlay bones;
@@ -240,21 +175,13 @@ int RunRender(const RenderOptions& o) {
   if (!character.ok()) return Fail(character.error());
   const Character& ch = *character;
 
-  const double frame_time = o.fps > 0.0 ? 1.0 / o.fps
-                                        : (ch.motion.frame_time_s > 0 ? ch.motion.frame_time_s : 1.0 / 30.0);
-  const int motion_frames =
-      ch.motion.num_frames > 0
-          ? static_cast<int>(std::floor(ch.motion.duration_s() / frame_time + 1e-9)) + 1
-          : 1;
   const bool turntable = o.camera == "turntable";
-  mocap::Result<FrameRange> range = ParseFrames(o.frames, motion_frames);
-  if (!range.ok()) return Fail(range.error());
-  std::vector<OutputFrame> frames;
-  if (turntable) {
-    for (int k = 0; k < o.turntable_frames; ++k) frames.push_back({k, range->first * frame_time, k});
-  } else {
-    for (int f = range->first; f <= range->last; f += range->step) frames.push_back({f, f * frame_time, f});
-  }
+  mocap::Result<FramePlan> plan = PlanFrames(
+      ch.motion, {.frames = o.frames, .fps = o.fps, .turntable = turntable,
+                  .turntable_frames = o.turntable_frames});
+  if (!plan.ok()) return Fail(plan.error());
+  const double frame_time = plan->frame_time_s;
+  const std::vector<OutputFrame>& frames = plan->frames;
 
   std::string pattern = o.out;
   if (pattern.empty()) pattern = "out/" + name + (turntable ? "_turntable" : "") + "/frame_####.png";
@@ -274,65 +201,12 @@ int RunRender(const RenderOptions& o) {
     right_pipeline.emplace(std::move(*p));
   }
 
-  // --- Framing: a pre-pass over up to 64 frames of the range ------------------
+  // --- Framing (app/frame_plan.h) ------------------------------------------------
   DeformedFrame frame, right_frame;
-  deform::Bounds all_bounds;
-  glm::vec3 largest_extent(0.0f);
-  float ground_y = 1e30f;
-  {
-    const int samples = std::min<int>(64, static_cast<int>(frames.size()));
-    for (int i = 0; i < samples; ++i) {
-      const std::size_t k = frames.size() * static_cast<std::size_t>(i) / static_cast<std::size_t>(samples);
-      const mocap::Status s = pipeline->Evaluate(frames[k].time_s, frame);
-      if (!s.ok()) return Fail(s.error());
-      all_bounds.Extend(frame.bounds.min);
-      all_bounds.Extend(frame.bounds.max);
-      largest_extent = glm::max(largest_extent, frame.bounds.size());
-      ground_y = std::min(ground_y, frame.bounds.min.y);
-    }
-  }
-  const float aspect = static_cast<float>(size->x) / static_cast<float>(size->y);
-  const float elevation = glm::radians(o.elevation_deg);
-  // Seen from the character's front-left, slightly above (characters face +Z).
-  const glm::vec3 view_dir = -glm::normalize(glm::vec3(0.45f, 0.0f, 1.0f) * std::cos(elevation) +
-                                             glm::vec3(0.0f, std::sin(elevation), 0.0f));
-  std::vector<render::Camera> turntable_cameras;
-  render::Camera fixed_camera;
-  render::FollowCamera follow;
-  std::vector<glm::vec3> centres;  // follow camera: one per motion frame up to the last output
-  int centre_base = 0;
-  if (turntable) {
-    const mocap::Status s = pipeline->Evaluate(frames.front().time_s, frame);
-    if (!s.ok()) return Fail(s.error());
-    const render::Camera framed = render::FrameBounds(frame.bounds, kFovYDeg, aspect, view_dir);
-    turntable_cameras = render::TurntablePath(frame.bounds.center(),
-                                              glm::length(framed.eye - framed.target),
-                                              o.elevation_deg, o.turntable_frames);
-    for (render::Camera& c : turntable_cameras) {
-      c.fov_y_deg = kFovYDeg;
-      c.aspect = aspect;
-    }
-  } else if (o.camera == "fixed") {
-    fixed_camera = render::FrameBounds(all_bounds, kFovYDeg, aspect, view_dir);
-  } else {
-    deform::Bounds typical;
-    typical.Extend(-0.5f * largest_extent);
-    typical.Extend(0.5f * largest_extent);
-    const render::Camera framed = render::FrameBounds(typical, kFovYDeg, aspect, view_dir);
-    follow.offset = framed.eye - framed.target;
-    follow.fov_y_deg = kFovYDeg;
-    follow.aspect = aspect;
-    follow.near_plane = framed.near_plane;
-    follow.far_plane = framed.far_plane * 4.0f;
-    follow.frame_time_s = static_cast<float>(frame_time);
-    centre_base = std::max(0, range->first - follow.window_frames);
-    // Centres of the body's bounds at every output frame the filter can see.
-    for (int f = centre_base; f <= range->last; ++f) {
-      const mocap::Status s = pipeline->Evaluate(f * frame_time, frame);
-      if (!s.ok()) return Fail(s.error());
-      centres.push_back(frame.bounds.center());
-    }
-  }
+  mocap::Result<CameraPlan> cameras = CameraPlan::Create(*pipeline, *plan, o.camera,
+                                                         o.elevation_deg, *size);
+  if (!cameras.ok()) return Fail(cameras.error());
+  const float ground_y = cameras->ground_y();
 
   // --- Outputs -------------------------------------------------------------------
   {
@@ -371,7 +245,7 @@ int RunRender(const RenderOptions& o) {
   }
   std::unique_ptr<render::VideoWriter> video;
   if (!o.no_video) {
-    const double video_fps = turntable ? 24.0 : 1.0 / (frame_time * range->step);
+    const double video_fps = turntable ? 24.0 : 1.0 / (frame_time * plan->range.step);
     auto v = render::VideoWriter::Open((out_dir / "preview.mp4").string(), size->x & ~1,
                                        size->y & ~1, {.fps = video_fps});
     if (!v.ok()) return Fail(v.error());
@@ -386,10 +260,7 @@ int RunRender(const RenderOptions& o) {
     const OutputFrame& of = frames[i];
     mocap::Status s = pipeline->Evaluate(of.time_s, frame);
     if (!s.ok()) return Fail(s.error());
-    render::Camera camera = turntable ? turntable_cameras[static_cast<std::size_t>(of.camera)]
-                            : o.camera == "fixed"
-                                ? fixed_camera
-                                : follow.At(centres, of.camera - centre_base);
+    const render::Camera camera = cameras->At(of);
     auto draw = [&](const DeformedFrame& f, render::Renderer& r, const std::string& label,
                     int label_x, render::Image& into) -> mocap::Status {
       const deform::Mesh& bind = ch.mesh.bind;

@@ -138,3 +138,16 @@ inline constexpr double kVertexEditRelTol = 1e-5;
 inline constexpr float kRotationTol = 1e-5f;
 
 }  // namespace testsupport
+
+namespace testsupport {
+
+// A morph-target frame read back: base + (frame - base) in float, for values of
+// order 1 (round-off of one subtraction and one addition, a few ulps).
+inline constexpr float kMorphRoundTripTol = 1e-6f;
+// glb size estimates (JSON bytes per frame approximated) vs the written file.
+inline constexpr double kGlbSizeEstimateRelTol = 0.15;
+// Two glb layouts whose files differ by less than this are a tie for the
+// automatic choice (it decides on estimates).
+inline constexpr double kGlbLayoutTieRelTol = 0.02;
+
+}  // namespace testsupport

@@ -1,0 +1,224 @@
+#include "app/export_command.h"
+
+#include <cctype>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <optional>
+
+#include <nlohmann/json.hpp>
+
+#include "app/demo_data.h"
+#include "app/frame_plan.h"
+#include "app/motion_source.h"
+#include "app/pipeline.h"
+#include "app/progress.h"
+#include "deform/file_output.h"
+#include "deform/gltf_export.h"
+#include "deform/obj_writer.h"
+#include "render/image_io.h"
+
+namespace app {
+namespace {
+
+int Fail(const mocap::Error& e) {
+  std::fprintf(stderr, "%s\n", e.ToString().c_str());
+  return e.code == mocap::ErrorCode::kInternal ? 3 : 2;
+}
+
+std::string Lower(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+nlohmann::json Vec3(const glm::vec3& v) { return nlohmann::json::array({v.x, v.y, v.z}); }
+
+nlohmann::json ColumnMajor(const glm::mat4& m) {
+  nlohmann::json a = nlohmann::json::array();
+  for (int c = 0; c < 4; ++c) {
+    for (int r = 0; r < 4; ++r) a.push_back(m[c][r]);
+  }
+  return a;
+}
+
+mocap::Result<deform::GltfExportLayout> ParseLayout(const std::string& text) {
+  if (text == "auto") return deform::GltfExportLayout::kAuto;
+  if (text == "morph") return deform::GltfExportLayout::kMorphTargets;
+  if (text == "baked") return deform::GltfExportLayout::kBakedMeshes;
+  return ArgError("--layout", "expected auto, morph or baked, found '" + text + "'");
+}
+
+mocap::Status CreateFolder(const std::filesystem::path& dir) {
+  std::error_code ec;
+  if (!dir.empty()) std::filesystem::create_directories(dir, ec);
+  if (ec) {
+    return mocap::MakeError(mocap::ErrorCode::kIo, {dir.string(), 0, 0, {}},
+                            "cannot create the output folder: " + ec.message());
+  }
+  return mocap::Status::Ok();
+}
+
+}  // namespace
+
+std::string CameraJson(const render::Camera& camera, glm::ivec2 size, float ground_y, int frame,
+                       double time_s) {
+  nlohmann::ordered_json j;
+  j["frame"] = frame;
+  j["time_s"] = time_s;
+  j["width"] = size.x;
+  j["height"] = size.y;
+  j["aspect"] = camera.aspect;
+  j["fov_y_deg"] = camera.fov_y_deg;
+  j["near"] = camera.near_plane;
+  j["far"] = camera.far_plane;
+  j["eye"] = Vec3(camera.eye);
+  j["target"] = Vec3(camera.target);
+  j["up"] = Vec3(camera.up);
+  j["ground_y"] = ground_y;
+  j["view"] = ColumnMajor(camera.ViewFromWorld());
+  j["projection"] = ColumnMajor(camera.ClipFromView());
+  return j.dump(2) + "\n";
+}
+
+CLI::App* AddExportCommand(CLI::App& parent, ExportOptions& o) {
+  CLI::App* cmd = parent.add_subcommand(
+      "export", "Write the deformed mesh of every frame as an OBJ sequence or one glTF (.glb)");
+  cmd->add_option("input", o.input, "BVH, glTF or GLB file; none = the built-in demo");
+  cmd->add_option("--frames", o.frames, "A:B[:STEP] output frames, inclusive (default all)");
+  cmd->add_option("--fps", o.fps, "Output frame rate; the motion is resampled (default: its own)");
+  cmd->add_option("--out", o.out,
+                  "mesh_####.obj (one OBJ per frame, #### = frame number) or FILE.glb "
+                  "(default out/<name>_export/mesh_####.obj)");
+  cmd->add_option("--global", o.global, "Global skinning: ssd, dqs or swd")->capture_default_str();
+  cmd->add_option("--layout", o.layout, ".glb: auto (smaller), morph or baked")
+      ->capture_default_str();
+  cmd->add_flag("--step", o.step, ".glb: hold each frame (STEP) instead of blending (LINEAR)");
+  cmd->add_flag("--with-camera", o.with_camera,
+                "Also write camera_####.json per frame: the camera render would use");
+  cmd->add_option("--camera", o.camera, "Camera for --with-camera: follow or fixed")
+      ->capture_default_str();
+  cmd->add_option("--size", o.size, "Image size for --with-camera, WxH")->capture_default_str();
+  cmd->add_option("--elevation", o.elevation_deg, "Camera elevation in degrees")
+      ->capture_default_str();
+  cmd->add_option("--threads", o.threads, "Worker threads (0 = all cores)")->capture_default_str();
+  cmd->add_flag("--quiet", o.quiet, "No progress output");
+  return cmd;
+}
+
+int RunExport(const ExportOptions& o) {
+  // --- Arguments -------------------------------------------------------------
+  const mocap::Result<glm::ivec2> size = ParseSize(o.size);
+  if (!size.ok()) return Fail(size.error());
+  if (o.camera != "follow" && o.camera != "fixed") {
+    return Fail(ArgError("--camera", "expected follow or fixed, found '" + o.camera + "'"));
+  }
+  if (o.threads < 0 || o.threads > 256) return Fail(ArgError("--threads", "expected 0..256"));
+  if (!(o.fps >= 0.0) || o.fps > 10000.0) return Fail(ArgError("--fps", "expected 0 < fps <= 10000"));
+  const mocap::Result<GlobalMethod> method = ParseGlobalMethod(o.global);
+  if (!method.ok()) return Fail(method.error());
+  const mocap::Result<deform::GltfExportLayout> layout = ParseLayout(o.layout);
+  if (!layout.ok()) return Fail(layout.error());
+
+  // --- Input (as render) --------------------------------------------------------
+  MotionSourceOptions load;
+  load.y_up = true;
+  const bool demo = o.input.empty();
+  mocap::Result<MotionSource> src = demo ? LoadBvhText(DemoBvhText(), "demo_walk.bvh", load)
+                                         : LoadMotionSource(o.input, load);
+  if (!src.ok()) return Fail(src.error());
+  if (!o.quiet) {
+    for (const mocap::Warning& w : src->warnings) std::fprintf(stderr, "%s\n", w.ToString().c_str());
+  }
+  const std::string name = demo ? "demo" : std::filesystem::path(o.input).stem().string();
+  mocap::Result<Character> character = MakeCharacter(std::move(*src));
+  if (!character.ok()) return Fail(character.error());
+  const Character& ch = *character;
+  mocap::Result<FramePlan> plan = PlanFrames(ch.motion, {.frames = o.frames, .fps = o.fps});
+  if (!plan.ok()) return Fail(plan.error());
+
+  const std::string out = o.out.empty() ? "out/" + name + "_export/mesh_####.obj" : o.out;
+  const std::string ext = Lower(std::filesystem::path(out).extension().string());
+  const bool glb = ext == ".glb";
+  if (!glb && ext != ".obj") {
+    return Fail(ArgError("--out", "expected a .obj pattern or a .glb file, found '" + out + "'"));
+  }
+  if (!glb && !render::HasFramePlaceholder(out)) {
+    return Fail(ArgError("--out", "the OBJ pattern '" + out +
+                                      "' needs one frame placeholder such as #### or %04d"));
+  }
+  const std::filesystem::path out_dir =
+      glb ? std::filesystem::path(out).parent_path()
+          : std::filesystem::path(*render::ExpandFramePattern(out, 0)).parent_path();
+  if (mocap::Status s = CreateFolder(out_dir); !s) return Fail(s.error());
+
+  // --- Pipeline and cameras ----------------------------------------------------------
+  mocap::Result<FramePipeline> pipeline = FramePipeline::Create(ch, *method, o.threads);
+  if (!pipeline.ok()) return Fail(pipeline.error());
+  std::optional<CameraPlan> cameras;
+  if (o.with_camera) {
+    mocap::Result<CameraPlan> c = CameraPlan::Create(*pipeline, *plan, o.camera, o.elevation_deg, *size);
+    if (!c.ok()) return Fail(c.error());
+    cameras.emplace(std::move(*c));
+  }
+  std::optional<deform::GltfSequenceWriter> gltf;
+  const deform::Mesh& bind = ch.mesh.bind;
+  if (glb) {
+    deform::GltfExportOptions go;
+    go.frame_time_s = plan->frame_time_s * plan->range.step;
+    go.layout = *layout;
+    go.step_interpolation = o.step;
+    go.generator = "patchskin export (" + std::string(GlobalMethodName(*method)) + ")";
+    mocap::Result<deform::GltfSequenceWriter> w = deform::GltfSequenceWriter::Create(
+        bind.triangles, bind.colors, bind.num_vertices(), static_cast<int>(plan->frames.size()), go);
+    if (!w.ok()) return Fail(w.error());
+    gltf.emplace(std::move(*w));
+  }
+
+  // --- The frame loop: one frame in memory (OBJ) ---------------------------------------
+  Progress progress(demo ? "export demo" : "export " + name, static_cast<int>(plan->frames.size()),
+                    o.quiet);
+  DeformedFrame frame;
+  deform::ObjSequenceWriter obj;
+  const std::string source = demo ? "demo_walk.bvh (built in)" : o.input;
+  for (const OutputFrame& of : plan->frames) {
+    mocap::Status s = pipeline->Evaluate(of.time_s, frame);
+    if (!s.ok()) return Fail(s.error());
+    if (gltf) {
+      s = gltf->AddFrame(frame.positions, frame.normals);
+    } else {
+      const mocap::Result<std::string> path = render::ExpandFramePattern(out, of.number);
+      if (!path.ok()) return Fail(path.error());
+      char comment[160];
+      std::snprintf(comment, sizeof(comment), "frame %d, t = %.6f s, %s skinning", of.number,
+                    of.time_s, GlobalMethodName(*method));
+      s = obj.Write({.positions = frame.positions, .normals = frame.normals,
+                     .triangles = bind.triangles,
+                     .comment = "patchskin export of " + source + "\n" + comment},
+                    *path);
+    }
+    if (!s.ok()) return Fail(s.error());
+    if (cameras) {
+      char file[32];
+      std::snprintf(file, sizeof(file), "camera_%04d.json", of.number);
+      s = deform::WriteFileAtomic((out_dir / file).string(),
+                                  CameraJson(cameras->At(of), *size, cameras->ground_y(),
+                                             of.number, of.time_s));
+      if (!s.ok()) return Fail(s.error());
+    }
+    progress.Step(of.number);
+  }
+  if (gltf) {
+    if (mocap::Status s = gltf->Finish(out); !s) return Fail(s.error());
+  }
+  progress.Finish();
+  if (glb) {
+    std::printf("glb:     %s (%zu frames, %s layout)\n", out.c_str(), plan->frames.size(),
+                deform::GltfExportLayoutName(gltf->layout()));
+  } else {
+    std::printf("obj:     %s (%zu frames)\n", out.c_str(), plan->frames.size());
+  }
+  if (cameras) std::printf("cameras: %s\n", (out_dir / "camera_####.json").string().c_str());
+  return 0;
+}
+
+}  // namespace app

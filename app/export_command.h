@@ -1,0 +1,55 @@
+#pragma once
+// `patchskin export [INPUT] --out PATTERN`: the deformed mesh of every output
+// frame as geometry other tools open, evaluated by the same FramePipeline,
+// frame plan and options as `render` (so frame N of an export is exactly the
+// mesh `render` draws as frame N):
+//   * --out ending in .obj (with a #### placeholder): one OBJ per frame
+//     (deform/obj_writer.h), written as the frames are evaluated; one frame is
+//     held in memory whatever the frame count;
+//   * --out ending in .glb: one glTF 2.0 file with the deformation as a
+//     morph-target animation or baked per-frame meshes (deform/gltf_export.h).
+// --with-camera also writes camera_####.json per frame next to the output: the
+// camera `render` would use for that frame (see CameraJson).
+
+#include <string>
+
+#include <CLI/CLI.hpp>
+#include <glm/glm.hpp>
+
+#include "render/camera.h"
+
+namespace app {
+
+struct ExportOptions {
+  std::string input;              // empty = built-in demo
+  std::string frames;             // "A:B[:STEP]", inclusive, in output frames; empty = all
+  double fps = 0.0;               // output frame rate; 0 = the capture's own
+  std::string out;                // .obj pattern with ####, or a .glb path;
+                                  // empty = out/<name>_export/mesh_####.obj
+  std::string global = "ssd";     // ssd | dqs | swd
+  std::string layout = "auto";    // .glb: auto | morph | baked
+  bool step = false;              // .glb morph weights: STEP instead of LINEAR
+  bool with_camera = false;       // also write camera_####.json per frame
+  std::string camera = "follow";  // follow | fixed (as render)
+  std::string size = "1280x720";  // image size the camera JSON is for
+  float elevation_deg = 15.0f;    // camera elevation (as render)
+  int threads = 0;                // 0 = hardware concurrency
+  bool quiet = false;
+};
+
+CLI::App* AddExportCommand(CLI::App& parent, ExportOptions& options);
+
+// Runs an export. Exit code: 0 ok, 2 bad input, 3 internal error.
+int RunExport(const ExportOptions& options);
+
+// The camera JSON of one frame (one object, keys in this order):
+//   frame, time_s, width, height, aspect, fov_y_deg, near, far,
+//   eye [x,y,z], target [x,y,z], up [x,y,z] (world space),
+//   ground_y (world Y of the ground plane render draws under the body),
+//   view: world->view matrix, projection: view->clip matrix (OpenGL clip
+//   space, depth -1..1), both 16 numbers in column-major order (element
+//   (row r, column c) at index 4c + r, as glm and glTF store matrices).
+std::string CameraJson(const render::Camera& camera, glm::ivec2 size, float ground_y, int frame,
+                       double time_s);
+
+}  // namespace app

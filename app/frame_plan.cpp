@@ -1,0 +1,160 @@
+#include "app/frame_plan.h"
+
+#include <algorithm>
+#include <climits>
+#include <cmath>
+#include <optional>
+#include <sstream>
+
+namespace app {
+
+constexpr int kMaxImageSide = 16384;
+
+mocap::Error ArgError(const std::string& option, const std::string& message) {
+  return mocap::MakeError(mocap::ErrorCode::kInvalidArgument, {option, 0, 0, {}}, message);
+}
+
+mocap::Result<glm::ivec2> ParseSize(const std::string& text) {
+  int w = 0, h = 0;
+  char x = 0, extra = 0;
+  std::istringstream in(text);
+  if (!(in >> w >> x >> h) || (x != 'x' && x != 'X') || (in >> extra)) {
+    return ArgError("--size", "expected WIDTHxHEIGHT such as 1280x720, found '" + text + "'");
+  }
+  if (w < 16 || h < 16 || w > kMaxImageSide || h > kMaxImageSide) {
+    return ArgError("--size", "width and height must be within 16.." + std::to_string(kMaxImageSide) +
+                                  ", found " + text);
+  }
+  return glm::ivec2(w, h);
+}
+
+mocap::Result<FrameRange> ParseFrames(const std::string& text, int num_frames) {
+  FrameRange r{0, num_frames - 1, 1};
+  if (text.empty()) return r;
+  std::vector<std::string> parts;
+  std::stringstream ss(text);
+  for (std::string part; std::getline(ss, part, ':');) parts.push_back(part);
+  if (parts.empty() || parts.size() > 3) {
+    return ArgError("--frames", "expected A:B or A:B:STEP, found '" + text + "'");
+  }
+  auto parse_int = [&](const std::string& s, int fallback) -> std::optional<int> {
+    if (s.empty()) return fallback;
+    std::size_t used = 0;
+    try {
+      const long v = std::stol(s, &used);
+      if (used != s.size() || v < INT32_MIN || v > INT32_MAX) return std::nullopt;
+      return static_cast<int>(v);
+    } catch (...) {
+      return std::nullopt;
+    }
+  };
+  const auto a = parse_int(parts[0], 0);
+  const auto b = parse_int(parts.size() > 1 ? parts[1] : parts[0], num_frames - 1);
+  const auto c = parse_int(parts.size() > 2 ? parts[2] : "", 1);
+  if (!a || !b || !c) return ArgError("--frames", "expected whole numbers in '" + text + "'");
+  r = {*a, *b, *c};
+  if (r.step < 1) return ArgError("--frames", "STEP must be at least 1, found " + std::to_string(r.step));
+  if (r.first < 0 || r.last < r.first || r.last >= num_frames) {
+    return ArgError("--frames", "range " + text + " is outside the motion's frames 0.." +
+                                    std::to_string(num_frames - 1) + " (A <= B, both inclusive)");
+  }
+  return r;
+}
+
+mocap::Result<FramePlan> PlanFrames(const mocap::Motion& motion, const FramePlanOptions& o) {
+  FramePlan plan;
+  plan.frame_time_s = o.fps > 0.0 ? 1.0 / o.fps
+                                  : (motion.frame_time_s > 0 ? motion.frame_time_s : 1.0 / 30.0);
+  plan.motion_frames =
+      motion.num_frames > 0
+          ? static_cast<int>(std::floor(motion.duration_s() / plan.frame_time_s + 1e-9)) + 1
+          : 1;
+  mocap::Result<FrameRange> range = ParseFrames(o.frames, plan.motion_frames);
+  if (!range.ok()) return range.error();
+  plan.range = *range;
+  if (o.turntable) {
+    for (int k = 0; k < o.turntable_frames; ++k) {
+      plan.frames.push_back({k, plan.range.first * plan.frame_time_s, k});
+    }
+  } else {
+    for (int f = plan.range.first; f <= plan.range.last; f += plan.range.step) {
+      plan.frames.push_back({f, f * plan.frame_time_s, f});
+    }
+  }
+  return plan;
+}
+
+mocap::Result<CameraPlan> CameraPlan::Create(FramePipeline& pipeline, const FramePlan& plan,
+                                             const std::string& mode, float elevation_deg,
+                                             glm::ivec2 size) {
+  if (mode != "follow" && mode != "fixed" && mode != "turntable") {
+    return ArgError("--camera", "expected follow, fixed or turntable, found '" + mode + "'");
+  }
+  if (plan.frames.empty()) return ArgError("--frames", "no frames to frame");
+  CameraPlan cp;
+  cp.mode_ = mode;
+  const std::vector<OutputFrame>& frames = plan.frames;
+  // Framing: a pre-pass over up to 64 frames of the range.
+  DeformedFrame frame;
+  deform::Bounds all_bounds;
+  glm::vec3 largest_extent(0.0f);
+  float ground_y = 1e30f;
+  const int samples = std::min<int>(64, static_cast<int>(frames.size()));
+  for (int i = 0; i < samples; ++i) {
+    const std::size_t k = frames.size() * static_cast<std::size_t>(i) / static_cast<std::size_t>(samples);
+    const mocap::Status s = pipeline.Evaluate(frames[k].time_s, frame);
+    if (!s.ok()) return s.error();
+    all_bounds.Extend(frame.bounds.min);
+    all_bounds.Extend(frame.bounds.max);
+    largest_extent = glm::max(largest_extent, frame.bounds.size());
+    ground_y = std::min(ground_y, frame.bounds.min.y);
+  }
+  cp.ground_y_ = ground_y;
+  const float aspect = static_cast<float>(size.x) / static_cast<float>(size.y);
+  const float elevation = glm::radians(elevation_deg);
+  // Seen from the character's front-left, slightly above (characters face +Z).
+  const glm::vec3 view_dir = -glm::normalize(glm::vec3(0.45f, 0.0f, 1.0f) * std::cos(elevation) +
+                                             glm::vec3(0.0f, std::sin(elevation), 0.0f));
+  if (mode == "turntable") {
+    const mocap::Status s = pipeline.Evaluate(frames.front().time_s, frame);
+    if (!s.ok()) return s.error();
+    const render::Camera framed = render::FrameBounds(frame.bounds, kFovYDeg, aspect, view_dir);
+    cp.turntable_ = render::TurntablePath(frame.bounds.center(),
+                                          glm::length(framed.eye - framed.target), elevation_deg,
+                                          static_cast<int>(frames.size()));
+    for (render::Camera& c : cp.turntable_) {
+      c.fov_y_deg = kFovYDeg;
+      c.aspect = aspect;
+    }
+  } else if (mode == "fixed") {
+    cp.fixed_ = render::FrameBounds(all_bounds, kFovYDeg, aspect, view_dir);
+  } else {
+    deform::Bounds typical;
+    typical.Extend(-0.5f * largest_extent);
+    typical.Extend(0.5f * largest_extent);
+    const render::Camera framed = render::FrameBounds(typical, kFovYDeg, aspect, view_dir);
+    render::FollowCamera& follow = cp.follow_;
+    follow.offset = framed.eye - framed.target;
+    follow.fov_y_deg = kFovYDeg;
+    follow.aspect = aspect;
+    follow.near_plane = framed.near_plane;
+    follow.far_plane = framed.far_plane * 4.0f;
+    follow.frame_time_s = static_cast<float>(plan.frame_time_s);
+    cp.centre_base_ = std::max(0, plan.range.first - follow.window_frames);
+    // Centres of the body's bounds at every output frame the filter can see.
+    for (int f = cp.centre_base_; f <= plan.range.last; ++f) {
+      const mocap::Status s = pipeline.Evaluate(f * plan.frame_time_s, frame);
+      if (!s.ok()) return s.error();
+      cp.centres_.push_back(frame.bounds.center());
+    }
+  }
+  return cp;
+}
+
+render::Camera CameraPlan::At(const OutputFrame& frame) const {
+  if (mode_ == "turntable") return turntable_[static_cast<std::size_t>(frame.camera)];
+  if (mode_ == "fixed") return fixed_;
+  return follow_.At(centres_, frame.camera - centre_base_);
+}
+
+}  // namespace app

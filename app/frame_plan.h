@@ -1,0 +1,91 @@
+#pragma once
+// What `render` and `export` share: parsing of --size and --frames, the output
+// frames' timing (which motion time each output frame evaluates) and the
+// camera each output frame is seen from. Keeping these in one place is what
+// makes an exported frame and its camera JSON match the rendered image.
+
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "app/pipeline.h"
+#include "mocap/error.h"
+#include "mocap/motion.h"
+#include "render/camera.h"
+
+namespace app {
+
+// Vertical field of view of every render camera, degrees.
+inline constexpr float kFovYDeg = 35.0f;
+
+// kInvalidArgument naming the command-line option, e.g. "--frames: error: ...".
+mocap::Error ArgError(const std::string& option, const std::string& message);
+
+// "WxH" with both sides in 16..16384.
+mocap::Result<glm::ivec2> ParseSize(const std::string& text);
+
+// Output frames first..last (inclusive) every step.
+struct FrameRange {
+  int first = 0;
+  int last = 0;   // inclusive
+  int step = 1;   // >= 1
+};
+
+// "A:B[:STEP]" (A or B may be empty: 0 / the last frame; "A" alone is one
+// frame) within 0..num_frames-1; empty text = all frames.
+mocap::Result<FrameRange> ParseFrames(const std::string& text, int num_frames);
+
+// Everything about one output frame that a frame loop needs.
+struct OutputFrame {
+  int number = 0;      // output frame number (names the file)
+  double time_s = 0;   // motion time evaluated, seconds from the motion's first frame
+  int camera = 0;      // turntable camera index, or the follow-camera frame
+};
+
+struct FramePlanOptions {
+  std::string frames;         // --frames text, see ParseFrames
+  double fps = 0.0;           // output frame rate; 0 = the motion's own (30 when unknown)
+  bool turntable = false;     // frames are turntable views of range.first
+  int turntable_frames = 36;  // views of a turntable
+};
+
+// The output frames of a command.
+struct FramePlan {
+  double frame_time_s = 1.0 / 30.0;  // seconds between output frame numbers
+  int motion_frames = 1;             // output frames the motion spans (numbers 0..N-1)
+  FrameRange range;                  // the parsed --frames
+  std::vector<OutputFrame> frames;   // in output order; time_s = number * frame_time_s
+};
+
+// Errors: kInvalidArgument from ParseFrames.
+mocap::Result<FramePlan> PlanFrames(const mocap::Motion& motion, const FramePlanOptions& options);
+
+// The camera of every output frame, as `render` uses it: "follow" (a smoothed
+// follow camera framing the body's largest extent), "fixed" (one camera
+// framing the bounds of up to 64 frames of the range) or "turntable" (an orbit
+// of the first frame). Built by evaluating the pipeline (a pre-pass).
+class CameraPlan {
+ public:
+  // mode: follow | fixed | turntable; elevation in degrees; size in pixels.
+  // Errors: kInvalidArgument (mode), and the pipeline's errors.
+  static mocap::Result<CameraPlan> Create(FramePipeline& pipeline, const FramePlan& plan,
+                                          const std::string& mode, float elevation_deg,
+                                          glm::ivec2 size);
+
+  // The camera of `frame` (one of the plan's frames).
+  render::Camera At(const OutputFrame& frame) const;
+  // Lowest point of the sampled frames (world Y): where render draws the ground.
+  float ground_y() const { return ground_y_; }
+
+ private:
+  std::string mode_;
+  std::vector<render::Camera> turntable_;
+  render::Camera fixed_;
+  render::FollowCamera follow_;
+  std::vector<glm::vec3> centres_;  // follow: bounds centre per output frame from centre_base_
+  int centre_base_ = 0;
+  float ground_y_ = 0.0f;
+};
+
+}  // namespace app

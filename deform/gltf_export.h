@@ -1,0 +1,102 @@
+#pragma once
+// glTF 2.0 (.glb) export of a deformed mesh sequence: one file that Blender,
+// three.js and other viewers open as an animated mesh.
+//
+// Two layouts (the smaller one is chosen unless the caller forces one):
+//
+//  * kMorphTargets: one mesh whose base attributes are frame 0's positions and
+//    normals, with one morph target per exported frame k (POSITION and NORMAL
+//    deltas = frame k - frame 0; target 0 is all zero, stored as accessors
+//    without a buffer view, which the specification defines as zeros), and an
+//    animation of the
+//    mesh node's `weights`: key k at time k * frame_time_s holds weight 1 for
+//    target k and 0 for all others. LINEAR interpolation (default) blends two
+//    neighbouring frames between keys, which is the linear interpolation of
+//    their vertices; STEP holds frame k until the next key. Either way, at key
+//    k's time exactly frame k is shown. The mesh's `extras.targetNames` names
+//    the targets "frame_NNNN" (Blender uses them for shape keys).
+//  * kBakedMeshes: one mesh per frame (sharing the index and colour accessors)
+//    on its own node under a root node; a STEP `scale` animation shows node k
+//    (scale 1) from key k's time until key k+1's and hides it (scale 0)
+//    otherwise. Static viewers see frame 0.
+//
+// Sizes: both cost 24 bytes x #V per frame (morph: the base plus F-1 targets;
+// baked: F meshes). On top, morph stores 4 x #F^2 bytes of (dense) weights and
+// ~330 bytes of JSON per frame, baked ~935 bytes of JSON and keys per frame, so
+// morph is smaller up to about 150 frames and baked beyond, whatever #V (the
+// difference is small next to the vertex data either way).
+// EstimateGltfExportBytes gives both figures.
+//
+// Units and axes are the caller's (glTF expects metres, +Y up). Every accessor
+// POSITION carries min/max as the specification requires. The file is written
+// atomically (deform/file_output.h). Memory held while adding frames is the
+// output's binary chunk (the whole animation; it has to be in the one file).
+
+#include <cstddef>
+#include <memory>
+#include <span>
+#include <string>
+
+#include <glm/glm.hpp>
+
+#include "mocap/error.h"
+
+namespace deform {
+
+enum class GltfExportLayout : std::uint8_t { kAuto, kMorphTargets, kBakedMeshes };
+const char* GltfExportLayoutName(GltfExportLayout layout);  // "auto", "morph", "baked"
+
+struct GltfExportOptions {
+  double frame_time_s = 1.0 / 30.0;             // seconds between exported frames, > 0
+  GltfExportLayout layout = GltfExportLayout::kAuto;
+  bool step_interpolation = false;              // morph weights: STEP instead of LINEAR
+  std::string generator = "patchskin";          // asset.generator
+  std::string mesh_name = "body";               // mesh and node name
+};
+
+// Estimated file sizes in bytes of both layouts (binary data exact, JSON
+// approximated per frame).
+struct GltfExportEstimate {
+  std::size_t morph_bytes = 0;
+  std::size_t baked_bytes = 0;
+};
+GltfExportEstimate EstimateGltfExportBytes(int num_vertices, int num_triangles, int num_frames,
+                                           bool with_colors);
+
+// Builds the file frame by frame:
+//   auto w = GltfSequenceWriter::Create(tris, colors, nv, nf, options);
+//   for each frame: w->AddFrame(positions, normals);
+//   w->Finish("out.glb");
+class GltfSequenceWriter {
+ public:
+  GltfSequenceWriter(GltfSequenceWriter&&) noexcept;
+  GltfSequenceWriter& operator=(GltfSequenceWriter&&) noexcept;
+  ~GltfSequenceWriter();
+
+  // triangles: #T, indices < num_vertices; colors: #V linear RGB or empty;
+  // num_frames: how many AddFrame calls will follow (>= 1), which fixes the
+  // layout when options.layout is kAuto. Errors: kInvalidArgument.
+  static mocap::Result<GltfSequenceWriter> Create(std::span<const glm::uvec3> triangles,
+                                                  std::span<const glm::vec3> colors,
+                                                  int num_vertices, int num_frames,
+                                                  const GltfExportOptions& options);
+
+  // Adds the next frame: positions and normals are #V, finite. Errors:
+  // kInvalidArgument (sizes, non-finite values, more frames than announced).
+  mocap::Status AddFrame(std::span<const glm::vec3> positions, std::span<const glm::vec3> normals);
+
+  // Writes the .glb to `path` (folder must exist) after exactly num_frames
+  // AddFrame calls. Call once: after it, AddFrame and Finish are errors.
+  // Errors: kInvalidArgument (frame count, second call), kIo.
+  mocap::Status Finish(const std::string& path);
+
+  GltfExportLayout layout() const;  // kMorphTargets or kBakedMeshes, never kAuto
+  int frames_added() const;
+
+ private:
+  struct Impl;
+  explicit GltfSequenceWriter(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace deform
