@@ -4,6 +4,8 @@
 #include <string>
 
 #include "deform/patch_region.h"
+#include "render/camera.h"
+#include "render/region_select.h"
 
 namespace app {
 namespace {
@@ -46,21 +48,28 @@ mocap::Result<std::vector<deform::PatchSetup>> BuildRigPatches(const Rig& rig,
         .grid_v = p.grid.y,
         .border_width = p.border_width};
     std::vector<int> region;
-    if (p.region.kind == RigRegion::Kind::kScreen) {
-      return mocap::MakeError(mocap::ErrorCode::kUnsupported, {rig.file, 0, 0, path + ".region"},
-                              "screen-rectangle regions are not supported yet; use \"joint\" or "
-                              "\"vertices\"");
+    if (p.region.kind != RigRegion::Kind::kJoint && p.cylinder) {
+      return mocap::MakeError(mocap::ErrorCode::kInvalidArgument,
+                              {rig.file, 0, 0, path + ".parametrization"},
+                              "expected \"plane\" for a vertex-list or screen region (a cylinder "
+                              "needs a joint for its axis), found \"cylinder\"");
     }
-    if (p.region.kind == RigRegion::Kind::kVertices) {
+    if (p.region.kind == RigRegion::Kind::kScreen) {
+      // The named view frames the bind mesh; the character faces +Z, its left is +X.
+      const glm::vec3 direction = p.region.view == "front"  ? glm::vec3(0, 0, -1)
+                                  : p.region.view == "back" ? glm::vec3(0, 0, 1)
+                                  : p.region.view == "left" ? glm::vec3(-1, 0, 0)
+                                                            : glm::vec3(1, 0, 0);
+      const render::Camera camera = render::FrameBounds(
+          deform::ComputeBounds(mesh.bind.positions), 35.0f, 1.0f, direction);
+      auto selected = render::SelectScreenRegion(camera, mesh.bind.positions, mesh.bind.normals,
+                                                 mesh.bind.triangles, {.rect = p.region.rect});
+      if (!selected.ok()) return At(rig, path + ".region", std::move(selected).error());
+      region = std::move(*selected);
+    } else if (p.region.kind == RigRegion::Kind::kVertices) {
       auto checked = deform::CheckVertexRegion(p.region.vertices, mesh.bind.num_vertices());
       if (!checked.ok()) return At(rig, path + ".region.vertices", std::move(checked).error());
       region = std::move(*checked);
-      if (p.cylinder) {
-        return mocap::MakeError(mocap::ErrorCode::kInvalidArgument,
-                                {rig.file, 0, 0, path + ".parametrization"},
-                                "expected \"plane\" for a vertex-list region (a cylinder needs a "
-                                "joint for its axis), found \"cylinder\"");
-      }
     } else {
       const int j = character.skeleton.FindJoint(p.region.joint);
       if (j < 0) {

@@ -10,6 +10,8 @@
 
 #include <gtest/gtest.h>
 
+#include "app/motion_source.h"
+#include "app/rig_patches.h"
 #include "render/image_io.h"
 #include "support/data_paths.h"
 
@@ -214,6 +216,38 @@ TEST(RigFile, RenderCommandReportsABadJointWithItsFieldPath) {
   EXPECT_NE(r.err.find("bad.json: patches[0].region.joint: error: expected a joint of "), std::string::npos)
       << r.err;
   EXPECT_FALSE(fs::exists(dir / "f_0000.png"));  // no partial output
+}
+
+TEST(RigFile, ScreenRegionBuildsAFrontPatchOnTheBelly) {
+  const std::string bvh = fs::absolute(kSamples / "bend.bvh").lexically_normal().string();
+  auto source = app::LoadMotionSource(bvh, {.y_up = true});
+  ASSERT_TRUE(source.ok()) << source.error().ToString();
+  auto character = app::MakeCharacter(std::move(*source));
+  ASSERT_TRUE(character.ok());
+  const auto rig = app::ParseRig(
+      R"({"character": "mannequin", "motion": {"file": "b.bvh"}, "patches": [{"name": "belly",
+          "region": {"view": "front", "rect": [0.44, 0.42, 0.56, 0.52]},
+          "parametrization": "plane", "grid": [5, 5]}]})",
+      "r.json");
+  ASSERT_TRUE(rig.ok()) << rig.error().ToString();
+  const auto patches = app::BuildRigPatches(*rig, *character);
+  ASSERT_TRUE(patches.ok()) << patches.error().ToString();
+  ASSERT_EQ(patches->size(), 1u);
+  const deform::PatchSetup& p = (*patches)[0];
+  EXPECT_GT(p.num_bound(), 20);
+  std::vector<glm::vec3> normals(character->mesh.bind.positions.size());
+  deform::ComputeVertexNormals(character->mesh.bind.positions, character->mesh.bind.triangles,
+                               normals);
+  for (const int v : p.region) EXPECT_GT(normals[static_cast<std::size_t>(v)].z, 0.0f) << v;
+  // A cylinder needs a joint axis.
+  const auto cyl = app::ParseRig(
+      R"({"character": "mannequin", "motion": {"file": "b.bvh"}, "patches": [{"name": "v",
+          "region": {"vertices": [1, 2, 3]}}]})",
+      "r.json");
+  ASSERT_TRUE(cyl.ok());
+  EXPECT_EQ(app::BuildRigPatches(*cyl, *character).error().ToString(),
+            "r.json: patches[0].parametrization: error: expected \"plane\" for a vertex-list or "
+            "screen region (a cylinder needs a joint for its axis), found \"cylinder\"");
 }
 
 }  // namespace
