@@ -216,6 +216,8 @@ TEST(PatchLayer, BorderBlendLeavesNoJump) {
 
 // The SSD ring figure against cos(angle/2): rings sit within 0.6 of the plane.
 constexpr double kCollapseTol = 2e-3;
+// Float rounding of a few sums of positions of size ~100 (model units).
+constexpr float kOverlapTol = 1e-4f;
 // Least improvement of the collapse figure the patches must bring (of 1 = no collapse).
 constexpr double kMinCollapseGain = 0.05;
 
@@ -264,6 +266,41 @@ TEST(PatchLayer, ElbowAndKneePatchesReduceTheCollapse) {
     EXPECT_GT(elbow_patch, elbow_ssd + kMinCollapseGain) << angle;
     EXPECT_GT(knee_patch, knee_ssd + kMinCollapseGain) << angle;
   }
+}
+
+}  // namespace
+
+namespace {
+
+// Two patches sharing vertices (front and top of the left elbow): each shared
+// vertex gets G + sum_k beta_k (P_k - G) / max(1, sum_k beta_k), checked
+// against one-patch runs, which give G + beta_k (P_k - G) each.
+TEST(PatchLayer, OverlappingPatchesAverage) {
+  const LayeredBody& b = Body();
+  std::vector<deform::PatchSetup> both;
+  both.push_back(*testfixture::MakePatch(b, testfixture::ElbowSpec(b)));
+  both.push_back(*testfixture::MakePatch(b, {b.shoulder, b.elbow, 14.0f, glm::vec3(0, 1, 0)}));
+  const std::vector<glm::mat4> pose = testfixture::BendPose(b, 120.0f);
+  const testfixture::LayeredFrame f = testfixture::EvaluateLayered(b, both, pose);
+  const testfixture::LayeredFrame f0 = testfixture::EvaluateLayered(b, {&both[0], 1}, pose);
+  const testfixture::LayeredFrame f1 = testfixture::EvaluateLayered(b, {&both[1], 1}, pose);
+  std::vector<float> beta(b.mesh.bind.positions.size(), 0.0f);
+  for (const deform::PatchSetup& p : both) {
+    for (std::size_t r = 0; r < p.bound.binding.size(); ++r) {
+      beta[static_cast<std::size_t>(p.bound.binding.vertex[r])] += p.border_weight[r];
+    }
+  }
+  int shared = 0;
+  for (const int v : both[0].bound.binding.vertex) {
+    const auto vi = static_cast<std::size_t>(v);
+    const glm::vec3 g = f.global[vi];
+    const glm::vec3 expected = g + ((f0.layered[vi] - g) + (f1.layered[vi] - g)) /
+                                       std::max(1.0f, beta[vi]);
+    EXPECT_LT(glm::length(f.layered[vi] - expected), kOverlapTol) << "vertex " << v;
+    const auto& other = both[1].bound.binding.vertex;
+    shared += std::find(other.begin(), other.end(), v) != other.end() && beta[vi] > 1.0f;
+  }
+  EXPECT_GT(shared, 20);  // the patches do overlap where both are fully on
 }
 
 }  // namespace
