@@ -119,6 +119,11 @@ struct FramePipeline::Impl {
   std::vector<glm::mat4> model_from_joint;
   std::vector<glm::mat4> palette;
   std::vector<deform::DualQuat> dq_palette;
+  // The patch layer (empty: global only).
+  std::vector<deform::PatchSetup> patches;
+  std::vector<std::vector<glm::vec3>> carried;          // per patch, #M x #N
+  std::vector<std::span<const glm::vec3>> carried_views;
+  deform::PatchLayerScratch patch_scratch;
 };
 
 FramePipeline::FramePipeline(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -127,6 +132,25 @@ FramePipeline& FramePipeline::operator=(FramePipeline&&) noexcept = default;
 FramePipeline::~FramePipeline() = default;
 
 GlobalMethod FramePipeline::method() const { return impl_->method; }
+
+int FramePipeline::num_patches() const { return static_cast<int>(impl_->patches.size()); }
+
+mocap::Status FramePipeline::SetPatches(std::vector<deform::PatchSetup> patches) {
+  Impl& m = *impl_;
+  if (!patches.empty() && m.method == GlobalMethod::kSwd) {
+    return mocap::MakeError(mocap::ErrorCode::kUnsupported, {m.character->source, 0, 0, {}},
+                            "patches on --global swd are not available in this build yet");
+  }
+  m.patches = std::move(patches);
+  m.carried.assign(m.patches.size(), {});
+  m.carried_views.clear();
+  for (std::size_t k = 0; k < m.patches.size(); ++k) {
+    m.carried[k].resize(m.patches[k].rest_control.size());
+    m.carried_views.emplace_back(m.carried[k]);
+  }
+  m.patch_scratch.Prepare(m.patches, m.character->mesh.bind.num_vertices());
+  return mocap::Status::Ok();
+}
 
 mocap::Result<FramePipeline> FramePipeline::Create(const Character& character, GlobalMethod method,
                                                    int threads) {
@@ -212,7 +236,25 @@ mocap::Status FramePipeline::Evaluate(double time_s, DeformedFrame& out) {
   for (const mocap::JobStatus& r : results) {
     if (!r) return JobError(c, r, GlobalMethodName(m.method));
   }
-  if (has_normals) {
+  if (!m.patches.empty()) {
+    // Patch layer: carry the control points like skin vertices, rebuild and
+    // blend (no displacements yet: dS, dE come with issues 6 and 7).
+    for (std::size_t p = 0; p < m.patches.size(); ++p) {
+      const bool dqs = m.method == GlobalMethod::kDqs;
+      s = deform::CarryControlPointsJob{
+          .patch = &m.patches[p],
+          .model_from_bind = dqs ? std::span<const glm::mat4>() : std::span<const glm::mat4>(m.palette),
+          .dq_palette = dqs ? std::span<const deform::DualQuat>(m.dq_palette)
+                            : std::span<const deform::DualQuat>(),
+          .control = m.carried[p]}
+              .Run();
+      if (!s) return JobError(c, s, "patch control points");
+    }
+    const mocap::Status layered =
+        deform::ApplyPatchLayer(m.patches, m.carried_views, {}, m.patch_scratch, out.positions);
+    if (!layered.ok()) return layered;
+    deform::ComputeVertexNormals(out.positions, mesh.bind.triangles, out.normals);
+  } else if (has_normals) {
     for (glm::vec3& n : out.normals) {
       const float len = glm::length(n);
       n = len > 0.0f ? n / len : glm::vec3(0.0f, 1.0f, 0.0f);

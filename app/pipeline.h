@@ -21,6 +21,7 @@
 
 #include "deform/mannequin.h"
 #include "deform/mesh.h"
+#include "deform/patch_layer.h"
 #include "mocap/error.h"
 #include "mocap/motion.h"
 #include "mocap/skeleton.h"
@@ -80,6 +81,14 @@ class FramePipeline {
   mocap::Status Evaluate(double time_s, DeformedFrame& out);
 
   GlobalMethod method() const;
+
+  // Adds the patch layer (ALGORITHMS.md 0, 3.7, 3.8), applied after the global
+  // step: control points carried by the same method (SSD or DQS), bound
+  // vertices rebuilt and blended, then normals recomputed from the mesh.
+  // Patches must be built on this character's bind mesh. kUnsupported with SWD
+  // (its control-point binding is not wired yet).
+  mocap::Status SetPatches(std::vector<deform::PatchSetup> patches);
+  int num_patches() const;
 
  private:
   struct Impl;

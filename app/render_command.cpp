@@ -13,6 +13,8 @@
 #include "app/motion_source.h"
 #include "app/pipeline.h"
 #include "app/progress.h"
+#include "app/rig_file.h"
+#include "app/rig_patches.h"
 #include "render/async_writer.h"
 #include "render/camera.h"
 #include "render/contact_sheet.h"
@@ -61,7 +63,7 @@ void ComposeSplit(const render::Image& right, render::Image& left) {
 CLI::App* AddRenderCommand(CLI::App& parent, RenderOptions& o) {
   CLI::App* cmd = parent.add_subcommand(
       "render", "Render a capture (BVH on a mannequin) or a glTF animation to image frames");
-  cmd->add_option("input", o.input, "BVH, glTF or GLB file; none = the built-in demo");
+  cmd->add_option("input", o.input, "BVH, glTF or GLB file, or a rig (.json); none = the built-in demo");
   cmd->add_option("--frames", o.frames, "A:B[:STEP] output frames, inclusive (default all)");
   cmd->add_option("--fps", o.fps, "Output frame rate; the motion is resampled (default: its own)");
   cmd->add_option("--size", o.size, "Image size WxH")->capture_default_str();
@@ -121,7 +123,31 @@ int Fail(const mocap::Error& e) {
 
 }  // namespace
 
-int RunRender(const RenderOptions& o) {
+int RunRender(const RenderOptions& options) {
+  // --- A rig file (README "Rig files") sets the inputs and render settings ---
+  RenderOptions o = options;
+  std::optional<Rig> rig;
+  if (std::filesystem::path(o.input).extension() == ".json") {
+    mocap::Result<Rig> loaded = LoadRig(o.input);
+    if (!loaded.ok()) return Fail(loaded.error());
+    rig = std::move(*loaded);
+    if (rig->character != "mannequin" && !rig->motion.empty()) {
+      return Fail(mocap::MakeError(mocap::ErrorCode::kUnsupported, {rig->file, 0, 0, "motion"},
+                                   "a glTF character with a separate motion is not supported "
+                                   "yet; leave out \"motion\" to use the glTF's animation"));
+    }
+    o.input = rig->character == "mannequin" ? rig->motion : rig->character;
+    o.global = rig->global;
+    o.fps = rig->fps;
+    o.size = std::to_string(rig->render.size.x) + "x" + std::to_string(rig->render.size.y);
+    o.camera = rig->render.camera;
+    o.overlay.clear();
+    for (const std::string& item : rig->render.overlays) o.overlay += item + ",";
+    if (o.out.empty()) o.out = rig->render.output;
+    if (o.frames.empty()) o.frames = rig->render.frames;
+    o.split.reset();  // the rig's split is global only | global + patches (below)
+  }
+
   // --- Arguments -------------------------------------------------------------
   const mocap::Result<glm::ivec2> size = ParseSize(o.size);
   if (!size.ok()) return Fail(size.error());
@@ -170,7 +196,9 @@ int RunRender(const RenderOptions& o) {
   if (!o.quiet) {
     for (const mocap::Warning& w : src->warnings) std::fprintf(stderr, "%s\n", w.ToString().c_str());
   }
-  const std::string name = demo ? "demo" : std::filesystem::path(o.input).stem().string();
+  const std::string name = demo  ? "demo"
+                           : rig ? std::filesystem::path(rig->file).stem().string()
+                                 : std::filesystem::path(o.input).stem().string();
   mocap::Result<Character> character = MakeCharacter(std::move(*src));
   if (!character.ok()) return Fail(character.error());
   const Character& ch = *character;
@@ -191,6 +219,14 @@ int RunRender(const RenderOptions& o) {
   }
 
   // --- Pipelines ---------------------------------------------------------------
+  std::vector<deform::PatchSetup> patches;
+  const bool rig_split = rig && !rig->patches.empty() && rig->render.split;
+  if (rig) {
+    mocap::Result<std::vector<deform::PatchSetup>> built = BuildRigPatches(*rig, ch);
+    if (!built.ok()) return Fail(built.error());
+    patches = std::move(*built);
+    if (rig_split) split_left = split_right = *method;
+  }
   const GlobalMethod main_method = split_left ? *split_left : *method;
   mocap::Result<FramePipeline> pipeline = FramePipeline::Create(ch, main_method, o.threads);
   if (!pipeline.ok()) return Fail(pipeline.error());
@@ -200,6 +236,17 @@ int RunRender(const RenderOptions& o) {
     if (!p.ok()) return Fail(p.error());
     right_pipeline.emplace(std::move(*p));
   }
+  if (!patches.empty()) {
+    // Split: the left half stays global only, the right half gets the patches.
+    FramePipeline& layered = right_pipeline ? *right_pipeline : *pipeline;
+    const mocap::Status s = layered.SetPatches(std::move(patches));
+    if (!s.ok()) return Fail(s.error());
+  }
+  const std::string right_label =
+      !right_pipeline ? ""
+      : right_pipeline->num_patches() > 0
+          ? std::string(GlobalMethodName(right_pipeline->method())) + " + patches"
+          : GlobalMethodName(right_pipeline->method());
 
   // --- Framing (app/frame_plan.h) ------------------------------------------------
   DeformedFrame frame, right_frame;
@@ -234,7 +281,7 @@ int RunRender(const RenderOptions& o) {
   render::AsyncImageWriter writer({.num_workers = 2, .max_in_flight = 4});
   render::WriteOptions write_options;
   write_options.png_compression = o.png_compression;
-  write_options.source_file = demo ? "demo_walk.bvh (built in)" : o.input;
+  write_options.source_file = demo ? "demo_walk.bvh (built in)" : rig ? rig->file : o.input;
 
   const int sheet_count = std::min<int>(kMaxSheetFrames, static_cast<int>(frames.size()));
   std::unique_ptr<render::ContactSheetBuilder> sheet;
@@ -284,8 +331,7 @@ int RunRender(const RenderOptions& o) {
       if (!s.ok()) return Fail(s.error());
       s = draw(frame, renderer, GlobalMethodName(main_method), 10, image);
       if (!s.ok()) return Fail(s.error());
-      s = draw(right_frame, right_renderer, GlobalMethodName(right_pipeline->method()),
-               size->x / 2 + 10, right_image);
+      s = draw(right_frame, right_renderer, right_label, size->x / 2 + 10, right_image);
       if (!s.ok()) return Fail(s.error());
       ComposeSplit(right_image, image);
     } else {

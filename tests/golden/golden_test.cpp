@@ -18,6 +18,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "deform/patch_layer_fixture.h"
 #include "render/camera.h"
 #include "render/image.h"
 #include "render/renderer.h"
@@ -197,6 +198,43 @@ render::Image TurntableFrame(int k) {
   return render::Render(c, meshes, {}, SmallSettings(128, 128));
 }
 
+// The left elbow of the mannequin bent 120 degrees (bend ramp), seen from
+// above: SSD alone on the left, SSD + elbow and knee patches on the right.
+render::Image ElbowSplit(int w, int h) {
+  const testfixture::LayeredBody b = testfixture::MakeLayeredBody();
+  std::vector<deform::PatchSetup> patches;
+  patches.push_back(*testfixture::MakePatch(b, testfixture::ElbowSpec(b)));
+  const std::vector<glm::mat4> pose = testfixture::BendPose(b, 120.0f);
+  const testfixture::LayeredFrame f = testfixture::EvaluateLayered(b, patches, pose);
+  const glm::vec3 elbow = testfixture::JointPos(pose, b.elbow);
+  deform::Bounds box;
+  box.Extend(elbow - glm::vec3(14.0f));
+  box.Extend(elbow + glm::vec3(14.0f));
+  const float aspect = static_cast<float>(w / 2) / static_cast<float>(h);
+  const render::Camera camera =
+      render::FrameBounds(box, 35.0f, aspect, glm::normalize(glm::vec3(-0.2f, -1.0f, -0.3f)), 1.0f);
+  render::RenderSettings settings;
+  settings.width = w / 2;
+  settings.height = h;
+  settings.supersample = 2;
+  settings.threads = 1;
+  settings.ground = false;
+  render::Image out(w, h);
+  for (int side = 0; side < 2; ++side) {
+    const std::vector<glm::vec3>& pos = side == 0 ? f.global : f.layered;
+    std::vector<glm::vec3> normals(pos.size());
+    deform::ComputeVertexNormals(pos, b.mesh.bind.triangles, normals);
+    const render::SceneMesh mesh{.positions = pos, .normals = normals,
+                                 .triangles = b.mesh.bind.triangles};
+    const render::Image half = render::Render(camera, {&mesh, 1}, {}, settings);
+    for (int y = 0; y < h; ++y) {
+      for (int x = 0; x < w / 2; ++x) out.at(side * (w / 2) + x, y) = half.at(x, y);
+    }
+  }
+  for (int y = 0; y < h; ++y) out.at(w / 2, y) = glm::vec4(1.0f);  // divider
+  return out;
+}
+
 struct GoldenCase {
   std::string name;
   std::function<render::Image()> render;
@@ -216,6 +254,7 @@ const std::vector<GoldenCase>& Cases() {
       {"turntable_5", [] { return TurntableFrame(5); }, {}},
       {"turntable_6", [] { return TurntableFrame(6); }, {}},
       {"turntable_7", [] { return TurntableFrame(7); }, {}},
+      {"patch_elbow_split_120", [] { return ElbowSplit(256, 128); }, {}},
   };
   return cases;
 }

@@ -1,0 +1,366 @@
+#include "app/rig_file.h"
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <initializer_list>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+namespace app {
+namespace {
+
+using nlohmann::json;
+
+// Short description of a JSON value for "found ..." in messages.
+std::string Describe(const json& v) {
+  std::string s = v.dump();
+  if (s.size() > 40) s = s.substr(0, 37) + "...";
+  switch (v.type()) {
+    case json::value_t::object: return "an object";
+    case json::value_t::array: return "an array " + s;
+    case json::value_t::null: return "null";
+    default: return s;
+  }
+}
+
+// Parsing context: the file name and the error to return.
+struct Ctx {
+  std::string file;
+  mocap::Error Fail(const std::string& path, const std::string& message,
+                    mocap::ErrorCode code = mocap::ErrorCode::kInvalidArgument) const {
+    return mocap::MakeError(code, {file, 0, 0, path}, message);
+  }
+  mocap::Error Expected(const std::string& path, const std::string& what, const json& found) const {
+    return Fail(path, "expected " + what + ", found " + Describe(found));
+  }
+};
+
+std::string Join(const std::string& path, const std::string& key) {
+  return path.empty() ? key : path + "." + key;
+}
+
+// Checks `obj` is an object with only `allowed` keys.
+std::optional<mocap::Error> CheckObject(const Ctx& c, const json& obj, const std::string& path,
+                                        std::initializer_list<const char*> allowed) {
+  if (!obj.is_object()) return c.Expected(path.empty() ? "rig" : path, "an object", obj);
+  for (const auto& [key, value] : obj.items()) {
+    bool known = false;
+    for (const char* a : allowed) known = known || key == a;
+    if (!known) {
+      std::string list;
+      for (const char* a : allowed) list += std::string(list.empty() ? "" : ", ") + a;
+      return c.Fail(Join(path, key), "unknown field (expected one of: " + list + ")");
+    }
+  }
+  return std::nullopt;
+}
+
+std::optional<mocap::Error> GetNumber(const Ctx& c, const json& v, const std::string& path,
+                                      double lo, double hi, double& out) {
+  std::ostringstream range;
+  range << "a number in " << lo << ".." << hi;
+  if (!v.is_number() || !std::isfinite(v.get<double>()) || v.get<double>() < lo ||
+      v.get<double>() > hi) {
+    return c.Expected(path, range.str(), v);
+  }
+  out = v.get<double>();
+  return std::nullopt;
+}
+
+std::optional<mocap::Error> GetFloat(const Ctx& c, const json& v, const std::string& path,
+                                     double lo, double hi, float& out) {
+  double d = 0.0;
+  if (auto e = GetNumber(c, v, path, lo, hi, d)) return e;
+  out = static_cast<float>(d);
+  return std::nullopt;
+}
+
+std::optional<mocap::Error> GetString(const Ctx& c, const json& v, const std::string& path,
+                                      std::string& out) {
+  if (!v.is_string() || v.get<std::string>().empty()) return c.Expected(path, "a non-empty string", v);
+  out = v.get<std::string>();
+  return std::nullopt;
+}
+
+std::optional<mocap::Error> GetChoice(const Ctx& c, const json& v, const std::string& path,
+                                      std::initializer_list<const char*> choices, std::string& out) {
+  std::string list;
+  bool ok = false;
+  for (const char* ch : choices) {
+    list += std::string(list.empty() ? "" : ", ") + '"' + ch + '"';
+    ok = ok || (v.is_string() && v.get<std::string>() == ch);
+  }
+  if (!ok) return c.Expected(path, "one of " + list, v);
+  out = v.get<std::string>();
+  return std::nullopt;
+}
+
+std::optional<mocap::Error> GetIntPair(const Ctx& c, const json& v, const std::string& path,
+                                       int lo, int hi, glm::ivec2& out) {
+  const std::string what =
+      "an array of two integers in " + std::to_string(lo) + ".." + std::to_string(hi);
+  if (!v.is_array() || v.size() != 2 || !v[0].is_number_integer() || !v[1].is_number_integer()) {
+    return c.Expected(path, what, v);
+  }
+  const auto a = v[0].get<long long>(), b = v[1].get<long long>();
+  if (a < lo || a > hi || b < lo || b > hi) return c.Expected(path, what, v);
+  out = {static_cast<int>(a), static_cast<int>(b)};
+  return std::nullopt;
+}
+
+template <int N>
+std::optional<mocap::Error> GetFloats(const Ctx& c, const json& v, const std::string& path,
+                                      double lo, double hi, glm::vec<N, float>& out) {
+  std::ostringstream what;
+  what << "an array of " << N << " numbers in " << lo << ".." << hi;
+  if (!v.is_array() || v.size() != N) return c.Expected(path, what.str(), v);
+  for (int i = 0; i < N; ++i) {
+    const json& e = v[static_cast<std::size_t>(i)];
+    if (!e.is_number() || !std::isfinite(e.get<double>()) || e.get<double>() < lo ||
+        e.get<double>() > hi) {
+      return c.Expected(path, what.str(), v);
+    }
+    out[i] = e.get<float>();
+  }
+  return std::nullopt;
+}
+
+std::string Resolve(const std::string& rig_file, const std::string& path) {
+  const std::filesystem::path p(path);
+  if (p.is_absolute()) return path;
+  return (std::filesystem::path(rig_file).parent_path() / p).lexically_normal().string();
+}
+
+std::optional<mocap::Error> ParseRegion(const Ctx& c, const json& v, const std::string& path,
+                                        RigRegion& r) {
+  if (auto e = CheckObject(c, v, path, {"joint", "radius", "side", "half_angle_deg",
+                                        "min_bone_weight", "vertices", "view", "rect"})) {
+    return e;
+  }
+  const int kinds = static_cast<int>(v.contains("joint")) + static_cast<int>(v.contains("vertices")) +
+                    static_cast<int>(v.contains("view"));
+  if (kinds != 1) {
+    return c.Fail(path, "expected exactly one of \"joint\" (with \"radius\"), \"vertices\" or "
+                        "\"view\" (with \"rect\")");
+  }
+  if (v.contains("joint")) {
+    r.kind = RigRegion::Kind::kJoint;
+    if (auto e = GetString(c, v["joint"], path + ".joint", r.joint)) return e;
+    if (!v.contains("radius")) return c.Fail(path + ".radius", "missing (model units, > 0)");
+    if (auto e = GetFloat(c, v["radius"], path + ".radius", 1e-6, 1e6, r.radius)) return e;
+    if (v.contains("side")) {
+      if (auto e = GetFloats<3>(c, v["side"], path + ".side", -1e6, 1e6, r.side)) return e;
+    }
+    if (v.contains("half_angle_deg")) {
+      if (auto e = GetFloat(c, v["half_angle_deg"], path + ".half_angle_deg", 1, 180,
+                            r.half_angle_deg)) {
+        return e;
+      }
+    }
+    if (v.contains("min_bone_weight")) {
+      if (auto e = GetFloat(c, v["min_bone_weight"], path + ".min_bone_weight", 0.01, 1,
+                            r.min_bone_weight)) {
+        return e;
+      }
+    }
+    for (const char* other : {"vertices", "view", "rect"}) {
+      if (v.contains(other)) return c.Fail(Join(path, other), "not allowed with \"joint\"");
+    }
+  } else if (v.contains("vertices")) {
+    r.kind = RigRegion::Kind::kVertices;
+    const json& list = v["vertices"];
+    if (!list.is_array() || list.size() < 3) {
+      return c.Expected(path + ".vertices", "an array of at least 3 vertex indices", list);
+    }
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      if (!list[i].is_number_integer() || list[i].get<long long>() < 0 ||
+          list[i].get<long long>() > 100000000) {
+        return c.Expected(path + ".vertices[" + std::to_string(i) + "]",
+                          "a vertex index (integer >= 0)", list[i]);
+      }
+      r.vertices.push_back(list[i].get<int>());
+    }
+    for (const char* other : {"radius", "side", "half_angle_deg", "min_bone_weight", "rect"}) {
+      if (v.contains(other)) return c.Fail(Join(path, other), "not allowed with \"vertices\"");
+    }
+  } else {
+    r.kind = RigRegion::Kind::kScreen;
+    if (auto e = GetChoice(c, v["view"], path + ".view", {"front", "back", "left", "right"},
+                           r.view)) {
+      return e;
+    }
+    if (!v.contains("rect")) return c.Fail(path + ".rect", "missing ([x0, y0, x1, y1] in 0..1)");
+    if (auto e = GetFloats<4>(c, v["rect"], path + ".rect", 0, 1, r.rect)) return e;
+    if (!(r.rect.x < r.rect.z && r.rect.y < r.rect.w)) {
+      return c.Expected(path + ".rect", "x0 < x1 and y0 < y1", v["rect"]);
+    }
+  }
+  return std::nullopt;
+}
+
+std::optional<mocap::Error> ParsePatch(const Ctx& c, const json& v, const std::string& path,
+                                       RigPatch& p) {
+  if (auto e = CheckObject(c, v, path, {"name", "region", "parametrization", "sampling", "grid",
+                                        "border_width", "examples", "elastic"})) {
+    return e;
+  }
+  for (const char* later : {"examples", "elastic"}) {
+    if (v.contains(later)) {
+      return c.Fail(Join(path, later),
+                    std::string(later) + " are not supported yet (" +
+                        (std::string(later) == "examples" ? "issue 6" : "issue 7") + ")",
+                    mocap::ErrorCode::kUnsupported);
+    }
+  }
+  if (!v.contains("name")) return c.Fail(path + ".name", "missing (a non-empty string)");
+  if (auto e = GetString(c, v["name"], path + ".name", p.name)) return e;
+  if (!v.contains("region")) return c.Fail(path + ".region", "missing (an object)");
+  if (auto e = ParseRegion(c, v["region"], path + ".region", p.region)) return e;
+  if (v.contains("parametrization")) {
+    std::string kind;
+    if (auto e = GetChoice(c, v["parametrization"], path + ".parametrization",
+                           {"cylinder", "plane"}, kind)) {
+      return e;
+    }
+    p.cylinder = kind == "cylinder";
+  }
+  if (v.contains("grid")) {
+    if (auto e = GetIntPair(c, v["grid"], path + ".grid", 4, 64, p.grid)) return e;
+  }
+  if (v.contains("sampling")) {
+    if (auto e = GetIntPair(c, v["sampling"], path + ".sampling", 4, 256, p.sampling)) return e;
+  }
+  if (p.sampling.x < p.grid.x || p.sampling.y < p.grid.y) {
+    return c.Fail(path + ".sampling", "expected at least the grid (" + std::to_string(p.grid.x) +
+                                          "x" + std::to_string(p.grid.y) + ") each way, found " +
+                                          std::to_string(p.sampling.x) + "x" +
+                                          std::to_string(p.sampling.y));
+  }
+  if (v.contains("border_width")) {
+    if (auto e = GetFloat(c, v["border_width"], path + ".border_width", 0, 0.5, p.border_width)) {
+      return e;
+    }
+  }
+  return std::nullopt;
+}
+
+std::optional<mocap::Error> ParseRender(const Ctx& c, const json& v, RigRender& r) {
+  if (auto e = CheckObject(c, v, "render",
+                           {"size", "camera", "overlays", "split", "output", "frames"})) {
+    return e;
+  }
+  if (v.contains("size")) {
+    if (auto e = GetIntPair(c, v["size"], "render.size", 16, 16384, r.size)) return e;
+  }
+  if (v.contains("camera")) {
+    if (auto e = GetChoice(c, v["camera"], "render.camera", {"follow", "fixed", "turntable"},
+                           r.camera)) {
+      return e;
+    }
+  }
+  if (v.contains("overlays")) {
+    const json& list = v["overlays"];
+    if (!list.is_array()) return c.Expected("render.overlays", "an array of strings", list);
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      std::string item;
+      if (auto e = GetChoice(c, list[i], "render.overlays[" + std::to_string(i) + "]",
+                             {"skeleton", "wire"}, item)) {
+        return e;
+      }
+      r.overlays.push_back(item);
+    }
+  }
+  if (v.contains("split")) {
+    if (!v["split"].is_boolean()) return c.Expected("render.split", "true or false", v["split"]);
+    r.split = v["split"].get<bool>();
+  }
+  if (v.contains("output")) {
+    if (auto e = GetString(c, v["output"], "render.output", r.output)) return e;
+    r.output = Resolve(c.file, r.output);
+  }
+  if (v.contains("frames")) {
+    if (auto e = GetString(c, v["frames"], "render.frames", r.frames)) return e;
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+mocap::Result<Rig> ParseRig(const std::string& text, const std::string& file) {
+  const Ctx c{file};
+  json doc;
+  try {
+    doc = json::parse(text);
+  } catch (const json::parse_error& e) {
+    // Byte offset -> line and column.
+    int line = 1, column = 1;
+    for (std::size_t i = 0; i + 1 < e.byte && i < text.size(); ++i) {
+      if (text[i] == '\n') ++line, column = 1;
+      else ++column;
+    }
+    std::string what = e.what();
+    const auto colon = what.rfind(": ");
+    if (colon != std::string::npos) what = what.substr(colon + 2);
+    return mocap::MakeError(mocap::ErrorCode::kSyntax, {file, line, column, {}},
+                            "invalid JSON: " + what);
+  }
+  if (auto e = CheckObject(c, doc, "", {"character", "motion", "global", "patches", "render"})) {
+    return *e;
+  }
+  Rig rig;
+  rig.file = file;
+  if (!doc.contains("character")) return c.Fail("character", "missing (\"mannequin\" or a glTF file)");
+  if (auto e = GetString(c, doc["character"], "character", rig.character)) return *e;
+  if (rig.character != "mannequin") rig.character = Resolve(file, rig.character);
+  if (doc.contains("motion")) {
+    const json& m = doc["motion"];
+    if (auto e = CheckObject(c, m, "motion", {"file", "fps"})) return *e;
+    if (!m.contains("file")) return c.Fail("motion.file", "missing (a BVH file)");
+    if (auto e = GetString(c, m["file"], "motion.file", rig.motion)) return *e;
+    rig.motion = Resolve(file, rig.motion);
+    if (m.contains("fps")) {
+      if (auto e = GetNumber(c, m["fps"], "motion.fps", 0, 10000, rig.fps)) return *e;
+    }
+  } else if (rig.character == "mannequin") {
+    return c.Fail("motion", "missing (the mannequin needs a BVH motion: {\"file\": ...})");
+  }
+  if (doc.contains("global")) {
+    if (auto e = GetChoice(c, doc["global"], "global", {"ssd", "dqs", "swd"}, rig.global)) return *e;
+  }
+  if (doc.contains("patches")) {
+    const json& list = doc["patches"];
+    if (!list.is_array()) return c.Expected("patches", "an array of patch objects", list);
+    if (list.size() > 64) return c.Fail("patches", "expected at most 64 patches");
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      RigPatch p;
+      if (auto e = ParsePatch(c, list[i], "patches[" + std::to_string(i) + "]", p)) return *e;
+      for (const RigPatch& q : rig.patches) {
+        if (q.name == p.name) {
+          return c.Fail("patches[" + std::to_string(i) + "].name",
+                        "expected a unique name, found \"" + p.name + "\" twice");
+        }
+      }
+      rig.patches.push_back(std::move(p));
+    }
+  }
+  if (doc.contains("render")) {
+    if (auto e = ParseRender(c, doc["render"], rig.render)) return *e;
+  }
+  return rig;
+}
+
+mocap::Result<Rig> LoadRig(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return mocap::MakeError(mocap::ErrorCode::kIo, {path, 0, 0, {}}, "cannot open the rig file");
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (text.str().size() > (1u << 24)) {
+    return mocap::MakeError(mocap::ErrorCode::kLimitExceeded, {path, 0, 0, {}},
+                            "rig file larger than 16 MiB");
+  }
+  return ParseRig(text.str(), path);
+}
+
+}  // namespace app

@@ -1,0 +1,86 @@
+#pragma once
+// Rig files: a JSON document saying what to deform and how (DESIGN.md "The rig
+// file"; every field is documented in README.md, section "Rig files").
+//
+//   {
+//     "character": "mannequin" | "body.glb",
+//     "motion":    {"file": "bend.bvh", "fps": 0},
+//     "global":    "ssd" | "dqs" | "swd",
+//     "patches":   [{"name": "left_elbow",
+//                    "region": {"joint": "LeftForeArm", "radius": 14, ...},
+//                    "parametrization": "cylinder", "sampling": [8, 8], "grid": [6, 6],
+//                    "border_width": 0.1}],
+//     "render":    {"size": [640, 360], "camera": "follow", "split": true, ...}
+//   }
+//
+// Parsing checks types, ranges and unknown fields and resolves paths against
+// the rig file's folder; it does not load the character or the motion (joint
+// names are checked when the patches are built). Errors name the file, the
+// field path (e.g. "patches[1].grid") and what was expected:
+//   rig.json: error: patches[1].grid: expected an array of two integers in 4..64, found "6x6"
+// `examples` (issue 6) and `elastic` (issue 7) are recognised per patch and
+// rejected as not supported yet.
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "mocap/error.h"
+
+namespace app {
+
+// How a patch's region is chosen (ALGORITHMS.md 3.1); exactly one kind.
+struct RigRegion {
+  enum class Kind { kJoint, kVertices, kScreen };
+  Kind kind = Kind::kJoint;
+  // kJoint: vertices within `radius` of the joint's bind position, weighted to
+  // the bones meeting there (the joint and its parent), optionally one side.
+  std::string joint;                 // skeleton joint name
+  float radius = 0.0f;               // model units, > 0
+  glm::vec3 side{0.0f};              // model-space direction, or zero (every side)
+  float half_angle_deg = 120.0f;     // in (0, 180]; used with `side`
+  float min_bone_weight = 0.5f;      // in (0, 1]
+  // kVertices: mesh vertex indices.
+  std::vector<int> vertices;
+  // kScreen: a rectangle in a named view (the paper's sketch).
+  std::string view;                  // "front", "back", "left", "right"
+  glm::vec4 rect{0.0f};              // x0, y0, x1, y1 in [0,1] of the view, y down
+};
+
+struct RigPatch {
+  std::string name;
+  RigRegion region;
+  bool cylinder = true;              // parametrization: "cylinder" (true) or "plane"
+  glm::ivec2 sampling{8, 8};         // S x T, each 4..256 and >= the grid
+  glm::ivec2 grid{6, 6};             // M x N, each 4..64
+  float border_width = 0.1f;         // parameter units, [0, 0.5]
+};
+
+struct RigRender {
+  glm::ivec2 size{640, 360};         // pixels, 16..16384
+  std::string camera = "follow";     // follow | fixed | turntable
+  std::vector<std::string> overlays; // skeleton, wire
+  bool split = true;                 // left global only, right global + patches
+  std::string output;                // frame pattern (resolved), empty = out/<rig>/frame_####.png
+  std::string frames;                // "A:B[:STEP]", empty = all
+};
+
+struct Rig {
+  std::string file;                  // the rig file as given
+  std::string character;             // "mannequin" or a resolved glTF/GLB path
+  std::string motion;                // resolved BVH path; empty = the glTF's animation
+  double fps = 0.0;                  // output frame rate, 0 = the motion's own
+  std::string global = "ssd";        // ssd | dqs | swd
+  std::vector<RigPatch> patches;
+  RigRender render;
+};
+
+// Parses rig JSON text; `file` names it in messages and its folder resolves
+// relative paths.
+mocap::Result<Rig> ParseRig(const std::string& text, const std::string& file);
+// Reads and parses a rig file (kIo when it cannot be read).
+mocap::Result<Rig> LoadRig(const std::string& path);
+
+}  // namespace app

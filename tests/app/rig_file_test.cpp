@@ -1,0 +1,253 @@
+#include "app/rig_file.h"
+
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "app/motion_source.h"
+#include "app/rig_patches.h"
+#include "render/image_io.h"
+#include "support/data_paths.h"
+
+namespace {
+
+constexpr const char* kGood = R"({
+  "character": "mannequin",
+  "motion": {"file": "bend.bvh"},
+  "global": "dqs",
+  "patches": [
+    {"name": "left_elbow",
+     "region": {"joint": "LeftForeArm", "radius": 14, "side": [0, 0, 1], "half_angle_deg": 120},
+     "parametrization": "cylinder", "sampling": [9, 8], "grid": [6, 5], "border_width": 0.2},
+    {"name": "belly", "region": {"vertices": [1, 2, 3]}, "parametrization": "plane"},
+    {"name": "sketch", "region": {"view": "front", "rect": [0.1, 0.2, 0.3, 0.4]}}
+  ],
+  "render": {"size": [320, 200], "camera": "fixed", "overlays": ["skeleton"], "split": false,
+             "output": "out/x_####.png", "frames": "0:10"}
+})";
+
+TEST(RigFile, ParsesEveryFieldAndResolvesPathsAgainstTheRigFolder) {
+  const mocap::Result<app::Rig> rig = app::ParseRig(kGood, "samples/data/rig.json");
+  ASSERT_TRUE(rig.ok()) << rig.error().ToString();
+  EXPECT_EQ(rig->character, "mannequin");
+  EXPECT_EQ(rig->motion, "samples/data/bend.bvh");
+  EXPECT_EQ(rig->global, "dqs");
+  ASSERT_EQ(rig->patches.size(), 3u);
+  const app::RigPatch& e = rig->patches[0];
+  EXPECT_EQ(e.name, "left_elbow");
+  EXPECT_EQ(e.region.kind, app::RigRegion::Kind::kJoint);
+  EXPECT_EQ(e.region.joint, "LeftForeArm");
+  EXPECT_EQ(e.region.radius, 14.0f);
+  EXPECT_EQ(e.region.side, glm::vec3(0, 0, 1));
+  EXPECT_TRUE(e.cylinder);
+  EXPECT_EQ(e.sampling, glm::ivec2(9, 8));
+  EXPECT_EQ(e.grid, glm::ivec2(6, 5));
+  EXPECT_EQ(e.border_width, 0.2f);
+  EXPECT_EQ(rig->patches[1].region.vertices, (std::vector<int>{1, 2, 3}));
+  EXPECT_FALSE(rig->patches[1].cylinder);
+  EXPECT_EQ(rig->patches[1].grid, glm::ivec2(6, 6));  // default
+  EXPECT_EQ(rig->patches[2].region.kind, app::RigRegion::Kind::kScreen);
+  EXPECT_EQ(rig->patches[2].region.rect, glm::vec4(0.1f, 0.2f, 0.3f, 0.4f));
+  EXPECT_EQ(rig->render.size, glm::ivec2(320, 200));
+  EXPECT_EQ(rig->render.camera, "fixed");
+  EXPECT_FALSE(rig->render.split);
+  EXPECT_EQ(rig->render.output, "samples/data/out/x_####.png");
+}
+
+TEST(RigFile, DefaultsOfAMinimalRig) {
+  const auto rig = app::ParseRig(R"({"character": "mannequin", "motion": {"file": "/m.bvh"}})",
+                                 "r.json");
+  ASSERT_TRUE(rig.ok());
+  EXPECT_EQ(rig->motion, "/m.bvh");
+  EXPECT_EQ(rig->global, "ssd");
+  EXPECT_TRUE(rig->patches.empty());
+  EXPECT_TRUE(rig->render.split);
+  EXPECT_EQ(rig->render.size, glm::ivec2(640, 360));
+}
+
+struct BadRig {
+  const char* text;
+  const char* message;  // the whole formatted error
+};
+
+// One row per check: the exact message names the file, the field path and what was expected.
+const BadRig kBadRigs[] = {
+    {R"({"character": "mannequin",)", "r.json:1:27: error: invalid JSON: syntax error while "
+                                      "parsing object key - unexpected end of input; expected "
+                                      "string literal"},
+    {R"([1])", "r.json: rig: error: expected an object, found an array [1]"},
+    {R"({"character": "mannequin", "motion": {"file": "m.bvh"}, "colour": 1})",
+     "r.json: colour: error: unknown field (expected one of: character, motion, global, "
+     "patches, render)"},
+    {R"({"motion": {"file": "m.bvh"}})",
+     "r.json: character: error: missing (\"mannequin\" or a glTF file)"},
+    {R"({"character": "mannequin"})",
+     "r.json: motion: error: missing (the mannequin needs a BVH motion: {\"file\": ...})"},
+    {R"({"character": 3, "motion": {"file": "m.bvh"}})",
+     "r.json: character: error: expected a non-empty string, found 3"},
+    {R"({"character": "mannequin", "motion": {"file": "m.bvh", "fps": -1}})",
+     "r.json: motion.fps: error: expected a number in 0..10000, found -1"},
+    {R"({"character": "mannequin", "motion": {"file": "m.bvh"}, "global": "lbs2"})",
+     "r.json: global: error: expected one of \"ssd\", \"dqs\", \"swd\", found \"lbs2\""},
+    {R"({"character": "mannequin", "motion": {"file": "m.bvh"}, "patches": [{"name": "a",
+        "region": {"joint": "J", "radius": 5}}, {"name": "b", "region": {"joint": "J",
+        "radius": 5}, "grid": "6x6"}]})",
+     "r.json: patches[1].grid: error: expected an array of two integers in 4..64, found \"6x6\""},
+    {R"({"character": "mannequin", "motion": {"file": "m.bvh"}, "patches": [{"name": "a",
+        "region": {"joint": "J", "radius": 5}, "grid": [3, 6]}]})",
+     "r.json: patches[0].grid: error: expected an array of two integers in 4..64, found an "
+     "array [3,6]"},
+    {R"({"character": "mannequin", "motion": {"file": "m.bvh"}, "patches": [{"name": "a",
+        "region": {"joint": "J", "radius": 5}, "grid": [8, 8], "sampling": [6, 6]}]})",
+     "r.json: patches[0].sampling: error: expected at least the grid (8x8) each way, found 6x6"},
+    {R"({"character": "mannequin", "motion": {"file": "m.bvh"}, "patches": [{"name": "a",
+        "region": {"joint": "J"}}]})",
+     "r.json: patches[0].region.radius: error: missing (model units, > 0)"},
+    {R"({"character": "mannequin", "motion": {"file": "m.bvh"}, "patches": [{"name": "a",
+        "region": {"joint": "J", "radius": 5, "vertices": [1, 2, 3]}}]})",
+     "r.json: patches[0].region: error: expected exactly one of \"joint\" (with \"radius\"), "
+     "\"vertices\" or \"view\" (with \"rect\")"},
+    {R"({"character": "mannequin", "motion": {"file": "m.bvh"}, "patches": [{"name": "a",
+        "region": {"vertices": [1, -2, 3]}}]})",
+     "r.json: patches[0].region.vertices[1]: error: expected a vertex index (integer >= 0), "
+     "found -2"},
+    {R"({"character": "mannequin", "motion": {"file": "m.bvh"}, "patches": [{"name": "a",
+        "region": {"view": "top", "rect": [0, 0, 1, 1]}}]})",
+     "r.json: patches[0].region.view: error: expected one of \"front\", \"back\", \"left\", "
+     "\"right\", found \"top\""},
+    {R"({"character": "mannequin", "motion": {"file": "m.bvh"}, "patches": [{"name": "a",
+        "region": {"view": "front", "rect": [0.5, 0, 0.2, 1]}}]})",
+     "r.json: patches[0].region.rect: error: expected x0 < x1 and y0 < y1, found an array "
+     "[0.5,0,0.2,1]"},
+    {R"({"character": "mannequin", "motion": {"file": "m.bvh"}, "patches": [{"name": "a",
+        "region": {"joint": "J", "radius": 5}, "parametrization": "sphere"}]})",
+     "r.json: patches[0].parametrization: error: expected one of \"cylinder\", \"plane\", found "
+     "\"sphere\""},
+    {R"({"character": "mannequin", "motion": {"file": "m.bvh"}, "patches": [{"name": "a",
+        "region": {"joint": "J", "radius": 5}, "examples": []}]})",
+     "r.json: patches[0].examples: error: examples are not supported yet (issue 6)"},
+    {R"({"character": "mannequin", "motion": {"file": "m.bvh"}, "patches": [{"name": "a",
+        "region": {"joint": "J", "radius": 5}, "elastic": {}}]})",
+     "r.json: patches[0].elastic: error: elastic are not supported yet (issue 7)"},
+    {R"({"character": "mannequin", "motion": {"file": "m.bvh"}, "patches": [{"name": "a",
+        "region": {"joint": "J", "radius": 5}}, {"name": "a", "region": {"joint": "K",
+        "radius": 5}}]})",
+     "r.json: patches[1].name: error: expected a unique name, found \"a\" twice"},
+    {R"({"character": "mannequin", "motion": {"file": "m.bvh"}, "patches": [{"name": "a",
+        "region": {"joint": "J", "radius": 5}, "border_width": 0.7}]})",
+     "r.json: patches[0].border_width: error: expected a number in 0..0.5, found 0.7"},
+    {R"({"character": "mannequin", "motion": {"file": "m.bvh"}, "render": {"size": [8, 8]}})",
+     "r.json: render.size: error: expected an array of two integers in 16..16384, found an "
+     "array [8,8]"},
+    {R"({"character": "mannequin", "motion": {"file": "m.bvh"}, "render": {"overlays":
+        ["bones"]}})",
+     "r.json: render.overlays[0]: error: expected one of \"skeleton\", \"wire\", found "
+     "\"bones\""},
+    {R"({"character": "mannequin", "motion": {"file": "m.bvh"}, "render": {"split": 1}})",
+     "r.json: render.split: error: expected true or false, found 1"},
+};
+
+TEST(RigFile, BadRigsGiveExactMessages) {
+  for (const BadRig& bad : kBadRigs) {
+    const mocap::Result<app::Rig> rig = app::ParseRig(bad.text, "r.json");
+    ASSERT_FALSE(rig.ok()) << bad.text;
+    EXPECT_EQ(rig.error().ToString(), bad.message) << bad.text;
+  }
+}
+
+TEST(RigFile, MissingFileIsAnIoError) {
+  const auto rig = app::LoadRig("/nonexistent/rig.json");
+  ASSERT_FALSE(rig.ok());
+  EXPECT_EQ(rig.error().code, mocap::ErrorCode::kIo);
+}
+
+namespace fs = std::filesystem;
+
+const fs::path kSamples = fs::path(GOLDEN_DIR) / ".." / ".." / "samples" / "data";
+
+struct ProcessRun {
+  int exit_code = -1;
+  std::string err;
+};
+
+ProcessRun Patchskin(const std::string& args, const fs::path& dir) {
+  const fs::path err = dir / "stderr.txt";
+  const std::string cmd = std::string("'") + PATCHSKIN_BINARY + "' " + args + " >/dev/null 2>'" +
+                          err.string() + "'";
+  const int status = std::system(cmd.c_str());
+  std::ifstream in(err);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1,
+          {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()}};
+}
+
+TEST(RigFile, RenderCommandRendersTheSampleRigAsASplitFrame) {
+  const fs::path dir = testsupport::TestOutputPath("rig_file/render/x").parent_path();
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const ProcessRun r = Patchskin("render '" + (kSamples / "elbow_knee.json").string() +
+                              "' --frames 45:45 --no-video --no-sheet --quiet --out '" +
+                              (dir / "f_####.png").string() + "'",
+                          dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto img = render::ReadImage((dir / "f_0045.png").string());
+  ASSERT_TRUE(img.ok());
+  EXPECT_EQ(img->width, 960);  // the rig's render.size
+  EXPECT_EQ(img->height, 540);
+}
+
+TEST(RigFile, RenderCommandReportsABadJointWithItsFieldPath) {
+  const fs::path dir = testsupport::TestOutputPath("rig_file/bad_joint/x").parent_path();
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path rig = dir / "bad.json";
+  std::ofstream(rig) << R"({"character": "mannequin", "motion": {"file": ")"
+                     << fs::absolute(kSamples / "bend.bvh").lexically_normal().string()
+                     << R"("}, "patches": [{"name": "e", "region": {"joint": "Elbow", "radius": 9}}]})";
+  const ProcessRun r = Patchskin("render '" + rig.string() + "' --no-video --no-sheet --quiet --out '" +
+                              (dir / "f_####.png").string() + "'",
+                          dir);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("bad.json: patches[0].region.joint: error: expected a joint of "), std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(dir / "f_0000.png"));  // no partial output
+}
+
+TEST(RigFile, ScreenRegionBuildsAFrontPatchOnTheBelly) {
+  const std::string bvh = fs::absolute(kSamples / "bend.bvh").lexically_normal().string();
+  auto source = app::LoadMotionSource(bvh, {.y_up = true});
+  ASSERT_TRUE(source.ok()) << source.error().ToString();
+  auto character = app::MakeCharacter(std::move(*source));
+  ASSERT_TRUE(character.ok());
+  const auto rig = app::ParseRig(
+      R"({"character": "mannequin", "motion": {"file": "b.bvh"}, "patches": [{"name": "belly",
+          "region": {"view": "front", "rect": [0.44, 0.42, 0.56, 0.52]},
+          "parametrization": "plane", "grid": [5, 5]}]})",
+      "r.json");
+  ASSERT_TRUE(rig.ok()) << rig.error().ToString();
+  const auto patches = app::BuildRigPatches(*rig, *character);
+  ASSERT_TRUE(patches.ok()) << patches.error().ToString();
+  ASSERT_EQ(patches->size(), 1u);
+  const deform::PatchSetup& p = (*patches)[0];
+  EXPECT_GT(p.num_bound(), 20);
+  std::vector<glm::vec3> normals(character->mesh.bind.positions.size());
+  deform::ComputeVertexNormals(character->mesh.bind.positions, character->mesh.bind.triangles,
+                               normals);
+  for (const int v : p.region) EXPECT_GT(normals[static_cast<std::size_t>(v)].z, 0.0f) << v;
+  // A cylinder needs a joint axis.
+  const auto cyl = app::ParseRig(
+      R"({"character": "mannequin", "motion": {"file": "b.bvh"}, "patches": [{"name": "v",
+          "region": {"vertices": [1, 2, 3]}}]})",
+      "r.json");
+  ASSERT_TRUE(cyl.ok());
+  EXPECT_EQ(app::BuildRigPatches(*cyl, *character).error().ToString(),
+            "r.json: patches[0].parametrization: error: expected \"plane\" for a vertex-list or "
+            "screen region (a cylinder needs a joint for its axis), found \"cylinder\"");
+}
+
+}  // namespace
