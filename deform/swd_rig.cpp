@@ -53,9 +53,10 @@ float SegmentDistance2(const glm::vec3& p, const glm::vec3& a, const glm::vec3& 
   return glm::dot(d, d);
 }
 
-// Binds the vertices part by part. A connected part of the mesh (a mannequin tube) that
-// lies mostly (kFamilyShare of its vertices) nearest the sweeps of one body chain and
-// that chain's trunk is bound to those sweeps only: without this, the inner side of a
+// Binds the vertices part by part. A connected part of the mesh (a mannequin tube) of a
+// mesh made of several parts, or one that lies mostly (kFamilyShare of its vertices)
+// nearest the sweeps of one body chain and that chain's trunk, is bound to the sweeps of
+// the body chain nearest most of its vertices (plus its trunk) only: without this, the inner side of a
 // thigh tube, as near the other leg's bone as its own, would follow the other leg.
 // Other parts (a welded skin) are bound to all sweeps.
 mocap::Result<std::vector<SweepVertexBinding>> BindByComponent(
@@ -93,6 +94,10 @@ mocap::Result<std::vector<SweepVertexBinding>> BindByComponent(
     ++count[chains.size()];  // part size
   }
   // The chain set of every part: a family (one body chain's sweeps plus its trunk) or all.
+  // A mesh made of several parts (the mannequin's tubes) binds every part to a family.
+  int num_parts = 0;
+  for (std::size_t v = 0; v < nv; ++v) num_parts += FindRoot(parent, static_cast<int>(v)) == static_cast<int>(v) ? 1 : 0;
+  const bool several_parts = num_parts > 1;
   std::vector<int> group_of(nv, -1);
   std::vector<std::vector<int>> groups;  // sweep indices of each group
   std::vector<int> all(chains.size());
@@ -112,7 +117,8 @@ mocap::Result<std::vector<SweepVertexBinding>> BindByComponent(
     if (trunk >= 0) family.push_back(trunk);
     int inside = 0;
     for (int c : family) inside += count[static_cast<std::size_t>(c)];
-    const bool restrict = static_cast<float>(inside) >= kFamilyShare * static_cast<float>(count.back());
+    const bool restrict = several_parts ||
+                          static_cast<float>(inside) >= kFamilyShare * static_cast<float>(count.back());
     const std::vector<int>& set = restrict ? family : all;
     std::size_t g = 0;
     while (g < groups.size() && groups[g] != set) ++g;
