@@ -24,6 +24,7 @@
 #include "app/motion_source.h"
 #include "app/pipeline.h"
 #include "deform/skinning_job.h"
+#include "deform/swd_rig.h"
 #include "mocap/synthetic.h"
 #include "support/data_paths.h"
 #include "support/tolerances.h"
@@ -70,6 +71,25 @@ float MaxEdgeGrowth(const deform::Mesh& rest, const std::vector<glm::vec3>& pos)
 }
 
 void CheckCharacter(const app::Character& c, const std::string& what, bool check_tears) {
+  {  // At the bind pose the rig rebuilds the mesh (ALGORITHMS.md 2.3).
+    auto bind = app::BindModelFromJoint(c);
+    ASSERT_TRUE(bind.ok());
+    auto rig = deform::BuildSwdRig(c.skeleton, *bind, c.mesh.bind);
+    ASSERT_TRUE(rig.ok()) << rig.error().ToString();
+    std::vector<glm::quat> rot(bind->size());
+    std::vector<glm::vec3> joints(bind->size());
+    std::vector<glm::vec3> pos(c.mesh.bind.positions.size());
+    ASSERT_TRUE((deform::SwdRigJob{.rig = &*rig, .model_from_joint = *bind, .vertex_begin = 0,
+                                   .joint_rotations = rot, .joint_positions = joints,
+                                   .keep_volume = false, .positions = pos, .normals = {}}
+                     .Run()));
+    float err = 0.0f;
+    for (std::size_t v = 0; v < pos.size(); ++v) {
+      err = std::max(err, glm::distance(pos[v], c.mesh.bind.positions[v]));
+    }
+    const glm::vec3 e = deform::ComputeBounds(c.mesh.bind.positions).size();
+    EXPECT_LT(err / std::max({e.x, e.y, e.z}), testsupport::kSwdRebuildRelTol) << what;
+  }
   ExpectClosed(c.mesh.bind, what);
   const mocap::Status w = deform::CheckSkinWeights(
       c.mesh.weights, static_cast<int>(c.mesh.skin_joints.size()), c.mesh.bind.num_vertices());
