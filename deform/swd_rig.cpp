@@ -23,13 +23,14 @@ struct Piece {
   int last = 0;
 };
 
-// The interior joint of `lengths` (bone lengths, #K) whose two bones are together the
-// longest; 0 when the chain has fewer than two bones.
+// The interior joint of `lengths` (bone lengths, #K) whose two bones are both the
+// longest (largest shorter bone of the pair: a long clavicle beside the upper arm does
+// not win over upper arm and forearm); 0 when the chain has fewer than two bones.
 int LongestPairJoint(const std::vector<double>& lengths) {
   int best = 0;
   double best_sum = -1.0;
   for (std::size_t k = 1; k < lengths.size(); ++k) {
-    const double sum = lengths[k - 1] + lengths[k];
+    const double sum = std::min(lengths[k - 1], lengths[k]);
     if (sum > best_sum) best_sum = sum, best = static_cast<int>(k);
   }
   return best;

@@ -17,8 +17,8 @@
 //   overlapping tubes) binds each part only to the sweeps of the body chain nearest most
 //   of its vertices plus that chain's trunk, so the inner side of a thigh never follows
 //   the other leg; a single welded skin is bound to all sweeps (nearest bone segment).
-// - Limbs (for artifact figures): in a limb chain, the interior joint whose two bones
-//   are together the longest is its elbow/knee; the next joint is its wrist/ankle.
+// - Limbs (for artifact figures): in a limb chain, the interior joint whose shorter bone
+//   is the longest is its elbow/knee; the next joint is its wrist/ankle.
 //   Limbs leaving the first point of a spine are legs, other limbs are arms.
 //
 // Per frame, SwdRigJob turns model-space joint matrices into positions and normals.
