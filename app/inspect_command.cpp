@@ -8,6 +8,9 @@
 #include <nlohmann/json.hpp>
 
 #include "app/motion_source.h"
+#include "app/pipeline.h"
+#include "deform/rig_artifacts.h"
+#include "deform/swd_rig.h"
 #include "mocap/joint_angles.h"
 #include "mocap/pose.h"
 
@@ -155,6 +158,53 @@ void PrintJson(const MotionSource& src, const InspectOptions& options) {
   std::printf("%s\n", doc.dump(2).c_str());
 }
 
+// Collapse and candy-wrapper figures of SSD, DQS and SWD on the file's body.
+int PrintArtifacts(MotionSource&& src, const std::string& file) {
+  mocap::Result<Character> ch = MakeCharacter(std::move(src));
+  if (!ch.ok()) {
+    std::fprintf(stderr, "%s\n", ch.error().ToString().c_str());
+    return 2;
+  }
+  mocap::Result<std::vector<glm::mat4>> bind = BindModelFromJoint(*ch);
+  mocap::Result<deform::SwdRig> rig =
+      bind.ok() ? deform::BuildSwdRig(ch->skeleton, *bind, ch->mesh.bind)
+                : mocap::Result<deform::SwdRig>(bind.error());
+  if (!rig.ok()) {
+    mocap::Error e = std::move(rig).error();
+    if (e.loc.file.empty()) e.loc.file = file;
+    std::fprintf(stderr, "%s\n", e.ToString().c_str());
+    return 2;
+  }
+  const std::vector<double> bends = {90.0, 120.0, 150.0};
+  const std::vector<double> twists = {90.0, 180.0};
+  mocap::Result<std::vector<deform::LimbArtifacts>> figures =
+      deform::MeasureLimbArtifacts(ch->skeleton, *bind, ch->mesh, *rig, bends, twists);
+  if (!figures.ok()) {
+    mocap::Error e = std::move(figures).error();
+    if (e.loc.file.empty()) e.loc.file = file;
+    std::fprintf(stderr, "%s\n", e.ToString().c_str());
+    return 2;
+  }
+  std::printf("artifact figures of %s (%d vertices%s): ring area / rest area, 1 = kept\n",
+              file.c_str(), ch->mesh.bind.num_vertices(),
+              ch->bound_at_first_frame ? ", bound at frame 0" : "");
+  std::printf("%-8s %-24s %-9s %7s %7s %7s\n", "limb", "joint", "pose", "SSD", "DQS", "SWD");
+  for (const deform::LimbArtifacts& l : *figures) {
+    const char* kind = l.arm ? "arm" : "leg";
+    for (const deform::AngleFigures& a : l.collapse) {
+      std::printf("%-8s %-24s bend %3.0f  %7.3f %7.3f %7.3f\n", kind, l.joint.c_str(), a.degrees,
+                  a.figures.ssd, a.figures.dqs, a.figures.swd);
+    }
+    for (const deform::AngleFigures& a : l.candy) {
+      std::printf("%-8s %-24s twist %3.0f %7.3f %7.3f %7.3f\n", kind, l.end_joint.c_str(),
+                  a.degrees, a.figures.ssd, a.figures.dqs, a.figures.swd);
+    }
+  }
+  std::printf("bend: collapse figure at the elbow/knee; twist: candy-wrapper figure along the "
+              "forearm (hand turned about it)\n");
+  return 0;
+}
+
 }  // namespace
 
 CLI::App* AddInspectCommand(CLI::App& parent, InspectOptions& options) {
@@ -162,6 +212,9 @@ CLI::App* AddInspectCommand(CLI::App& parent, InspectOptions& options) {
   cmd->add_option("file", options.file, "BVH, glTF or GLB file")->required();
   cmd->add_option("--frame", options.frame, "Also print world joint positions at this frame (0-based)");
   cmd->add_flag("--json", options.json, "Print one JSON document (schema in the README)");
+  cmd->add_flag("--artifacts", options.artifacts,
+                "Print collapse (elbow/knee bent 90/120/150 deg) and candy-wrapper (hand "
+                "twisted 90/180 deg) figures of SSD, DQS and SWD on the file's body");
   cmd->add_option("--scale", options.scale,
                   "Multiply lengths by this factor (0: convert detected units to metres)");
   cmd->add_flag("--y-up", options.y_up, "Rotate a Z-up capture to Y-up");
@@ -189,6 +242,7 @@ int RunInspect(const InspectOptions& options) {
       return 2;
     }
   }
+  if (options.artifacts) return PrintArtifacts(std::move(*src), options.file);
   if (options.json) {
     PrintJson(*src, options);
   } else {

@@ -3,7 +3,9 @@
 // channels, frame count, frame time, duration, detected units and up axis; with
 // --frame, every joint's world position and rotation at that frame, in the
 // file's own units and axes unless --scale / --y-up ask otherwise. The JSON
-// schema is documented in the README ("inspect --json").
+// schema is documented in the README ("inspect --json"). With --artifacts it
+// prints the collapse and candy-wrapper figures of SSD, DQS and SWD on the
+// file's body (deform/rig_artifacts.h) instead.
 
 #include <optional>
 #include <string>
@@ -16,6 +18,7 @@ struct InspectOptions {
   std::string file;
   std::optional<int> frame;       // 0-based frame index
   bool json = false;
+  bool artifacts = false;         // print SSD/DQS/SWD artifact figures instead
   float scale = 1.0f;             // 0 = automatic (detected units to metres)
   bool y_up = false;              // rotate a Z-up file to Y-up
   bool add_position_to_offset = false;

@@ -2,11 +2,13 @@
 
 #include <algorithm>
 #include <array>
+#include <optional>
 #include <thread>
 
 #include "app/motion_source.h"
 #include "deform/dqs_job.h"
 #include "deform/skinning_job.h"
+#include "deform/swd_rig.h"
 #include "mocap/bvh_reader.h"
 #include "mocap/pose.h"
 #include "mocap/sampling.h"
@@ -72,6 +74,26 @@ mocap::Result<GlobalMethod> ParseGlobalMethod(const std::string& name) {
                           "expected ssd, dqs or swd, found '" + name + "'");
 }
 
+mocap::Result<std::vector<glm::mat4>> BindModelFromJoint(const Character& c) {
+  const auto nj = static_cast<std::size_t>(c.skeleton.num_joints());
+  std::vector<mocap::JointTransform> locals(nj);
+  std::vector<glm::mat4> model(nj);
+  mocap::RestPose(c.skeleton, locals);
+  if (c.bound_at_first_frame && c.motion.num_frames > 0) {
+    (void)mocap::LocalPoseJob{&c.skeleton, c.motion.frame(0), locals}.Run();
+  }
+  const mocap::JobStatus s =
+      mocap::LocalToModelJob{.parents = c.skeleton.parents, .locals = locals, .model_from_joint = model}
+          .Run();
+  if (!s) return JobError(c, s, "local-to-model");
+  // A skinned mesh's own bind matrices win over the rest pose (glTF).
+  for (std::size_t i = 0; i < c.mesh.skin_joints.size() && i < c.mesh.joint_from_bind.size(); ++i) {
+    const auto j = static_cast<std::size_t>(c.mesh.skin_joints[i]);
+    if (j < nj) model[j] = glm::inverse(c.mesh.joint_from_bind[i]);
+  }
+  return model;
+}
+
 mocap::Result<Character> MakeCharacter(MotionSource&& source,
                                        const deform::MannequinOptions& mannequin) {
   Character c;
@@ -84,24 +106,15 @@ mocap::Result<Character> MakeCharacter(MotionSource&& source,
     c.mesh = std::move(source.gltf->mesh);
     return c;
   }
-  const auto nj = static_cast<std::size_t>(c.skeleton.num_joints());
-  std::vector<mocap::JointTransform> locals(nj);
-  std::vector<glm::mat4> model(nj);
-  mocap::RestPose(c.skeleton, locals);
   // A rest pose far lower than the first frame's is not a body pose (limbs
   // folded or lying flat): build and bind the body at frame 0 instead.
   const mocap::UpAxis up = c.skeleton.info.up_axis;
   const float rest_h = mocap::RestHeight(c.skeleton, up);
   const float first_h = mocap::FirstFrameHeight(c.skeleton, c.motion, up);
-  if (c.motion.num_frames > 0 && first_h > 1.3f * rest_h) {
-    (void)mocap::LocalPoseJob{&c.skeleton, c.motion.frame(0), locals}.Run();
-    c.bound_at_first_frame = true;
-  }
-  const mocap::JobStatus s =
-      mocap::LocalToModelJob{.parents = c.skeleton.parents, .locals = locals, .model_from_joint = model}
-          .Run();
-  if (!s) return JobError(c, s, "local-to-model");
-  mocap::Result<deform::SkinnedMesh> body = deform::BuildMannequin(c.skeleton, model, mannequin);
+  c.bound_at_first_frame = c.motion.num_frames > 0 && first_h > 1.3f * rest_h;
+  mocap::Result<std::vector<glm::mat4>> model = BindModelFromJoint(c);
+  if (!model.ok()) return std::move(model).error();
+  mocap::Result<deform::SkinnedMesh> body = deform::BuildMannequin(c.skeleton, *model, mannequin);
   if (!body.ok()) {
     mocap::Error e = std::move(body).error();
     if (e.loc.file.empty()) e.loc.file = c.source;
@@ -124,6 +137,9 @@ struct FramePipeline::Impl {
   std::vector<std::vector<glm::vec3>> carried;          // per patch, #M x #N
   std::vector<std::span<const glm::vec3>> carried_views;
   deform::PatchLayerScratch patch_scratch;
+  std::optional<deform::SwdRig> swd_rig;
+  std::vector<glm::quat> swd_rotations;  // #threads x #J scratch
+  std::vector<glm::vec3> swd_joints;     // #threads x #J scratch
 };
 
 FramePipeline::FramePipeline(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -154,10 +170,6 @@ mocap::Status FramePipeline::SetPatches(std::vector<deform::PatchSetup> patches)
 
 mocap::Result<FramePipeline> FramePipeline::Create(const Character& character, GlobalMethod method,
                                                    int threads) {
-  if (method == GlobalMethod::kSwd) {
-    return mocap::MakeError(mocap::ErrorCode::kUnsupported, {character.source, 0, 0, {}},
-                            "--global swd is not available in this build yet");
-  }
   const mocap::Status weights = deform::CheckSkinWeights(
       character.mesh.weights, static_cast<int>(character.mesh.skin_joints.size()),
       character.mesh.bind.num_vertices());
@@ -172,6 +184,19 @@ mocap::Result<FramePipeline> FramePipeline::Create(const Character& character, G
   impl->model_from_joint.resize(nj);
   impl->palette.resize(character.mesh.skin_joints.size());
   impl->dq_palette.resize(character.mesh.skin_joints.size());
+  if (method == GlobalMethod::kSwd) {
+    mocap::Result<std::vector<glm::mat4>> bind = BindModelFromJoint(character);
+    if (!bind.ok()) return std::move(bind).error();
+    mocap::Result<deform::SwdRig> rig = deform::BuildSwdRig(character.skeleton, *bind, character.mesh.bind);
+    if (!rig.ok()) {
+      mocap::Error e = std::move(rig).error();
+      if (e.loc.file.empty()) e.loc.file = character.source;
+      return e;
+    }
+    impl->swd_rig = std::move(*rig);
+    impl->swd_rotations.resize(nj * static_cast<std::size_t>(kMaxThreads));
+    impl->swd_joints.resize(nj * static_cast<std::size_t>(kMaxThreads));
+  }
   return FramePipeline(std::move(impl));
 }
 
@@ -208,7 +233,19 @@ mocap::Status FramePipeline::Evaluate(double time_s, DeformedFrame& out) {
   std::array<mocap::JobStatus, kMaxThreads> results{};
   ParallelRanges(nv, m.threads, [&](int chunk, int begin, int end) {
     mocap::JobStatus r;
-    if (m.method == GlobalMethod::kDqs) {
+    if (m.method == GlobalMethod::kSwd) {
+      const int nj = static_cast<int>(m.model_from_joint.size());
+      r = deform::SwdRigJob{.rig = &*m.swd_rig,
+                            .model_from_joint = m.model_from_joint,
+                            .vertex_begin = begin,
+                            .joint_rotations = Sub(m.swd_rotations, chunk, chunk + 1, nj),
+                            .joint_positions = Sub(m.swd_joints, chunk, chunk + 1, nj),
+                            .keep_volume = false,
+                            .positions = Sub(out.positions, begin, end),
+                            .normals = has_normals ? Sub(out.normals, begin, end)
+                                                   : std::span<glm::vec3>()}
+              .Run();
+    } else if (m.method == GlobalMethod::kDqs) {
       r = deform::DqsJob{.palette = m.dq_palette,
                          .influences = k,
                          .joint_indices = Sub(mesh.weights.joints, begin, end, k),

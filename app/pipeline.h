@@ -56,6 +56,11 @@ struct Character {
 mocap::Result<Character> MakeCharacter(MotionSource&& source,
                                        const deform::MannequinOptions& mannequin = {});
 
+// The model-space joint matrices (#J) of the pose the character's mesh was made
+// in: the rest pose, or frame 0 when bound_at_first_frame; a skinned mesh's own
+// bind matrices replace those of its skin joints.
+mocap::Result<std::vector<glm::mat4>> BindModelFromJoint(const Character& character);
+
 // One evaluated frame, in world space.
 struct DeformedFrame {
   std::vector<glm::vec3> positions;        // #V

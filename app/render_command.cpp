@@ -10,6 +10,7 @@
 
 #include "app/demo_data.h"
 #include "app/frame_plan.h"
+#include "app/frame_render.h"
 #include "app/motion_source.h"
 #include "app/pipeline.h"
 #include "app/progress.h"
@@ -37,26 +38,6 @@ std::vector<std::string> SplitList(const std::string& text) {
   return out;
 }
 
-void AddSkeleton(const DeformedFrame& f, const mocap::Skeleton& s, render::Overlays& o) {
-  render::LineOverlay bones;
-  bones.depth_test = false;
-  render::AppendSkeletonLines(f.joint_positions, s.parents, bones);
-  o.lines.push_back(std::move(bones));
-  render::PointOverlay joints;
-  joints.points = f.joint_positions;
-  joints.depth_test = false;
-  o.points.push_back(std::move(joints));
-}
-
-// Copies the right half of `right` over `left`, and draws a divider.
-void ComposeSplit(const render::Image& right, render::Image& left) {
-  const int mid = left.width / 2;
-  for (int y = 0; y < left.height; ++y) {
-    for (int x = mid; x < left.width; ++x) left.at(x, y) = right.at(x, y);
-    left.at(mid, y) = glm::vec4(1.0f);
-    if (mid > 0) left.at(mid - 1, y) = glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);
-  }
-}
 
 }  // namespace
 
@@ -308,36 +289,18 @@ int RunRender(const RenderOptions& options) {
     mocap::Status s = pipeline->Evaluate(of.time_s, frame);
     if (!s.ok()) return Fail(s.error());
     const render::Camera camera = cameras->At(of);
-    auto draw = [&](const DeformedFrame& f, render::Renderer& r, const std::string& label,
-                    int label_x, render::Image& into) -> mocap::Status {
-      const deform::Mesh& bind = ch.mesh.bind;
-      render::SceneMesh body{.positions = f.positions, .normals = f.normals,
-                             .triangles = bind.triangles, .vertex_colors = bind.colors};
-      render::Overlays overlays;
-      if (overlay_skeleton) AddSkeleton(f, ch.skeleton, overlays);
-      overlays.wireframe = overlay_wire;
-      overlays.text.push_back({.text = "frame " + std::to_string(of.number),
-                               .origin_px = {10, size->y - 12}});
-      if (!label.empty()) overlays.text.push_back({.text = label, .origin_px = {label_x, 30}});
-      const mocap::JobStatus js = r.Render(camera, {&body, 1}, overlays, settings, into);
-      if (!js) {
-        return mocap::MakeError(mocap::ErrorCode::kInternal, {ch.source, 0, 0, {}},
-                                std::string("renderer refused the frame: ") + js.what);
-      }
-      return mocap::Status::Ok();
-    };
+    const FrameDrawOptions draw{.skeleton = overlay_skeleton,
+                                .wireframe = overlay_wire,
+                                .frame_number = of.number,
+                                .left_label = right_pipeline ? GlobalMethodName(main_method) : "",
+                                .right_label = right_pipeline ? right_label : ""};
     if (right_pipeline) {
       s = right_pipeline->Evaluate(of.time_s, right_frame);
       if (!s.ok()) return Fail(s.error());
-      s = draw(frame, renderer, GlobalMethodName(main_method), 10, image);
-      if (!s.ok()) return Fail(s.error());
-      s = draw(right_frame, right_renderer, right_label, size->x / 2 + 10, right_image);
-      if (!s.ok()) return Fail(s.error());
-      ComposeSplit(right_image, image);
-    } else {
-      s = draw(frame, renderer, "", 0, image);
-      if (!s.ok()) return Fail(s.error());
     }
+    s = DrawCharacterFrame(ch, frame, right_pipeline ? &right_frame : nullptr, camera, settings,
+                           draw, renderer, right_renderer, right_image, image);
+    if (!s.ok()) return Fail(s.error());
     if (sheet && next_sheet < sheet_count &&
         i == frames.size() * static_cast<std::size_t>(next_sheet) / static_cast<std::size_t>(sheet_count)) {
       s = sheet->Add(image, of.number);

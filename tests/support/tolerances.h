@@ -149,5 +149,15 @@ inline constexpr double kGlbSizeEstimateRelTol = 0.15;
 // Two glb layouts whose files differ by less than this are a tie for the
 // automatic choice (it decides on estimates).
 inline constexpr double kGlbLayoutTieRelTol = 0.02;
+// Candy-wrapper figure under a 180 degree twist of the hand on the mannequin: SSD's
+// blend collapses the forearm rings to well under this area ratio...
+inline constexpr double kCandyWrapperCollapsedMax = 0.5;
+// ...while DQS and SWD keep at least this much of them.
+inline constexpr double kCandyWrapperKeptMin = 0.8;
+
+// SWD on a mannequin: largest growth of any edge, as a fraction of the body size. A tear
+// (a tube part following the wrong bone) opens gaps of a limb radius (5-10%); the rest-bent
+// ankle's inner side, bound ambiguously, creases by up to about 3%.
+inline constexpr float kSwdMaxEdgeGrowthFraction = 0.04f;
 
 }  // namespace testsupport

@@ -1,0 +1,58 @@
+#pragma once
+// A skeleton's body decomposed into chains by topology (never by name), shared by
+// the mannequin (one tube per chain) and the SWD rig (one sweep per chain):
+//  1. Joints closer than 1e-4 S (S = largest extent of joints and end sites) to their
+//     parent merge with it; end sites become leaf points.
+//  2. A spine starts at each root toward the child with the most descendants (a root
+//     with one child that branches only positions the body and is skipped); at every
+//     branch point a chain continues into the straightest child and each other child
+//     starts a new chain whose first point is the branch point. Side branches reaching
+//     less than `min_branch_extent` S are folded into their chain (fingers, eyes).
+
+#include <span>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "mocap/error.h"
+#include "mocap/skeleton.h"
+
+namespace deform {
+
+// A point of the simplified tree: a joint with a bone of non-zero length, a root, or an
+// end site.
+struct BodyPoint {
+  glm::vec3 pos{0.0f};       // model space (of the given rest matrices), model units
+  int parent = -1;           // parent point, -1 for roots
+  int joint = -1;            // skeleton joint at this point, -1 for an end site
+  int bone_joint = -1;       // skeleton joint whose rotation moves the bone parent -> this
+  std::vector<int> children;  // child points
+  int descendants = 0;        // number of points below this one
+};
+
+enum class BodyChainKind { kSpine, kLimb };
+
+struct BodyChain {
+  // Tree points from the start (a branch point or a root) to a leaf, >= 2. Bone k runs
+  // from points[k] to points[k+1] and turns with points[k+1]'s bone_joint.
+  std::vector<int> points;
+  BodyChainKind kind = BodyChainKind::kLimb;
+  int parent_chain = -1;         // chain holding points[0] (-1 for spines)
+  bool folded_branches = false;  // small side branches (fingers) were folded in
+  int first_folded = -1;         // index in `points` of the first point that had them
+};
+
+struct BodyChains {
+  std::vector<BodyPoint> points;  // parents before children
+  std::vector<BodyChain> chains;  // spines first, then their branches (parents first)
+  float size = 0.0f;              // S: largest extent of the body's points, model units
+};
+
+// Errors: kCountMismatch when the matrix count is not #J, kInvalidArgument for
+// broken parent order or a skeleton without any bone of non-zero length, kNonFinite
+// for non-finite matrices.
+[[nodiscard]] mocap::Result<BodyChains> BuildBodyChains(
+    const mocap::Skeleton& skeleton, std::span<const glm::mat4> rest_model_from_joint,
+    float min_branch_extent);
+
+}  // namespace deform

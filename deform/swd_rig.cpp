@@ -1,0 +1,345 @@
+#include "deform/swd_rig.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <string>
+#include <utility>
+
+#include "deform/body_chains.h"
+#include "deform/swd_job.h"
+
+namespace deform {
+namespace {
+
+using mocap::ErrorCode;
+using mocap::JobStatus;
+using mocap::MakeError;
+
+// One sweep cut from a body chain: body-chain points [first, last].
+struct Piece {
+  int body_chain = 0;
+  int first = 0;
+  int last = 0;
+};
+
+// The interior joint of `lengths` (bone lengths, #K) whose two bones are both the
+// longest (largest shorter bone of the pair: a long clavicle beside the upper arm does
+// not win over upper arm and forearm); 0 when the chain has fewer than two bones.
+int LongestPairJoint(const std::vector<double>& lengths) {
+  int best = 0;
+  double best_sum = -1.0;
+  for (std::size_t k = 1; k < lengths.size(); ++k) {
+    const double sum = std::min(lengths[k - 1], lengths[k]);
+    if (sum > best_sum) best_sum = sum, best = static_cast<int>(k);
+  }
+  return best;
+}
+
+int FindRoot(std::vector<int>& parent, int i) {
+  while (parent[static_cast<std::size_t>(i)] != i) {
+    parent[static_cast<std::size_t>(i)] =
+        parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(i)])];
+    i = parent[static_cast<std::size_t>(i)];
+  }
+  return i;
+}
+
+// Squared distance from p to the segment [a, b].
+float SegmentDistance2(const glm::vec3& p, const glm::vec3& a, const glm::vec3& b) {
+  const glm::vec3 ab = b - a;
+  const float len2 = glm::dot(ab, ab);
+  const float t = len2 > 0.0f ? std::clamp(glm::dot(p - a, ab) / len2, 0.0f, 1.0f) : 0.0f;
+  const glm::vec3 d = p - (a + t * ab);
+  return glm::dot(d, d);
+}
+
+// Binds the vertices part by part. A connected part of the mesh (a mannequin tube) of a
+// mesh made of several parts, or one that lies mostly (kFamilyShare of its vertices)
+// nearest the sweeps of one body chain and that chain's trunk, is bound to the sweeps of
+// the body chain nearest most of its vertices (plus its trunk) only: without this, the inner side of a
+// thigh tube, as near the other leg's bone as its own, would follow the other leg.
+// Other parts (a welded skin) are bound to all sweeps.
+mocap::Result<std::vector<SweepVertexBinding>> BindByComponent(
+    std::span<const SweepChain> chains, std::span<const SweepJunction> junctions,
+    std::span<const int> piece_chain, const Mesh& mesh) {
+  constexpr float kFamilyShare = 0.75f;
+  const std::size_t nv = mesh.positions.size();
+  const auto nc = static_cast<int>(chains.size());
+  std::vector<int> parent(nv);
+  for (std::size_t v = 0; v < nv; ++v) parent[v] = static_cast<int>(v);
+  for (const glm::uvec3& t : mesh.triangles) {
+    if (t.x >= nv || t.y >= nv || t.z >= nv) continue;
+    const int a = FindRoot(parent, static_cast<int>(t.x));
+    parent[static_cast<std::size_t>(FindRoot(parent, static_cast<int>(t.y)))] = a;
+    parent[static_cast<std::size_t>(FindRoot(parent, static_cast<int>(t.z)))] = a;
+  }
+  // Nearest sweep of every vertex, counted per part.
+  std::vector<int> trunk_of(chains.size(), -1);
+  for (const SweepJunction& j : junctions) trunk_of[static_cast<std::size_t>(j.branch)] = j.trunk;
+  std::vector<std::vector<int>> counts(nv);
+  for (std::size_t v = 0; v < nv; ++v) {
+    int best = 0;
+    float best_d = 1e38f;
+    for (int c = 0; c < nc; ++c) {
+      const BasicSweepPose<double>& rest = chains[static_cast<std::size_t>(c)].rest_pose();
+      for (int k = 0; k < rest.num_bones; ++k) {
+        const float d = SegmentDistance2(mesh.positions[v], glm::vec3(rest.points[static_cast<std::size_t>(k)]),
+                                         glm::vec3(rest.points[static_cast<std::size_t>(k + 1)]));
+        if (d < best_d) best_d = d, best = c;
+      }
+    }
+    std::vector<int>& count = counts[static_cast<std::size_t>(FindRoot(parent, static_cast<int>(v)))];
+    if (count.empty()) count.assign(chains.size() + 1, 0);
+    ++count[static_cast<std::size_t>(best)];
+    ++count[chains.size()];  // part size
+  }
+  // The chain set of every part: a family (one body chain's sweeps plus its trunk) or all.
+  // A mesh made of several parts (the mannequin's tubes) binds every part to a family.
+  int num_parts = 0;
+  for (std::size_t v = 0; v < nv; ++v) num_parts += FindRoot(parent, static_cast<int>(v)) == static_cast<int>(v) ? 1 : 0;
+  const bool several_parts = num_parts > 1;
+  std::vector<int> group_of(nv, -1);
+  std::vector<std::vector<int>> groups;  // sweep indices of each group
+  std::vector<int> all(chains.size());
+  for (int c = 0; c < nc; ++c) all[static_cast<std::size_t>(c)] = c;
+  for (std::size_t v = 0; v < nv; ++v) {
+    const int root = FindRoot(parent, static_cast<int>(v));
+    if (static_cast<std::size_t>(root) != v) continue;
+    const std::vector<int>& count = counts[v];
+    const int top = static_cast<int>(std::max_element(count.begin(), count.end() - 1) - count.begin());
+    std::vector<int> family;
+    for (int c = 0; c < nc; ++c) {
+      if (piece_chain[static_cast<std::size_t>(c)] == piece_chain[static_cast<std::size_t>(top)]) {
+        family.push_back(c);
+      }
+    }
+    const int trunk = trunk_of[static_cast<std::size_t>(family.front())];
+    if (trunk >= 0) family.push_back(trunk);
+    int inside = 0;
+    for (int c : family) inside += count[static_cast<std::size_t>(c)];
+    const bool restrict = several_parts ||
+                          static_cast<float>(inside) >= kFamilyShare * static_cast<float>(count.back());
+    const std::vector<int>& set = restrict ? family : all;
+    std::size_t g = 0;
+    while (g < groups.size() && groups[g] != set) ++g;
+    if (g == groups.size()) groups.push_back(set);
+    group_of[v] = static_cast<int>(g);
+  }
+  std::vector<SweepVertexBinding> out(nv);
+  for (std::size_t g = 0; g < groups.size(); ++g) {
+    const std::vector<int>& set = groups[g];
+    std::vector<SweepChain> sub;
+    std::vector<int> local(chains.size(), -1);
+    for (int c : set) {
+      local[static_cast<std::size_t>(c)] = static_cast<int>(sub.size());
+      sub.push_back(chains[static_cast<std::size_t>(c)]);
+    }
+    std::vector<SweepJunction> sub_junctions;
+    for (SweepJunction j : junctions) {
+      if (local[static_cast<std::size_t>(j.branch)] < 0 || local[static_cast<std::size_t>(j.trunk)] < 0) continue;
+      j.branch = local[static_cast<std::size_t>(j.branch)];
+      j.trunk = local[static_cast<std::size_t>(j.trunk)];
+      sub_junctions.push_back(j);
+    }
+    std::vector<std::uint32_t> members;
+    std::vector<glm::vec3> positions;
+    for (std::size_t v = 0; v < nv; ++v) {
+      if (group_of[static_cast<std::size_t>(FindRoot(parent, static_cast<int>(v)))] != static_cast<int>(g)) continue;
+      members.push_back(static_cast<std::uint32_t>(v));
+      positions.push_back(mesh.positions[v]);
+    }
+    mocap::Result<std::vector<SweepVertexBinding>> b = BindToSweeps(sub, sub_junctions, positions);
+    if (!b.ok()) return std::move(b).error();
+    for (std::size_t i = 0; i < members.size(); ++i) {
+      SweepVertexBinding vb = (*b)[i];
+      vb.primary.chain = static_cast<std::uint16_t>(set[vb.primary.chain]);
+      vb.secondary.chain = static_cast<std::uint16_t>(set[vb.secondary.chain]);
+      out[members[i]] = vb;
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+mocap::Result<SwdRig> BuildSwdRig(const mocap::Skeleton& skeleton,
+                                  std::span<const glm::mat4> bind_model_from_joint,
+                                  const Mesh& bind_mesh, const SwdRigOptions& options) {
+  if (bind_mesh.positions.empty()) {
+    return MakeError(ErrorCode::kInvalidArgument, {}, "SWD rig: the mesh has no vertices");
+  }
+  if (!bind_mesh.normals.empty() && bind_mesh.normals.size() != bind_mesh.positions.size()) {
+    return MakeError(ErrorCode::kInvalidArgument, {},
+                     "SWD rig: expected one normal per vertex (" +
+                         std::to_string(bind_mesh.positions.size()) + "), found " +
+                         std::to_string(bind_mesh.normals.size()));
+  }
+  if (!(options.max_bend_rad > 0.0 && options.max_bend_rad <= 3.2)) {
+    return MakeError(ErrorCode::kInvalidArgument, {},
+                     "SWD rig: max_bend_rad must be in (0, 3.2]");
+  }
+  mocap::Result<BodyChains> tree =
+      BuildBodyChains(skeleton, bind_model_from_joint, options.min_branch_extent);
+  if (!tree.ok()) return std::move(tree).error();
+  const std::vector<BodyPoint>& pts = tree->points;
+  const std::vector<BodyChain>& body = tree->chains;
+
+  // Cut every chain into pieces of at most kMaxSweepBones bones sharing one bone.
+  std::vector<Piece> pieces;
+  std::vector<int> first_piece(body.size(), 0);
+  for (std::size_t c = 0; c < body.size(); ++c) {
+    first_piece[c] = static_cast<int>(pieces.size());
+    const int num_bones = static_cast<int>(body[c].points.size()) - 1;
+    int start = 0;
+    while (true) {
+      const int end = std::min(num_bones, start + kMaxSweepBones);
+      pieces.push_back({static_cast<int>(c), start, end});
+      if (end == num_bones) break;
+      start = end - 1;
+    }
+  }
+  if (pieces.size() > static_cast<std::size_t>(kMaxSwdChains)) {
+    return MakeError(ErrorCode::kLimitExceeded, {skeleton.info.source_file, 0, 0, {}},
+                     "SWD: the skeleton splits into " + std::to_string(pieces.size()) +
+                         " sweeps, more than the " + std::to_string(kMaxSwdChains) +
+                         " one body can use (use --global ssd or dqs)");
+  }
+
+  SwdRig rig;
+  const auto nj = static_cast<std::size_t>(skeleton.num_joints());
+  rig.joint_from_bind_.resize(nj);
+  for (std::size_t j = 0; j < nj; ++j) {
+    rig.joint_from_bind_[j] = glm::inverse(bind_model_from_joint[j]);
+  }
+  for (std::size_t p = 0; p < pieces.size(); ++p) {
+    const Piece& piece = pieces[p];
+    const BodyChain& chain = body[static_cast<std::size_t>(piece.body_chain)];
+    SweepChainSpec spec;
+    std::vector<double> lengths;
+    for (int i = piece.first; i <= piece.last; ++i) {
+      const BodyPoint& pt = pts[static_cast<std::size_t>(chain.points[static_cast<std::size_t>(i)])];
+      spec.rest_points.push_back(pt.pos);
+      if (i > piece.first) {
+        spec.joints.push_back(pt.bone_joint);
+        lengths.push_back(glm::distance(spec.rest_points[spec.rest_points.size() - 2], pt.pos));
+      }
+    }
+    const int k_bones = static_cast<int>(spec.joints.size());
+    // Limbs: the longest pair of bones meets at the elbow or knee; the joint after it
+    // (wrist, ankle) spreads its twist upstream.
+    spec.twist_spread.assign(static_cast<std::size_t>(k_bones + 1), TwistSpread::kDownstream);
+    const bool limb = chain.kind == BodyChainKind::kLimb && piece.first == 0;
+    if (limb && k_bones >= 2) {
+      SwdLimb l;
+      l.chain = static_cast<int>(p);
+      l.middle = LongestPairJoint(lengths);
+      l.has_end = l.middle + 1 < k_bones;
+      if (l.has_end) spec.twist_spread[static_cast<std::size_t>(l.middle + 1)] = TwistSpread::kUpstream;
+      const BodyChain& parent = body[static_cast<std::size_t>(chain.parent_chain)];
+      l.arm = !(parent.kind == BodyChainKind::kSpine && parent.points[0] == chain.points[0]);
+      rig.limbs_.push_back(l);
+    }
+    // Region half-widths from the skin radius near each interior joint.
+    spec.half_widths.assign(static_cast<std::size_t>(k_bones + 1), 0.0f);
+    for (int k = 1; k < k_bones; ++k) {
+      const double r = SkinRadiusNearJoint(spec, k, bind_mesh.positions);
+      const double lin = lengths[static_cast<std::size_t>(k - 1)];
+      const double lout = lengths[static_cast<std::size_t>(k)];
+      const double radius = r > 0.0 ? r : 0.1 * std::min(lin, lout);
+      spec.half_widths[static_cast<std::size_t>(k)] =
+          static_cast<float>(DefaultHalfWidth(radius, options.max_bend_rad, lin, lout));
+    }
+    mocap::Result<SweepChain> sweep = BuildSweepChain(spec);
+    if (!sweep.ok()) {
+      mocap::Error e = std::move(sweep).error();
+      e.message = "SWD: body chain " + std::to_string(piece.body_chain) +
+                  " cannot carry a sweep: " + e.message;
+      return e;
+    }
+    rig.chains_.push_back(std::move(*sweep));
+    // Junction with the trunk: the previous piece of the same chain, else the parent
+    // chain's piece holding the branch point.
+    int trunk = -1;
+    float seam = 0.0f;
+    if (piece.first > 0) {
+      trunk = static_cast<int>(p) - 1;
+    } else if (chain.parent_chain >= 0) {
+      const BodyChain& parent = body[static_cast<std::size_t>(chain.parent_chain)];
+      const auto at = std::find(parent.points.begin(), parent.points.end(), chain.points[0]);
+      const int index = static_cast<int>(at - parent.points.begin());
+      trunk = first_piece[static_cast<std::size_t>(chain.parent_chain)];
+      while (trunk + 1 < static_cast<int>(pieces.size()) &&
+             pieces[static_cast<std::size_t>(trunk + 1)].body_chain == chain.parent_chain &&
+             pieces[static_cast<std::size_t>(trunk)].last <= index) {
+        ++trunk;
+      }
+      seam = static_cast<float>(lengths[0]);
+    }
+    if (trunk >= 0) {
+      SweepJunction junction;
+      junction.branch = static_cast<int>(p);
+      junction.trunk = trunk;
+      junction.u_start = 0.0f;
+      junction.u_end = 1.0f;
+      junction.seam_band = seam;
+      rig.junctions_.push_back(junction);
+    }
+  }
+  // Bind each connected part of the mesh to its own chains (see BindByComponent).
+  std::vector<int> piece_chain(pieces.size());
+  for (std::size_t p = 0; p < pieces.size(); ++p) piece_chain[p] = pieces[p].body_chain;
+  mocap::Result<std::vector<SweepVertexBinding>> bindings =
+      BindByComponent(rig.chains_, rig.junctions_, piece_chain, bind_mesh);
+  if (!bindings.ok()) return std::move(bindings).error();
+  rig.bindings_ = std::move(*bindings);
+  rig.rest_normals_ = bind_mesh.normals;
+  return rig;
+}
+
+JobStatus SwdRigJob::Run() const {
+  if (rig == nullptr) return {JobStatus::kMissingInput, "SwdRigJob without a rig"};
+  const auto nj = static_cast<std::size_t>(rig->num_joints());
+  if (model_from_joint.size() != nj) {
+    return {JobStatus::kSizeMismatch, "model_from_joint is not one matrix per rig joint"};
+  }
+  if (joint_rotations.size() != nj || joint_positions.size() != nj) {
+    return {JobStatus::kSizeMismatch, "joint scratch is not one entry per rig joint"};
+  }
+  if (vertex_begin < 0 ||
+      static_cast<std::size_t>(vertex_begin) + positions.size() >
+          static_cast<std::size_t>(rig->num_vertices())) {
+    return {JobStatus::kOutOfRange, "vertex range past the rig's vertices"};
+  }
+  if (!normals.empty() && normals.size() != positions.size()) {
+    return {JobStatus::kSizeMismatch, "normals and positions differ in size"};
+  }
+  if (!normals.empty() && rig->rest_normals().empty()) {
+    return {JobStatus::kMissingInput, "normal output but the rig's mesh has no normals"};
+  }
+  for (std::size_t j = 0; j < nj; ++j) {
+    const glm::mat4 delta = model_from_joint[j] * rig->joint_from_bind()[j];
+    glm::mat3 r(delta);
+    for (int c = 0; c < 3; ++c) {  // drop any scale: dQ is a rotation
+      const float len = glm::length(r[c]);
+      if (len > 0.0f) r[c] /= len;
+    }
+    joint_rotations[j] = glm::normalize(glm::quat_cast(r));
+    joint_positions[j] = glm::vec3(model_from_joint[j][3]);
+  }
+  const auto begin = static_cast<std::size_t>(vertex_begin);
+  return SwdJob{.chains = rig->chains(),
+                .joint_rotations = joint_rotations,
+                .joint_positions = joint_positions,
+                .bindings = rig->bindings().subspan(begin, positions.size()),
+                .rest_normals = normals.empty()
+                                    ? std::span<const glm::vec3>()
+                                    : rig->rest_normals().subspan(begin, positions.size()),
+                .keep_volume = keep_volume,
+                .section_scales = {},
+                .positions = positions,
+                .normals = normals}
+      .Run();
+}
+
+}  // namespace deform

@@ -1,0 +1,101 @@
+#pragma once
+// The SWD rig of a whole body (ALGORITHMS.md 2.3): sweep chains built from the body's
+// topological chains (deform/body_chains.h, the ones the mannequin's tubes follow),
+// junctions where a branch leaves its trunk, and every mesh vertex bound to them.
+//
+// - Sweeps: one per body chain. A branch chain starts at its branch point on the trunk,
+//   so its sweep already starts one bone early (chest -> clavicle -> upper arm -> ...,
+//   pelvis -> hip -> thigh -> ...). A chain of more than kMaxSweepBones bones is cut into
+//   pieces of at most that many, each next piece starting one bone before the previous
+//   one ends (a junction on the shared bone).
+// - Junctions: every branch sweep is blended with the trunk sweep over its first bone,
+//   u in [0, 1], with SweepJunction::seam_band = the branch's first bone length (the
+//   clavicle for an arm, as the SWD author recommends).
+// - Twist: downstream everywhere except the wrist/ankle of a limb (upstream: forearm
+//   pronation spreads along the forearm).
+// - Binding (ALGORITHMS.md 2.3): a mesh made of several connected parts (the mannequin's
+//   overlapping tubes) binds each part only to the sweeps of the body chain nearest most
+//   of its vertices plus that chain's trunk, so the inner side of a thigh never follows
+//   the other leg; a single welded skin is bound to all sweeps (nearest bone segment).
+// - Limbs (for artifact figures): in a limb chain, the interior joint whose shorter bone
+//   is the longest is its elbow/knee; the next joint is its wrist/ankle.
+//   Limbs leaving the first point of a spine are legs, other limbs are arms.
+//
+// Per frame, SwdRigJob turns model-space joint matrices into positions and normals.
+
+#include <span>
+#include <vector>
+
+#include <glm/glm.hpp>
+#include <glm/gtc/quaternion.hpp>
+
+#include "deform/mesh.h"
+#include "deform/sweep.h"
+#include "mocap/error.h"
+#include "mocap/skeleton.h"
+
+namespace deform {
+
+struct SwdRigOptions {
+  double max_bend_rad = kDefaultMaxBendRad;  // largest expected bend, sets region widths
+  float min_branch_extent = 0.15f;           // as MannequinOptions::min_branch_extent
+};
+
+// A limb found by topology.
+struct SwdLimb {
+  int chain = 0;       // sweep chain index
+  int middle = 1;      // interior joint k of that chain: elbow/knee (bones k-1, k)
+  bool has_end = false;  // the chain has a wrist/ankle at k+1 (interior joint)
+  bool arm = false;    // true: arm (or front leg); false: leg leaving the spine's start
+};
+
+class SwdRig {
+ public:
+  std::span<const SweepChain> chains() const { return chains_; }
+  std::span<const SweepJunction> junctions() const { return junctions_; }
+  std::span<const SweepVertexBinding> bindings() const { return bindings_; }  // #V
+  std::span<const glm::vec3> rest_normals() const { return rest_normals_; }   // #V, or empty
+  std::span<const SwdLimb> limbs() const { return limbs_; }
+  // #J inverse bind-pose joint matrices (model space of the mesh).
+  std::span<const glm::mat4> joint_from_bind() const { return joint_from_bind_; }
+  int num_joints() const { return static_cast<int>(joint_from_bind_.size()); }
+  int num_vertices() const { return static_cast<int>(bindings_.size()); }
+
+ private:
+  friend mocap::Result<SwdRig> BuildSwdRig(const mocap::Skeleton&, std::span<const glm::mat4>,
+                                           const Mesh&, const SwdRigOptions&);
+  std::vector<SweepChain> chains_;
+  std::vector<SweepJunction> junctions_;
+  std::vector<SweepVertexBinding> bindings_;
+  std::vector<glm::vec3> rest_normals_;
+  std::vector<SwdLimb> limbs_;
+  std::vector<glm::mat4> joint_from_bind_;
+};
+
+// Builds the rig of `bind_mesh` (bind model space) for `skeleton` posed by
+// bind_model_from_joint (#J, the pose the mesh was made in). Errors: those of
+// BuildBodyChains; kLimitExceeded when the body needs more than kMaxSwdChains sweeps;
+// kInvalidArgument when a chain cannot carry a sweep, the mesh is empty or the normals'
+// count is not #V.
+[[nodiscard]] mocap::Result<SwdRig> BuildSwdRig(const mocap::Skeleton& skeleton,
+                                               std::span<const glm::mat4> bind_model_from_joint,
+                                               const Mesh& bind_mesh,
+                                               const SwdRigOptions& options = {});
+
+// One frame of the rig over vertices [vertex_begin, vertex_begin + #n). Recomputes the
+// joint rotations dQ_j = rotation(W_j B_j^-1) and positions into the caller's scratch, so
+// any split of the vertex range gives bit-identical results. Never allocates.
+struct SwdRigJob {
+  const SwdRig* rig = nullptr;
+  std::span<const glm::mat4> model_from_joint;  // #J W_j, rigid, model space
+  int vertex_begin = 0;                         // first vertex of the range
+  std::span<glm::quat> joint_rotations;         // #J scratch
+  std::span<glm::vec3> joint_positions;         // #J scratch
+  bool keep_volume = false;                     // see SwdJob::keep_volume
+  std::span<glm::vec3> positions;               // #n outputs, model space
+  std::span<glm::vec3> normals;                 // #n unit normals (empty: not computed)
+
+  [[nodiscard]] mocap::JobStatus Run() const;
+};
+
+}  // namespace deform

@@ -1,0 +1,174 @@
+// `--global swd` through FramePipeline on every BVH of ../shared/data (skipped when
+// absent) and on the synthetic humanoid (deterministic for any thread count, finite; the
+// walk does not tear; the captures' largest edge growth is printed, not yet asserted); the mannequin of every such BVH is closed and
+// its weights are valid; `patchskin inspect --artifacts` prints the figures.
+
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "app/motion_source.h"
+#include "app/pipeline.h"
+#include "deform/skinning_job.h"
+#include "deform/swd_rig.h"
+#include "mocap/synthetic.h"
+#include "support/data_paths.h"
+#include "support/tolerances.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+const char* const kSharedBvh[] = {
+    "bvh/cmu_cgspeed/01_01.bvh",           "bvh/cmu_cgspeed/01_03.bvh",
+    "bvh/bandai_namco/dataset-1_walk_normal_001.bvh",
+    "bvh/bandai_namco/dataset-2_run_active_034.bvh",
+    "bvh/lafan1_resolved/Geno_bind.bvh",   "bvh/lafan1_resolved/Geno_stance.bvh",
+    "bvh/bvh_python/test_freebvh.bvh",     "bvh/bvh_python/test_mocapbank.bvh",
+};
+
+// Every edge in exactly two triangles.
+void ExpectClosed(const deform::Mesh& m, const std::string& what) {
+  std::map<std::pair<std::uint32_t, std::uint32_t>, int> uses;
+  for (const glm::uvec3& t : m.triangles) {
+    for (int e = 0; e < 3; ++e) {
+      const std::uint32_t a = t[e], b = t[(e + 1) % 3];
+      ++uses[{std::min(a, b), std::max(a, b)}];
+    }
+  }
+  int bad = 0;
+  for (const auto& [edge, n] : uses) bad += n != 2 ? 1 : 0;
+  EXPECT_EQ(bad, 0) << what << ": edges not shared by exactly two triangles";
+}
+
+// Largest growth of an edge (deformed minus rest length) over the body size: a tear
+// (a part following the wrong bone) opens gaps of a limb's radius, several percent.
+float MaxEdgeGrowth(const deform::Mesh& rest, const std::vector<glm::vec3>& pos) {
+  float worst = 0.0f;
+  for (const glm::uvec3& t : rest.triangles) {
+    for (int e = 0; e < 3; ++e) {
+      const std::uint32_t a = t[e], b = t[(e + 1) % 3];
+      worst = std::max(worst, glm::distance(pos[a], pos[b]) -
+                                  glm::distance(rest.positions[a], rest.positions[b]));
+    }
+  }
+  const glm::vec3 e = deform::ComputeBounds(rest.positions).size();
+  return worst / std::max({e.x, e.y, e.z});
+}
+
+void CheckCharacter(const app::Character& c, const std::string& what, bool check_tears) {
+  {  // At the bind pose the rig rebuilds the mesh (ALGORITHMS.md 2.3).
+    auto bind = app::BindModelFromJoint(c);
+    ASSERT_TRUE(bind.ok());
+    auto rig = deform::BuildSwdRig(c.skeleton, *bind, c.mesh.bind);
+    ASSERT_TRUE(rig.ok()) << rig.error().ToString();
+    std::vector<glm::quat> rot(bind->size());
+    std::vector<glm::vec3> joints(bind->size());
+    std::vector<glm::vec3> pos(c.mesh.bind.positions.size());
+    ASSERT_TRUE((deform::SwdRigJob{.rig = &*rig, .model_from_joint = *bind, .vertex_begin = 0,
+                                   .joint_rotations = rot, .joint_positions = joints,
+                                   .keep_volume = false, .positions = pos, .normals = {}}
+                     .Run()));
+    float err = 0.0f;
+    for (std::size_t v = 0; v < pos.size(); ++v) {
+      err = std::max(err, glm::distance(pos[v], c.mesh.bind.positions[v]));
+    }
+    const glm::vec3 e = deform::ComputeBounds(c.mesh.bind.positions).size();
+    EXPECT_LT(err / std::max({e.x, e.y, e.z}), testsupport::kSwdRebuildRelTol) << what;
+  }
+  ExpectClosed(c.mesh.bind, what);
+  const mocap::Status w = deform::CheckSkinWeights(
+      c.mesh.weights, static_cast<int>(c.mesh.skin_joints.size()), c.mesh.bind.num_vertices());
+  EXPECT_TRUE(w.ok()) << what << ": " << w.error().ToString();
+  auto one = app::FramePipeline::Create(c, app::GlobalMethod::kSwd, 1);
+  ASSERT_TRUE(one.ok()) << what << ": " << one.error().ToString();
+  auto two = app::FramePipeline::Create(c, app::GlobalMethod::kSwd, 2);
+  ASSERT_TRUE(two.ok());
+  app::DeformedFrame a, b;
+  const double duration = c.motion.duration_s();
+  for (double t : {0.0, 0.5 * duration, duration}) {
+    ASSERT_TRUE(one->Evaluate(t, a).ok());
+    ASSERT_TRUE(two->Evaluate(t, b).ok());
+    ASSERT_EQ(a.positions.size(), b.positions.size());
+    EXPECT_EQ(0, std::memcmp(a.positions.data(), b.positions.data(),
+                             a.positions.size() * sizeof(glm::vec3)))
+        << what << ": thread count changed the result at t = " << t;
+    for (const glm::vec3& p : a.positions) {
+      ASSERT_TRUE(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z)) << what;
+    }
+    // No tearing: no edge of the closed body gets much longer (shoulders, hips).
+    const float growth = MaxEdgeGrowth(c.mesh.bind, a.positions);
+    std::printf("%s t = %.2f s: largest edge growth %.4f of the body size\n", what.c_str(), t, growth);
+    // Known open defect (see the SWD report): captures still tear at hands and feet.
+    if (check_tears) {
+      EXPECT_LT(growth, testsupport::kSwdMaxEdgeGrowthFraction) << what << " at t = " << t;
+    }
+  }
+}
+
+TEST(SwdPipeline, EveryBvhOfTheSharedData) {
+  for (const char* rel : kSharedBvh) {
+    const fs::path path = testsupport::SharedDataPath(rel);
+    PATCHSKIN_REQUIRE_SHARED_FILE(path);
+    app::MotionSourceOptions load;
+    load.y_up = true;
+    auto src = app::LoadMotionSource(path.string(), load);
+    ASSERT_TRUE(src.ok()) << src.error().ToString();
+    auto c = app::MakeCharacter(std::move(*src));
+    ASSERT_TRUE(c.ok()) << c.error().ToString();
+    CheckCharacter(*c, rel, false);
+  }
+}
+
+TEST(SwdPipeline, SyntheticHumanoidWalkAndBend) {
+  for (int which = 0; which < 2; ++which) {
+    app::MotionSource src;
+    src.format = "bvh";
+    src.skeleton = mocap::MakeHumanoidSkeleton();
+    auto motion = which == 0 ? mocap::MakeWalkMotion(src.skeleton) : mocap::MakeBendRamp(src.skeleton);
+    ASSERT_TRUE(motion.ok());
+    src.motion = std::move(*motion);
+    auto c = app::MakeCharacter(std::move(src));
+    ASSERT_TRUE(c.ok());
+    CheckCharacter(*c, which == 0 ? "walk" : "bend ramp", which == 0);
+  }
+}
+
+std::string RunPatchskin(const std::string& args, int* exit_code) {
+  const fs::path out = testsupport::TestOutputPath("swd_pipeline/stdout.txt");
+  const std::string cmd = std::string("'") + PATCHSKIN_BINARY + "' " + args + " >'" +
+                          out.string() + "' 2>&1";
+  const int status = std::system(cmd.c_str());
+  *exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  std::ifstream in(out);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+TEST(SwdPipeline, InspectPrintsArtifactFigures) {
+  const fs::path path = testsupport::SharedDataPath("bvh/cmu_cgspeed/01_01.bvh");
+  PATCHSKIN_REQUIRE_SHARED_FILE(path);
+  int code = -1;
+  const std::string out = RunPatchskin("inspect --artifacts '" + path.string() + "'", &code);
+  EXPECT_EQ(code, 0) << out;
+  EXPECT_NE(out.find("bend 150"), std::string::npos) << out;
+  EXPECT_NE(out.find("twist 180"), std::string::npos) << out;
+  EXPECT_NE(out.find("SWD"), std::string::npos) << out;
+}
+
+}  // namespace

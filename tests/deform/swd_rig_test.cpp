@@ -1,0 +1,245 @@
+#include "deform/swd_rig.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <map>
+#include <utility>
+#include <vector>
+
+#include <glm/gtc/matrix_transform.hpp>
+#include <gtest/gtest.h>
+
+#include "deform/mannequin.h"
+#include "deform/swd_job.h"
+#include "mocap/pose.h"
+#include "mocap/synthetic.h"
+#include "support/test_skeletons.h"
+#include "support/tolerances.h"
+
+namespace {
+
+using testsupport::BuiltSkeleton;
+using testsupport::SkeletonFrom;
+
+struct Rigged {
+  BuiltSkeleton b;
+  deform::SkinnedMesh mesh;
+  deform::SwdRig rig;
+};
+
+Rigged MakeRigged(BuiltSkeleton b) {
+  Rigged r{std::move(b), {}, {}};
+  auto mesh = deform::BuildMannequin(r.b.skeleton, r.b.model_from_joint);
+  EXPECT_TRUE(mesh.ok()) << mesh.error().ToString();
+  r.mesh = std::move(*mesh);
+  auto rig = deform::BuildSwdRig(r.b.skeleton, r.b.model_from_joint, r.mesh.bind);
+  EXPECT_TRUE(rig.ok()) << rig.error().ToString();
+  if (rig.ok()) r.rig = std::move(*rig);
+  return r;
+}
+
+BuiltSkeleton SyntheticHumanoid() {
+  BuiltSkeleton b;
+  b.skeleton = mocap::MakeHumanoidSkeleton();
+  std::vector<mocap::JointTransform> locals(static_cast<std::size_t>(b.skeleton.num_joints()));
+  mocap::RestPose(b.skeleton, locals);
+  b.model_from_joint.resize(locals.size());
+  EXPECT_TRUE((mocap::LocalToModelJob{.parents = b.skeleton.parents, .locals = locals,
+                                     .model_from_joint = b.model_from_joint}
+                  .Run()));
+  return b;
+}
+
+// Runs the rig over all vertices split into `pieces` ranges.
+std::vector<glm::vec3> Deform(const deform::SwdRig& rig, std::span<const glm::mat4> model,
+                              int pieces, std::vector<glm::vec3>* normals = nullptr) {
+  const int nv = rig.num_vertices();
+  std::vector<glm::vec3> pos(static_cast<std::size_t>(nv));
+  std::vector<glm::vec3> nrm(static_cast<std::size_t>(nv));
+  std::vector<glm::quat> rot(model.size());
+  std::vector<glm::vec3> joints(model.size());
+  for (int p = 0; p < pieces; ++p) {
+    const int begin = nv * p / pieces;
+    const int end = nv * (p + 1) / pieces;
+    const auto n = static_cast<std::size_t>(end - begin);
+    const mocap::JobStatus s =
+        deform::SwdRigJob{.rig = &rig,
+                          .model_from_joint = model,
+                          .vertex_begin = begin,
+                          .joint_rotations = rot,
+                          .joint_positions = joints,
+                          .keep_volume = false,
+                          .positions = std::span(pos).subspan(static_cast<std::size_t>(begin), n),
+                          .normals = std::span(nrm).subspan(static_cast<std::size_t>(begin), n)}
+            .Run();
+    EXPECT_TRUE(s) << s.what;
+  }
+  if (normals != nullptr) *normals = std::move(nrm);
+  return pos;
+}
+
+float MeshSize(const deform::Mesh& m) {
+  const glm::vec3 e = deform::ComputeBounds(m.positions).size();
+  return std::max({e.x, e.y, e.z});
+}
+
+// Largest growth of an edge (deformed minus rest length) over the mesh size: a tear
+// (a part following the wrong bone) opens gaps of a limb's radius, several percent.
+float MaxEdgeGrowth(const deform::Mesh& rest, std::span<const glm::vec3> pos) {
+  float worst = 0.0f;
+  for (const glm::uvec3& t : rest.triangles) {
+    for (int e = 0; e < 3; ++e) {
+      const std::uint32_t a = t[e], b = t[(e + 1) % 3];
+      const float l0 = glm::distance(rest.positions[a], rest.positions[b]);
+      worst = std::max(worst, glm::distance(pos[a], pos[b]) - l0);
+    }
+  }
+  return worst / MeshSize(rest);
+}
+
+void ExpectRestAndRigid(const Rigged& r) {
+  const float size = MeshSize(r.mesh.bind);
+  const std::vector<glm::vec3> rest = Deform(r.rig, r.b.model_from_joint, 1);
+  float err = 0.0f;
+  for (std::size_t v = 0; v < rest.size(); ++v) {
+    err = std::max(err, glm::distance(rest[v], r.mesh.bind.positions[v]));
+  }
+  EXPECT_LT(err, 10.0f * testsupport::kSwdRebuildRelTol * size);
+  // A rigid motion of the whole skeleton moves every vertex rigidly.
+  const glm::mat4 rigid = glm::translate(glm::mat4(1.0f), glm::vec3(0.3f, -0.2f, 0.5f) * size) *
+                          glm::mat4_cast(glm::angleAxis(1.1f, glm::normalize(glm::vec3(1, 2, 3))));
+  std::vector<glm::mat4> moved = r.b.model_from_joint;
+  for (glm::mat4& m : moved) m = rigid * m;
+  std::vector<glm::vec3> normals;
+  const std::vector<glm::vec3> pos = Deform(r.rig, moved, 3, &normals);
+  err = 0.0f;
+  float nerr = 0.0f;
+  for (std::size_t v = 0; v < pos.size(); ++v) {
+    err = std::max(err, glm::distance(pos[v], glm::vec3(rigid * glm::vec4(r.mesh.bind.positions[v], 1))));
+    nerr = std::max(nerr, glm::distance(normals[v], glm::mat3(rigid) * r.mesh.bind.normals[v]));
+  }
+  EXPECT_LT(err, 10.0f * testsupport::kSwdRebuildRelTol * size);
+  EXPECT_LT(nerr, 1e-3f);
+}
+
+// Model matrices with the subtree of `joint` turned by `q` about its joint position.
+std::vector<glm::mat4> TurnSubtree(const mocap::Skeleton& s, std::vector<glm::mat4> model,
+                                   int joint, const glm::quat& q) {
+  const glm::vec3 pivot(model[static_cast<std::size_t>(joint)][3]);
+  const glm::mat4 turn = glm::translate(glm::mat4(1.0f), pivot) * glm::mat4_cast(q) *
+                         glm::translate(glm::mat4(1.0f), -pivot);
+  std::vector<bool> inside(model.size(), false);
+  for (std::size_t j = 0; j < model.size(); ++j) {
+    const int p = s.parents[j];
+    inside[j] = static_cast<int>(j) == joint || (p >= 0 && inside[static_cast<std::size_t>(p)]);
+    if (inside[j]) model[j] = turn * model[j];
+  }
+  return model;
+}
+
+TEST(SwdRig, SyntheticHumanoidHasFiveSweepsFourLimbsAndFourJunctions) {
+  const Rigged r = MakeRigged(SyntheticHumanoid());
+  EXPECT_EQ(r.rig.chains().size(), 5u);
+  EXPECT_EQ(r.rig.junctions().size(), 4u);
+  ASSERT_EQ(r.rig.limbs().size(), 4u);
+  int arms = 0;
+  for (const deform::SwdLimb& l : r.rig.limbs()) {
+    arms += l.arm ? 1 : 0;
+    const deform::SweepChain& c = r.rig.chains()[static_cast<std::size_t>(l.chain)];
+    const int elbow = c.joint(l.middle);
+    const std::string& name = r.b.skeleton.names[static_cast<std::size_t>(elbow)];
+    // The joint that moves the forearm / shin, found by topology only.
+    EXPECT_TRUE(name.find("ForeArm") != std::string::npos || name.find("Leg") != std::string::npos)
+        << name;
+    EXPECT_EQ(name.find("UpLeg"), std::string::npos) << name;
+  }
+  EXPECT_EQ(arms, 2);
+  for (const deform::SweepJunction& j : r.rig.junctions()) EXPECT_GT(j.seam_band, 0.0f);
+  ExpectRestAndRigid(r);
+}
+
+TEST(SwdRig, BodiesOfOtherShapes) {
+  ExpectRestAndRigid(MakeRigged(SkeletonFrom(testsupport::Humanoid(1.0f, true, false, ""), false, 5.0f)));
+  ExpectRestAndRigid(MakeRigged(SkeletonFrom(testsupport::Humanoid(1.0f, false, true, ""), true, 2.0f)));
+  ExpectRestAndRigid(MakeRigged(SkeletonFrom(testsupport::Tail(10, 50.0f), false, 3.0f)));
+  const Rigged quad = MakeRigged(SkeletonFrom(testsupport::Quadruped(), false, 4.0f));
+  EXPECT_EQ(quad.rig.limbs().size(), 5u);  // four legs and the tail
+  ExpectRestAndRigid(quad);
+}
+
+TEST(SwdRig, ChainsLongerThanOneSweepAreCutWithJunctions) {
+  const Rigged r = MakeRigged(SkeletonFrom(testsupport::Tail(20, 100.0f), false, 3.0f));
+  ASSERT_GE(r.rig.chains().size(), 3u);
+  for (const deform::SweepChain& c : r.rig.chains()) EXPECT_LE(c.num_bones(), deform::kMaxSweepBones);
+  EXPECT_EQ(r.rig.junctions().size(), r.rig.chains().size() - 1);
+  ExpectRestAndRigid(r);
+}
+
+TEST(SwdRig, AnySplitOfTheVerticesGivesTheSameBits) {
+  const Rigged r = MakeRigged(SyntheticHumanoid());
+  auto walk = mocap::MakeWalkMotion(r.b.skeleton);
+  ASSERT_TRUE(walk.ok());
+  std::vector<mocap::JointTransform> locals(r.b.model_from_joint.size());
+  std::vector<glm::mat4> model(locals.size());
+  ASSERT_TRUE((mocap::LocalPoseJob{&r.b.skeleton, walk->frame(walk->num_frames / 3), locals}.Run()));
+  ASSERT_TRUE((mocap::LocalToModelJob{.parents = r.b.skeleton.parents, .locals = locals,
+                                     .model_from_joint = model}
+                  .Run()));
+  const std::vector<glm::vec3> one = Deform(r.rig, model, 1);
+  const std::vector<glm::vec3> seven = Deform(r.rig, model, 7);
+  ASSERT_EQ(one.size(), seven.size());
+  EXPECT_EQ(0, std::memcmp(one.data(), seven.data(), one.size() * sizeof(glm::vec3)));
+  // No tearing anywhere while walking (shoulders and hips included).
+  EXPECT_LT(MaxEdgeGrowth(r.mesh.bind, one), testsupport::kSwdMaxEdgeGrowthFraction);
+}
+
+TEST(SwdRig, BentElbowsAndKneesDoNotTear) {
+  const Rigged r = MakeRigged(SyntheticHumanoid());
+  std::vector<glm::mat4> model = r.b.model_from_joint;
+  for (const deform::SwdLimb& l : r.rig.limbs()) {
+    const deform::SweepChain& c = r.rig.chains()[static_cast<std::size_t>(l.chain)];
+    const glm::vec3 axis = glm::normalize(glm::cross(glm::vec3(c.rest_axis(l.middle)), glm::vec3(0, 0, 1)) +
+                                          glm::vec3(0, 0, 1e-3f));
+    model = TurnSubtree(r.b.skeleton, model, c.joint(l.middle), glm::angleAxis(glm::radians(120.0f), axis));
+  }
+  const std::vector<glm::vec3> pos = Deform(r.rig, model, 2);
+  EXPECT_LT(MaxEdgeGrowth(r.mesh.bind, pos), testsupport::kSwdMaxEdgeGrowthFraction);
+}
+
+TEST(SwdRig, ClearErrors) {
+  const Rigged r = MakeRigged(SyntheticHumanoid());
+  // Too many sweeps for one body.
+  const BuiltSkeleton chain = SkeletonFrom(testsupport::Tail(200, 300.0f), true, 0.0f);
+  auto mesh = deform::BuildMannequin(chain.skeleton, chain.model_from_joint);
+  ASSERT_TRUE(mesh.ok());
+  auto big = deform::BuildSwdRig(chain.skeleton, chain.model_from_joint, mesh->bind);
+  ASSERT_FALSE(big.ok());
+  EXPECT_EQ(big.error().code, mocap::ErrorCode::kLimitExceeded);
+  EXPECT_NE(big.error().message.find("sweeps"), std::string::npos);
+  // No bone at all.
+  const BuiltSkeleton point = SkeletonFrom({{"a", -1, {1, 1, 1}}, {"b", 0, {1, 1, 1}}}, false, 0.0f);
+  auto none = deform::BuildSwdRig(point.skeleton, point.model_from_joint, r.mesh.bind);
+  ASSERT_FALSE(none.ok());
+  EXPECT_EQ(none.error().code, mocap::ErrorCode::kInvalidArgument);
+  // Bad job inputs.
+  std::vector<glm::quat> rot(r.b.model_from_joint.size());
+  std::vector<glm::vec3> joints(rot.size()), pos(4);
+  EXPECT_EQ((deform::SwdRigJob{.rig = &r.rig, .model_from_joint = r.b.model_from_joint,
+                              .vertex_begin = r.rig.num_vertices() - 2, .joint_rotations = rot,
+                              .joint_positions = joints, .keep_volume = false, .positions = pos,
+                              .normals = {}}
+                .Run()
+                .code),
+            mocap::JobStatus::kOutOfRange);
+  EXPECT_EQ((deform::SwdRigJob{.rig = &r.rig,
+                              .model_from_joint = std::span(r.b.model_from_joint).first(2),
+                              .vertex_begin = 0, .joint_rotations = rot, .joint_positions = joints,
+                              .keep_volume = false, .positions = pos, .normals = {}}
+                .Run()
+                .code),
+            mocap::JobStatus::kSizeMismatch);
+}
+
+}  // namespace

@@ -1,0 +1,121 @@
+// Golden frames of the whole per-frame path: FramePipeline (sampling, forward
+// kinematics, global deformation, normals) and render::Renderer through
+// app::DrawCharacterFrame, the function `patchskin render` draws with.
+// Cases: the built-in demo walk under SWD (first, middle and last frame) and the
+// synthetic elbow/knee bend ramp at its last frame (150 degrees), split SSD | SWD.
+
+#include <cmath>
+#include <cstdlib>
+#include <ostream>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "app/demo_data.h"
+#include "app/frame_render.h"
+#include "app/motion_source.h"
+#include "app/pipeline.h"
+#include "mocap/synthetic.h"
+#include "render/camera.h"
+#include "support/golden.h"
+
+namespace {
+
+constexpr int kWidth = 256;
+constexpr int kHeight = 144;
+
+app::Character Demo() {
+  app::MotionSourceOptions load;
+  load.y_up = true;
+  auto src = app::LoadBvhText(app::DemoBvhText(), "demo_walk.bvh", load);
+  EXPECT_TRUE(src.ok());
+  auto c = app::MakeCharacter(std::move(*src));
+  EXPECT_TRUE(c.ok());
+  return std::move(*c);
+}
+
+app::Character BendRamp() {
+  app::MotionSource src;
+  src.format = "bvh";
+  src.skeleton = mocap::MakeHumanoidSkeleton();
+  auto motion = mocap::MakeBendRamp(src.skeleton);
+  EXPECT_TRUE(motion.ok());
+  src.motion = std::move(*motion);
+  auto c = app::MakeCharacter(std::move(src));
+  EXPECT_TRUE(c.ok());
+  return std::move(*c);
+}
+
+// Renders frame `frame` of `c` (SWD alone, or `left` | SWD when split) with a fixed
+// camera framing that frame from the front-left, as the command's cameras look.
+render::Image Render(const app::Character& c, int frame, bool split) {
+  const double t = frame * c.motion.frame_time_s;
+  auto swd = app::FramePipeline::Create(c, app::GlobalMethod::kSwd, 1);
+  EXPECT_TRUE(swd.ok()) << swd.error().ToString();
+  app::DeformedFrame right, left;
+  EXPECT_TRUE(swd->Evaluate(t, right).ok());
+  if (split) {
+    auto ssd = app::FramePipeline::Create(c, app::GlobalMethod::kSsd, 1);
+    EXPECT_TRUE(ssd.ok());
+    EXPECT_TRUE(ssd->Evaluate(t, left).ok());
+  }
+  const float aspect = static_cast<float>(kWidth) / static_cast<float>(kHeight);
+  const float elevation = 0.26f;
+  const glm::vec3 view_dir = -glm::normalize(glm::vec3(0.45f, 0.0f, 1.0f) * std::cos(elevation) +
+                                             glm::vec3(0.0f, std::sin(elevation), 0.0f));
+  const render::Camera camera = render::FrameBounds(right.bounds, 35.0f, aspect, view_dir);
+  render::RenderSettings settings;
+  settings.width = kWidth;
+  settings.height = kHeight;
+  settings.supersample = 2;
+  settings.threads = 1;
+  settings.ground_at_scene_min = false;
+  settings.ground_y = right.bounds.min.y;
+  render::Renderer renderer, right_renderer;
+  render::Image image, scratch;
+  const app::FrameDrawOptions options{.frame_number = frame,
+                                      .left_label = split ? "ssd" : "",
+                                      .right_label = split ? "swd" : ""};
+  const mocap::Status s =
+      split ? app::DrawCharacterFrame(c, left, &right, camera, settings, options, renderer,
+                                      right_renderer, scratch, image)
+            : app::DrawCharacterFrame(c, right, nullptr, camera, settings, options, renderer,
+                                      right_renderer, scratch, image);
+  EXPECT_TRUE(s.ok());
+  return image;
+}
+
+struct PipelineCase {
+  std::string name;
+  int which;  // 0, 1, 2: demo first/middle/last; 3: bend ramp split
+};
+
+void PrintTo(const PipelineCase& c, std::ostream* os) { *os << c.name; }
+
+class PipelineGoldenTest : public ::testing::TestWithParam<PipelineCase> {};
+
+TEST_P(PipelineGoldenTest, MatchesReference) {
+  const PipelineCase& pc = GetParam();
+  render::Image image;
+  if (pc.which < 3) {
+    static const app::Character demo = Demo();
+    const int last = demo.motion.num_frames - 1;
+    const int frame = pc.which == 0 ? 0 : pc.which == 1 ? last / 2 : last;
+    image = Render(demo, frame, false);
+  } else {
+    const app::Character bend = BendRamp();
+    image = Render(bend, bend.motion.num_frames - 1, true);
+  }
+  testsupport::ExpectMatchesGolden(image, pc.name, {});
+}
+
+INSTANTIATE_TEST_SUITE_P(Frames, PipelineGoldenTest,
+                         ::testing::Values(PipelineCase{"demo_swd_first", 0},
+                                           PipelineCase{"demo_swd_middle", 1},
+                                           PipelineCase{"demo_swd_last", 2},
+                                           PipelineCase{"bend_split_ssd_swd", 3}),
+                         [](const auto& test_info) { return test_info.param.name; });
+
+}  // namespace
