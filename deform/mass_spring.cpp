@@ -1,0 +1,588 @@
+#include "deform/mass_spring.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+#include <string>
+
+#include <opencv2/core.hpp>
+
+namespace deform {
+namespace {
+
+using mocap::ErrorCode;
+using mocap::FileLoc;
+using mocap::MakeError;
+
+constexpr double kStandardGravityMps2 = 9.81;
+constexpr double kStepRuleAccurate = 0.5;  // h x rate for ~1e-4 amplitude error per step
+constexpr double kStepRuleHardLimit = 2.5; // RK4 reaches 2.78 (real) / 2.83 (imaginary)
+constexpr int kMaxHalvings = 6;
+constexpr int kMaxGridSize = 16;
+
+bool Finite(const glm::vec3& v) {
+  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+
+Result<MassSpringNetwork> Invalid(const std::string& what) {
+  return MakeError(ErrorCode::kInvalidArgument, FileLoc{}, "mass-spring network: " + what);
+}
+
+// Everything the forces need at one stage time, per unit mass.
+struct Forcing {
+  glm::vec3 common{0.0f};  // -gam a + (R^T g - R_bind^T g) + u: the same for every point
+  glm::vec3 w{0.0f};       // angular velocity (frame)
+  glm::vec3 al{0.0f};      // angular acceleration (frame)
+  float gain = 1.0f;
+};
+
+// -gam [al x k + w x (w x k)]: the rigid part of R^T K'' that depends on the
+// point's position k in the frame (Euler and centrifugal terms).
+inline glm::vec3 RigidTerm(const Forcing& f, const glm::vec3& k) {
+  return -f.gain * (glm::cross(f.al, k) + glm::cross(f.w, glm::cross(f.w, k)));
+}
+
+// -gam [2 w x e' + al x e + w x (w x e)]: Coriolis, Euler and centrifugal on e.
+inline glm::vec3 MovingFrameTerm(const Forcing& f, const glm::vec3& e, const glm::vec3& v) {
+  return -f.gain * (2.0f * glm::cross(f.w, v) + glm::cross(f.al, e) +
+                    glm::cross(f.w, glm::cross(f.w, e)));
+}
+
+class Integrator {
+ public:
+  explicit Integrator(const MassSpringStepJob& job)
+      : job_(job), net_(*job.network), st_(*job.state), p_(job.network->params) {
+    const double g = kStandardGravityMps2 * p_.units_per_metre;
+    gravity_ = glm::vec3(glm::dvec3(glm::normalize(p_.down)) * g);
+    gravity_bind_ = glm::conjugate(net_.bind_rotation) * gravity_;
+    max_accel_ = p_.max_acceleration_mps2 * p_.units_per_metre;
+  }
+
+  Forcing Sample(double t) {
+    DrivingFrame d;
+    if (!job_.kinematics.empty()) {
+      mocap::JointKinematics k;
+      if (mocap::SampleJointKinematics(job_.kinematics, job_.num_joints, job_.joint,
+                                       job_.frame_time_s, t, &k)) {
+        d = {k.rotation, k.local_linear_acceleration, k.local_angular_velocity,
+             k.local_angular_acceleration};
+      }
+    } else {
+      d = (*job_.driving)(t);
+    }
+    MassSpringCounters& c = st_.counters;
+    const glm::vec4 q(d.rotation.x, d.rotation.y, d.rotation.z, d.rotation.w);
+    if (!Finite(d.linear_acceleration) || !Finite(d.angular_velocity) ||
+        !Finite(d.angular_acceleration) || !std::isfinite(glm::dot(q, q)) ||
+        glm::dot(q, q) < 1e-12f) {
+      ++c.non_finite_inputs;  // a glitch: the frame is taken as at rest in the bind pose
+      d = DrivingFrame{net_.bind_rotation};
+    }
+    const float a_len = glm::length(d.linear_acceleration);
+    if (a_len > max_accel_) {
+      ++c.acceleration_clamps;
+      d.linear_acceleration *= max_accel_ / a_len;
+    }
+    Forcing f;
+    f.gain = p_.gain;
+    f.w = d.angular_velocity;
+    f.al = d.angular_acceleration;
+    f.common = -p_.gain * d.linear_acceleration + job_.user_acceleration;
+    if (p_.gravity) {
+      f.common += glm::conjugate(glm::normalize(d.rotation)) * gravity_ - gravity_bind_;
+    }
+    return f;
+  }
+
+  // One RK4 step of every mode, each an independent 3-D oscillator.
+  void ModalStep(double h_d, const Forcing& f0, const Forcing& fm, const Forcing& f1) {
+    const float h = static_cast<float>(h_d);
+    const int n = net_.num_free;
+    for (int k = 0; k < n; ++k) {
+      const std::size_t ks = static_cast<std::size_t>(k);
+      const float w2 = net_.mode_omega2[ks];
+      const float c = net_.mode_damping[ks];
+      const float sk = net_.mode_sum[ks];
+      const glm::vec3 pk = net_.mode_rest[ks];
+      const glm::vec3 drive0 = sk * f0.common + RigidTerm(f0, pk);
+      const glm::vec3 drivem = sk * fm.common + RigidTerm(fm, pk);
+      const glm::vec3 drive1 = sk * f1.common + RigidTerm(f1, pk);
+      const auto acc = [&](const Forcing& f, const glm::vec3& drive, const glm::vec3& x,
+                           const glm::vec3& v) {
+        return drive - w2 * x - c * v + MovingFrameTerm(f, x, v);
+      };
+      const glm::vec3 x = st_.position[ks], v = st_.velocity[ks];
+      const glm::vec3 a1 = acc(f0, drive0, x, v);
+      const glm::vec3 x2 = x + 0.5f * h * v, v2 = v + 0.5f * h * a1;
+      const glm::vec3 a2 = acc(fm, drivem, x2, v2);
+      const glm::vec3 x3 = x + 0.5f * h * v2, v3 = v + 0.5f * h * a2;
+      const glm::vec3 a3 = acc(fm, drivem, x3, v3);
+      const glm::vec3 x4 = x + h * v3, v4 = v + h * a3;
+      const glm::vec3 a4 = acc(f1, drive1, x4, v4);
+      st_.prev_position[ks] = x;
+      st_.prev_velocity[ks] = v;
+      st_.position[ks] = x + (h / 6.0f) * (v + 2.0f * v2 + 2.0f * v3 + v4);
+      st_.velocity[ks] = v + (h / 6.0f) * (a1 + 2.0f * a2 + 2.0f * a3 + a4);
+    }
+  }
+
+  // Accelerations of every free point from point-space springs.
+  void PointAccelerations(const Forcing& f, std::span<const glm::vec3> e,
+                          std::span<const glm::vec3> v, std::span<glm::vec3> acc) const {
+    const int n = net_.num_free;
+    const float inv_m = 1.0f / p_.mass;
+    for (int a = 0; a < n; ++a) {
+      const std::size_t as = static_cast<std::size_t>(a);
+      const glm::vec3 k = net_.rest_points[static_cast<std::size_t>(net_.point_of_free[as])];
+      acc[as] = inv_m * (-net_.anchor_stiffness * e[as] - net_.anchor_damping * v[as]) +
+                f.common + RigidTerm(f, k) + MovingFrameTerm(f, e[as], v[as]);
+    }
+    const bool length_model = p_.force_model == SpringForceModel::kLength;
+    for (const Spring& s : net_.springs) {
+      const std::size_t fa = static_cast<std::size_t>(s.free_a);
+      const std::size_t fb = static_cast<std::size_t>(s.free_b);
+      const glm::vec3 ea = s.free_a >= 0 ? e[fa] : glm::vec3(0.0f);
+      const glm::vec3 eb = s.free_b >= 0 ? e[fb] : glm::vec3(0.0f);
+      const glm::vec3 va = s.free_a >= 0 ? v[fa] : glm::vec3(0.0f);
+      const glm::vec3 vb = s.free_b >= 0 ? v[fb] : glm::vec3(0.0f);
+      glm::vec3 force = -s.damping * (va - vb);  // on a
+      if (length_model) {
+        const glm::vec3 d = net_.rest_points[static_cast<std::size_t>(s.point_a)] + ea -
+                            net_.rest_points[static_cast<std::size_t>(s.point_b)] - eb;
+        const float len = glm::length(d);
+        if (len > 0.0f) force -= s.stiffness * (len - s.rest_length) / len * d;
+      } else {
+        force -= s.stiffness * (ea - eb);
+      }
+      if (s.free_a >= 0) acc[fa] += inv_m * force;
+      if (s.free_b >= 0) acc[fb] -= inv_m * force;
+    }
+  }
+
+  void PointStep(double h_d, const Forcing& f0, const Forcing& fm, const Forcing& f1) {
+    const float h = static_cast<float>(h_d);
+    const std::size_t n = static_cast<std::size_t>(net_.num_free);
+    std::span<glm::vec3> w(st_.work);
+    std::span<glm::vec3> xs = w.subspan(0, n), vs = w.subspan(n, n), acc = w.subspan(2 * n, n),
+                         sx = w.subspan(3 * n, n), sv = w.subspan(4 * n, n);
+    std::span<glm::vec3> x(st_.position), v(st_.velocity);
+    PointAccelerations(f0, x, v, acc);  // stage 1
+    for (std::size_t a = 0; a < n; ++a) {
+      sx[a] = v[a];
+      sv[a] = acc[a];
+      xs[a] = x[a] + 0.5f * h * v[a];
+      vs[a] = v[a] + 0.5f * h * acc[a];
+    }
+    PointAccelerations(fm, xs, vs, acc);  // stage 2
+    for (std::size_t a = 0; a < n; ++a) {
+      sx[a] += 2.0f * vs[a];
+      sv[a] += 2.0f * acc[a];
+      xs[a] = x[a] + 0.5f * h * vs[a];
+      vs[a] = v[a] + 0.5f * h * acc[a];
+    }
+    PointAccelerations(fm, xs, vs, acc);  // stage 3
+    for (std::size_t a = 0; a < n; ++a) {
+      sx[a] += 2.0f * vs[a];
+      sv[a] += 2.0f * acc[a];
+      xs[a] = x[a] + h * vs[a];
+      vs[a] = v[a] + h * acc[a];
+    }
+    PointAccelerations(f1, xs, vs, acc);  // stage 4
+    for (std::size_t a = 0; a < n; ++a) {
+      sx[a] += vs[a];
+      sv[a] += acc[a];
+      st_.prev_position[a] = x[a];
+      st_.prev_velocity[a] = v[a];
+      x[a] += (h / 6.0f) * sx[a];
+      v[a] += (h / 6.0f) * sv[a];
+    }
+  }
+
+  // |e_a| <= e_max with the outward velocity removed; non-finite state resets.
+  void ApplyLimits(bool modal) {
+    const std::size_t n = static_cast<std::size_t>(net_.num_free);
+    const float e_max = p_.max_displacement;
+    float sum_x = 0.0f, sum_v = 0.0f;
+    for (std::size_t a = 0; a < n; ++a) {
+      sum_x += glm::dot(st_.position[a], st_.position[a]);
+      sum_v += glm::dot(st_.velocity[a], st_.velocity[a]);
+    }
+    if (!std::isfinite(sum_x) || !std::isfinite(sum_v)) {
+      ++st_.counters.non_finite_resets;
+      std::fill(st_.position.begin(), st_.position.end(), glm::vec3(0.0f));
+      std::fill(st_.velocity.begin(), st_.velocity.end(), glm::vec3(0.0f));
+      std::fill(st_.prev_position.begin(), st_.prev_position.end(), glm::vec3(0.0f));
+      std::fill(st_.prev_velocity.begin(), st_.prev_velocity.end(), glm::vec3(0.0f));
+      return;
+    }
+    // U is orthonormal, so |e_a|^2 <= sum_k |eta_k|^2: below e_max^2 nothing can exceed.
+    if (sum_x <= e_max * e_max) return;
+    std::span<glm::vec3> e(st_.position), v(st_.velocity);
+    if (modal) {
+      e = std::span<glm::vec3>(st_.work).subspan(0, n);
+      v = std::span<glm::vec3>(st_.work).subspan(n, n);
+      ToPoints(st_.position, e);
+      ToPoints(st_.velocity, v);
+    }
+    bool changed = false;
+    for (std::size_t a = 0; a < n; ++a) {
+      const float len = glm::length(e[a]);
+      if (len <= e_max) continue;
+      const glm::vec3 dir = e[a] / len;
+      e[a] = dir * e_max;
+      const float outward = glm::dot(v[a], dir);
+      if (outward > 0.0f) v[a] -= outward * dir;
+      ++st_.counters.displacement_clamps;
+      changed = true;
+    }
+    if (modal && changed) {
+      ToModes(e, st_.position);
+      ToModes(v, st_.velocity);
+    }
+  }
+
+  void ToPoints(std::span<const glm::vec3> modal, std::span<glm::vec3> points) const {
+    const std::size_t n = static_cast<std::size_t>(net_.num_free);
+    for (std::size_t a = 0; a < n; ++a) {
+      glm::vec3 sum(0.0f);
+      const float* row = &net_.modes[a * n];
+      for (std::size_t k = 0; k < n; ++k) sum += row[k] * modal[k];
+      points[a] = sum;
+    }
+  }
+  void ToModes(std::span<const glm::vec3> points, std::span<glm::vec3> modal) const {
+    const std::size_t n = static_cast<std::size_t>(net_.num_free);
+    std::fill(modal.begin(), modal.end(), glm::vec3(0.0f));
+    for (std::size_t a = 0; a < n; ++a) {
+      const float* row = &net_.modes[a * n];
+      for (std::size_t k = 0; k < n; ++k) modal[k] += row[k] * points[a];
+    }
+  }
+
+ private:
+  const MassSpringStepJob& job_;
+  const MassSpringNetwork& net_;
+  MassSpringState& st_;
+  const MassSpringParams& p_;
+  glm::vec3 gravity_{0.0f}, gravity_bind_{0.0f};
+  float max_accel_ = 0.0f;
+};
+
+bool UsesModes(const MassSpringNetwork& net) {
+  return net.params.force_model == SpringForceModel::kLinear &&
+         net.params.solver == MassSpringSolver::kModal;
+}
+
+}  // namespace
+
+Result<MassSpringNetwork> BuildMassSpringNetwork(const MassSpringSetup& setup,
+                                                 const MassSpringParams& params) {
+  const int M = setup.rows, N = setup.cols;
+  if (M < 3 || N < 3 || M > kMaxGridSize || N > kMaxGridSize) {
+    return Invalid("grid " + std::to_string(M) + " x " + std::to_string(N) +
+                   " outside 3..16 x 3..16 (a free interior needs 3 x 3)");
+  }
+  const std::size_t num_points = static_cast<std::size_t>(M) * static_cast<std::size_t>(N);
+  if (setup.rest_points.size() != num_points) {
+    return Invalid("expected " + std::to_string(num_points) + " rest points, found " +
+                   std::to_string(setup.rest_points.size()));
+  }
+  for (const glm::vec3& p : setup.rest_points)
+    if (!Finite(p)) return Invalid("non-finite rest control point");
+  const MassSpringParams& p = params;
+  const bool ok = p.mass > 0 && p.frequency_hz > 0 && p.damping_ratio >= 0 &&
+                  p.structural_ratio >= 0 && p.shear_ratio >= 0 && p.bending_ratio >= 0 &&
+                  p.spring_damping_s >= 0 && p.time_step_s > 0 && p.gain >= 0 &&
+                  p.units_per_metre > 0 && p.max_acceleration_mps2 > 0 && p.max_time_gap_s > 0 &&
+                  p.preroll_s >= 0 && std::isfinite(p.max_displacement) &&
+                  std::isfinite(p.preroll_s) && std::isfinite(p.time_step_s) &&
+                  std::isfinite(p.max_acceleration_mps2) && std::isfinite(p.frequency_hz) &&
+                  std::isfinite(p.mass) && std::isfinite(p.gain) && Finite(p.down) &&
+                  glm::length(p.down) > 0.5f && setup.max_angular_speed_rad_s >= 0 &&
+                  std::isfinite(setup.max_angular_speed_rad_s);
+  if (!ok) return Invalid("a parameter is out of range (see MassSpringParams)");
+
+  MassSpringNetwork net;
+  net.rows = M;
+  net.cols = N;
+  net.params = p;
+  net.bind_rotation = glm::normalize(setup.bind_rotation);
+  net.rest_points.assign(setup.rest_points.begin(), setup.rest_points.end());
+  net.free_of_point.assign(num_points, -1);
+  for (int i = 1; i + 1 < M; ++i) {
+    for (int j = 1; j + 1 < N; ++j) {
+      net.free_of_point[static_cast<std::size_t>(i * N + j)] = net.num_free++;
+      net.point_of_free.push_back(i * N + j);
+    }
+  }
+  const int n = net.num_free;
+  const std::size_t ns = static_cast<std::size_t>(n);
+
+  // Each pair once: offsets pointing "forward" in row-major order.
+  struct Offset { int di, dj; SpringKind kind; float ratio; };
+  const Offset offsets[] = {{0, 1, kStructural, p.structural_ratio},
+                            {1, 0, kStructural, p.structural_ratio},
+                            {1, 1, kShear, p.shear_ratio},
+                            {1, -1, kShear, p.shear_ratio},
+                            {0, 2, kBending, p.bending_ratio},
+                            {2, 0, kBending, p.bending_ratio}};
+  double spacing_sum = 0.0;
+  int spacing_count = 0;
+  cv::Mat k1 = cv::Mat::eye(n, n, CV_64F);  // anchors: k_an = 1
+  for (int i = 0; i < M; ++i) {
+    for (int j = 0; j < N; ++j) {
+      for (const Offset& o : offsets) {
+        const int i2 = i + o.di, j2 = j + o.dj;
+        if (i2 < 0 || i2 >= M || j2 < 0 || j2 >= N) continue;
+        const int a = i * N + j, b = i2 * N + j2;
+        const glm::vec3 pa = net.rest_points[static_cast<std::size_t>(a)];
+        const glm::vec3 pb = net.rest_points[static_cast<std::size_t>(b)];
+        if (o.kind == kStructural) {
+          spacing_sum += glm::length(pa - pb);
+          ++spacing_count;
+        }
+        const int fa = net.free_of_point[static_cast<std::size_t>(a)];
+        const int fb = net.free_of_point[static_cast<std::size_t>(b)];
+        if (fa < 0 && fb < 0) continue;
+        net.springs.push_back({a, b, fa, fb, o.ratio, 0.0f, glm::length(pa - pb), o.kind});
+        ++net.num_springs[o.kind];
+        if (fa >= 0) k1.at<double>(fa, fa) += o.ratio;
+        if (fb >= 0) k1.at<double>(fb, fb) += o.ratio;
+        if (fa >= 0 && fb >= 0) {
+          k1.at<double>(fa, fb) -= o.ratio;
+          k1.at<double>(fb, fa) -= o.ratio;
+        }
+      }
+    }
+  }
+  const double mean_spacing = spacing_sum / spacing_count;
+  if (net.params.max_displacement <= 0.0f) {
+    if (!(mean_spacing > 0.0)) return Invalid("rest control points coincide (zero spacing)");
+    net.params.max_displacement = static_cast<float>(0.5 * mean_spacing);
+  }
+
+  cv::Mat eigenvalues, eigenvectors;  // descending; eigenvectors in rows
+  try {
+    if (!cv::eigen(k1, eigenvalues, eigenvectors)) return Invalid("eigen solve failed");
+  } catch (const cv::Exception& e) {
+    return MakeError(ErrorCode::kInternal, FileLoc{}, std::string("cv::eigen: ") + e.what());
+  }
+  net.lambda_min = eigenvalues.at<double>(n - 1);
+  const double two_pi_f0 = 2.0 * std::numbers::pi * p.frequency_hz;
+  const double s = p.mass * two_pi_f0 * two_pi_f0 / net.lambda_min;
+  net.stiffness_scale = s;
+  net.anchor_stiffness = static_cast<float>(s);
+  net.anchor_damping = static_cast<float>(2.0 * p.damping_ratio * two_pi_f0 * p.mass);
+  for (Spring& sp : net.springs) {
+    sp.stiffness = static_cast<float>(sp.stiffness * s);
+    sp.damping = p.spring_damping_s * sp.stiffness;
+  }
+  net.modes.resize(ns * ns);
+  net.mode_omega2.resize(ns);
+  net.mode_damping.resize(ns);
+  net.mode_sum.assign(ns, 0.0f);
+  net.mode_rest.assign(ns, glm::vec3(0.0f));
+  for (int k = 0; k < n; ++k) {
+    const int row = n - 1 - k;  // ascending order
+    const double lambda = eigenvalues.at<double>(row);
+    const std::size_t ks = static_cast<std::size_t>(k);
+    net.mode_omega2[ks] = static_cast<float>(s * lambda / p.mass);
+    net.mode_damping[ks] = static_cast<float>(
+        (net.anchor_damping + p.spring_damping_s * s * (lambda - 1.0)) / p.mass);
+    for (int a = 0; a < n; ++a) {
+      const float u = static_cast<float>(eigenvectors.at<double>(row, a));
+      net.modes[static_cast<std::size_t>(a) * ns + ks] = u;
+      net.mode_sum[ks] += u;
+      net.mode_rest[ks] += u * net.rest_points[static_cast<std::size_t>(net.point_of_free[
+                                   static_cast<std::size_t>(a)])];
+    }
+  }
+
+  // Gershgorin bound on the eigenvalues of the linear system (ALGORITHMS.md 6).
+  std::vector<double> row_k(ns, s), row_c(ns, net.anchor_damping);
+  for (const Spring& sp : net.springs) {
+    for (int f : {sp.free_a, sp.free_b}) {
+      if (f < 0) continue;
+      row_k[static_cast<std::size_t>(f)] += 2.0 * sp.stiffness;
+      row_c[static_cast<std::size_t>(f)] += 2.0 * sp.damping;
+    }
+  }
+  const double w_max = std::sqrt(*std::max_element(row_k.begin(), row_k.end()) / p.mass);
+  const double c_max = *std::max_element(row_c.begin(), row_c.end());
+  net.gershgorin_rate = std::max(w_max, c_max / p.mass);
+  const double rate = net.gershgorin_rate + 2.0 * setup.max_angular_speed_rad_s;
+  double h = p.time_step_s;
+  int halvings = 0;
+  while (h * rate > kStepRuleAccurate && halvings < kMaxHalvings) {
+    h *= 0.5;
+    ++halvings;
+  }
+  char buf[200];
+  if (halvings > 0) {
+    std::snprintf(buf, sizeof buf,
+                  "time step halved %d time(s) to %.6g s: h (max(w_max, c_max/m) + 2|w|) was "
+                  "%.3f > %.1f",
+                  halvings, h, p.time_step_s * rate, kStepRuleAccurate);
+    net.messages.emplace_back(buf);
+  }
+  if (h * rate > kStepRuleHardLimit) {
+    std::snprintf(buf, sizeof buf,
+                  "step rule: h (max(w_max, c_max/m) + 2|w|) = %.3f > %.1f even at h = %.6g s "
+                  "(stiffness or damping too high)",
+                  h * rate, kStepRuleHardLimit, h);
+    return Invalid(buf);
+  }
+  net.time_step_s = h;
+  return net;
+}
+
+void MassSpringState::Resize(const MassSpringNetwork& network) {
+  const std::size_t n = static_cast<std::size_t>(network.num_free);
+  position.assign(n, glm::vec3(0.0f));
+  velocity.assign(n, glm::vec3(0.0f));
+  prev_position.assign(n, glm::vec3(0.0f));
+  prev_velocity.assign(n, glm::vec3(0.0f));
+  work.assign(5 * n, glm::vec3(0.0f));
+  Reset();
+}
+
+void MassSpringState::Reset() {
+  started = false;
+  step_time_s = output_time_s = 0.0;
+  std::fill(position.begin(), position.end(), glm::vec3(0.0f));
+  std::fill(velocity.begin(), velocity.end(), glm::vec3(0.0f));
+  std::fill(prev_position.begin(), prev_position.end(), glm::vec3(0.0f));
+  std::fill(prev_velocity.begin(), prev_velocity.end(), glm::vec3(0.0f));
+}
+
+JobStatus MassSpringStepJob::Validate() const {
+  if (network == nullptr || state == nullptr) return {JobStatus::kMissingInput, "no network or state"};
+  if (kinematics.empty() && (driving == nullptr || !*driving)) {
+    return {JobStatus::kMissingInput, "no kinematics and no driving callback"};
+  }
+  const std::size_t n = static_cast<std::size_t>(network->num_free);
+  if (state->position.size() != n || state->velocity.size() != n ||
+      state->prev_position.size() != n || state->prev_velocity.size() != n ||
+      state->work.size() != 5 * n) {
+    return {JobStatus::kSizeMismatch, "state not sized for the network (call Resize)"};
+  }
+  const std::size_t num_points = static_cast<std::size_t>(network->rows * network->cols);
+  if (!displacements.empty() && displacements.size() != num_points) {
+    return {JobStatus::kSizeMismatch, "displacements must hold M*N entries"};
+  }
+  if (!kinematics.empty()) {
+    if (num_joints <= 0 || joint < 0 || joint >= num_joints || !(frame_time_s > 0.0)) {
+      return {JobStatus::kOutOfRange, "kinematics: joint, num_joints or frame_time_s"};
+    }
+    if (kinematics.size() % static_cast<std::size_t>(num_joints) != 0) {
+      return {JobStatus::kSizeMismatch, "kinematics is not a whole number of frames"};
+    }
+  }
+  if (!std::isfinite(time_s)) return {JobStatus::kOutOfRange, "time_s is not finite"};
+  return mocap::kJobOk;
+}
+
+JobStatus MassSpringStepJob::Run() const {
+  const JobStatus status = Validate();
+  if (!status) return status;
+  const MassSpringNetwork& net = *network;
+  MassSpringState& st = *state;
+  const MassSpringParams& p = net.params;
+  const double h = net.time_step_s;
+  const double eps = 1e-9;
+  if (!st.started || time_s < st.output_time_s - eps ||
+      time_s > st.output_time_s + p.max_time_gap_s) {
+    st.Reset();
+    st.started = true;
+    ++st.counters.time_resets;
+    st.step_time_s = time_s - p.preroll_s;
+  }
+  const bool modal = UsesModes(net);
+  Integrator integrator(*this);
+  if (st.step_time_s < time_s - eps) {
+    Forcing f0 = integrator.Sample(st.step_time_s);
+    while (st.step_time_s < time_s - eps) {
+      const double t = st.step_time_s;
+      const Forcing fm = integrator.Sample(t + 0.5 * h);
+      const Forcing f1 = integrator.Sample(t + h);
+      if (modal) {
+        integrator.ModalStep(h, f0, fm, f1);
+      } else {
+        integrator.PointStep(h, f0, fm, f1);
+      }
+      integrator.ApplyLimits(modal);
+      st.step_time_s = t + h;
+      ++st.counters.steps;
+      f0 = f1;
+    }
+  }
+  st.output_time_s = time_s;
+  if (displacements.empty()) return mocap::kJobOk;
+
+  // Linear interpolation between the last two steps (exact when no step was taken
+  // since a reset: both are the same zero state).
+  const std::size_t n = static_cast<std::size_t>(net.num_free);
+  const float alpha = static_cast<float>(std::clamp((time_s - (st.step_time_s - h)) / h, 0.0, 1.0));
+  std::span<glm::vec3> blended = std::span<glm::vec3>(st.work).subspan(2 * n, n);
+  for (std::size_t a = 0; a < n; ++a) {
+    blended[a] = st.prev_position[a] + alpha * (st.position[a] - st.prev_position[a]);
+  }
+  std::span<glm::vec3> points = std::span<glm::vec3>(st.work).subspan(3 * n, n);
+  if (modal) {
+    for (std::size_t a = 0; a < n; ++a) {
+      glm::vec3 sum(0.0f);
+      const float* row = &net.modes[a * n];
+      for (std::size_t k = 0; k < n; ++k) sum += row[k] * blended[k];
+      points[a] = sum;
+    }
+  } else {
+    std::copy(blended.begin(), blended.end(), points.begin());
+  }
+  std::fill(displacements.begin(), displacements.end(), glm::vec3(0.0f));
+  for (std::size_t a = 0; a < n; ++a) {
+    displacements[static_cast<std::size_t>(net.point_of_free[a])] = points[a];
+  }
+  return mocap::kJobOk;
+}
+
+namespace {
+void ToPointSpace(const MassSpringNetwork& net, std::span<const glm::vec3> in,
+                  std::span<glm::vec3> out) {
+  const std::size_t n = static_cast<std::size_t>(net.num_free);
+  if (!UsesModes(net)) {
+    std::copy(in.begin(), in.end(), out.begin());
+    return;
+  }
+  for (std::size_t a = 0; a < n; ++a) {
+    glm::vec3 sum(0.0f);
+    for (std::size_t k = 0; k < n; ++k) sum += net.modes[a * n + k] * in[k];
+    out[a] = sum;
+  }
+}
+}  // namespace
+
+void MassSpringPointDisplacements(const MassSpringNetwork& network, const MassSpringState& state,
+                                  std::span<glm::vec3> out) {
+  ToPointSpace(network, state.position, out);
+}
+
+double MassSpringEnergy(const MassSpringNetwork& network, const MassSpringState& state) {
+  const std::size_t n = static_cast<std::size_t>(network.num_free);
+  std::vector<glm::vec3> e(n), v(n);
+  ToPointSpace(network, state.position, e);
+  ToPointSpace(network, state.velocity, v);
+  double energy = 0.0;
+  for (std::size_t a = 0; a < n; ++a) {
+    energy += 0.5 * network.params.mass * glm::dot(glm::dvec3(v[a]), glm::dvec3(v[a]));
+    energy += 0.5 * network.anchor_stiffness * glm::dot(glm::dvec3(e[a]), glm::dvec3(e[a]));
+  }
+  for (const Spring& s : network.springs) {
+    const glm::dvec3 ea = s.free_a >= 0 ? glm::dvec3(e[static_cast<std::size_t>(s.free_a)]) : glm::dvec3(0.0);
+    const glm::dvec3 eb = s.free_b >= 0 ? glm::dvec3(e[static_cast<std::size_t>(s.free_b)]) : glm::dvec3(0.0);
+    energy += 0.5 * s.stiffness * glm::dot(ea - eb, ea - eb);
+  }
+  return energy;
+}
+
+}  // namespace deform
