@@ -4,7 +4,9 @@
 
 #include "deform/mass_spring.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <functional>
 #include <numbers>
 #include <vector>
@@ -299,6 +301,255 @@ TEST(MassSpringStepJob, SustainedAccelerationGivesStaticDisplacement) {
     const double rule = gain * a / std::pow(2 * std::numbers::pi * 3.0, 2);
     EXPECT_NEAR(-c.back().x, rule, 0.3 * rule);
   }
+}
+
+TEST(MassSpringStepJob, ModalAndPointSpaceAgree) {
+  MassSpringParams p = QuietParams();
+  p.gravity = true;  // the bind rotation below differs from the frame's
+  const std::vector<glm::vec3> pts = FlatGrid(7, 7);
+  float largest = 0.0f, worst = 0.0f;
+  std::vector<std::vector<glm::vec3>> runs;
+  for (auto solver : {deform::MassSpringSolver::kModal, deform::MassSpringSolver::kPointSpace}) {
+    p.solver = solver;
+    auto net = BuildMassSpringNetwork(
+        {.rows = 7, .cols = 7, .rest_points = pts,
+         .bind_rotation = glm::angleAxis(0.3f, glm::vec3(1, 0, 0)), .max_angular_speed_rad_s = 1},
+        p);
+    ASSERT_TRUE(net.ok());
+    MassSpringState state;
+    state.Resize(*net);
+    runs.push_back(RunCentre(*net, state, Shake(1.5), 0.0, 1.0 / 30, 60));
+  }
+  for (std::size_t k = 0; k < runs[0].size(); ++k) {
+    largest = std::max(largest, glm::length(runs[1][k]));
+    worst = std::max(worst, glm::length(runs[0][k] - runs[1][k]));
+  }
+  ASSERT_GT(largest, 0.1f);
+  EXPECT_LT(worst, kSolverAgreementRelTol * largest);
+}
+
+// Global error at t = 1.5 s of a smoothly driven 1 Hz network against a run at
+// h / 16: halving h must divide it by ~16.
+TEST(MassSpringStepJob, RungeKuttaIsFourthOrder) {
+  const DriveFn drive = [](double t) {
+    DrivingFrame d;
+    d.linear_acceleration = glm::vec3(300.0f * static_cast<float>(std::sin(4.0 * t)), 0, 0);
+    return d;
+  };
+  const auto run = [&](double h) {
+    MassSpringParams p = QuietParams();
+    p.frequency_hz = 1.0f;
+    p.time_step_s = h;
+    p.max_displacement = 100.0f;
+    const MassSpringNetwork net = Build(3, 3, p);
+    EXPECT_EQ(net.time_step_s, h);
+    MassSpringState state;
+    state.Resize(net);
+    return RunCentre(net, state, drive, 0.0, 0.1, 16).back().x;
+  };
+  const double h = 1.0 / 20;
+  const double ref = run(h / 16);
+  const double e1 = std::abs(run(h) - ref), e2 = std::abs(run(h / 2) - ref);
+  ASSERT_GT(e2, 0.0);
+  EXPECT_GT(e1 / e2, kFourthOrderMinRatio) << e1 << " " << e2;
+  EXPECT_LT(e1 / e2, kFourthOrderMaxRatio) << e1 << " " << e2;
+}
+
+// Kinematics of a capture after the optional 10 Hz zero-phase low-pass
+// (ALGORITHMS.md 6: differentiating mocap twice amplifies noise).
+std::vector<mocap::JointKinematics> SmoothedKinematics(const mocap::Skeleton& skel,
+                                                       const mocap::Motion& motion) {
+  const std::size_t nj = static_cast<std::size_t>(skel.num_joints());
+  const std::size_t nf = static_cast<std::size_t>(motion.num_frames);
+  std::vector<mocap::JointTransform> locals(nj);
+  std::vector<glm::mat4> raw(nj * nf), smooth(nj * nf);
+  EXPECT_TRUE((mocap::ModelMatricesJob{.skeleton = &skel, .motion = &motion, .locals = locals,
+                                       .model_from_joint = raw})
+                  .Run());
+  EXPECT_TRUE((mocap::SmoothTrajectoriesJob{.model_from_joint = raw,
+                                            .num_joints = skel.num_joints(),
+                                            .frame_time_s = motion.frame_time_s,
+                                            .output = smooth})
+                  .Run());
+  std::vector<mocap::JointKinematics> kin(nj * nf);
+  EXPECT_TRUE((mocap::KinematicsJob{.model_from_joint = smooth, .num_joints = skel.num_joints(),
+                                    .frame_time_s = motion.frame_time_s, .output = kin})
+                  .Run());
+  return kin;
+}
+
+// Hips-driven 5x5 patch over the synthetic jump sampled at `fps` (10 Hz low-pass); the centre
+// point's displacement at every 1/30 s.
+std::vector<glm::vec3> JumpResponse(double fps) {
+  const mocap::Skeleton skel = mocap::MakeHumanoidSkeleton();
+  mocap::JumpOptions options;
+  options.frame_time_s = 1.0 / fps;
+  auto motion = mocap::MakeJumpMotion(skel, options);
+  EXPECT_TRUE(motion.ok());
+  const std::vector<mocap::JointKinematics> kin = SmoothedKinematics(skel, *motion);
+  const int hips = skel.FindJoint("Hips");
+  MassSpringParams p;  // a 24 x 24 cm belly patch, stiff enough to stay under e_max
+  p.frequency_hz = 6.0f;
+  p.damping_ratio = 0.25f;
+  const std::vector<glm::vec3> pts = FlatGrid(5, 5, 6.0f);
+  const MassSpringNetwork net =
+      *BuildMassSpringNetwork({.rows = 5, .cols = 5, .rest_points = pts}, p);
+  MassSpringState state;
+  state.Resize(net);
+  std::vector<glm::vec3> disp(25), out;
+  const int num_joints = skel.num_joints();
+  const int per_output = static_cast<int>(std::lround(fps / 30.0));
+  for (int f = 0; f < motion->num_frames; ++f) {
+    const MassSpringStepJob job{.network = &net, .state = &state, .time_s = f / fps,
+                                .kinematics = kin, .num_joints = num_joints, .joint = hips,
+                                .frame_time_s = 1.0 / fps, .displacements = disp};
+    EXPECT_TRUE(job.Run());
+    if (f % per_output == 0) out.push_back(disp[12]);
+  }
+  EXPECT_EQ(state.counters.any_limit(), 0);
+  return out;
+}
+
+TEST(MassSpringStepJob, FrameRateIndependence) {
+  const std::vector<glm::vec3> r30 = JumpResponse(30), r60 = JumpResponse(60),
+                               r120 = JumpResponse(120);
+  const std::size_t n = std::min({r30.size(), r60.size(), r120.size()});
+  ASSERT_GT(n, 30u);
+  float peak = 0.0f, d30 = 0.0f, d60 = 0.0f;
+  for (std::size_t k = 0; k < n; ++k) {
+    peak = std::max(peak, glm::length(r120[k]));
+    d30 = std::max(d30, glm::length(r30[k] - r120[k]));
+    d60 = std::max(d60, glm::length(r60[k] - r120[k]));
+  }
+  ASSERT_GT(peak, 0.2f);  // the jump visibly moves the patch
+  EXPECT_LT(d60, kFrameRateAgreement60 * peak);
+  EXPECT_LT(d30, kFrameRateAgreement30 * peak);
+  std::printf("jump: peak %.3f cm, max difference 30 vs 120 fps %.4f cm, 60 vs 120 fps %.4f cm\n",
+              double(peak), double(d30), double(d60));
+}
+
+// A glitchy capture: 1000 m/s^2 spikes, wild rotation and NaN samples.
+TEST(MassSpringStepJob, SpikesAndNanStayBounded) {
+  for (auto model : {deform::SpringForceModel::kLinear, deform::SpringForceModel::kLength}) {
+    MassSpringParams p;
+    p.force_model = model;
+    const MassSpringNetwork net = Build(7, 7, p, 10.0f);
+    MassSpringState state;
+    state.Resize(net);
+    const DriveFn drive = [](double t) {
+      DrivingFrame d;
+      const int k = static_cast<int>(t * 240.0);
+      if (k % 7 == 0) d.linear_acceleration = glm::vec3(1e5f, -1e5f, 3e4f);  // 1000+ m/s^2
+      if (k % 11 == 0) d.angular_velocity = glm::vec3(0, 40.0f, 0);
+      if (k % 13 == 0) d.angular_acceleration = glm::vec3(5e3f, 0, 0);
+      if (k % 29 == 0) d.linear_acceleration.x = std::nanf("");
+      if (k % 31 == 0) d.rotation = glm::quat(0, 0, 0, 0);
+      return d;
+    };
+    std::vector<glm::vec3> disp(49);
+    for (int f = 0; f < 600; ++f) {
+      const MassSpringStepJob job{.network = &net, .state = &state, .time_s = f / 30.0,
+                                  .driving = &drive, .displacements = disp};
+      ASSERT_TRUE(job.Run());
+      for (const glm::vec3& e : disp) {
+        ASSERT_TRUE(std::isfinite(e.x) && std::isfinite(e.y) && std::isfinite(e.z));
+        ASSERT_LE(glm::length(e), net.params.max_displacement * (1.0f + kFloatTol));
+      }
+    }
+    EXPECT_GT(state.counters.acceleration_clamps, 0);
+    EXPECT_GT(state.counters.non_finite_inputs, 0);
+    EXPECT_GT(state.counters.displacement_clamps, 0);
+  }
+}
+
+TEST(MassSpringStepJob, ResetsWhenTimeJumps) {
+  const MassSpringNetwork net = Build(5, 5, QuietParams());
+  MassSpringState state;
+  state.Resize(net);
+  const DriveFn drive = Shake(100.0);
+  const std::vector<glm::vec3> a = RunCentre(net, state, drive, 0.0, 1.0 / 30, 30);
+  EXPECT_EQ(state.counters.time_resets, 1);
+  EXPECT_GT(glm::length(a.back()), 0.0f);
+  // Forward jump beyond max_time_gap_s, then backwards: each starts from rest.
+  for (double t : {10.0, 2.0}) {
+    const std::vector<glm::vec3> b = RunCentre(net, state, drive, t, 1.0 / 30, 1);
+    EXPECT_EQ(glm::length(b[0]), 0.0f);
+  }
+  EXPECT_EQ(state.counters.time_resets, 3);
+  // The same frame twice is no jump.
+  RunCentre(net, state, drive, 2.0, 0.0, 2);
+  EXPECT_EQ(state.counters.time_resets, 3);
+}
+
+TEST(MassSpringStepJob, PrerollStartsSettled) {
+  // Gravity with the frame tilted 30 degrees from bind: a constant load the
+  // patch sags under. Without preroll the first frame is at rest (e = 0); with
+  // 3 s of preroll it is already at the settled sag.
+  const glm::quat tilted = glm::angleAxis(0.5f, glm::vec3(0, 0, 1));
+  const DriveFn drive = [tilted](double) { return DrivingFrame{tilted}; };
+  const auto first = [&](double preroll) {
+    MassSpringParams p;
+    p.preroll_s = preroll;
+    const MassSpringNetwork net = Build(5, 5, p);
+    MassSpringState state;
+    state.Resize(net);
+    return RunCentre(net, state, drive, 7.0, 0.25, 20);
+  };
+  const std::vector<glm::vec3> cold = first(0.0), warm = first(3.0);
+  EXPECT_EQ(glm::length(cold[0]), 0.0f);
+  const glm::vec3 settled = cold.back();
+  ASSERT_GT(glm::length(settled), 0.1f);
+  EXPECT_LT(glm::length(warm[0] - settled), kPrerollSettledRel * glm::length(settled));
+}
+
+// 10,000 frames of real captures (CMU, 120 fps, hips-driven), with the default
+// belly and face parameters: no NaN, displacement within e_max.
+TEST(MassSpringStepJob, RealCapturesStayFinite) {
+  constexpr float kCmuUnitsPerMetre = 18.7f;
+  const auto path1 = SharedDataPath("bvh/cmu_cgspeed/01_01.bvh");
+  const auto path3 = SharedDataPath("bvh/cmu_cgspeed/01_03.bvh");
+  PATCHSKIN_REQUIRE_SHARED_FILE(path1);
+  PATCHSKIN_REQUIRE_SHARED_FILE(path3);
+  int frames = 0;
+  std::int64_t limits = 0;
+  for (int pass = 0; frames < 10000; ++pass) {
+    mocap::BvhReadOptions options;
+    auto file = mocap::ReadBvhFile((pass % 2 == 0 ? path3 : path1).string(), options);
+    ASSERT_TRUE(file.ok()) << file.error().ToString();
+    const std::vector<mocap::JointKinematics> kin = SmoothedKinematics(file->skeleton, file->motion);
+    const int joint = file->skeleton.FindJoint(pass % 2 == 0 ? "Hips" : "Spine");
+    ASSERT_GE(joint, 0);
+    MassSpringParams p;
+    // cgspeed's CMU units: the hips stand ~17.8 units high, ~0.95 m.
+    p.units_per_metre = kCmuUnitsPerMetre;
+    if (pass % 2 == 1) {
+      p.frequency_hz = 5.0f;
+      p.damping_ratio = 0.25f;
+    }
+    const std::vector<glm::vec3> pts = FlatGrid(7, 7, 0.06f * kCmuUnitsPerMetre);  // 36 cm wide
+    auto net = BuildMassSpringNetwork(
+        {.rows = 7, .cols = 7, .rest_points = pts, .max_angular_speed_rad_s = 20}, p);
+    ASSERT_TRUE(net.ok());
+    MassSpringState state;
+    state.Resize(*net);
+    std::vector<glm::vec3> disp(49);
+    const double h = file->motion.frame_time_s;
+    for (int f = 0; f < file->motion.num_frames && frames < 10000; ++f, ++frames) {
+      const MassSpringStepJob job{.network = &*net, .state = &state, .time_s = f * h,
+                                  .kinematics = kin, .num_joints = file->skeleton.num_joints(),
+                                  .joint = joint, .frame_time_s = h, .displacements = disp};
+      ASSERT_TRUE(job.Run());
+      for (const glm::vec3& e : disp) {
+        ASSERT_TRUE(std::isfinite(e.x) && std::isfinite(e.y) && std::isfinite(e.z));
+        ASSERT_LE(glm::length(e), net->params.max_displacement * (1.0f + kFloatTol));
+      }
+    }
+    limits += state.counters.any_limit();
+    std::printf("pass %d: %lld acceleration clamps, %lld displacement clamps\n", pass,
+                static_cast<long long>(state.counters.acceleration_clamps),
+                static_cast<long long>(state.counters.displacement_clamps));
+  }
+  std::printf("10000 real frames: %lld limit events\n", static_cast<long long>(limits));
 }
 
 }  // namespace
