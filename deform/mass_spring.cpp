@@ -20,6 +20,7 @@ constexpr double kStepRuleAccurate = 0.5;  // h x rate for ~1e-4 amplitude error
 constexpr double kStepRuleHardLimit = 2.5; // RK4 reaches 2.78 (real) / 2.83 (imaginary)
 constexpr int kMaxHalvings = 6;
 constexpr int kMaxGridSize = 16;
+constexpr int kMaxFree = (kMaxGridSize - 2) * (kMaxGridSize - 2);
 
 bool Finite(const glm::vec3& v) {
   return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
@@ -95,35 +96,101 @@ class Integrator {
     return f;
   }
 
-  // One RK4 step of every mode, each an independent 3-D oscillator.
+  // One RK4 step of every mode, each an independent 3-D oscillator. The modes
+  // are processed in structure-of-arrays form so the loops over k vectorize.
   void ModalStep(double h_d, const Forcing& f0, const Forcing& fm, const Forcing& f1) {
-    const float h = static_cast<float>(h_d);
+    const float h = static_cast<float>(h_d), hh = 0.5f * h;
     const int n = net_.num_free;
-    for (int k = 0; k < n; ++k) {
-      const std::size_t ks = static_cast<std::size_t>(k);
-      const float w2 = net_.mode_omega2[ks];
-      const float c = net_.mode_damping[ks];
-      const float sk = net_.mode_sum[ks];
-      const glm::vec3 pk = net_.mode_rest[ks];
-      const glm::vec3 drive0 = sk * f0.common + RigidTerm(f0, pk);
-      const glm::vec3 drivem = sk * fm.common + RigidTerm(fm, pk);
-      const glm::vec3 drive1 = sk * f1.common + RigidTerm(f1, pk);
-      const auto acc = [&](const Forcing& f, const glm::vec3& drive, const glm::vec3& x,
-                           const glm::vec3& v) {
-        return drive - w2 * x - c * v + MovingFrameTerm(f, x, v);
-      };
-      const glm::vec3 x = st_.position[ks], v = st_.velocity[ks];
-      const glm::vec3 a1 = acc(f0, drive0, x, v);
-      const glm::vec3 x2 = x + 0.5f * h * v, v2 = v + 0.5f * h * a1;
-      const glm::vec3 a2 = acc(fm, drivem, x2, v2);
-      const glm::vec3 x3 = x + 0.5f * h * v2, v3 = v + 0.5f * h * a2;
-      const glm::vec3 a3 = acc(fm, drivem, x3, v3);
-      const glm::vec3 x4 = x + h * v3, v4 = v + h * a3;
-      const glm::vec3 a4 = acc(f1, drive1, x4, v4);
-      st_.prev_position[ks] = x;
-      st_.prev_velocity[ks] = v;
-      st_.position[ks] = x + (h / 6.0f) * (v + 2.0f * v2 + 2.0f * v3 + v4);
-      st_.velocity[ks] = v + (h / 6.0f) * (a1 + 2.0f * a2 + 2.0f * a3 + a4);
+    const std::size_t ns = static_cast<std::size_t>(n);
+    float x[3][kMaxFree], v[3][kMaxFree], xs[3][kMaxFree], vs[3][kMaxFree];
+    float sx[3][kMaxFree], sv[3][kMaxFree], acc[3][kMaxFree];
+    for (std::size_t k = 0; k < ns; ++k) {
+      for (int c = 0; c < 3; ++c) {
+        x[c][k] = st_.position[k][c];
+        v[c][k] = st_.velocity[k][c];
+      }
+    }
+    const StageMatrices m0(f0), mm(fm), m1(f1);
+    Accelerations(m0, x, v, acc);
+    for (int c = 0; c < 3; ++c) {
+      for (int k = 0; k < n; ++k) {
+        sx[c][k] = v[c][k];
+        sv[c][k] = acc[c][k];
+        xs[c][k] = x[c][k] + hh * v[c][k];
+        vs[c][k] = v[c][k] + hh * acc[c][k];
+      }
+    }
+    Accelerations(mm, xs, vs, acc);
+    for (int c = 0; c < 3; ++c) {
+      for (int k = 0; k < n; ++k) {
+        sx[c][k] += 2.0f * vs[c][k];
+        sv[c][k] += 2.0f * acc[c][k];
+        xs[c][k] = x[c][k] + hh * vs[c][k];
+        vs[c][k] = v[c][k] + hh * acc[c][k];
+      }
+    }
+    Accelerations(mm, xs, vs, acc);
+    for (int c = 0; c < 3; ++c) {
+      for (int k = 0; k < n; ++k) {
+        sx[c][k] += 2.0f * vs[c][k];
+        sv[c][k] += 2.0f * acc[c][k];
+        xs[c][k] = x[c][k] + h * vs[c][k];
+        vs[c][k] = v[c][k] + h * acc[c][k];
+      }
+    }
+    Accelerations(m1, xs, vs, acc);
+    for (std::size_t k = 0; k < ns; ++k) {
+      st_.prev_position[k] = st_.position[k];
+      st_.prev_velocity[k] = st_.velocity[k];
+      for (int c = 0; c < 3; ++c) {
+        st_.position[k][c] = x[c][k] + (h / 6.0f) * (sx[c][k] + vs[c][k]);
+        st_.velocity[k][c] = v[c][k] + (h / 6.0f) * (sv[c][k] + acc[c][k]);
+      }
+    }
+  }
+
+  // The moving-frame terms as matrices: -gam ([al]x + [w]x^2) acts on positions
+  // (the rigid Euler + centrifugal term on k, and the same on e), -2 gam [w]x on
+  // velocities (Coriolis). Row-major.
+  struct StageMatrices {
+    float mx[3][3], mv[3][3], common[3];
+    explicit StageMatrices(const Forcing& f) {
+      const glm::vec3 w = f.w, al = f.al;
+      const float ww = glm::dot(w, w);
+      const float skew_al[3][3] = {{0, -al.z, al.y}, {al.z, 0, -al.x}, {-al.y, al.x, 0}};
+      const float skew_w[3][3] = {{0, -w.z, w.y}, {w.z, 0, -w.x}, {-w.y, w.x, 0}};
+      for (int r = 0; r < 3; ++r) {
+        for (int c = 0; c < 3; ++c) {
+          const float w2 = w[r] * w[c] - (r == c ? ww : 0.0f);  // [w]x^2 = w w^T - |w|^2 I
+          mx[r][c] = -f.gain * (skew_al[r][c] + w2);
+          mv[r][c] = -2.0f * f.gain * skew_w[r][c];
+        }
+        common[r] = f.common[r];
+      }
+    }
+  };
+
+  void Accelerations(const StageMatrices& m, const float (*x)[kMaxFree],
+                     const float (*v)[kMaxFree], float (*acc)[kMaxFree]) const {
+    const int n = net_.num_free;
+    const float* w2 = net_.mode_omega2.data();
+    const float* cd = net_.mode_damping.data();
+    const float* sk = net_.mode_sum.data();
+    const float* px = net_.mode_rest_soa.data();
+    const float* py = px + n;
+    const float* pz = py + n;
+    for (int c = 0; c < 3; ++c) {
+      const float* r = m.mx[c];
+      const float* q = m.mv[c];
+      const float cc = m.common[c];
+      float* out = acc[c];
+      const float* xc = x[c];
+      const float* vc = v[c];
+      for (int k = 0; k < n; ++k) {
+        out[k] = sk[k] * cc + r[0] * (px[k] + x[0][k]) + r[1] * (py[k] + x[1][k]) +
+                 r[2] * (pz[k] + x[2][k]) + q[0] * v[0][k] + q[1] * v[1][k] + q[2] * v[2][k] -
+                 w2[k] * xc[k] - cd[k] * vc[k];
+      }
     }
   }
 
@@ -398,6 +465,9 @@ Result<MassSpringNetwork> BuildMassSpringNetwork(const MassSpringSetup& setup,
                                    static_cast<std::size_t>(a)])];
     }
   }
+  net.mode_rest_soa.resize(3 * ns);
+  for (std::size_t k = 0; k < ns; ++k)
+    for (std::size_t c = 0; c < 3; ++c) net.mode_rest_soa[c * ns + k] = net.mode_rest[k][static_cast<int>(c)];
 
   // Gershgorin bound on the eigenvalues of the linear system (ALGORITHMS.md 6).
   std::vector<double> row_k(ns, s), row_c(ns, net.anchor_damping);
