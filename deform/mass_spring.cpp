@@ -283,8 +283,16 @@ class Integrator {
       std::fill(st_.prev_velocity.begin(), st_.prev_velocity.end(), glm::vec3(0.0f));
       return;
     }
-    // U is orthonormal, so |e_a|^2 <= sum_k |eta_k|^2: below e_max^2 nothing can exceed.
+    // U is orthonormal, so |e_a|^2 <= sum_k |eta_k|^2; also |e_a| <= sum_k u_k |eta_k|
+    // with u_k = max_a |U[a, k]|. Below e_max by either bound nothing can exceed.
     if (sum_x <= e_max * e_max) return;
+    if (modal) {
+      float bound = 0.0f;
+      for (std::size_t k = 0; k < n; ++k) {
+        bound += net_.mode_max_abs[k] * glm::length(st_.position[k]);
+      }
+      if (bound <= e_max) return;
+    }
     std::span<glm::vec3> e(st_.position), v(st_.velocity);
     if (modal) {
       e = std::span<glm::vec3>(st_.work).subspan(0, n);
@@ -465,6 +473,10 @@ Result<MassSpringNetwork> BuildMassSpringNetwork(const MassSpringSetup& setup,
                                    static_cast<std::size_t>(a)])];
     }
   }
+  net.mode_max_abs.assign(ns, 0.0f);
+  for (std::size_t a = 0; a < ns; ++a)
+    for (std::size_t k = 0; k < ns; ++k)
+      net.mode_max_abs[k] = std::max(net.mode_max_abs[k], std::abs(net.modes[a * ns + k]));
   net.mode_rest_soa.resize(3 * ns);
   for (std::size_t k = 0; k < ns; ++k)
     for (std::size_t c = 0; c < 3; ++c) net.mode_rest_soa[c * ns + k] = net.mode_rest[k][static_cast<int>(c)];

@@ -130,6 +130,7 @@ struct MassSpringNetwork {
   std::vector<float> mode_damping;         // #free: c_k / m = (c_an + b s (lambda_k - 1)) / m
   std::vector<float> mode_sum;             // #free: sum_a U[a, k]
   std::vector<glm::vec3> mode_rest;        // #free: sum_a U[a, k] k_a
+  std::vector<float> mode_max_abs;         // #free: max_a |U[a, k]| (cheap limit check)
   std::vector<float> mode_rest_soa;        // 3 x #free: mode_rest as x..., y..., z... (SoA)
   std::vector<std::string> messages;       // step-rule notes ("time step halved to ...")
 };
