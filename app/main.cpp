@@ -9,6 +9,7 @@
 #include <CLI/CLI.hpp>
 
 #include "app/compare_command.h"
+#include "app/elastic_command.h"
 #include "app/inspect_command.h"
 #include "app/render_command.h"
 
@@ -26,6 +27,8 @@ int main(int argc, char** argv) {
   CLI::App* turntable = app::AddTurntableCommand(app, turntable_options);
   app::CompareCommandOptions compare_options;
   CLI::App* compare = app::AddCompareCommand(app, &compare_options);
+  app::ElasticOptions elastic_options;
+  CLI::App* elastic = app::AddElasticCommand(app, elastic_options);
 
   try {
     app.parse(argc, argv);
@@ -40,6 +43,7 @@ int main(int argc, char** argv) {
     if (render->parsed()) return app::RunRender(render_options);
     if (turntable->parsed()) return app::RunRender(turntable_options);
     if (compare->parsed()) return app::RunCompareCommand(compare_options);
+    if (elastic->parsed()) return app::RunElastic(elastic_options);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "patchskin: internal error: %s\n", e.what());
     return 3;
