@@ -10,6 +10,7 @@
 
 #include "app/compare_command.h"
 #include "app/export_command.h"
+#include "app/elastic_command.h"
 #include "app/inspect_command.h"
 #include "app/render_command.h"
 
@@ -29,6 +30,8 @@ int main(int argc, char** argv) {
   CLI::App* export_cmd = app::AddExportCommand(app, export_options);
   app::CompareCommandOptions compare_options;
   CLI::App* compare = app::AddCompareCommand(app, &compare_options);
+  app::ElasticOptions elastic_options;
+  CLI::App* elastic = app::AddElasticCommand(app, elastic_options);
 
   try {
     app.parse(argc, argv);
@@ -44,6 +47,7 @@ int main(int argc, char** argv) {
     if (turntable->parsed()) return app::RunRender(turntable_options);
     if (compare->parsed()) return app::RunCompareCommand(compare_options);
     if (export_cmd->parsed()) return app::RunExport(export_options);
+    if (elastic->parsed()) return app::RunElastic(elastic_options);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "patchskin: internal error: %s\n", e.what());
     return 3;

@@ -161,3 +161,41 @@ inline constexpr double kCandyWrapperKeptMin = 0.8;
 inline constexpr float kSwdMaxEdgeGrowthFraction = 0.04f;
 
 }  // namespace testsupport
+
+namespace testsupport {
+
+// Mass-spring network (ALGORITHMS.md 6). Period of the slowest mode measured by
+// zero crossings of a float RK4 run at h = 1/240 s (RK4 phase error ~(wh)^4/120).
+inline constexpr double kModePeriodRelTol = 1e-3;
+// Damping ratio from the log decrement of parabola-interpolated peaks.
+inline constexpr double kDampingRatioTol = 5e-3;
+// Energy of a damped linear network may not grow between steps beyond float round-off.
+inline constexpr double kEnergyMonotoneRelTol = 1e-5;
+// Energy left 4 s after the motion stops, relative to the energy at the stop.
+inline constexpr double kRestEnergyFraction = 1e-6;
+// Displacement (cm) counted as "back at rest".
+inline constexpr float kRestDisplacementCm = 1e-3f;
+// Settled displacement under constant acceleration vs the static solution.
+inline constexpr double kStaticResponseRelTol = 1e-3;
+// Modal and point-space integration of the same linear system (float round-off
+// over a few hundred steps), relative to the largest displacement.
+inline constexpr double kSolverAgreementRelTol = 1e-4;
+// RK4: halving h divides the global error by 16; accept more than 12.
+inline constexpr double kFourthOrderMinRatio = 12.0;
+inline constexpr double kFourthOrderMaxRatio = 20.0;
+
+}  // namespace testsupport
+
+namespace testsupport {
+
+// The synthetic jump resampled at 30, 60 and 120 fps (10 Hz low-pass) drives the
+// same patch: the largest difference of the centre point's displacement curve
+// from the 120 fps one, relative to its peak (measured 6.8% and 2.0%). The
+// forcing differs only by each rate's finite-difference kinematics: the jump's
+// acceleration steps are smeared over a frame, 33 ms at 30 fps.
+inline constexpr double kFrameRateAgreement30 = 0.08;
+inline constexpr double kFrameRateAgreement60 = 0.03;
+// First frame after a 3 s preroll vs the settled sag under a constant load.
+inline constexpr double kPrerollSettledRel = 0.01;
+
+}  // namespace testsupport

@@ -1,0 +1,188 @@
+#include "app/elastic_command.h"
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <functional>
+#include <vector>
+
+#include "app/motion_source.h"
+#include "deform/mass_spring.h"
+#include "mocap/kinematics.h"
+#include "mocap/synthetic.h"
+#include "render/image_io.h"
+#include "render/plot.h"
+
+namespace app {
+namespace {
+
+int Fail(const mocap::Error& e, int code) {
+  std::fprintf(stderr, "%s\n", e.ToString().c_str());
+  return code;
+}
+
+// Per-frame kinematics of every joint, low-passed first when cutoff_hz > 0.
+mocap::Result<std::vector<mocap::JointKinematics>> Kinematics(const mocap::Skeleton& skel,
+                                                              const mocap::Motion& motion,
+                                                              double cutoff_hz) {
+  if (cutoff_hz <= 0.0) return mocap::ComputeKinematics(skel, motion);
+  const std::size_t nj = static_cast<std::size_t>(skel.num_joints());
+  const std::size_t nf = static_cast<std::size_t>(motion.num_frames);
+  std::vector<mocap::JointTransform> locals(nj);
+  std::vector<glm::mat4> raw(nj * nf), smooth(nj * nf);
+  std::vector<mocap::JointKinematics> kin(nj * nf);
+  const mocap::JobStatus s1 = mocap::ModelMatricesJob{
+      .skeleton = &skel, .motion = &motion, .locals = locals, .model_from_joint = raw}.Run();
+  const mocap::JobStatus s2 = mocap::SmoothTrajectoriesJob{
+      .model_from_joint = raw, .num_joints = skel.num_joints(),
+      .frame_time_s = motion.frame_time_s, .cutoff_hz = cutoff_hz, .output = smooth}.Run();
+  const mocap::JobStatus s3 = mocap::KinematicsJob{
+      .model_from_joint = smooth, .num_joints = skel.num_joints(),
+      .frame_time_s = motion.frame_time_s, .output = kin}.Run();
+  for (const mocap::JobStatus& s : {s1, s2, s3}) {
+    if (!s) return mocap::MakeError(mocap::ErrorCode::kInvalidArgument, mocap::FileLoc(), s.what);
+  }
+  return kin;
+}
+
+}  // namespace
+
+CLI::App* AddElasticCommand(CLI::App& parent, ElasticOptions& o) {
+  CLI::App* cmd = parent.add_subcommand(
+      "elastic", "Simulate an elastic patch driven by a joint and plot its response (PNG)");
+  cmd->add_option("file", o.file, "BVH or glTF motion (default: the built-in synthetic jump)");
+  cmd->add_option("--joint", o.joint, "Driving joint")->capture_default_str();
+  cmd->add_option("--out", o.out, "Output PNG")->capture_default_str();
+  cmd->add_option("--grid", o.grid, "Control points per side (3..16)")->capture_default_str();
+  cmd->add_option("--spacing-m", o.spacing_m, "Control-point spacing, metres")->capture_default_str();
+  cmd->add_option("--frequency", o.frequency_hz, "Slowest-mode frequency f0, Hz")->capture_default_str();
+  cmd->add_option("--damping", o.damping_ratio, "Damping ratio z0")->capture_default_str();
+  cmd->add_option("--gain", o.gain, "Inertial gain")->capture_default_str();
+  cmd->add_option("--preroll", o.preroll_s, "Seconds simulated before the first frame")->capture_default_str();
+  cmd->add_option("--cutoff-hz", o.cutoff_hz, "Low-pass of the joint paths (0 = off)")->capture_default_str();
+  cmd->add_option("--scale", o.scale, "File length factor (0 = detected units to metres)")->capture_default_str();
+  cmd->add_option("--units-per-metre", o.units_per_metre,
+                  "Model units per metre (0 = 1 for files, 100 for the built-in jump)");
+  return cmd;
+}
+
+int RunElastic(const ElasticOptions& o) {
+  mocap::Skeleton skel;
+  mocap::Motion motion;
+  float upm = o.units_per_metre;
+  std::string source = "built-in jump";
+  if (o.file.empty()) {
+    skel = mocap::MakeHumanoidSkeleton();
+    mocap::JumpOptions jump;
+    jump.frame_time_s = 1.0 / 60.0;
+    auto m = mocap::MakeJumpMotion(skel, jump);
+    if (!m.ok()) return Fail(m.error(), 3);
+    motion = std::move(m).value();
+    if (upm <= 0.0f) upm = 100.0f;
+  } else {
+    MotionSourceOptions mo;
+    mo.scale = o.scale;
+    auto loaded = LoadMotionSource(o.file, mo);
+    if (!loaded.ok()) return Fail(loaded.error(), 2);
+    skel = std::move(loaded->skeleton);
+    motion = std::move(loaded->motion);
+    if (upm <= 0.0f) upm = 1.0f;
+    source = o.file;
+  }
+  mocap::FileLoc loc;
+  loc.file = o.file.empty() ? "elastic" : o.file;
+  const int joint = skel.FindJoint(o.joint);
+  if (joint < 0) {
+    return Fail(mocap::MakeError(mocap::ErrorCode::kNotFound, loc,
+                                 "no joint named '" + o.joint + "'"), 2);
+  }
+  if (motion.num_frames < 2) {
+    return Fail(mocap::MakeError(mocap::ErrorCode::kInvalidArgument, loc,
+                                 "expected at least 2 frames"), 2);
+  }
+  auto kin = Kinematics(skel, motion, o.cutoff_hz);
+  if (!kin.ok()) return Fail(kin.error(), 2);
+  const std::size_t nj = static_cast<std::size_t>(skel.num_joints());
+  float max_w = 0.0f;
+  for (std::size_t f = 0; f < static_cast<std::size_t>(motion.num_frames); ++f) {
+    max_w = std::max(max_w, glm::length((*kin)[f * nj + static_cast<std::size_t>(joint)]
+                                            .local_angular_velocity));
+  }
+
+  // A flat grid 10 cm in front of the joint, facing +Z of its frame.
+  const int n = o.grid;
+  std::vector<glm::vec3> pts;
+  const float spacing = o.spacing_m * upm;
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j)
+      pts.emplace_back((static_cast<float>(j) - 0.5f * static_cast<float>(n - 1)) * spacing,
+                       (static_cast<float>(i) - 0.5f * static_cast<float>(n - 1)) * spacing,
+                       0.1f * upm);
+  deform::MassSpringParams params;
+  params.frequency_hz = o.frequency_hz;
+  params.damping_ratio = o.damping_ratio;
+  params.gain = o.gain;
+  params.preroll_s = o.preroll_s;
+  params.units_per_metre = upm;
+  const glm::quat bind = (*kin)[static_cast<std::size_t>(joint)].rotation;
+  auto net = deform::BuildMassSpringNetwork(
+      {.rows = n, .cols = n, .rest_points = pts, .bind_rotation = bind,
+       .max_angular_speed_rad_s = max_w},
+      params);
+  if (!net.ok()) return Fail(net.error(), 2);
+  for (const std::string& m : net->messages) std::printf("note: %s\n", m.c_str());
+
+  deform::MassSpringState state;
+  state.Resize(*net);
+  std::vector<glm::vec3> disp(pts.size());
+  const std::size_t centre = static_cast<std::size_t>((n / 2) * n + n / 2);
+  render::PlotOptions plot;
+  plot.title = "elastic patch " + std::to_string(n) + "x" + std::to_string(n) + " driven by " +
+               o.joint + " (" + source + "), f0 " + std::to_string(o.frequency_hz).substr(0, 4) +
+               " Hz, z0 " + std::to_string(o.damping_ratio).substr(0, 4);
+  render::PlotCurve accel{"|a| in joint frame", {}, {0.85f, 0.25f, 0.05f, 1.0f}};
+  render::PlotCurve magnitude{"|e|", {}, {0.05f, 0.2f, 0.8f, 1.0f}};
+  render::PlotCurve normal{"e along patch normal", {}, {0.1f, 0.55f, 0.15f, 1.0f}};
+  double peak = 0.0;
+  for (int f = 0; f < motion.num_frames; ++f) {
+    const double t = f * motion.frame_time_s;
+    const deform::MassSpringStepJob job{
+        .network = &*net, .state = &state, .time_s = t, .kinematics = *kin,
+        .num_joints = skel.num_joints(), .joint = joint, .frame_time_s = motion.frame_time_s,
+        .displacements = disp};
+    if (const mocap::JobStatus s = job.Run(); !s) {
+      return Fail(mocap::MakeError(mocap::ErrorCode::kInternal, loc, s.what), 3);
+    }
+    const glm::vec3 a = (*kin)[static_cast<std::size_t>(f) * nj + static_cast<std::size_t>(joint)]
+                            .local_linear_acceleration;
+    plot.times_s.push_back(t);
+    accel.values.push_back(glm::length(a) / upm);
+    magnitude.values.push_back(100.0 * glm::length(disp[centre]) / upm);
+    normal.values.push_back(100.0 * disp[centre].z / upm);
+    peak = std::max(peak, magnitude.values.back());
+  }
+  plot.panels = {{"driving acceleration", "m/s^2", {accel}},
+                 {"patch centre displacement", "cm", {magnitude, normal}}};
+  auto image = render::DrawTimePlot(plot);
+  if (!image.ok()) return Fail(image.error(), 3);
+  const std::filesystem::path out(o.out);
+  if (out.has_parent_path()) {
+    std::error_code ec;
+    std::filesystem::create_directories(out.parent_path(), ec);
+  }
+  if (const mocap::Status s = render::WriteImage(*image, o.out); !s) return Fail(s.error(), 2);
+  const deform::MassSpringCounters& c = state.counters;
+  std::printf("%d frames, h = %.6g s, %lld steps, peak |e| %.3f cm (e_max %.3f cm)\n",
+              motion.num_frames, net->time_step_s, static_cast<long long>(c.steps), peak,
+              100.0 * net->params.max_displacement / upm);
+  std::printf("limits: %lld acceleration clamps, %lld displacement clamps, %lld non-finite "
+              "inputs, %lld non-finite resets\n",
+              static_cast<long long>(c.acceleration_clamps),
+              static_cast<long long>(c.displacement_clamps),
+              static_cast<long long>(c.non_finite_inputs),
+              static_cast<long long>(c.non_finite_resets));
+  std::printf("wrote %s\n", o.out.c_str());
+  return 0;
+}
+
+}  // namespace app

@@ -1,0 +1,494 @@
+#include "deform/mass_spring.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+#include <string>
+
+
+namespace deform {
+namespace {
+
+using mocap::ErrorCode;
+using mocap::FileLoc;
+using mocap::MakeError;
+
+constexpr double kStandardGravityMps2 = 9.81;
+constexpr int kMaxGridSize = 16;
+constexpr int kMaxFree = (kMaxGridSize - 2) * (kMaxGridSize - 2);
+
+bool Finite(const glm::vec3& v) {
+  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+
+// Everything the forces need at one stage time, per unit mass.
+struct Forcing {
+  glm::vec3 common{0.0f};  // -gam a + (R^T g - R_bind^T g) + u: the same for every point
+  glm::vec3 w{0.0f};       // angular velocity (frame)
+  glm::vec3 al{0.0f};      // angular acceleration (frame)
+  float gain = 1.0f;
+};
+
+// -gam [al x k + w x (w x k)]: the rigid part of R^T K'' that depends on the
+// point's position k in the frame (Euler and centrifugal terms).
+inline glm::vec3 RigidTerm(const Forcing& f, const glm::vec3& k) {
+  return -f.gain * (glm::cross(f.al, k) + glm::cross(f.w, glm::cross(f.w, k)));
+}
+
+// -gam [2 w x e' + al x e + w x (w x e)]: Coriolis, Euler and centrifugal on e.
+inline glm::vec3 MovingFrameTerm(const Forcing& f, const glm::vec3& e, const glm::vec3& v) {
+  return -f.gain * (2.0f * glm::cross(f.w, v) + glm::cross(f.al, e) +
+                    glm::cross(f.w, glm::cross(f.w, e)));
+}
+
+class Integrator {
+ public:
+  explicit Integrator(const MassSpringStepJob& job)
+      : job_(job), net_(*job.network), st_(*job.state), p_(job.network->params) {
+    const double g = kStandardGravityMps2 * p_.units_per_metre;
+    gravity_ = glm::vec3(glm::dvec3(glm::normalize(p_.down)) * g);
+    gravity_bind_ = glm::conjugate(net_.bind_rotation) * gravity_;
+    max_accel_ = p_.max_acceleration_mps2 * p_.units_per_metre;
+  }
+
+  Forcing Sample(double t) {
+    DrivingFrame d;
+    if (!job_.kinematics.empty()) {
+      mocap::JointKinematics k;
+      if (mocap::SampleJointKinematics(job_.kinematics, job_.num_joints, job_.joint,
+                                       job_.frame_time_s, t, &k)) {
+        d = {k.rotation, k.local_linear_acceleration, k.local_angular_velocity,
+             k.local_angular_acceleration};
+      }
+    } else {
+      d = (*job_.driving)(t);
+    }
+    MassSpringCounters& c = st_.counters;
+    const glm::vec4 q(d.rotation.x, d.rotation.y, d.rotation.z, d.rotation.w);
+    if (!Finite(d.linear_acceleration) || !Finite(d.angular_velocity) ||
+        !Finite(d.angular_acceleration) || !std::isfinite(glm::dot(q, q)) ||
+        glm::dot(q, q) < 1e-12f) {
+      ++c.non_finite_inputs;  // a glitch: the frame is taken as at rest in the bind pose
+      d = DrivingFrame{net_.bind_rotation};
+    }
+    const float a_len = glm::length(d.linear_acceleration);
+    if (a_len > max_accel_) {
+      ++c.acceleration_clamps;
+      d.linear_acceleration *= max_accel_ / a_len;
+    }
+    Forcing f;
+    f.gain = p_.gain;
+    f.w = d.angular_velocity;
+    f.al = d.angular_acceleration;
+    f.common = -p_.gain * d.linear_acceleration + job_.user_acceleration;
+    if (p_.gravity) {
+      f.common += glm::conjugate(glm::normalize(d.rotation)) * gravity_ - gravity_bind_;
+    }
+    return f;
+  }
+
+  // One RK4 step of every mode, each an independent 3-D oscillator. The modes
+  // are processed in structure-of-arrays form so the loops over k vectorize.
+  void ModalStep(double h_d, const Forcing& f0, const Forcing& fm, const Forcing& f1) {
+    const float h = static_cast<float>(h_d), hh = 0.5f * h;
+    const int n = net_.num_free;
+    const std::size_t ns = static_cast<std::size_t>(n);
+    float x[3][kMaxFree], v[3][kMaxFree], xs[3][kMaxFree], vs[3][kMaxFree];
+    float sx[3][kMaxFree], sv[3][kMaxFree], acc[3][kMaxFree];
+    for (std::size_t k = 0; k < ns; ++k) {
+      for (int c = 0; c < 3; ++c) {
+        x[c][k] = st_.position[k][c];
+        v[c][k] = st_.velocity[k][c];
+      }
+    }
+    const StageMatrices m0(f0), mm(fm), m1(f1);
+    Accelerations(m0, x, v, acc);
+    for (int c = 0; c < 3; ++c) {
+      for (int k = 0; k < n; ++k) {
+        sx[c][k] = v[c][k];
+        sv[c][k] = acc[c][k];
+        xs[c][k] = x[c][k] + hh * v[c][k];
+        vs[c][k] = v[c][k] + hh * acc[c][k];
+      }
+    }
+    Accelerations(mm, xs, vs, acc);
+    for (int c = 0; c < 3; ++c) {
+      for (int k = 0; k < n; ++k) {
+        sx[c][k] += 2.0f * vs[c][k];
+        sv[c][k] += 2.0f * acc[c][k];
+        xs[c][k] = x[c][k] + hh * vs[c][k];
+        vs[c][k] = v[c][k] + hh * acc[c][k];
+      }
+    }
+    Accelerations(mm, xs, vs, acc);
+    for (int c = 0; c < 3; ++c) {
+      for (int k = 0; k < n; ++k) {
+        sx[c][k] += 2.0f * vs[c][k];
+        sv[c][k] += 2.0f * acc[c][k];
+        xs[c][k] = x[c][k] + h * vs[c][k];
+        vs[c][k] = v[c][k] + h * acc[c][k];
+      }
+    }
+    Accelerations(m1, xs, vs, acc);
+    for (std::size_t k = 0; k < ns; ++k) {
+      st_.prev_position[k] = st_.position[k];
+      st_.prev_velocity[k] = st_.velocity[k];
+      for (int c = 0; c < 3; ++c) {
+        st_.position[k][c] = x[c][k] + (h / 6.0f) * (sx[c][k] + vs[c][k]);
+        st_.velocity[k][c] = v[c][k] + (h / 6.0f) * (sv[c][k] + acc[c][k]);
+      }
+    }
+  }
+
+  // The moving-frame terms as matrices: -gam ([al]x + [w]x^2) acts on positions
+  // (the rigid Euler + centrifugal term on k, and the same on e), -2 gam [w]x on
+  // velocities (Coriolis). Row-major.
+  struct StageMatrices {
+    float mx[3][3], mv[3][3], common[3];
+    explicit StageMatrices(const Forcing& f) {
+      const glm::vec3 w = f.w, al = f.al;
+      const float ww = glm::dot(w, w);
+      const float skew_al[3][3] = {{0, -al.z, al.y}, {al.z, 0, -al.x}, {-al.y, al.x, 0}};
+      const float skew_w[3][3] = {{0, -w.z, w.y}, {w.z, 0, -w.x}, {-w.y, w.x, 0}};
+      for (int r = 0; r < 3; ++r) {
+        for (int c = 0; c < 3; ++c) {
+          const float w2 = w[r] * w[c] - (r == c ? ww : 0.0f);  // [w]x^2 = w w^T - |w|^2 I
+          mx[r][c] = -f.gain * (skew_al[r][c] + w2);
+          mv[r][c] = -2.0f * f.gain * skew_w[r][c];
+        }
+        common[r] = f.common[r];
+      }
+    }
+  };
+
+  void Accelerations(const StageMatrices& m, const float (*x)[kMaxFree],
+                     const float (*v)[kMaxFree], float (*acc)[kMaxFree]) const {
+    const int n = net_.num_free;
+    const float* w2 = net_.mode_omega2.data();
+    const float* cd = net_.mode_damping.data();
+    const float* sk = net_.mode_sum.data();
+    const float* px = net_.mode_rest_soa.data();
+    const float* py = px + n;
+    const float* pz = py + n;
+    for (int c = 0; c < 3; ++c) {
+      const float* r = m.mx[c];
+      const float* q = m.mv[c];
+      const float cc = m.common[c];
+      float* out = acc[c];
+      const float* xc = x[c];
+      const float* vc = v[c];
+      for (int k = 0; k < n; ++k) {
+        out[k] = sk[k] * cc + r[0] * (px[k] + x[0][k]) + r[1] * (py[k] + x[1][k]) +
+                 r[2] * (pz[k] + x[2][k]) + q[0] * v[0][k] + q[1] * v[1][k] + q[2] * v[2][k] -
+                 w2[k] * xc[k] - cd[k] * vc[k];
+      }
+    }
+  }
+
+  // Accelerations of every free point from point-space springs.
+  void PointAccelerations(const Forcing& f, std::span<const glm::vec3> e,
+                          std::span<const glm::vec3> v, std::span<glm::vec3> acc) const {
+    const int n = net_.num_free;
+    const float inv_m = 1.0f / p_.mass;
+    for (int a = 0; a < n; ++a) {
+      const std::size_t as = static_cast<std::size_t>(a);
+      const glm::vec3 k = net_.rest_points[static_cast<std::size_t>(net_.point_of_free[as])];
+      acc[as] = inv_m * (-net_.anchor_stiffness * e[as] - net_.anchor_damping * v[as]) +
+                f.common + RigidTerm(f, k) + MovingFrameTerm(f, e[as], v[as]);
+    }
+    const bool length_model = p_.force_model == SpringForceModel::kLength;
+    for (const Spring& s : net_.springs) {
+      const std::size_t fa = static_cast<std::size_t>(s.free_a);
+      const std::size_t fb = static_cast<std::size_t>(s.free_b);
+      const glm::vec3 ea = s.free_a >= 0 ? e[fa] : glm::vec3(0.0f);
+      const glm::vec3 eb = s.free_b >= 0 ? e[fb] : glm::vec3(0.0f);
+      const glm::vec3 va = s.free_a >= 0 ? v[fa] : glm::vec3(0.0f);
+      const glm::vec3 vb = s.free_b >= 0 ? v[fb] : glm::vec3(0.0f);
+      glm::vec3 force = -s.damping * (va - vb);  // on a
+      if (length_model) {
+        const glm::vec3 d = net_.rest_points[static_cast<std::size_t>(s.point_a)] + ea -
+                            net_.rest_points[static_cast<std::size_t>(s.point_b)] - eb;
+        const float len = glm::length(d);
+        if (len > 0.0f) force -= s.stiffness * (len - s.rest_length) / len * d;
+      } else {
+        force -= s.stiffness * (ea - eb);
+      }
+      if (s.free_a >= 0) acc[fa] += inv_m * force;
+      if (s.free_b >= 0) acc[fb] -= inv_m * force;
+    }
+  }
+
+  void PointStep(double h_d, const Forcing& f0, const Forcing& fm, const Forcing& f1) {
+    const float h = static_cast<float>(h_d);
+    const std::size_t n = static_cast<std::size_t>(net_.num_free);
+    std::span<glm::vec3> w(st_.work);
+    std::span<glm::vec3> xs = w.subspan(0, n), vs = w.subspan(n, n), acc = w.subspan(2 * n, n),
+                         sx = w.subspan(3 * n, n), sv = w.subspan(4 * n, n);
+    std::span<glm::vec3> x(st_.position), v(st_.velocity);
+    PointAccelerations(f0, x, v, acc);  // stage 1
+    for (std::size_t a = 0; a < n; ++a) {
+      sx[a] = v[a];
+      sv[a] = acc[a];
+      xs[a] = x[a] + 0.5f * h * v[a];
+      vs[a] = v[a] + 0.5f * h * acc[a];
+    }
+    PointAccelerations(fm, xs, vs, acc);  // stage 2
+    for (std::size_t a = 0; a < n; ++a) {
+      sx[a] += 2.0f * vs[a];
+      sv[a] += 2.0f * acc[a];
+      xs[a] = x[a] + 0.5f * h * vs[a];
+      vs[a] = v[a] + 0.5f * h * acc[a];
+    }
+    PointAccelerations(fm, xs, vs, acc);  // stage 3
+    for (std::size_t a = 0; a < n; ++a) {
+      sx[a] += 2.0f * vs[a];
+      sv[a] += 2.0f * acc[a];
+      xs[a] = x[a] + h * vs[a];
+      vs[a] = v[a] + h * acc[a];
+    }
+    PointAccelerations(f1, xs, vs, acc);  // stage 4
+    for (std::size_t a = 0; a < n; ++a) {
+      sx[a] += vs[a];
+      sv[a] += acc[a];
+      st_.prev_position[a] = x[a];
+      st_.prev_velocity[a] = v[a];
+      x[a] += (h / 6.0f) * sx[a];
+      v[a] += (h / 6.0f) * sv[a];
+    }
+  }
+
+  // |e_a| <= e_max with the outward velocity removed; non-finite state resets.
+  void ApplyLimits(bool modal) {
+    const std::size_t n = static_cast<std::size_t>(net_.num_free);
+    const float e_max = p_.max_displacement;
+    float sum_x = 0.0f, sum_v = 0.0f;
+    for (std::size_t a = 0; a < n; ++a) {
+      sum_x += glm::dot(st_.position[a], st_.position[a]);
+      sum_v += glm::dot(st_.velocity[a], st_.velocity[a]);
+    }
+    if (!std::isfinite(sum_x) || !std::isfinite(sum_v)) {
+      ++st_.counters.non_finite_resets;
+      std::fill(st_.position.begin(), st_.position.end(), glm::vec3(0.0f));
+      std::fill(st_.velocity.begin(), st_.velocity.end(), glm::vec3(0.0f));
+      std::fill(st_.prev_position.begin(), st_.prev_position.end(), glm::vec3(0.0f));
+      std::fill(st_.prev_velocity.begin(), st_.prev_velocity.end(), glm::vec3(0.0f));
+      return;
+    }
+    // U is orthonormal, so |e_a|^2 <= sum_k |eta_k|^2; also |e_a| <= sum_k u_k |eta_k|
+    // with u_k = max_a |U[a, k]|. Below e_max by either bound nothing can exceed.
+    if (sum_x <= e_max * e_max) return;
+    if (modal) {
+      float bound = 0.0f;
+      for (std::size_t k = 0; k < n; ++k) {
+        bound += net_.mode_max_abs[k] * glm::length(st_.position[k]);
+      }
+      if (bound <= e_max) return;
+    }
+    std::span<glm::vec3> e(st_.position), v(st_.velocity);
+    if (modal) {
+      e = std::span<glm::vec3>(st_.work).subspan(0, n);
+      v = std::span<glm::vec3>(st_.work).subspan(n, n);
+      ToPoints(st_.position, e);
+      ToPoints(st_.velocity, v);
+    }
+    bool changed = false;
+    for (std::size_t a = 0; a < n; ++a) {
+      const float len = glm::length(e[a]);
+      if (len <= e_max) continue;
+      const glm::vec3 dir = e[a] / len;
+      e[a] = dir * e_max;
+      const float outward = glm::dot(v[a], dir);
+      if (outward > 0.0f) v[a] -= outward * dir;
+      ++st_.counters.displacement_clamps;
+      changed = true;
+    }
+    if (modal && changed) {
+      ToModes(e, st_.position);
+      ToModes(v, st_.velocity);
+    }
+  }
+
+  void ToPoints(std::span<const glm::vec3> modal, std::span<glm::vec3> points) const {
+    const std::size_t n = static_cast<std::size_t>(net_.num_free);
+    for (std::size_t a = 0; a < n; ++a) {
+      glm::vec3 sum(0.0f);
+      const float* row = &net_.modes[a * n];
+      for (std::size_t k = 0; k < n; ++k) sum += row[k] * modal[k];
+      points[a] = sum;
+    }
+  }
+  void ToModes(std::span<const glm::vec3> points, std::span<glm::vec3> modal) const {
+    const std::size_t n = static_cast<std::size_t>(net_.num_free);
+    std::fill(modal.begin(), modal.end(), glm::vec3(0.0f));
+    for (std::size_t a = 0; a < n; ++a) {
+      const float* row = &net_.modes[a * n];
+      for (std::size_t k = 0; k < n; ++k) modal[k] += row[k] * points[a];
+    }
+  }
+
+ private:
+  const MassSpringStepJob& job_;
+  const MassSpringNetwork& net_;
+  MassSpringState& st_;
+  const MassSpringParams& p_;
+  glm::vec3 gravity_{0.0f}, gravity_bind_{0.0f};
+  float max_accel_ = 0.0f;
+};
+
+bool UsesModes(const MassSpringNetwork& net) {
+  return net.params.force_model == SpringForceModel::kLinear &&
+         net.params.solver == MassSpringSolver::kModal;
+}
+
+}  // namespace
+
+void MassSpringState::Resize(const MassSpringNetwork& network) {
+  const std::size_t n = static_cast<std::size_t>(network.num_free);
+  position.assign(n, glm::vec3(0.0f));
+  velocity.assign(n, glm::vec3(0.0f));
+  prev_position.assign(n, glm::vec3(0.0f));
+  prev_velocity.assign(n, glm::vec3(0.0f));
+  work.assign(5 * n, glm::vec3(0.0f));
+  Reset();
+}
+
+void MassSpringState::Reset() {
+  started = false;
+  step_time_s = output_time_s = 0.0;
+  std::fill(position.begin(), position.end(), glm::vec3(0.0f));
+  std::fill(velocity.begin(), velocity.end(), glm::vec3(0.0f));
+  std::fill(prev_position.begin(), prev_position.end(), glm::vec3(0.0f));
+  std::fill(prev_velocity.begin(), prev_velocity.end(), glm::vec3(0.0f));
+}
+
+JobStatus MassSpringStepJob::Validate() const {
+  if (network == nullptr || state == nullptr) return {JobStatus::kMissingInput, "no network or state"};
+  if (kinematics.empty() && (driving == nullptr || !*driving)) {
+    return {JobStatus::kMissingInput, "no kinematics and no driving callback"};
+  }
+  const std::size_t n = static_cast<std::size_t>(network->num_free);
+  if (state->position.size() != n || state->velocity.size() != n ||
+      state->prev_position.size() != n || state->prev_velocity.size() != n ||
+      state->work.size() != 5 * n) {
+    return {JobStatus::kSizeMismatch, "state not sized for the network (call Resize)"};
+  }
+  const std::size_t num_points = static_cast<std::size_t>(network->rows * network->cols);
+  if (!displacements.empty() && displacements.size() != num_points) {
+    return {JobStatus::kSizeMismatch, "displacements must hold M*N entries"};
+  }
+  if (!kinematics.empty()) {
+    if (num_joints <= 0 || joint < 0 || joint >= num_joints || !(frame_time_s > 0.0)) {
+      return {JobStatus::kOutOfRange, "kinematics: joint, num_joints or frame_time_s"};
+    }
+    if (kinematics.size() % static_cast<std::size_t>(num_joints) != 0) {
+      return {JobStatus::kSizeMismatch, "kinematics is not a whole number of frames"};
+    }
+  }
+  if (!std::isfinite(time_s)) return {JobStatus::kOutOfRange, "time_s is not finite"};
+  return mocap::kJobOk;
+}
+
+JobStatus MassSpringStepJob::Run() const {
+  const JobStatus status = Validate();
+  if (!status) return status;
+  const MassSpringNetwork& net = *network;
+  MassSpringState& st = *state;
+  const MassSpringParams& p = net.params;
+  const double h = net.time_step_s;
+  const double eps = 1e-9;
+  if (!st.started || time_s < st.output_time_s - eps ||
+      time_s > st.output_time_s + p.max_time_gap_s) {
+    st.Reset();
+    st.started = true;
+    ++st.counters.time_resets;
+    st.step_time_s = time_s - p.preroll_s;
+  }
+  const bool modal = UsesModes(net);
+  Integrator integrator(*this);
+  if (st.step_time_s < time_s - eps) {
+    Forcing f0 = integrator.Sample(st.step_time_s);
+    while (st.step_time_s < time_s - eps) {
+      const double t = st.step_time_s;
+      const Forcing fm = integrator.Sample(t + 0.5 * h);
+      const Forcing f1 = integrator.Sample(t + h);
+      if (modal) {
+        integrator.ModalStep(h, f0, fm, f1);
+      } else {
+        integrator.PointStep(h, f0, fm, f1);
+      }
+      integrator.ApplyLimits(modal);
+      st.step_time_s = t + h;
+      ++st.counters.steps;
+      f0 = f1;
+    }
+  }
+  st.output_time_s = time_s;
+  if (displacements.empty()) return mocap::kJobOk;
+
+  // Linear interpolation between the last two steps (exact when no step was taken
+  // since a reset: both are the same zero state).
+  const std::size_t n = static_cast<std::size_t>(net.num_free);
+  const float alpha = static_cast<float>(std::clamp((time_s - (st.step_time_s - h)) / h, 0.0, 1.0));
+  std::span<glm::vec3> blended = std::span<glm::vec3>(st.work).subspan(2 * n, n);
+  for (std::size_t a = 0; a < n; ++a) {
+    blended[a] = st.prev_position[a] + alpha * (st.position[a] - st.prev_position[a]);
+  }
+  std::span<glm::vec3> points = std::span<glm::vec3>(st.work).subspan(3 * n, n);
+  if (modal) {
+    for (std::size_t a = 0; a < n; ++a) {
+      glm::vec3 sum(0.0f);
+      const float* row = &net.modes[a * n];
+      for (std::size_t k = 0; k < n; ++k) sum += row[k] * blended[k];
+      points[a] = sum;
+    }
+  } else {
+    std::copy(blended.begin(), blended.end(), points.begin());
+  }
+  std::fill(displacements.begin(), displacements.end(), glm::vec3(0.0f));
+  for (std::size_t a = 0; a < n; ++a) {
+    displacements[static_cast<std::size_t>(net.point_of_free[a])] = points[a];
+  }
+  return mocap::kJobOk;
+}
+
+namespace {
+void ToPointSpace(const MassSpringNetwork& net, std::span<const glm::vec3> in,
+                  std::span<glm::vec3> out) {
+  const std::size_t n = static_cast<std::size_t>(net.num_free);
+  if (!UsesModes(net)) {
+    std::copy(in.begin(), in.end(), out.begin());
+    return;
+  }
+  for (std::size_t a = 0; a < n; ++a) {
+    glm::vec3 sum(0.0f);
+    for (std::size_t k = 0; k < n; ++k) sum += net.modes[a * n + k] * in[k];
+    out[a] = sum;
+  }
+}
+}  // namespace
+
+void MassSpringPointDisplacements(const MassSpringNetwork& network, const MassSpringState& state,
+                                  std::span<glm::vec3> out) {
+  ToPointSpace(network, state.position, out);
+}
+
+double MassSpringEnergy(const MassSpringNetwork& network, const MassSpringState& state) {
+  const std::size_t n = static_cast<std::size_t>(network.num_free);
+  std::vector<glm::vec3> e(n), v(n);
+  ToPointSpace(network, state.position, e);
+  ToPointSpace(network, state.velocity, v);
+  double energy = 0.0;
+  for (std::size_t a = 0; a < n; ++a) {
+    energy += 0.5 * network.params.mass * glm::dot(glm::dvec3(v[a]), glm::dvec3(v[a]));
+    energy += 0.5 * network.anchor_stiffness * glm::dot(glm::dvec3(e[a]), glm::dvec3(e[a]));
+  }
+  for (const Spring& s : network.springs) {
+    const glm::dvec3 ea = s.free_a >= 0 ? glm::dvec3(e[static_cast<std::size_t>(s.free_a)]) : glm::dvec3(0.0);
+    const glm::dvec3 eb = s.free_b >= 0 ? glm::dvec3(e[static_cast<std::size_t>(s.free_b)]) : glm::dvec3(0.0);
+    energy += 0.5 * s.stiffness * glm::dot(ea - eb, ea - eb);
+  }
+  return energy;
+}
+
+}  // namespace deform
