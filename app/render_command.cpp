@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -12,6 +13,7 @@
 #include "app/frame_plan.h"
 #include "app/frame_render.h"
 #include "app/motion_source.h"
+#include "app/output_guard.h"
 #include "app/pipeline.h"
 #include "app/progress.h"
 #include "app/rig_file.h"
@@ -28,6 +30,9 @@ namespace app {
 namespace {
 
 constexpr int kMaxSheetFrames = 24;
+// Most samples per frame (width * height * supersample^2): 8K UHD at 2x2 fits;
+// beyond it the sample buffers alone would take several GiB.
+constexpr std::int64_t kMaxFrameSamples = std::int64_t{1} << 27;
 
 std::vector<std::string> SplitList(const std::string& text) {
   std::vector<std::string> out;
@@ -38,6 +43,12 @@ std::vector<std::string> SplitList(const std::string& text) {
   return out;
 }
 
+
+void AddOutputFlags(CLI::App& cmd, RenderOptions& o) {
+  cmd.add_flag("--overwrite", o.overwrite, "Replace existing frames, contact sheet and video");
+  cmd.add_flag("--resume", o.resume,
+               "Keep the frames that exist (an interrupted render), render the missing ones");
+}
 
 }  // namespace
 
@@ -70,6 +81,7 @@ CLI::App* AddRenderCommand(CLI::App& parent, RenderOptions& o) {
   cmd->add_flag("--no-sheet", o.no_sheet, "Do not write the contact sheet");
   cmd->add_flag("--no-video", o.no_video, "Do not write the preview video");
   cmd->add_flag("--quiet", o.quiet, "No progress output");
+  AddOutputFlags(*cmd, o);
   return cmd;
 }
 
@@ -91,6 +103,7 @@ CLI::App* AddTurntableCommand(CLI::App& parent, RenderOptions& o) {
   cmd->add_flag("--no-sheet", o.no_sheet, "Do not write the contact sheet");
   cmd->add_flag("--no-video", o.no_video, "Do not write the preview video");
   cmd->add_flag("--quiet", o.quiet, "No progress output");
+  AddOutputFlags(*cmd, o);
   cmd->callback([&o] { o.camera = "turntable"; });
   return cmd;
 }
@@ -134,6 +147,11 @@ int RunRender(const RenderOptions& options) {
   if (!size.ok()) return Fail(size.error());
   if (o.supersample != 1 && o.supersample != 2 && o.supersample != 4) {
     return Fail(ArgError("--supersample", "expected 1, 2 or 4, found " + std::to_string(o.supersample)));
+  }
+  if (std::int64_t{size->x} * size->y * o.supersample * o.supersample > kMaxFrameSamples) {
+    return Fail(ArgError("--size", "expected at most " + std::to_string(kMaxFrameSamples) +
+                                       " samples per frame (width x height x supersample^2), found " +
+                                       o.size + " at supersample " + std::to_string(o.supersample)));
   }
   if (o.png_compression < 0 || o.png_compression > 9) {
     return Fail(ArgError("--png-compression", "expected 0..9"));
@@ -197,6 +215,24 @@ int RunRender(const RenderOptions& options) {
   if (!render::HasFramePlaceholder(pattern)) {
     return Fail(ArgError("--out", "the pattern '" + pattern +
                                       "' needs one frame placeholder such as #### or %04d"));
+  }
+  // Existing outputs are refused (or, with --resume, skipped) before anything renders.
+  // The built-in demo replaces its own out/demo/ so the README's first command
+  // can be run again; anything else refuses to overwrite unless asked.
+  OutputGuard guard({.overwrite = o.overwrite || (demo && !o.resume), .resume = o.resume});
+  {
+    std::vector<std::string> frame_paths;
+    for (const OutputFrame& f : frames) {
+      mocap::Result<std::string> p = render::ExpandFramePattern(pattern, f.number);
+      if (!p.ok()) return Fail(p.error());
+      frame_paths.push_back(std::move(*p));
+    }
+    const std::filesystem::path dir = std::filesystem::path(frame_paths.front()).parent_path();
+    std::vector<std::string> others;
+    if (!o.no_sheet) others.push_back((dir / "contact_sheet.png").string());
+    if (!o.no_video) others.push_back((dir / "preview.mp4").string());
+    const mocap::Status planned = guard.Plan(frame_paths, others);
+    if (!planned.ok()) return Fail(planned.error());
   }
 
   // --- Pipelines ---------------------------------------------------------------
@@ -284,43 +320,72 @@ int RunRender(const RenderOptions& options) {
   Progress progress(demo ? "render demo" : "render " + name, static_cast<int>(frames.size()), o.quiet);
   render::Image image, right_image;
   int next_sheet = 0;
+  auto feed_sheet_and_video = [&](std::size_t i, int number, const render::Image& img) {
+    if (sheet && next_sheet < sheet_count &&
+        i == frames.size() * static_cast<std::size_t>(next_sheet) / static_cast<std::size_t>(sheet_count)) {
+      if (mocap::Status st = sheet->Add(img, number); !st.ok()) return st;
+      ++next_sheet;
+    }
+    if (video) return video->AddFrame(img);
+    return mocap::Status::Ok();
+  };
+  int frames_done = guard.num_skipped();
+  int last_done_number = -1;
   for (std::size_t i = 0; i < frames.size(); ++i) {
+    if (guard.interrupted()) break;
     const OutputFrame& of = frames[i];
+    // Skipped frames are still evaluated: a pipeline that carries state from
+    // frame to frame (the elastic layer) must see every frame to give a
+    // resumed range the same result.
     mocap::Status s = pipeline->Evaluate(of.time_s, frame);
     if (!s.ok()) return Fail(s.error());
+    if (right_pipeline) {
+      s = right_pipeline->Evaluate(of.time_s, right_frame);
+      if (!s.ok()) return Fail(s.error());
+    }
+    if (guard.skip(i)) {
+      // Resumed: the finished frame on disk feeds the sheet and the video.
+      if (!sheet && !video) continue;
+      const mocap::Result<std::string> done_path = render::ExpandFramePattern(pattern, of.number);
+      if (!done_path.ok()) return Fail(done_path.error());
+      mocap::Result<render::Image> done = render::ReadImage(*done_path);
+      if (!done.ok()) return Fail(done.error());
+      s = feed_sheet_and_video(i, of.number, *done);
+      if (!s.ok()) return Fail(s.error());
+      continue;
+    }
     const render::Camera camera = cameras->At(of);
     const FrameDrawOptions draw{.skeleton = overlay_skeleton,
                                 .wireframe = overlay_wire,
                                 .frame_number = of.number,
                                 .left_label = right_pipeline ? GlobalMethodName(main_method) : "",
                                 .right_label = right_pipeline ? right_label : ""};
-    if (right_pipeline) {
-      s = right_pipeline->Evaluate(of.time_s, right_frame);
-      if (!s.ok()) return Fail(s.error());
-    }
     s = DrawCharacterFrame(ch, frame, right_pipeline ? &right_frame : nullptr, camera, settings,
                            draw, renderer, right_renderer, right_image, image);
     if (!s.ok()) return Fail(s.error());
-    if (sheet && next_sheet < sheet_count &&
-        i == frames.size() * static_cast<std::size_t>(next_sheet) / static_cast<std::size_t>(sheet_count)) {
-      s = sheet->Add(image, of.number);
-      if (!s.ok()) return Fail(s.error());
-      ++next_sheet;
-    }
-    if (video) {
-      s = video->AddFrame(image);
-      if (!s.ok()) return Fail(s.error());
-    }
+    s = feed_sheet_and_video(i, of.number, image);
+    if (!s.ok()) return Fail(s.error());
     const mocap::Result<std::string> path = render::ExpandFramePattern(pattern, of.number);
     if (!path.ok()) return Fail(path.error());
     write_options.frame = of.number;
     s = writer.Submit(image, *path, write_options);
     if (!s.ok()) return Fail(s.error());
+    ++frames_done;
+    last_done_number = of.number;
     progress.Step(of.number);
   }
+  // Every frame handed to the writer is finished (so none is left half-written).
   mocap::Status s = writer.Finish();
   if (!s.ok()) return Fail(s.error());
   progress.Finish();
+  if (guard.interrupted()) {
+    // The sheet and the video would be partial: the video writer's destructor
+    // removes its temporary file; --resume rebuilds both.
+    std::fprintf(stderr, "%s: %s\n", pattern.c_str(),
+                 guard.StopMessage(last_done_number, frames_done, static_cast<int>(frames.size()))
+                     .c_str());
+    return guard.exit_code();
+  }
   std::printf("frames:        %s (%zu)\n", pattern.c_str(), frames.size());
   if (sheet) {
     const std::string sheet_path = (out_dir / "contact_sheet.png").string();

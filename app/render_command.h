@@ -30,12 +30,17 @@ struct RenderOptions {
   bool no_sheet = false;
   bool no_video = false;
   bool quiet = false;
+  bool overwrite = false;             // replace existing outputs (else refuse before rendering)
+  bool resume = false;                // keep existing frames, render the missing ones
 };
 
 CLI::App* AddRenderCommand(CLI::App& parent, RenderOptions& options);
 CLI::App* AddTurntableCommand(CLI::App& parent, RenderOptions& options);
 
-// Runs a render. Exit code: 0 ok, 2 bad input, 3 internal error.
+// Runs a render. Exit code: 0 ok, 2 bad input (also: outputs exist without
+// --overwrite / --resume), 3 internal error, 128 + signal when SIGINT or
+// SIGTERM stopped it (the frames written so far are complete; see
+// app/output_guard.h).
 int RunRender(const RenderOptions& options);
 
 }  // namespace app

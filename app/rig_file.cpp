@@ -8,6 +8,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "app/output_guard.h"
+
 namespace app {
 namespace {
 
@@ -278,6 +280,10 @@ std::optional<mocap::Error> ParseRender(const Ctx& c, const json& v, RigRender& 
   }
   if (v.contains("output")) {
     if (auto e = GetString(c, v["output"], "render.output", r.output)) return e;
+    // A pattern from a file may not leave the rig's folder (no "..", not absolute).
+    const mocap::Status confined =
+        CheckRigOutputPattern(r.output, {c.file, 0, 0, "render.output"});
+    if (!confined.ok()) return confined.error();
     r.output = Resolve(c.file, r.output);
   }
   if (v.contains("frames")) {

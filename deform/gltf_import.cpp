@@ -699,7 +699,17 @@ Result<GltfModel> ConvertGltf(const tinygltf::Model& model, const std::string& p
 Result<GltfModel> ReadGltf(const std::string& path, const GltfReadOptions& options) {
   auto bytes = ReadFileBounded(path, options.max_file_bytes);
   if (!bytes.ok()) return std::move(bytes).error();
-  const std::vector<unsigned char>& data = bytes.value();
+  return ReadGltfFromMemory(bytes.value(), path, options);
+}
+
+Result<GltfModel> ReadGltfFromMemory(std::span<const unsigned char> bytes, const std::string& path,
+                                     const GltfReadOptions& options) {
+  if (bytes.size() > options.max_file_bytes) {
+    return mocap::MakeError(ErrorCode::kLimitExceeded, mocap::FileLoc{path, 0, 0, {}},
+                            "file has " + std::to_string(bytes.size()) +
+                                " bytes, more than the limit of " + std::to_string(options.max_file_bytes));
+  }
+  const std::vector<unsigned char> data(bytes.begin(), bytes.end());
   const bool is_glb = data.size() >= 4 && std::memcmp(data.data(), "glTF", 4) == 0;
   std::string json_text;
   if (is_glb) {

@@ -104,6 +104,15 @@ struct GltfReadOptions {
 // "walk.gltf: accessors[3].count: error: ...". Never throws.
 mocap::Result<GltfModel> ReadGltf(const std::string& path, const GltfReadOptions& options = {});
 
+// ReadGltf on the bytes of a .gltf or .glb already in memory (the fuzz target,
+// embedders). `path` labels messages and decides the folder that external
+// buffers are read from (its parent; "." when it has none), under the same
+// confinement rules; a path whose folder does not exist makes every external
+// URI a read error, so only data: URIs and the GLB chunk load. Never throws.
+mocap::Result<GltfModel> ReadGltfFromMemory(std::span<const unsigned char> bytes,
+                                            const std::string& path,
+                                            const GltfReadOptions& options = {});
+
 // Exact evaluation of animation `animation` at time t_s into local transforms:
 // rest TRS for joints and properties the animation does not drive; before the
 // first key the first value, after the last key the last value. LINEAR lerps

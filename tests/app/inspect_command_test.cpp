@@ -35,7 +35,7 @@ struct RefBvh {
 // Whitespace tokens; enough for well-formed files (the real reader's own tests
 // cover the dialects). Joint names are single tokens in the files used here.
 RefBvh ReadReference(const fs::path& path) {
-  std::istringstream in(testsupport::ReadWholeFile(path));
+  std::istringstream in(testsupport::SlurpFile(path));
   RefBvh bvh;
   std::vector<int> stack;
   int channels = 0;
@@ -151,7 +151,7 @@ TEST_P(InspectAgainstReference, WorldPositionsMatch) {
   for (int frame : {0, static_cast<int>(ref.frames.size()) / 2,
                     static_cast<int>(ref.frames.size()) - 1}) {
     const testsupport::ProcessResult r = testsupport::RunPatchskin(
-        "inspect --json --frame " + std::to_string(frame) + " '" + file.string() + "'", scratch);
+        {"inspect", "--json", "--frame", std::to_string(frame), file.string()}, scratch);
     ASSERT_EQ(r.exit_code, 0) << r.err;
     const nlohmann::json doc = nlohmann::json::parse(r.out);
     EXPECT_EQ(doc["frames"].get<int>(), static_cast<int>(ref.frames.size()));
@@ -182,7 +182,7 @@ TEST(InspectCommand, TextListsTimingAndUnits) {
   const fs::path file = testsupport::SharedDataPath("bvh/bandai_namco/dataset-2_run_active_034.bvh");
   PATCHSKIN_REQUIRE_SHARED_FILE(file);
   const testsupport::ProcessResult r = testsupport::RunPatchskin(
-      "inspect '" + file.string() + "'", testsupport::TestOutputPath("inspect/text/x").parent_path());
+      {"inspect", file.string()}, testsupport::TestOutputPath("inspect/text/x").parent_path());
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("frames:      75"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("(30 fps)"), std::string::npos) << r.out;
@@ -198,15 +198,15 @@ TEST(InspectCommand, BadInputExitsTwoNamingTheFile) {
     out << "HIERARCHY\nROOT Hips\n{\n  OFFSET 0 0 0\n  CHANNELS 3 Xposition Yposition Zposition\n}\n"
            "MOTION\nFrames: 2\nFrame Time: 0.1\n1 2 3\n4 5\n";
   }
-  const testsupport::ProcessResult r = testsupport::RunPatchskin("inspect '" + bad.string() + "'", scratch);
+  const testsupport::ProcessResult r = testsupport::RunPatchskin({"inspect", bad.string()}, scratch);
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_EQ(r.err.rfind(bad.string() + ":11:4: error: expected 3 values in frame 2, found 2", 0), 0u)
       << r.err;
-  const testsupport::ProcessResult dir = testsupport::RunPatchskin("inspect '" + scratch.string() + "'", scratch);
+  const testsupport::ProcessResult dir = testsupport::RunPatchskin({"inspect", scratch.string()}, scratch);
   EXPECT_EQ(dir.exit_code, 2);
   EXPECT_NE(dir.err.find("found a directory"), std::string::npos) << dir.err;
   const testsupport::ProcessResult frame = testsupport::RunPatchskin(
-      "inspect --frame 9 '" + (scratch / "missing.bvh").string() + "'", scratch);
+      {"inspect", "--frame", "9", (scratch / "missing.bvh").string()}, scratch);
   EXPECT_EQ(frame.exit_code, 2);
 }
 

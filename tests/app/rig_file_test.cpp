@@ -151,6 +151,12 @@ const BadRig kBadRigs[] = {
      "\"bones\""},
     {R"({"character": "mannequin", "motion": {"file": "m.bvh"}, "render": {"split": 1}})",
      "r.json: render.split: error: expected true or false, found 1"},
+    {R"({"character": "mannequin", "motion": {"file": "m.bvh"}, "render": {"output": "../x_####.png"}})",
+     "r.json: render.output: error: expected a relative path inside the rig's output folder, "
+     "found '../x_####.png' (a '..' component)"},
+    {R"({"character": "mannequin", "motion": {"file": "m.bvh"}, "render": {"output": "/tmp/x_####.png"}})",
+     "r.json: render.output: error: expected a relative path inside the rig's output folder, "
+     "found '/tmp/x_####.png' (an absolute path)"},
 };
 
 TEST(RigFile, BadRigsGiveExactMessages) {

@@ -183,7 +183,7 @@ TEST(WriteImage, SameImageGivesSameBytesAcrossTime) {
     ASSERT_TRUE(WriteImage(src, a));
     std::this_thread::sleep_for(std::chrono::milliseconds(1100));
     ASSERT_TRUE(WriteImage(src, b));
-    EXPECT_EQ(testsupport::ReadWholeFile(a), testsupport::ReadWholeFile(b)) << ext;
+    EXPECT_EQ(testsupport::SlurpFile(a), testsupport::SlurpFile(b)) << ext;
   }
 }
 

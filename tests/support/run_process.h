@@ -1,43 +1,83 @@
 #pragma once
-// Runs the built `patchskin` command (PATCHSKIN_BINARY) as a child process and
-// captures its exit code, stdout and stderr, for tests of the command line.
+// Runs the built `patchskin` (PATCHSKIN_BINARY) as a child process for the app
+// tests: arguments passed as a vector (no shell quoting), stdout and stderr
+// captured into files, exit code returned. StartPatchskin leaves it running so
+// a test can signal it.
 
+#include <fcntl.h>
+#include <signal.h>
+#include <spawn.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <string>
+#include <vector>
+
+extern char** environ;
 
 namespace testsupport {
 
 struct ProcessResult {
-  int exit_code = -1;  // -1 when the process did not exit normally
+  int exit_code = -1;  // the child's exit status; -1 when a signal ended it
+  int term_signal = 0; // the signal that ended it, or 0
   std::string out;
   std::string err;
+
+  // The first line of stderr (without the newline).
+  std::string FirstErrLine() const { return err.substr(0, err.find('\n')); }
 };
 
-inline std::string ReadWholeFile(const std::filesystem::path& p) {
+inline std::string SlurpFile(const std::filesystem::path& p) {
   std::ifstream in(p, std::ios::binary);
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
-// `args` is appended to the command line as is (quote paths yourself); stdout
-// and stderr are captured through files in `scratch_dir`.
-inline ProcessResult RunPatchskin(const std::string& args,
-                                  const std::filesystem::path& scratch_dir) {
-  std::filesystem::create_directories(scratch_dir);
-  const std::filesystem::path out = scratch_dir / "stdout.txt";
-  const std::filesystem::path err = scratch_dir / "stderr.txt";
-  const std::string cmd = std::string("'") + PATCHSKIN_BINARY + "' " + args + " >'" +
-                          out.string() + "' 2>'" + err.string() + "'";
-  const int status = std::system(cmd.c_str());
+// A started child: its pid and where its output goes.
+struct RunningProcess {
+  pid_t pid = -1;
+  std::filesystem::path out, err;
+};
+
+// Starts PATCHSKIN_BINARY with `args`, stdout/stderr to `log_dir`/{stdout,stderr}.txt.
+inline RunningProcess StartPatchskin(const std::vector<std::string>& args,
+                                     const std::filesystem::path& log_dir) {
+  RunningProcess p;
+  std::filesystem::create_directories(log_dir);
+  p.out = log_dir / "stdout.txt";
+  p.err = log_dir / "stderr.txt";
+  std::vector<std::string> all{PATCHSKIN_BINARY};
+  all.insert(all.end(), args.begin(), args.end());
+  std::vector<char*> argv;
+  for (std::string& a : all) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
+  posix_spawn_file_actions_addopen(&actions, 1, p.out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_addopen(&actions, 2, p.err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  if (posix_spawn(&p.pid, argv[0], &actions, nullptr, argv.data(), environ) != 0) p.pid = -1;
+  posix_spawn_file_actions_destroy(&actions);
+  return p;
+}
+
+inline ProcessResult WaitFor(const RunningProcess& p) {
   ProcessResult r;
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  r.out = ReadWholeFile(out);
-  r.err = ReadWholeFile(err);
+  if (p.pid <= 0) return r;
+  int status = 0;
+  waitpid(p.pid, &status, 0);
+  if (WIFEXITED(status)) r.exit_code = WEXITSTATUS(status);
+  if (WIFSIGNALED(status)) r.term_signal = WTERMSIG(status);
+  r.out = SlurpFile(p.out);
+  r.err = SlurpFile(p.err);
   return r;
+}
+
+inline ProcessResult RunPatchskin(const std::vector<std::string>& args,
+                                  const std::filesystem::path& log_dir) {
+  return WaitFor(StartPatchskin(args, log_dir));
 }
 
 }  // namespace testsupport
