@@ -217,9 +217,7 @@ int RunRender(const RenderOptions& options) {
                                       "' needs one frame placeholder such as #### or %04d"));
   }
   // Existing outputs are refused (or, with --resume, skipped) before anything renders.
-  // The built-in demo replaces its own out/demo/ so the README's first command
-  // can be run again; anything else refuses to overwrite unless asked.
-  OutputGuard guard({.overwrite = o.overwrite || (demo && !o.resume), .resume = o.resume});
+  OutputGuard guard({.overwrite = o.overwrite, .resume = o.resume});
   {
     std::vector<std::string> frame_paths;
     for (const OutputFrame& f : frames) {

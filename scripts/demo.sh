@@ -8,6 +8,7 @@ cmake -S "$root" -B "$root/build/demo" -DCMAKE_BUILD_TYPE=Release -DPATCHSKIN_BU
   -DPATCHSKIN_BUILD_SAMPLES=OFF >/dev/null
 cmake --build "$root/build/demo" --target patchskin -j 2
 # No arguments: the built-in demo (a walk on the mannequin) to out/demo/ under
-# the current directory. Any arguments are passed to patchskin instead.
-if [ $# -eq 0 ]; then set -- render; fi
+# the current directory, replacing an earlier run's frames so the command can
+# be repeated. Any arguments are passed to patchskin instead.
+if [ $# -eq 0 ]; then set -- render --overwrite; fi
 "$root/build/demo/app/patchskin" "$@"
