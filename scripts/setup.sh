@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Installs every Debian package patchskin needs to build, test and benchmark.
-# Skips apt entirely when all of them are already present.
+# Installs every Debian package patchskin needs to build, test and benchmark,
+# plus any package names given as arguments (scripts/setup_fuzz.sh adds the
+# fuzzing toolchain that way). Skips apt entirely when all are present.
 set -euo pipefail
 
 packages=(
@@ -13,6 +14,7 @@ packages=(
   libcli11-dev
   libfast-float-dev
   libassimp-dev
+  "$@"
 )
 
 missing=()
