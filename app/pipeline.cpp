@@ -50,6 +50,22 @@ std::span<const T> Sub(const std::vector<T>& v, int begin, int end, int stride =
                                        static_cast<std::size_t>((end - begin) * stride));
 }
 
+// Sets the fields SkinningJob and DqsJob share to vertices [begin, end) of
+// `mesh` and `out` (normals only when the mesh has them).
+template <typename Job>
+Job WithVertexRange(Job job, const deform::SkinnedMesh& mesh, int begin, int end,
+                    DeformedFrame& out) {
+  const int k = mesh.weights.influences;
+  job.influences = k;
+  job.joint_indices = Sub(mesh.weights.joints, begin, end, k);
+  job.joint_weights = Sub(mesh.weights.weights, begin, end, k);
+  job.rest_positions = Sub(mesh.bind.positions, begin, end);
+  if (!mesh.bind.normals.empty()) job.rest_normals = Sub(mesh.bind.normals, begin, end);
+  job.positions = Sub(out.positions, begin, end);
+  job.normals = Sub(out.normals, begin, end);
+  return job;
+}
+
 mocap::Error JobError(const Character& c, const mocap::JobStatus& s, const char* stage) {
   return mocap::MakeError(mocap::ErrorCode::kInternal, {c.source, 0, 0, {}},
                           std::string(stage) + " refused to run: " + s.what);
@@ -224,7 +240,6 @@ mocap::Status FramePipeline::Evaluate(double time_s, DeformedFrame& out) {
   const int nv = mesh.bind.num_vertices();
   out.positions.resize(static_cast<std::size_t>(nv));
   out.normals.resize(static_cast<std::size_t>(nv));
-  const int k = mesh.weights.influences;
   const bool has_normals = !mesh.bind.normals.empty();
   if (m.method == GlobalMethod::kDqs) {
     s = deform::BuildDualQuatPalette(m.palette, m.dq_palette);
@@ -246,27 +261,13 @@ mocap::Status FramePipeline::Evaluate(double time_s, DeformedFrame& out) {
                                                    : std::span<glm::vec3>()}
               .Run();
     } else if (m.method == GlobalMethod::kDqs) {
-      r = deform::DqsJob{.palette = m.dq_palette,
-                         .influences = k,
-                         .joint_indices = Sub(mesh.weights.joints, begin, end, k),
-                         .joint_weights = Sub(mesh.weights.weights, begin, end, k),
-                         .rest_positions = Sub(mesh.bind.positions, begin, end),
-                         .rest_normals = has_normals ? Sub(mesh.bind.normals, begin, end)
-                                                     : std::span<const glm::vec3>(),
-                         .positions = Sub(out.positions, begin, end),
-                         .normals = Sub(out.normals, begin, end)}
-              .Run();
+      deform::DqsJob job;
+      job.palette = m.dq_palette;
+      r = WithVertexRange(job, mesh, begin, end, out).Run();
     } else {
-      r = deform::SkinningJob{.model_from_bind = m.palette,
-                              .influences = k,
-                              .joint_indices = Sub(mesh.weights.joints, begin, end, k),
-                              .joint_weights = Sub(mesh.weights.weights, begin, end, k),
-                              .rest_positions = Sub(mesh.bind.positions, begin, end),
-                              .rest_normals = has_normals ? Sub(mesh.bind.normals, begin, end)
-                                                          : std::span<const glm::vec3>(),
-                              .positions = Sub(out.positions, begin, end),
-                              .normals = Sub(out.normals, begin, end)}
-              .Run();
+      deform::SkinningJob job;
+      job.model_from_bind = m.palette;
+      r = WithVertexRange(job, mesh, begin, end, out).Run();
     }
     results[static_cast<std::size_t>(chunk)] = r;
   });
