@@ -220,6 +220,8 @@ CLI::App* AddInspectCommand(CLI::App& parent, InspectOptions& options) {
   cmd->add_flag("--y-up", options.y_up, "Rotate a Z-up capture to Y-up");
   cmd->add_flag("--add-position-to-offset", options.add_position_to_offset,
                 "BVH position channels add to OFFSET (three.js) instead of replacing it");
+  cmd->add_flag("--allow-short", options.allow_short,
+                "BVH with fewer frames than 'Frames:' declares: load those present (with a warning)");
   return cmd;
 }
 
@@ -228,6 +230,7 @@ int RunInspect(const InspectOptions& options) {
   load.scale = options.scale;
   load.y_up = options.y_up;
   load.add_position_to_offset = options.add_position_to_offset;
+  load.allow_short_motion = options.allow_short;
   mocap::Result<MotionSource> src = LoadMotionSource(options.file, load);
   if (!src.ok()) {
     std::fprintf(stderr, "%s\n", src.error().ToString().c_str());

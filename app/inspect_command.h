@@ -22,6 +22,7 @@ struct InspectOptions {
   float scale = 1.0f;             // 0 = automatic (detected units to metres)
   bool y_up = false;              // rotate a Z-up file to Y-up
   bool add_position_to_offset = false;
+  bool allow_short = false;       // load the complete frames of a file with fewer than declared
 };
 
 // Registers the subcommand and its options; the callback stores into `options`.

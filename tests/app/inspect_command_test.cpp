@@ -202,6 +202,21 @@ TEST(InspectCommand, BadInputExitsTwoNamingTheFile) {
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_EQ(r.err.rfind(bad.string() + ":11:4: error: expected 3 values in frame 2, found 2", 0), 0u)
       << r.err;
+  // Fewer data lines than declared: an error naming both counts, or with
+  // --allow-short the frames present and a warning.
+  const fs::path fewer = scratch / "fewer.bvh";
+  {
+    std::ofstream out(fewer);
+    out << "HIERARCHY\nROOT Hips\n{\n  OFFSET 0 0 0\n  CHANNELS 3 Xposition Yposition Zposition\n}\n"
+           "MOTION\nFrames: 3\nFrame Time: 0.1\n1 2 3\n4 5 6\n";
+  }
+  const testsupport::ProcessResult strict = testsupport::RunPatchskin({"inspect", fewer.string()}, scratch);
+  EXPECT_EQ(strict.exit_code, 2);
+  const testsupport::ProcessResult shortened =
+      testsupport::RunPatchskin({"inspect", "--allow-short", fewer.string()}, scratch);
+  EXPECT_EQ(shortened.exit_code, 0) << shortened.err;
+  EXPECT_NE(shortened.out.find("frames:      2\n"), std::string::npos) << shortened.out;
+  EXPECT_NE(shortened.err.find("warning"), std::string::npos) << shortened.err;
   const testsupport::ProcessResult dir = testsupport::RunPatchskin({"inspect", scratch.string()}, scratch);
   EXPECT_EQ(dir.exit_code, 2);
   EXPECT_NE(dir.err.find("found a directory"), std::string::npos) << dir.err;
