@@ -6,6 +6,7 @@
 #include <random>
 
 #include "deform/patch_fit.h"
+#include "support/bound_tube.h"
 #include "support/patch_meshes.h"
 #include "support/tolerances.h"
 
@@ -243,24 +244,10 @@ TEST(DirectManipulation, RejectsBadInput) {
 // Binds a tube (the fixture of patch_binding_test) to a 9 x 10 patch, edits
 // vertices and rebuilds them with the per-frame job.
 TEST(DirectManipulation, VertexEditMovesRebuiltVertexByTheRequestedVector) {
-  const deform::Mesh tube = testsupport::MakeTube(40, 30, 2.0f, 180.0f, 5.0f);
-  const std::vector<int> region = testsupport::AllVertices(tube);
-  auto param = deform::ParametrizeCylinder(tube.positions, region, tube.triangles, glm::dvec3(0.0),
-                                           glm::dvec3(0, 0, 1));
-  ASSERT_TRUE(param.ok());
-  auto samples = deform::SampleRegion(tube.positions, tube.triangles, *param,
-                                      deform::UniformParameters(18), deform::UniformParameters(20));
-  ASSERT_TRUE(samples.ok());
-  auto fit = deform::FitSurface(*samples, {.num_u = 9, .num_v = 10});
-  ASSERT_TRUE(fit.ok());
-  deform::OrientNormal(fit->surface, *param);
-  const BSplineSurface& surface = fit->surface;
-  // Push the tube's outside by a known offset so d != 0 and the normal matters.
-  std::vector<glm::vec3> skin = tube.positions;
-  for (glm::vec3& p : skin) p += 0.1f * glm::normalize(glm::vec3(p.x, p.y, 0.0f));
-  auto bound = deform::BindPatch(surface, skin, region, param->uv);
-  ASSERT_TRUE(bound.ok());
-  const deform::PatchBinding& b = bound->binding;
+  const std::optional<testsupport::BoundTube> fixture = testsupport::MakeBoundTube();
+  ASSERT_TRUE(fixture.has_value());
+  const BSplineSurface& surface = fixture->surface;
+  const deform::PatchBinding& b = fixture->binding;
 
   auto rebuild = [&](const BSplineSurface& s) {
     const std::vector<glm::vec3> control = deform::ControlPointsAsFloat(s);

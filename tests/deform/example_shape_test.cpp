@@ -7,6 +7,7 @@
 #include "deform/patch_fit.h"
 #include "deform/pose_space.h"
 #include "mocap/joint_angles.h"
+#include "support/bound_tube.h"
 #include "support/patch_meshes.h"
 #include "support/tolerances.h"
 
@@ -16,23 +17,10 @@ using deform::BSplineSurface;
 
 TEST(ExampleShape, VertexEditAtExamplePoseReappearsThroughTheRbf) {
   // A tube patch bound to an offset skin (d != 0), 9 x 10 control points.
-  const deform::Mesh tube = testsupport::MakeTube(40, 30, 2.0f, 180.0f, 5.0f);
-  const std::vector<int> region = testsupport::AllVertices(tube);
-  auto param = deform::ParametrizeCylinder(tube.positions, region, tube.triangles, glm::dvec3(0.0),
-                                           glm::dvec3(0, 0, 1));
-  ASSERT_TRUE(param.ok());
-  auto samples = deform::SampleRegion(tube.positions, tube.triangles, *param,
-                                      deform::UniformParameters(18), deform::UniformParameters(20));
-  ASSERT_TRUE(samples.ok());
-  auto fit = deform::FitSurface(*samples, {.num_u = 9, .num_v = 10});
-  ASSERT_TRUE(fit.ok());
-  deform::OrientNormal(fit->surface, *param);
-  const BSplineSurface& rest = fit->surface;
-  std::vector<glm::vec3> skin = tube.positions;
-  for (glm::vec3& p : skin) p += 0.1f * glm::normalize(glm::vec3(p.x, p.y, 0.0f));
-  auto bound = deform::BindPatch(rest, skin, region, param->uv);
-  ASSERT_TRUE(bound.ok());
-  const deform::PatchBinding& b = bound->binding;
+  const std::optional<testsupport::BoundTube> fixture = testsupport::MakeBoundTube();
+  ASSERT_TRUE(fixture.has_value());
+  const BSplineSurface& rest = fixture->surface;
+  const deform::PatchBinding& b = fixture->binding;
   const size_t count = rest.control().size();
 
   // The example pose: one joint turns the whole patch rigidly (the global
