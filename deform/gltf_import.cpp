@@ -20,6 +20,8 @@
 #include "deform/internal/gltf_accessor.h"
 #include "deform/internal/gltf_build.h"
 #include "deform/internal/gltf_files.h"
+#include "deform/internal/gltf_morph.h"
+#include "deform/internal/gltf_view.h"
 
 namespace deform {
 namespace {
@@ -97,26 +99,9 @@ std::string FirstLines(const std::string& text) {
 }
 
 // ---------------------------------------------------------------------------
-// Accessors.
+// Accessors (checked in internal/gltf_view.cpp).
 
-const char* TypeName(int type) {
-  switch (type) {
-    case TINYGLTF_TYPE_SCALAR:
-      return "SCALAR";
-    case TINYGLTF_TYPE_VEC2:
-      return "VEC2";
-    case TINYGLTF_TYPE_VEC3:
-      return "VEC3";
-    case TINYGLTF_TYPE_VEC4:
-      return "VEC4";
-    case TINYGLTF_TYPE_MAT4:
-      return "MAT4";
-    default:
-      return "other";
-  }
-}
-
-std::string Indexed(const char* array, int i) { return std::string(array) + "[" + std::to_string(i) + "]"; }
+using internal::Indexed;
 
 class Converter {
  public:
@@ -129,65 +114,7 @@ class Converter {
   // `user` names the field holding the index, e.g. "skins[0].inverseBindMatrices".
   Result<AccessorView> View(int index, const std::string& user, int type,
                             std::initializer_list<int> component_types) const {
-    if (index < 0 || index >= static_cast<int>(m_.accessors.size())) {
-      return Fail(ErrorCode::kNotFound, user,
-                  "accessor index " + std::to_string(index) + " out of range (" +
-                      std::to_string(m_.accessors.size()) + " accessors)");
-    }
-    const tinygltf::Accessor& a = m_.accessors[static_cast<std::size_t>(index)];
-    const std::string at = Indexed("accessors", index);
-    if (a.sparse.isSparse)
-      return Fail(ErrorCode::kUnsupported, at + ".sparse", "sparse accessors are not supported");
-    if (a.type != type) {
-      return Fail(ErrorCode::kUnsupported, at + ".type",
-                  std::string("expected ") + TypeName(type) + " for " + user + ", found " + TypeName(a.type));
-    }
-    if (std::find(component_types.begin(), component_types.end(), a.componentType) == component_types.end()) {
-      return Fail(ErrorCode::kUnsupported, at + ".componentType",
-                  "component type " + std::to_string(a.componentType) + " not allowed for " + user);
-    }
-    if (a.bufferView < 0 || a.bufferView >= static_cast<int>(m_.bufferViews.size())) {
-      return Fail(ErrorCode::kNotFound, at + ".bufferView",
-                  "buffer view " + std::to_string(a.bufferView) + " out of range");
-    }
-    const tinygltf::BufferView& bv = m_.bufferViews[static_cast<std::size_t>(a.bufferView)];
-    const std::string bv_at = Indexed("bufferViews", a.bufferView);
-    if (bv.buffer < 0 || bv.buffer >= static_cast<int>(m_.buffers.size())) {
-      return Fail(ErrorCode::kNotFound, bv_at + ".buffer",
-                  "buffer " + std::to_string(bv.buffer) + " out of range");
-    }
-    const std::vector<unsigned char>& buffer = m_.buffers[static_cast<std::size_t>(bv.buffer)].data;
-    if (bv.byteOffset > buffer.size() || bv.byteLength > buffer.size() - bv.byteOffset) {
-      return Fail(ErrorCode::kCountMismatch, bv_at + ".byteLength",
-                  "view of " + std::to_string(bv.byteLength) + " bytes at offset " +
-                      std::to_string(bv.byteOffset) + " runs past the " + std::to_string(buffer.size()) +
-                      " bytes of its buffer");
-    }
-    const int components = tinygltf::GetNumComponentsInType(static_cast<std::uint32_t>(a.type));
-    const std::size_t element = static_cast<std::size_t>(components * ComponentBytes(a.componentType));
-    const std::size_t stride = bv.byteStride == 0 ? element : bv.byteStride;
-    if (stride < element || stride > 252) {
-      return Fail(ErrorCode::kCountMismatch, bv_at + ".byteStride",
-                  "stride " + std::to_string(stride) + " must be in " + std::to_string(element) + "..252");
-    }
-    const std::size_t available = bv.byteLength;
-    const bool fits = a.byteOffset <= available &&
-                      (a.count == 0 || (a.count - 1 <= available / stride &&
-                                        (a.count - 1) * stride + element <= available - a.byteOffset));
-    if (!fits) {
-      return Fail(ErrorCode::kCountMismatch, at + ".count",
-                  std::to_string(a.count) + " elements of " + std::to_string(element) + " bytes at offset " +
-                      std::to_string(a.byteOffset) + " do not fit in the " + std::to_string(available) +
-                      " bytes of " + bv_at);
-    }
-    AccessorView v;
-    v.index = index;
-    v.data = buffer.data() + bv.byteOffset + a.byteOffset;
-    v.stride = stride;
-    v.count = a.count;
-    v.components = components;
-    v.component_type = a.componentType;
-    return v;
+    return internal::CheckedView(m_, path_, index, user, type, component_types);
   }
 
   Result<std::vector<float>> Floats(const AccessorView& v, bool normalize) const {
@@ -205,7 +132,8 @@ class Converter {
   mocap::Status ReadSkin(int skin);
   mocap::Status ReadMeshes(int skin);
   Result<glm::mat4> RestWorld(int node) const;
-  mocap::Status ReadPrimitive(int mesh, int prim, int skin, bool& computed_normals);
+  mocap::Status ReadPrimitive(int mesh, int prim, int skin, int rigid_slot, bool& computed_normals);
+  mocap::Status MergeMorphTargets(std::size_t num_vertices);
   mocap::Status ReadAnimations();
   void Warn(std::string field, std::string message) {
     out_.warnings.push_back({{path_, 0, 0, std::move(field)}, std::move(message)});
@@ -217,6 +145,10 @@ class Converter {
   std::vector<int> parent_;      // node -> parent node or -1
   std::vector<int> node_joint_;  // node -> skeleton joint or -1
   std::vector<int> joint_node_;  // skeleton joint -> node
+  // No skin (GltfReadOptions::require_skin false): the mesh nodes, each a
+  // "skin joint" its vertices are rigidly attached to.
+  std::vector<int> rigid_nodes_;
+  GltfReadOptions options_;
   // Per primitive before merging, so weights can be widened to 8 later.
   struct Part {
     std::vector<glm::vec3> positions, normals;
@@ -224,8 +156,12 @@ class Converter {
     std::vector<std::uint32_t> joints;  // #V x influences
     std::vector<float> weights;         // #V x influences
     int influences = 4;
+    int mesh = -1;                      // the glTF mesh it came from
+    internal::PrimitiveTargets targets;
   };
   std::vector<Part> parts_;
+  std::vector<int> mesh_first_target_;  // glTF mesh -> its first row in out_.morph, or -1
+  std::vector<int> mesh_num_targets_;   // glTF mesh -> its target count, -1 when not imported
 };
 
 // Rest TRS of a node; a matrix is decomposed (shear dropped with a warning).
@@ -276,10 +212,21 @@ mocap::Status Converter::BuildSkeleton(int skin) {
     }
   }
   parent_ = parent;
-  const tinygltf::Skin& s = m_.skins[static_cast<std::size_t>(skin)];
+  // The nodes the skeleton must reach: the skin's joints, or (no skin) the mesh nodes.
+  std::vector<int> leaves;
+  if (skin >= 0) {
+    leaves = m_.skins[static_cast<std::size_t>(skin)].joints;
+  } else {
+    for (int n = 0; n < num_nodes; ++n) {
+      const tinygltf::Node& node = m_.nodes[static_cast<std::size_t>(n)];
+      if (node.mesh >= 0 && node.skin < 0) rigid_nodes_.push_back(n);
+    }
+    if (rigid_nodes_.empty()) return Fail(ErrorCode::kNotFound, "nodes", "no node holds a mesh");
+    leaves = rigid_nodes_;
+  }
   std::vector<char> needed(static_cast<std::size_t>(num_nodes), 0);
-  for (std::size_t k = 0; k < s.joints.size(); ++k) {
-    int n = s.joints[k];
+  for (std::size_t k = 0; k < leaves.size(); ++k) {
+    int n = leaves[k];
     if (n < 0 || n >= num_nodes) {
       return Fail(ErrorCode::kNotFound, Indexed("skins", skin) + ".joints[" + std::to_string(k) + "]",
                   "node " + std::to_string(n) + " out of range");
@@ -325,11 +272,15 @@ mocap::Status Converter::BuildSkeleton(int skin) {
   }
   sk.info.source_file = path_;
   sk.info.detected_units = "m";
-  for (int j : s.joints) out_.mesh.skin_joints.push_back(node_joint_[static_cast<std::size_t>(j)]);
+  for (int j : leaves) out_.mesh.skin_joints.push_back(node_joint_[static_cast<std::size_t>(j)]);
   return mocap::Status::Ok();
 }
 
 mocap::Status Converter::ReadSkin(int skin) {
+  if (skin < 0) {  // rigid attachment: bind space is each mesh's own space
+    out_.mesh.joint_from_bind.assign(rigid_nodes_.size(), glm::mat4(1.0f));
+    return mocap::Status::Ok();
+  }
   const tinygltf::Skin& s = m_.skins[static_cast<std::size_t>(skin)];
   const std::size_t n = s.joints.size();
   out_.mesh.joint_from_bind.assign(n, glm::mat4(1.0f));
@@ -351,7 +302,8 @@ mocap::Status Converter::ReadSkin(int skin) {
   return mocap::Status::Ok();
 }
 
-mocap::Status Converter::ReadPrimitive(int mesh, int prim, int skin, bool& computed_normals) {
+mocap::Status Converter::ReadPrimitive(int mesh, int prim, int skin, int rigid_slot,
+                                       bool& computed_normals) {
   const tinygltf::Primitive& p =
       m_.meshes[static_cast<std::size_t>(mesh)].primitives[static_cast<std::size_t>(prim)];
   const std::string at = Indexed("meshes", mesh) + ".primitives[" + std::to_string(prim) + "]";
@@ -359,7 +311,6 @@ mocap::Status Converter::ReadPrimitive(int mesh, int prim, int skin, bool& compu
     Warn(at + ".mode", "only triangle lists are imported; primitive skipped");
     return mocap::Status::Ok();
   }
-  if (!p.targets.empty()) Warn(at + ".targets", "morph targets are ignored");
   auto attribute = [&](const char* name) {
     const auto it = p.attributes.find(name);
     return it == p.attributes.end() ? -1 : it->second;
@@ -393,11 +344,23 @@ mocap::Status Converter::ReadPrimitive(int mesh, int prim, int skin, bool& compu
     part.positions[v] = glm::vec3((*positions)[3 * v], (*positions)[3 * v + 1], (*positions)[3 * v + 2]);
   }
 
-  const std::uint64_t num_skin_joints = m_.skins[static_cast<std::size_t>(skin)].joints.size();
-  const int sets = attribute("JOINTS_1") >= 0 || attribute("WEIGHTS_1") >= 0 ? 2 : 1;
-  part.influences = 4 * sets;
+  part.mesh = mesh;
+  auto targets = internal::ReadPrimitiveTargets(m_, path_, mesh, prim, num_vertices,
+                                                options_.max_morph_values, out_.warnings);
+  if (!targets.ok()) return std::move(targets).error();
+  part.targets = std::move(targets).value();
+
+  const std::uint64_t num_skin_joints = skin >= 0 ? m_.skins[static_cast<std::size_t>(skin)].joints.size() : 0;
+  const int sets = skin < 0 ? 0 : attribute("JOINTS_1") >= 0 || attribute("WEIGHTS_1") >= 0 ? 2 : 1;
+  part.influences = 4 * std::max(sets, 1);
   part.joints.assign(num_vertices * static_cast<std::size_t>(part.influences), 0);
   part.weights.assign(num_vertices * static_cast<std::size_t>(part.influences), 0.0f);
+  if (skin < 0) {  // rigid: every vertex follows its node, weight 1 in slot 0
+    for (std::size_t v = 0; v < num_vertices; ++v) {
+      part.joints[v * 4] = static_cast<std::uint32_t>(rigid_slot);
+      part.weights[v * 4] = 1.0f;
+    }
+  }
   for (int set = 0; set < sets; ++set) {
     const std::string jname = "JOINTS_" + std::to_string(set);
     const std::string wname = "WEIGHTS_" + std::to_string(set);
@@ -524,17 +487,27 @@ mocap::Status Converter::ReadMeshes(int skin) {
       Warn(at, "skinned mesh nodes with different transforms; model_from_bind is the first one's");
     }
     const auto& prims = m_.meshes[static_cast<std::size_t>(node.mesh)].primitives;
+    int rigid_slot = -1;
+    if (skin < 0) {
+      rigid_slot = static_cast<int>(std::find(rigid_nodes_.begin(), rigid_nodes_.end(), static_cast<int>(n)) -
+                                    rigid_nodes_.begin());
+    }
     for (std::size_t p = 0; p < prims.size(); ++p) {
-      if (auto st = ReadPrimitive(node.mesh, static_cast<int>(p), skin, computed_normals); !st) return st;
+      if (auto st = ReadPrimitive(node.mesh, static_cast<int>(p), skin, rigid_slot, computed_normals); !st) {
+        return st;
+      }
     }
   }
   if (parts_.empty()) {
-    return Fail(ErrorCode::kNotFound, Indexed("skins", skin),
-                "no triangle primitive of a node uses this skin");
+    return Fail(ErrorCode::kNotFound, skin >= 0 ? Indexed("skins", skin) : std::string("meshes"),
+                skin >= 0 ? "no triangle primitive of a node uses this skin" : "no triangle primitive");
   }
   if (computed_normals) Warn("", "some primitives have no NORMAL; normals were computed");
   int influences = 4;
   for (const Part& part : parts_) influences = std::max(influences, part.influences);
+  std::size_t total_vertices = 0;
+  for (const Part& part : parts_) total_vertices += part.positions.size();
+  if (auto st = MergeMorphTargets(total_vertices); !st) return st;
   SkinnedMesh& mesh = out_.mesh;
   mesh.weights.influences = influences;
   for (const Part& part : parts_) {
@@ -559,6 +532,66 @@ mocap::Status Converter::ReadMeshes(int skin) {
   return mocap::Status::Ok();
 }
 
+// Concatenates the targets of every morphed glTF mesh into out_.morph (each
+// mesh's targets once, zero on other meshes' vertices).
+mocap::Status Converter::MergeMorphTargets(std::size_t num_vertices) {
+  GltfMorphTargets& morph = out_.morph;
+  mesh_first_target_.assign(m_.meshes.size(), -1);
+  mesh_num_targets_.assign(m_.meshes.size(), -1);
+  std::vector<int>& mesh_targets = mesh_num_targets_;
+  std::vector<std::size_t> part_base;
+  std::size_t base = 0;
+  bool any_normals = false;
+  for (std::size_t i = 0; i < parts_.size(); ++i) {
+    const Part& part = parts_[i];
+    part_base.push_back(base);
+    base += part.positions.size();
+    const auto mesh = static_cast<std::size_t>(part.mesh);
+    if (mesh_targets[mesh] < 0) {
+      mesh_targets[mesh] = part.targets.num_targets;
+      if (part.targets.num_targets > 0) {
+        mesh_first_target_[mesh] = morph.num_targets;
+        morph.num_targets += part.targets.num_targets;
+        auto weights = internal::ReadDefaultWeights(m_, path_, part.mesh, part.targets.num_targets);
+        if (!weights.ok()) return std::move(weights).error();
+        morph.default_weights.insert(morph.default_weights.end(), weights->begin(), weights->end());
+      }
+    } else if (mesh_targets[mesh] != part.targets.num_targets) {
+      return Fail(ErrorCode::kCountMismatch, Indexed("meshes", part.mesh) + ".primitives",
+                  "every primitive of a mesh needs the same number of morph targets; found " +
+                      std::to_string(mesh_targets[mesh]) + " and " + std::to_string(part.targets.num_targets));
+    }
+    any_normals = any_normals || !part.targets.normals.empty();
+  }
+  if (morph.num_targets == 0) return mocap::Status::Ok();
+  const auto k_total = static_cast<std::size_t>(morph.num_targets);
+  if (num_vertices != 0 && k_total > options_.max_morph_values / num_vertices) {
+    return Fail(ErrorCode::kLimitExceeded, "meshes",
+                std::to_string(k_total) + " morph targets x " + std::to_string(num_vertices) +
+                    " vertices exceed the limit of " + std::to_string(options_.max_morph_values) +
+                    " morph deltas");
+  }
+  morph.position_deltas.assign(k_total * num_vertices, glm::vec3(0.0f));
+  if (any_normals) morph.normal_deltas.assign(k_total * num_vertices, glm::vec3(0.0f));
+  for (std::size_t i = 0; i < parts_.size(); ++i) {
+    Part& part = parts_[i];
+    if (part.targets.num_targets == 0) continue;
+    const auto first = static_cast<std::size_t>(mesh_first_target_[static_cast<std::size_t>(part.mesh)]);
+    const std::size_t nv = part.positions.size();
+    for (std::size_t k = 0; k < static_cast<std::size_t>(part.targets.num_targets); ++k) {
+      const std::size_t dst = (first + k) * num_vertices + part_base[i];
+      std::copy_n(part.targets.positions.begin() + static_cast<std::ptrdiff_t>(k * nv), nv,
+                  morph.position_deltas.begin() + static_cast<std::ptrdiff_t>(dst));
+      if (!part.targets.normals.empty()) {
+        std::copy_n(part.targets.normals.begin() + static_cast<std::ptrdiff_t>(k * nv), nv,
+                    morph.normal_deltas.begin() + static_cast<std::ptrdiff_t>(dst));
+      }
+    }
+    part.targets = {};  // free as we go
+  }
+  return mocap::Status::Ok();
+}
+
 mocap::Status Converter::ReadAnimations() {
   mocap::Skeleton& sk = out_.skeleton;
   std::vector<std::array<bool, 3>> driven(static_cast<std::size_t>(sk.num_joints()), {false, false, false});
@@ -577,6 +610,23 @@ mocap::Status Converter::ReadAnimations() {
       if (ch.target_node < 0 || ch.target_node >= static_cast<int>(m_.nodes.size())) {
         return Fail(ErrorCode::kNotFound, cat + ".target.node",
                     "node " + std::to_string(ch.target_node) + " out of range");
+      }
+      if (ch.target_path == "weights") {
+        const tinygltf::Node& node = m_.nodes[static_cast<std::size_t>(ch.target_node)];
+        const int first = node.mesh >= 0 && node.mesh < static_cast<int>(mesh_first_target_.size())
+                              ? mesh_first_target_[static_cast<std::size_t>(node.mesh)]
+                              : -1;
+        if (first < 0) {
+          Warn(cat + ".target.node", "not an imported mesh with morph targets; weights channel ignored");
+          continue;
+        }
+        const int count = mesh_num_targets_[static_cast<std::size_t>(node.mesh)];
+        auto weights = internal::ReadWeightsSampler(m_, path_, static_cast<int>(a), ch.sampler, count);
+        if (!weights.ok()) return std::move(weights).error();
+        weights->first_target = first;
+        anim.duration_s = std::max(anim.duration_s, static_cast<double>(weights->times_s.back()));
+        anim.weights_channels.push_back(std::move(weights).value());
+        continue;
       }
       GltfChannel out;
       if (ch.target_path == "translation")
@@ -659,21 +709,25 @@ mocap::Status Converter::ReadAnimations() {
 
 Result<GltfModel> Converter::Run(const GltfReadOptions& options, std::vector<mocap::Warning> warnings) {
   out_.warnings = std::move(warnings);
+  options_ = options;
   for (const std::string& ext : m_.extensionsRequired) {
     if (ext.rfind("KHR_materials_", 0) != 0 && ext.rfind("KHR_texture_", 0) != 0) {
       return Fail(ErrorCode::kUnsupported, "extensionsRequired",
                   "required extension '" + ext + "' is not supported");
     }
   }
-  if (m_.skins.empty()) return Fail(ErrorCode::kNotFound, "skins", "the file has no skin");
-  if (options.skin < 0 || options.skin >= static_cast<int>(m_.skins.size())) {
+  if (m_.skins.empty() && options.require_skin) {
+    return Fail(ErrorCode::kNotFound, "skins", "the file has no skin");
+  }
+  const int skin = m_.skins.empty() ? -1 : options.skin;  // -1: rigid mesh nodes
+  if (!m_.skins.empty() && (options.skin < 0 || options.skin >= static_cast<int>(m_.skins.size()))) {
     return Fail(ErrorCode::kInvalidArgument, "skins",
                 "skin " + std::to_string(options.skin) + " requested, the file has " +
                     std::to_string(m_.skins.size()));
   }
-  if (auto st = BuildSkeleton(options.skin); !st) return st.error();
-  if (auto st = ReadSkin(options.skin); !st) return st.error();
-  if (auto st = ReadMeshes(options.skin); !st) return st.error();
+  if (auto st = BuildSkeleton(skin); !st) return st.error();
+  if (auto st = ReadSkin(skin); !st) return st.error();
+  if (auto st = ReadMeshes(skin); !st) return st.error();
   if (auto st = ReadAnimations(); !st) return st.error();
   if (auto st = out_.skeleton.Check(); !st) return st.error();
   if (auto st = out_.mesh.bind.Check(); !st) {

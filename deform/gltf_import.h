@@ -12,8 +12,14 @@
 // specification requires; non-joint ancestors of the joints (e.g. a "Z_UP" or
 // "Armature" node) are skeleton joints without channels, so they do apply.
 //
+// Morph targets (glTF 2.0, "Morph Targets") are imported with the mesh's
+// default weights and the animations' "weights" channels; GltfMeshSampler
+// (deform/gltf_mesh_sampler.h) evaluates morphed and skinned vertices at a
+// time. A file without any skin is read when GltfReadOptions::require_skin is
+// false: each mesh node is then attached rigidly to its node (see GltfModel).
+//
 // Units are the file's (metres by the specification); the up axis is +Y.
-// Textures, materials, cameras and morph targets are not imported.
+// Textures, materials and cameras are not imported.
 
 #include <span>
 #include <string>
@@ -56,10 +62,43 @@ struct GltfChannel {
   int num_keys() const { return static_cast<int>(times_s.size()); }
 };
 
+// The morph weights of one mesh: keys of a glTF channel whose target.path is
+// "weights". Each key holds one weight per morph target of the mesh the
+// channel's node instances; they drive GltfMorphTargets rows
+// first_target .. first_target + num_targets - 1.
+struct GltfWeightsChannel {
+  int first_target = 0;        // first row of GltfMorphTargets it drives
+  int num_targets = 0;         // weights per key (the mesh's target count), >= 1
+  GltfInterpolation interpolation = GltfInterpolation::kLinear;
+  std::vector<float> times_s;  // #K key times, non-decreasing, seconds
+  // #K x num_targets weights for kLinear / kStep; #K x 3 x num_targets for
+  // kCubicSpline (in-tangents, values, out-tangents per key, as in the file).
+  // Normalized integer outputs are converted to floats.
+  std::vector<float> values;
+
+  int num_keys() const { return static_cast<int>(times_s.size()); }
+};
+
 struct GltfAnimation {
   std::string name;                   // the file's name, or "animation_<index>"
   double duration_s = 0.0;            // last key time over all channels (glTF time starts at 0)
   std::vector<GltfChannel> channels;  // channels on nodes outside the skeleton are dropped (warning)
+  // "weights" channels of imported meshes with morph targets; channels on
+  // other nodes are dropped with a warning.
+  std::vector<GltfWeightsChannel> weights_channels;
+};
+
+// The morph targets of the imported (merged) mesh. In bind space, before
+// skinning (glTF applies morphing first):
+//   position(v) = bind.positions[v] + sum_k w_k * position_deltas[k * #V + v]
+//   normal(v)   = normalize(bind.normals[v] + sum_k w_k * normal_deltas[k * #V + v])
+// The targets of every morphed glTF mesh are concatenated (mesh order of
+// import); a target is zero on the vertices of the other meshes.
+struct GltfMorphTargets {
+  int num_targets = 0;                     // #K over all imported meshes (0: no morphing)
+  std::vector<glm::vec3> position_deltas;  // #K x #V, bind space, file units
+  std::vector<glm::vec3> normal_deltas;    // #K x #V, or empty when no target has NORMAL
+  std::vector<float> default_weights;      // #K, each mesh's `weights` (zeros where absent)
 };
 
 struct GltfModel {
@@ -85,6 +124,8 @@ struct GltfModel {
   // guaranteed: the early RiggedSimple export in ../shared/data leaves its
   // "Armature" node out of the bind matrices. Informational only.
   glm::mat4 model_from_bind{1.0f};
+  // Morph targets of `mesh` (num_targets 0 when the file has none).
+  GltfMorphTargets morph;
   std::vector<GltfAnimation> animations;  // in file order
   std::vector<mocap::Warning> warnings;   // tinygltf's warnings and ours
 };
@@ -94,6 +135,18 @@ struct GltfReadOptions {
   std::size_t max_file_bytes = std::size_t{1} << 30;
   // Which skin to import when several exist (index into the file's skins).
   int skin = 0;
+  // When false, a file without skins is read too: the skeleton is every node
+  // holding a mesh and their ancestors, and each mesh node's vertices are
+  // attached rigidly to its own joint (one influence, weight 1, identity
+  // joint_from_bind): bind positions are in the mesh's own space and
+  // skinning applies the animated node transform, as a viewer does. Mesh
+  // nodes with a skin are then ignored. When true (default), no skin is an
+  // error (kNotFound "skins").
+  bool require_skin = true;
+  // Upper bound on #K x #V of the morph deltas (each of positions and normals),
+  // checked before allocating: accessors without a buffer view cost no file
+  // bytes, so the file size alone does not bound them. kLimitExceeded past it.
+  std::size_t max_morph_values = std::size_t{1} << 26;
 };
 
 // Reads a .gltf (JSON, buffers as data: URIs or files) or .glb file. External
