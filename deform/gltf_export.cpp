@@ -1,16 +1,29 @@
-// glTF export: builds a tinygltf::Model directly around one binary buffer that
-// grows frame by frame, then lets tinygltf serialize it as a .glb.
+// glTF export: builds a tinygltf::Model that describes the file (accessors,
+// buffer views, meshes, animation) while the binary data of every frame goes
+// straight to an unnamed scratch file; Finish lets tinygltf serialize the JSON
+// and assembles the .glb (header, JSON chunk, BIN chunk copied from the
+// scratch file in blocks) under a temporary name, renamed into place.
 // Debian's libtinygltf.so holds the implementation (see gltf_import.cpp).
 
 #include "deform/gltf_export.h"
 
 #include <tiny_gltf.h>
 
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cerrno>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <sstream>
+#include <system_error>
 #include <vector>
+
+#include <nlohmann/json.hpp>
 
 #include "deform/file_output.h"
 
@@ -27,6 +40,10 @@ constexpr std::size_t kBakedKeysPerFrame = 3 * 4 + 3 * 12;
 // Fixed JSON (asset, scene, root node, base accessors).
 constexpr std::size_t kFixedJson = 1200;
 constexpr int kMaxFrames = 1000000;
+// Bytes copied at a time from the scratch file into the .glb.
+constexpr std::size_t kCopyBlock = std::size_t{1} << 20;
+// A GLB's lengths are 32-bit.
+constexpr std::uint64_t kMaxGlbBytes = 0xFFFFFFFFu;
 
 mocap::Error Invalid(const std::string& what) {
   return mocap::MakeError(mocap::ErrorCode::kInvalidArgument, {"glb", 0, 0, {}}, what);
@@ -37,6 +54,30 @@ bool AllFinite(std::span<const glm::vec3> v) {
     if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) return false;
   }
   return true;
+}
+
+std::string ErrnoText(int e) { return std::error_code(e, std::generic_category()).message(); }
+
+void PutU32(std::string& out, std::uint32_t v) {
+  for (int i = 0; i < 4; ++i) out += static_cast<char>((v >> (8 * i)) & 0xFFu);
+}
+
+// An unnamed read-write file in `dir` (created, then unlinked at once, so it
+// disappears when closed, even if the process dies). nullptr + errno on failure.
+std::FILE* OpenScratch(const std::string& dir, std::string& error) {
+  static std::atomic<int> counter{0};
+  std::error_code ec;
+  const std::filesystem::path folder = dir.empty() ? std::filesystem::temp_directory_path(ec) : std::filesystem::path(dir);
+  const std::string name = (folder / (".patchskin-glb-" + std::to_string(::getpid()) + "-" +
+                                      std::to_string(counter++) + ".bin"))
+                               .string();
+  std::FILE* f = std::fopen(name.c_str(), "w+b");
+  if (f == nullptr) {
+    error = "cannot create the scratch file '" + name + "': " + ErrnoText(errno);
+    return nullptr;
+  }
+  std::remove(name.c_str());
+  return f;
 }
 
 std::string FrameName(int k) {
@@ -70,7 +111,12 @@ GltfExportEstimate EstimateGltfExportBytes(int num_vertices, int num_triangles, 
 }
 
 struct GltfSequenceWriter::Impl {
+  // The description of the file; buffers[0].data stays empty (the bytes are in
+  // `scratch`, bin_bytes of them).
   tinygltf::Model model;
+  std::FILE* scratch = nullptr;
+  std::uint64_t bin_bytes = 0;
+  std::string write_error;  // the first failed scratch write, or empty
   GltfExportOptions options;
   GltfExportLayout layout = GltfExportLayout::kMorphTargets;
   int num_vertices = 0;
@@ -84,21 +130,35 @@ struct GltfSequenceWriter::Impl {
   std::vector<glm::vec3> delta;           // morph: scratch, #V
   std::vector<std::map<std::string, int>> frame_attributes;  // per frame: accessors added
 
-  std::vector<unsigned char>& bin() { return model.buffers[0].data; }
+  ~Impl() {
+    if (scratch != nullptr) std::fclose(scratch);
+  }
 
-  // Appends raw bytes as a buffer view; returns its index.
+  // Appends raw bytes to the scratch file; the first failure is kept.
+  void Append(const void* data, std::size_t bytes) {
+    if (!write_error.empty() || bytes == 0) return;
+    if (std::fwrite(data, 1, bytes, scratch) != bytes) {
+      write_error = "writing the scratch file failed: " + ErrnoText(errno);
+      return;
+    }
+    bin_bytes += bytes;
+  }
+
+  // Appends raw bytes as a buffer view (4-byte aligned); returns its index.
   int AddView(const void* data, std::size_t bytes, int target) {
-    std::vector<unsigned char>& b = bin();
+    static constexpr unsigned char kZeros[4] = {0, 0, 0, 0};
+    Append(kZeros, static_cast<std::size_t>((4 - bin_bytes % 4) % 4));
     tinygltf::BufferView view;
     view.buffer = 0;
-    view.byteOffset = b.size();
+    view.byteOffset = static_cast<std::size_t>(bin_bytes);
     view.byteLength = bytes;
     view.target = target;
-    const auto* p = static_cast<const unsigned char*>(data);
-    b.insert(b.end(), p, p + bytes);
+    Append(data, bytes);
     model.bufferViews.push_back(std::move(view));
     return static_cast<int>(model.bufferViews.size()) - 1;
   }
+
+  mocap::Status WriteGlb(const std::string& path);
 
   int AddAccessor(int view, int component, int type, std::size_t count,
                   std::vector<double> min = {}, std::vector<double> max = {}) {
@@ -186,11 +246,19 @@ void GltfSequenceWriter::Impl::FinishMorph() {
   const auto f = static_cast<std::size_t>(num_frames);
   std::vector<float> times(f);
   for (std::size_t k = 0; k < f; ++k) times[k] = KeyTime(static_cast<int>(k));
-  std::vector<float> weights(f * f, 0.0f);
-  for (std::size_t k = 0; k < f; ++k) weights[k * f + k] = 1.0f;
   tinygltf::AnimationSampler sampler;
   sampler.input = AddFloats(times, TINYGLTF_TYPE_SCALAR, f, true);
-  sampler.output = AddFloats(weights, TINYGLTF_TYPE_SCALAR, f * f, false);
+  // The #F x #F weights (key k: 1 for target k, 0 for the others) are
+  // written one key at a time: memory stays #F, not #F^2.
+  const int weights_view = AddView(nullptr, 0, -1);
+  std::vector<float> row(f, 0.0f);
+  for (std::size_t k = 0; k < f; ++k) {
+    row[k] = 1.0f;
+    Append(row.data(), f * sizeof(float));
+    row[k] = 0.0f;
+  }
+  model.bufferViews[static_cast<std::size_t>(weights_view)].byteLength = f * f * sizeof(float);
+  sampler.output = AddAccessor(weights_view, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_SCALAR, f * f);
   sampler.interpolation = options.step_interpolation ? "STEP" : "LINEAR";
   tinygltf::AnimationChannel channel;
   channel.sampler = 0;
@@ -284,6 +352,11 @@ mocap::Result<GltfSequenceWriter> GltfSequenceWriter::Create(std::span<const glm
   }
 
   auto impl = std::make_unique<Impl>();
+  std::string scratch_error;
+  impl->scratch = OpenScratch(options.scratch_dir, scratch_error);
+  if (impl->scratch == nullptr) {
+    return mocap::MakeError(mocap::ErrorCode::kIo, {options.scratch_dir, 0, 0, {}}, scratch_error);
+  }
   impl->options = options;
   impl->num_vertices = num_vertices;
   impl->num_frames = num_frames;
@@ -325,6 +398,9 @@ mocap::Status GltfSequenceWriter::AddFrame(std::span<const glm::vec3> positions,
   }
   if (!AllFinite(positions) || !AllFinite(normals)) {
     return Invalid("frame " + std::to_string(m.added) + ": positions and normals must be finite");
+  }
+  if (!m.write_error.empty()) {
+    return mocap::MakeError(mocap::ErrorCode::kIo, {m.options.scratch_dir, 0, 0, {}}, m.write_error);
   }
   std::map<std::string, int> attributes;
   if (m.layout == GltfExportLayout::kBakedMeshes) {
@@ -375,16 +451,80 @@ mocap::Status GltfSequenceWriter::Finish(const std::string& path) {
     m.FinishMorph();
   }
   m.model.buffers[0].name = "geometry";
-  std::ostringstream out;
+  mocap::Status s = m.WriteGlb(path);
+  std::fclose(m.scratch);  // the scratch file disappears with it
+  m.scratch = nullptr;
+  return s;
+}
+
+mocap::Status GltfSequenceWriter::Impl::WriteGlb(const std::string& path) {
+  auto io_error = [&](const std::string& why) {
+    return mocap::MakeError(mocap::ErrorCode::kIo, {path, 0, 0, {}}, why);
+  };
+  if (!write_error.empty()) return io_error(write_error);
+  if (std::fflush(scratch) != 0) return io_error("writing the scratch file failed: " + ErrnoText(errno));
+  // tinygltf writes the JSON (every property but the buffer's bytes, which it
+  // sees as empty); the buffer's real length is set afterwards.
+  std::ostringstream glb;
   tinygltf::TinyGLTF gltf;
-  if (!gltf.WriteGltfSceneToStream(&m.model, out, false, true)) {
-    return mocap::MakeError(mocap::ErrorCode::kIo, {path, 0, 0, {}},
-                            "tinygltf could not serialize the model");
+  if (!gltf.WriteGltfSceneToStream(&model, glb, false, true)) {
+    return io_error("tinygltf could not serialize the model");
   }
-  // The model is consumed: free the binary chunk before the file copy is written.
-  std::vector<unsigned char>().swap(m.bin());
-  const std::string bytes = std::move(out).str();
-  return WriteFileAtomic(path, bytes);
+  const std::string tiny = std::move(glb).str();
+  std::uint32_t json_length = 0;
+  if (tiny.size() >= 20) std::memcpy(&json_length, tiny.data() + 12, 4);  // GLB is little-endian, as is x86
+  if (tiny.size() < 20 || json_length > tiny.size() - 20) return io_error("tinygltf wrote no JSON chunk");
+  nlohmann::json doc = nlohmann::json::parse(tiny.substr(20, json_length), nullptr, false);
+  if (doc.is_discarded() || !doc.contains("buffers")) return io_error("tinygltf wrote unreadable JSON");
+  doc["buffers"][0]["byteLength"] = bin_bytes;
+  std::string json = doc.dump();
+  json.append((4 - json.size() % 4) % 4, ' ');  // chunks are 4-byte aligned: JSON pads with spaces
+  const std::uint64_t bin_padded = bin_bytes + (4 - bin_bytes % 4) % 4;
+  const std::uint64_t total = 12 + 8 + json.size() + (bin_bytes > 0 ? 8 + bin_padded : 0);
+  if (total > kMaxGlbBytes) {
+    return mocap::MakeError(mocap::ErrorCode::kLimitExceeded, {path, 0, 0, {}},
+                            "the .glb would have " + std::to_string(total) +
+                                " bytes; the format holds at most 4 GiB (export fewer frames)");
+  }
+  std::string head = "glTF";
+  PutU32(head, 2);
+  PutU32(head, static_cast<std::uint32_t>(total));
+  PutU32(head, static_cast<std::uint32_t>(json.size()));
+  PutU32(head, 0x4E4F534Au);  // "JSON"
+  head += json;
+  if (bin_bytes > 0) {
+    PutU32(head, static_cast<std::uint32_t>(bin_padded));
+    PutU32(head, 0x004E4942u);  // "BIN\0"
+  }
+
+  const std::string temp = TemporaryOutputPath(path);
+  std::FILE* out = std::fopen(temp.c_str(), "wb");
+  if (out == nullptr) return io_error("cannot create '" + temp + "': " + ErrnoText(errno));
+  bool ok = std::fwrite(head.data(), 1, head.size(), out) == head.size();
+  std::vector<unsigned char> block(static_cast<std::size_t>(std::min<std::uint64_t>(kCopyBlock, bin_bytes)));
+  ok = ok && std::fseek(scratch, 0, SEEK_SET) == 0;
+  for (std::uint64_t left = bin_bytes; ok && left > 0;) {
+    const auto n = static_cast<std::size_t>(std::min<std::uint64_t>(left, block.size()));
+    ok = std::fread(block.data(), 1, n, scratch) == n && std::fwrite(block.data(), 1, n, out) == n;
+    left -= n;
+  }
+  static constexpr unsigned char kZeros[4] = {0, 0, 0, 0};
+  const auto pad = static_cast<std::size_t>(bin_padded - bin_bytes);
+  ok = ok && std::fwrite(kZeros, 1, pad, out) == pad;
+  const int write_errno = errno;
+  ok = std::fclose(out) == 0 && ok;
+  std::error_code ec;
+  if (!ok) {
+    std::filesystem::remove(temp, ec);
+    return io_error("writing failed: " + ErrnoText(write_errno));
+  }
+  std::filesystem::rename(temp, path, ec);
+  if (ec) {
+    std::error_code ignored;
+    std::filesystem::remove(temp, ignored);
+    return io_error("cannot rename the finished temporary file into place: " + ec.message());
+  }
+  return mocap::Status::Ok();
 }
 
 }  // namespace deform

@@ -28,9 +28,17 @@
 // EstimateGltfExportBytes gives both figures.
 //
 // Units and axes are the caller's (glTF expects metres, +Y up). Every accessor
-// POSITION carries min/max as the specification requires. The file is written
-// atomically (deform/file_output.h). Memory held while adding frames is the
-// output's binary chunk (the whole animation; it has to be in the one file).
+// POSITION carries min/max as the specification requires.
+//
+// Memory: frame data is not held. AddFrame appends each frame's bytes to an
+// unnamed scratch file (in options.scratch_dir; it vanishes when closed, even
+// on a crash); Finish writes the .glb under a temporary name (header, the JSON
+// from tinygltf, then the binary chunk copied from the scratch file in 1 MiB
+// blocks) and renames it into place. What stays in memory grows by about 1 KB
+// of accessor/view/mesh descriptions per frame whatever #V (plus, for morph,
+// frame 0's positions and normals, 24 x #V bytes, to form the deltas, and one
+// #F-float row of weights at Finish). The file is limited to 4 GiB (GLB's
+// 32-bit lengths; kLimitExceeded).
 
 #include <cstddef>
 #include <memory>
@@ -52,6 +60,9 @@ struct GltfExportOptions {
   bool step_interpolation = false;              // morph weights: STEP instead of LINEAR
   std::string generator = "patchskin";          // asset.generator
   std::string mesh_name = "body";               // mesh and node name
+  // Folder for the scratch file holding the binary data until Finish; empty =
+  // the system's temporary folder. Best: the output's folder (same disk).
+  std::string scratch_dir = "";
 };
 
 // Estimated file sizes in bytes of both layouts (binary data exact, JSON
@@ -75,19 +86,22 @@ class GltfSequenceWriter {
 
   // triangles: #T, indices < num_vertices; colors: #V linear RGB or empty;
   // num_frames: how many AddFrame calls will follow (>= 1), which fixes the
-  // layout when options.layout is kAuto. Errors: kInvalidArgument.
+  // layout when options.layout is kAuto. Errors: kInvalidArgument, kIo (the
+  // scratch file cannot be created).
   static mocap::Result<GltfSequenceWriter> Create(std::span<const glm::uvec3> triangles,
                                                   std::span<const glm::vec3> colors,
                                                   int num_vertices, int num_frames,
                                                   const GltfExportOptions& options);
 
   // Adds the next frame: positions and normals are #V, finite. Errors:
-  // kInvalidArgument (sizes, non-finite values, more frames than announced).
+  // kInvalidArgument (sizes, non-finite values, more frames than announced),
+  // kIo (writing the scratch file failed, e.g. disk full).
   mocap::Status AddFrame(std::span<const glm::vec3> positions, std::span<const glm::vec3> normals);
 
   // Writes the .glb to `path` (folder must exist) after exactly num_frames
   // AddFrame calls. Call once: after it, AddFrame and Finish are errors.
-  // Errors: kInvalidArgument (frame count, second call), kIo.
+  // Errors: kInvalidArgument (frame count, second call), kIo, kLimitExceeded
+  // (more than 4 GiB).
   mocap::Status Finish(const std::string& path);
 
   GltfExportLayout layout() const;  // kMorphTargets or kBakedMeshes, never kAuto
