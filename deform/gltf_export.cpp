@@ -470,14 +470,31 @@ mocap::Status GltfSequenceWriter::Impl::WriteGlb(const std::string& path) {
   if (!gltf.WriteGltfSceneToStream(&model, glb, false, true)) {
     return io_error("tinygltf could not serialize the model");
   }
-  const std::string tiny = std::move(glb).str();
-  std::uint32_t json_length = 0;
-  if (tiny.size() >= 20) std::memcpy(&json_length, tiny.data() + 12, 4);  // GLB is little-endian, as is x86
-  if (tiny.size() < 20 || json_length > tiny.size() - 20) return io_error("tinygltf wrote no JSON chunk");
-  nlohmann::json doc = nlohmann::json::parse(tiny.substr(20, json_length), nullptr, false);
-  if (doc.is_discarded() || !doc.contains("buffers")) return io_error("tinygltf wrote unreadable JSON");
-  doc["buffers"][0]["byteLength"] = bin_bytes;
-  std::string json = doc.dump();
+  std::string json;
+  {
+    const std::string tiny = std::move(glb).str();
+    std::uint32_t json_length = 0;
+    if (tiny.size() >= 20) std::memcpy(&json_length, tiny.data() + 12, 4);  // GLB and x86 are little-endian
+    if (tiny.size() < 20 || json_length > tiny.size() - 20) return io_error("tinygltf wrote no JSON chunk");
+    json.assign(tiny, 20, json_length);
+  }
+  // tinygltf's JSON object keys are sorted and compact, so the buffer reads
+  // exactly as below; patching the text avoids a second copy of the document
+  // (which grows with the frame count). Anything else is parsed and patched.
+  const std::string empty_buffer = "{\"byteLength\":0,\"name\":\"geometry\"}";
+  const std::size_t at = json.find(empty_buffer);
+  if (at != std::string::npos && json.find(empty_buffer, at + 1) == std::string::npos) {
+    json.replace(at, empty_buffer.size(),
+                 "{\"byteLength\":" + std::to_string(bin_bytes) + ",\"name\":\"geometry\"}");
+  } else {
+    nlohmann::json doc = nlohmann::json::parse(json, nullptr, false);
+    if (doc.is_discarded() || !doc.contains("buffers")) return io_error("tinygltf wrote unreadable JSON");
+    doc["buffers"][0]["byteLength"] = bin_bytes;
+    json = doc.dump();
+  }
+  // The description is no longer needed: free it before the copy.
+  model = tinygltf::Model();
+  frame_attributes = {};
   json.append((4 - json.size() % 4) % 4, ' ');  // chunks are 4-byte aligned: JSON pads with spaces
   const std::uint64_t bin_padded = bin_bytes + (4 - bin_bytes % 4) % 4;
   const std::uint64_t total = 12 + 8 + json.size() + (bin_bytes > 0 ? 8 + bin_padded : 0);
