@@ -13,6 +13,8 @@
 #include "app/motion_source.h"
 #include "app/pipeline.h"
 #include "app/progress.h"
+#include "app/rig_file.h"
+#include "app/rig_setup.h"
 #include "deform/file_output.h"
 #include "deform/gltf_export.h"
 #include "deform/obj_writer.h"
@@ -83,7 +85,7 @@ std::string CameraJson(const render::Camera& camera, glm::ivec2 size, float grou
 CLI::App* AddExportCommand(CLI::App& parent, ExportOptions& o) {
   CLI::App* cmd = parent.add_subcommand(
       "export", "Write the deformed mesh of every frame as an OBJ sequence or one glTF (.glb)");
-  cmd->add_option("input", o.input, "BVH, glTF or GLB file; none = the built-in demo");
+  cmd->add_option("input", o.input, "BVH, glTF or GLB file, or a rig (.json); none = the built-in demo");
   cmd->add_option("--frames", o.frames, "A:B[:STEP] output frames, inclusive (default all)");
   cmd->add_option("--fps", o.fps, "Output frame rate; the motion is resampled (default: its own)");
   cmd->add_option("--out", o.out,
@@ -105,7 +107,24 @@ CLI::App* AddExportCommand(CLI::App& parent, ExportOptions& o) {
   return cmd;
 }
 
-int RunExport(const ExportOptions& o) {
+int RunExport(const ExportOptions& options) {
+  // --- A rig file sets the inputs, the method and the layers, as for render ---
+  ExportOptions o = options;
+  std::optional<Rig> rig;
+  if (Lower(std::filesystem::path(o.input).extension().string()) == ".json") {
+    mocap::Result<Rig> loaded = LoadRig(o.input);
+    if (!loaded.ok()) return Fail(loaded.error());
+    rig = std::move(*loaded);
+    mocap::Result<std::string> input = RigInputFile(*rig);
+    if (!input.ok()) return Fail(input.error());
+    o.input = *input;
+    o.global = rig->global;
+    o.fps = rig->fps;
+    o.size = std::to_string(rig->render.size.x) + "x" + std::to_string(rig->render.size.y);
+    if (rig->render.camera != "turntable") o.camera = rig->render.camera;
+    if (o.frames.empty()) o.frames = rig->render.frames;
+  }
+
   // --- Arguments -------------------------------------------------------------
   const mocap::Result<glm::ivec2> size = ParseSize(o.size);
   if (!size.ok()) return Fail(size.error());
@@ -129,7 +148,9 @@ int RunExport(const ExportOptions& o) {
   if (!o.quiet) {
     for (const mocap::Warning& w : src->warnings) std::fprintf(stderr, "%s\n", w.ToString().c_str());
   }
-  const std::string name = demo ? "demo" : std::filesystem::path(o.input).stem().string();
+  const std::string name = demo  ? "demo"
+                           : rig ? std::filesystem::path(rig->file).stem().string()
+                                 : std::filesystem::path(o.input).stem().string();
   mocap::Result<Character> character = MakeCharacter(std::move(*src));
   if (!character.ok()) return Fail(character.error());
   const Character& ch = *character;
@@ -152,14 +173,21 @@ int RunExport(const ExportOptions& o) {
   if (mocap::Status s = CreateFolder(out_dir); !s) return Fail(s.error());
 
   // --- Pipeline and cameras ----------------------------------------------------------
+  // The layered result: with a rig, every layer it asks for (render draws the
+  // same pipeline, or its right half when the rig splits the view).
   mocap::Result<FramePipeline> pipeline = FramePipeline::Create(ch, *method, o.threads);
   if (!pipeline.ok()) return Fail(pipeline.error());
-  std::optional<CameraPlan> cameras;
-  if (o.with_camera) {
-    mocap::Result<CameraPlan> c = CameraPlan::Create(*pipeline, *plan, o.camera, o.elevation_deg, *size);
-    if (!c.ok()) return Fail(c.error());
-    cameras.emplace(std::move(*c));
+  if (rig) {
+    if (mocap::Status s = ApplyRigLayers(*rig, ch, *pipeline); !s) return Fail(s.error());
   }
+  // The camera plan is built whether or not it is written: its framing
+  // pre-pass evaluates the pipeline, as render's does before its frame loop,
+  // so a pipeline that carries state between frames (the elastic layer) sees
+  // the same sequence of evaluations here as there.
+  mocap::Result<CameraPlan> camera_plan =
+      CameraPlan::Create(*pipeline, *plan, o.camera, o.elevation_deg, *size);
+  if (!camera_plan.ok()) return Fail(camera_plan.error());
+  const CameraPlan* cameras = o.with_camera ? &*camera_plan : nullptr;
   std::optional<deform::GltfSequenceWriter> gltf;
   const deform::Mesh& bind = ch.mesh.bind;
   if (glb) {
@@ -168,6 +196,7 @@ int RunExport(const ExportOptions& o) {
     go.layout = *layout;
     go.step_interpolation = o.step;
     go.generator = "patchskin export (" + std::string(GlobalMethodName(*method)) + ")";
+    go.scratch_dir = out_dir.empty() ? "." : out_dir.string();
     mocap::Result<deform::GltfSequenceWriter> w = deform::GltfSequenceWriter::Create(
         bind.triangles, bind.colors, bind.num_vertices(), static_cast<int>(plan->frames.size()), go);
     if (!w.ok()) return Fail(w.error());
@@ -175,11 +204,13 @@ int RunExport(const ExportOptions& o) {
   }
 
   // --- The frame loop: one frame in memory (OBJ) ---------------------------------------
+  // Every planned frame is evaluated in order by the one pipeline, as render
+  // does, so state carried from frame to frame (the elastic layer) is the same.
   Progress progress(demo ? "export demo" : "export " + name, static_cast<int>(plan->frames.size()),
                     o.quiet);
   DeformedFrame frame;
   deform::ObjSequenceWriter obj;
-  const std::string source = demo ? "demo_walk.bvh (built in)" : o.input;
+  const std::string source = demo ? "demo_walk.bvh (built in)" : rig ? rig->file : o.input;
   for (const OutputFrame& of : plan->frames) {
     mocap::Status s = pipeline->Evaluate(of.time_s, frame);
     if (!s.ok()) return Fail(s.error());

@@ -2,7 +2,11 @@
 // `patchskin export [INPUT] --out PATTERN`: the deformed mesh of every output
 // frame as geometry other tools open, evaluated by the same FramePipeline,
 // frame plan and options as `render` (so frame N of an export is exactly the
-// mesh `render` draws as frame N):
+// mesh `render` draws as frame N). A rig file (.json) as input sets the
+// motion or character, the global method, fps, frames, camera and size as it
+// does for render, and its layers (patches, ...) go on the pipeline
+// (app/rig_setup.h): the export is the layered mesh, i.e. the right half of a
+// split render. Outputs:
 //   * --out ending in .obj (with a #### placeholder): one OBJ per frame
 //     (deform/obj_writer.h), written as the frames are evaluated; one frame is
 //     held in memory whatever the frame count;
@@ -21,7 +25,7 @@
 namespace app {
 
 struct ExportOptions {
-  std::string input;              // empty = built-in demo
+  std::string input;              // BVH, glTF/GLB or rig .json; empty = built-in demo
   std::string frames;             // "A:B[:STEP]", inclusive, in output frames; empty = all
   double fps = 0.0;               // output frame rate; 0 = the capture's own
   std::string out;                // .obj pattern with ####, or a .glb path;

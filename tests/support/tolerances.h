@@ -144,6 +144,12 @@ namespace testsupport {
 // A morph-target frame read back: base + (frame - base) in float, for values of
 // order 1 (round-off of one subtraction and one addition, a few ulps).
 inline constexpr float kMorphRoundTripTol = 1e-6f;
+
+// Streaming exports: the peak memory growth from 100 to 1000 frames, as a
+// share of what holding the extra 900 frames' vertex data would take. What
+// legitimately grows is per-frame bookkeeping (the frame plan; for .glb about
+// 1 KB of accessor/view descriptions and JSON per frame), a few percent of it.
+inline constexpr double kStreamingGrowthShare = 0.25;
 // glb size estimates (JSON bytes per frame approximated) vs the written file.
 inline constexpr double kGlbSizeEstimateRelTol = 0.15;
 // Two glb layouts whose files differ by less than this are a tie for the

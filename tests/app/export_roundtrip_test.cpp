@@ -1,0 +1,273 @@
+// `patchskin export` read back with the project's own importer
+// (deform/gltf_import.h, morph targets and rigid mesh nodes; GltfMeshSampler):
+// a patch rig and a plain BVH, each exported over several frames, give back at
+// every key time the vertices the pipeline computed for that frame, and the
+// key times are frame / fps. The OBJ of a patch rig, drawn with its camera
+// JSON, is the frame `render` draws for the rig.
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "app/frame_plan.h"
+#include "app/motion_source.h"
+#include "app/pipeline.h"
+#include "app/rig_file.h"
+#include "app/rig_setup.h"
+#include "deform/gltf_import.h"
+#include "deform/gltf_mesh_sampler.h"
+#include "render/image_io.h"
+#include "render/renderer.h"
+#include "support/data_paths.h"
+#include "support/exported_geometry.h"
+#include "support/run_process.h"
+#include "support/tolerances.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+const fs::path kSamples = fs::path(GOLDEN_DIR) / ".." / ".." / "samples" / "data";
+
+fs::path Dir() {
+  const std::string test = ::testing::UnitTest::GetInstance()->current_test_info()->name();
+  const fs::path d = testsupport::TestOutputPath("export_roundtrip/" + test + "/x").parent_path();
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+std::string BendBvh() { return fs::absolute(kSamples / "bend.bvh").lexically_normal().string(); }
+
+// A rig with one cylinder patch on the left elbow of the mannequin driven by
+// bend.bvh, unsplit so render draws exactly the layered mesh.
+fs::path WriteElbowRig(const fs::path& dir) {
+  const fs::path rig = dir / "elbow.json";
+  std::ofstream(rig) << R"({"character": "mannequin", "motion": {"file": ")" << BendBvh() << R"("},
+    "global": "ssd",
+    "patches": [{"name": "left_elbow",
+                 "region": {"joint": "LeftForeArm", "radius": 14, "side": [0, 0, 1], "half_angle_deg": 120},
+                 "parametrization": "cylinder", "sampling": [8, 8], "grid": [6, 6]}],
+    "render": {"size": [96, 64], "camera": "fixed", "split": false}})";
+  return rig;
+}
+
+// The character of a rig and a pipeline with the rig's layers, as export builds them.
+struct RigRun {
+  app::Rig rig;
+  std::unique_ptr<app::Character> character;
+  std::optional<app::FramePipeline> pipeline;
+};
+
+RigRun LoadRigRun(const fs::path& rig_path) {
+  RigRun r;
+  auto rig = app::LoadRig(rig_path.string());
+  EXPECT_TRUE(rig.ok()) << rig.error().ToString();
+  r.rig = std::move(*rig);
+  auto src = app::LoadMotionSource(r.rig.motion, {.y_up = true});
+  EXPECT_TRUE(src.ok()) << src.error().ToString();
+  auto ch = app::MakeCharacter(std::move(*src));
+  EXPECT_TRUE(ch.ok());
+  r.character = std::make_unique<app::Character>(std::move(*ch));
+  auto p = app::FramePipeline::Create(*r.character, app::GlobalMethod::kSsd, 1);
+  EXPECT_TRUE(p.ok());
+  r.pipeline.emplace(std::move(*p));
+  EXPECT_TRUE(app::ApplyRigLayers(r.rig, *r.character, *r.pipeline).ok());
+  return r;
+}
+
+mocap::Result<deform::GltfModel> ReadExport(const fs::path& glb) {
+  deform::GltfReadOptions options;
+  options.require_skin = false;  // an export holds plain (morphed or per-frame) meshes
+  return deform::ReadGltf(glb.string(), options);
+}
+
+float MaxAbs(const std::vector<glm::vec3>& v) {
+  float m = 1.0f;
+  for (const glm::vec3& p : v) m = std::max({m, std::abs(p.x), std::abs(p.y), std::abs(p.z)});
+  return m;
+}
+
+TEST(ExportRoundTrip, PatchRigGlbReadsBackWithOurImporter) {
+  const fs::path dir = Dir();
+  const fs::path rig = WriteElbowRig(dir);
+  const testsupport::ProcessResult run = testsupport::RunPatchskin(
+      {"export", rig.string(), "--frames", "0:60:6", "--layout", "morph", "--quiet", "--out",
+       (dir / "elbow.glb").string()},
+      dir);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+
+  RigRun ref = LoadRigRun(rig);
+  ASSERT_EQ(ref.pipeline->num_patches(), 1);
+  auto global_only = app::FramePipeline::Create(*ref.character, app::GlobalMethod::kSsd, 1);
+  ASSERT_TRUE(global_only.ok());
+  auto plan = app::PlanFrames(ref.character->motion, {.frames = "0:60:6"});
+  ASSERT_TRUE(plan.ok());
+  ASSERT_EQ(plan->frames.size(), 11u);
+
+  auto model = ReadExport(dir / "elbow.glb");
+  ASSERT_TRUE(model.ok()) << model.error().ToString();
+  ASSERT_EQ(model->morph.num_targets, 11);
+  ASSERT_EQ(model->animations.size(), 1u);
+  ASSERT_EQ(model->animations[0].weights_channels.size(), 1u);
+  // Frame timing: key k at k x (frame time x step) seconds, stored as float.
+  const deform::GltfWeightsChannel& keys = model->animations[0].weights_channels[0];
+  const double key_step_s = plan->frame_time_s * plan->range.step;
+  ASSERT_EQ(keys.num_keys(), 11);
+  for (int k = 0; k < keys.num_keys(); ++k) {
+    EXPECT_EQ(keys.times_s[static_cast<std::size_t>(k)], static_cast<float>(k * key_step_s)) << k;
+  }
+  EXPECT_NEAR(model->animations[0].duration_s, 10 * key_step_s, 1e-6);
+
+  auto sampler = deform::GltfMeshSampler::Create(*model);
+  ASSERT_TRUE(sampler.ok()) << sampler.error().ToString();
+  app::DeformedFrame frame, plain;
+  const std::size_t nv = ref.character->mesh.bind.positions.size();
+  std::vector<glm::vec3> p(nv), n(nv);
+  float patch_effect = 0.0f;
+  for (std::size_t k = 0; k < plan->frames.size(); ++k) {
+    const app::OutputFrame& of = plan->frames[k];
+    ASSERT_TRUE(ref.pipeline->Evaluate(of.time_s, frame).ok());
+    ASSERT_TRUE(global_only->Evaluate(of.time_s, plain).ok());
+    ASSERT_TRUE(sampler->Sample(0, of.time_s - plan->frames.front().time_s, p, n).ok());
+    // base + (frame - base) in float: a couple of ulps of the largest coordinate.
+    const float tol = testsupport::kMorphRoundTripTol * MaxAbs(frame.positions);
+    float worst = 0.0f, worst_normal = 0.0f;
+    for (std::size_t v = 0; v < nv; ++v) {
+      worst = std::max(worst, glm::length(p[v] - frame.positions[v]));
+      worst_normal = std::max(worst_normal, glm::length(n[v] - frame.normals[v]));
+      patch_effect = std::max(patch_effect, glm::length(frame.positions[v] - plain.positions[v]));
+    }
+    EXPECT_LE(worst, tol) << "frame " << of.number;
+    EXPECT_LE(worst_normal, testsupport::kMorphRoundTripTol * 4.0f) << "frame " << of.number;
+  }
+  // The export carries the rig's layer: the elbow differs from global-only skinning.
+  EXPECT_GT(patch_effect, 0.01f);
+}
+
+// Baked layout: one mesh per frame on its own node, shown by a STEP scale
+// animation. Read as rigid mesh nodes, frame k's block of vertices is frame k
+// (exact: identity node transforms) at key k, and every other block has
+// scale 0 (collapsed onto its node's origin).
+TEST(ExportRoundTrip, BvhBakedGlbShowsOneFramePerKey) {
+  const fs::path dir = Dir();
+  const testsupport::ProcessResult run = testsupport::RunPatchskin(
+      {"export", BendBvh(), "--frames", "10:30:5", "--layout", "baked", "--global", "dqs", "--quiet",
+       "--out", (dir / "bend.glb").string()},
+      dir);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+
+  auto src = app::LoadMotionSource(BendBvh(), {.y_up = true});
+  ASSERT_TRUE(src.ok());
+  auto ch = app::MakeCharacter(std::move(*src));
+  ASSERT_TRUE(ch.ok());
+  auto pipeline = app::FramePipeline::Create(*ch, app::GlobalMethod::kDqs, 1);
+  ASSERT_TRUE(pipeline.ok());
+  auto plan = app::PlanFrames(ch->motion, {.frames = "10:30:5"});
+  ASSERT_TRUE(plan.ok());
+  const std::size_t frames = plan->frames.size();
+  ASSERT_EQ(frames, 5u);
+
+  auto model = ReadExport(dir / "bend.glb");
+  ASSERT_TRUE(model.ok()) << model.error().ToString();
+  const std::size_t nv = ch->mesh.bind.positions.size();
+  ASSERT_EQ(model->mesh.bind.positions.size(), frames * nv);
+  EXPECT_EQ(model->morph.num_targets, 0);
+  auto sampler = deform::GltfMeshSampler::Create(*model);
+  ASSERT_TRUE(sampler.ok()) << sampler.error().ToString();
+  std::vector<glm::vec3> p(frames * nv), n(frames * nv);
+  app::DeformedFrame frame;
+  const double key_step_s = plan->frame_time_s * plan->range.step;
+  for (std::size_t k = 0; k < frames; ++k) {
+    ASSERT_TRUE(pipeline->Evaluate(plan->frames[k].time_s, frame).ok());
+    // At key k and half-way to key k+1 (STEP holds).
+    const double key = static_cast<double>(k);
+    for (const double t : {key * key_step_s, (key + 0.5) * key_step_s}) {
+      ASSERT_TRUE(sampler->Sample(0, t, p, n).ok());
+      for (std::size_t block = 0; block < frames; ++block) {
+        for (std::size_t v = 0; v < nv; ++v) {
+          const glm::vec3 got = p[block * nv + v];
+          if (block == k) {
+            ASSERT_EQ(got, frame.positions[v]) << "key " << k << " vertex " << v;
+          } else {
+            ASSERT_EQ(got, glm::vec3(0.0f)) << "key " << k << " block " << block;
+          }
+        }
+      }
+    }
+  }
+}
+
+// The OBJ of a patch rig drawn with its exported camera is the frame `render`
+// draws for that rig, pixel for pixel.
+TEST(ExportRoundTrip, PatchRigObjIsWhatRenderDrew) {
+  const fs::path dir = Dir();
+  const fs::path rig = WriteElbowRig(dir);
+  testsupport::ProcessResult run = testsupport::RunPatchskin(
+      {"render", rig.string(), "--frames", "45:45", "--supersample", "1", "--no-sheet", "--no-video",
+       "--quiet", "--out", (dir / "frame_####.png").string()},
+      dir);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  run = testsupport::RunPatchskin({"export", rig.string(), "--frames", "45:45", "--with-camera", "--quiet",
+                                   "--out", (dir / "mesh_####.obj").string()},
+                                  dir);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+
+  const testsupport::ParsedObj obj = testsupport::ParseObjFile((dir / "mesh_0045.obj").string());
+  ASSERT_TRUE(obj.error.empty()) << obj.error;
+  RigRun ref = LoadRigRun(rig);
+  // Same vertices as the layered pipeline, bit for bit, in the same order.
+  app::DeformedFrame frame;
+  auto plan = app::PlanFrames(ref.character->motion, {.frames = "45:45"});
+  ASSERT_TRUE(plan.ok());
+  ASSERT_TRUE(ref.pipeline->Evaluate(plan->frames[0].time_s, frame).ok());
+  ASSERT_EQ(obj.positions, frame.positions);
+  ASSERT_EQ(obj.normals, frame.normals);
+  EXPECT_EQ(obj.triangles, ref.character->mesh.bind.triangles);
+
+  const nlohmann::json j = nlohmann::json::parse(testsupport::SlurpFile(dir / "camera_0045.json"));
+  render::Camera cam;
+  for (int c = 0; c < 3; ++c) {
+    const auto i = static_cast<std::size_t>(c);
+    cam.eye[c] = j["eye"][i].get<float>();
+    cam.target[c] = j["target"][i].get<float>();
+    cam.up[c] = j["up"][i].get<float>();
+  }
+  cam.fov_y_deg = j["fov_y_deg"].get<float>();
+  cam.near_plane = j["near"].get<float>();
+  cam.far_plane = j["far"].get<float>();
+  cam.aspect = j["aspect"].get<float>();
+  render::RenderSettings settings;
+  settings.width = j["width"].get<int>();
+  settings.height = j["height"].get<int>();
+  EXPECT_EQ(settings.width, 96);  // the rig's render.size
+  settings.supersample = 1;
+  settings.threads = 1;
+  settings.ground_at_scene_min = false;
+  settings.ground_y = j["ground_y"].get<float>();
+  const render::SceneMesh body{.positions = obj.positions, .normals = obj.normals,
+                               .triangles = obj.triangles,
+                               .vertex_colors = ref.character->mesh.bind.colors};
+  render::Overlays overlays;  // render labels every frame with its number
+  overlays.text.push_back({.text = "frame 45", .origin_px = {10, settings.height - 12}});
+  render::Renderer renderer;
+  render::Image image;
+  ASSERT_TRUE(renderer.Render(cam, {&body, 1}, overlays, settings, image));
+  ASSERT_TRUE(render::WriteImage(image, (dir / "from_obj.png").string(), {}));
+  auto a = render::ReadImage((dir / "frame_0045.png").string());
+  auto b = render::ReadImage((dir / "from_obj.png").string());
+  ASSERT_TRUE(a.ok() && b.ok());
+  ASSERT_EQ(a->width, b->width);
+  ASSERT_EQ(a->height, b->height);
+  int differing = 0;
+  for (int y = 0; y < a->height; ++y) {
+    for (int x = 0; x < a->width; ++x) differing += a->at(x, y) != b->at(x, y) ? 1 : 0;
+  }
+  EXPECT_EQ(differing, 0);
+}
+
+}  // namespace
