@@ -259,10 +259,28 @@ int RunFarm(const FarmOptions& o) {
   while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
   }
   if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
-    std::fprintf(stderr, "%s: error: submitting failed (sbatch exit %d)%s\n", submit_path.c_str(),
+    std::fprintf(stderr, "%s: error: submitting failed (exit %d)%s%s\n", submit_path.c_str(),
                  WIFEXITED(status) ? WEXITSTATUS(status) : -1,
-                 o.wait ? " or a job did not succeed; see the logs in " : "");
-    if (o.wait) std::fprintf(stderr, "%s\n", (script_dir / "logs").c_str());
+                 o.wait ? " or a job did not succeed; see the logs in " : "",
+                 o.wait ? (script_dir / "logs").c_str() : "");
+    return 3;
+  }
+  if (!o.wait) return 0;
+  // sbatch --wait returns 0 for a sheet job that never ran (cancelled because
+  // a task failed), so success is judged by the outputs: every frame and the
+  // contact sheet.
+  int missing = 0;
+  std::string first_missing;
+  for (const OutputFrame& f : plan->frames) {
+    const mocap::Result<std::string> p = render::ExpandFramePattern(pattern, f.number);
+    if (p.ok() && fs::is_regular_file(*p, ec)) continue;
+    if (missing++ == 0) first_missing = p.ok() ? *p : pattern;
+  }
+  const fs::path sheet_path = frames_dir / "contact_sheet.png";
+  if (missing > 0 || !fs::is_regular_file(sheet_path, ec)) {
+    std::fprintf(stderr, "%s: error: the jobs did not finish: %d of %d frames missing%s; see the logs in %s\n",
+                 missing > 0 ? first_missing.c_str() : sheet_path.c_str(), missing, num_frames,
+                 missing > 0 ? "" : ", no contact sheet", (script_dir / "logs").c_str());
     return 3;
   }
   return 0;

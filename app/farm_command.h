@@ -18,7 +18,9 @@
 // Every path in the scripts is absolute (jobs may start in another folder).
 // Without --submit it prints the scripts and the command to submit them; with
 // --submit it runs sbatch itself (and with --wait blocks until the sheet job
-// has ended, like `sbatch --wait`). The frame range and frame rate come from
+// has ended, like `sbatch --wait`, then checks that every frame and the
+// contact sheet exist: sbatch --wait reports success for a sheet job that was
+// cancelled because a task failed). The frame range and frame rate come from
 // the input (a BVH, glTF or rig file), read once here. There is no simulation
 // cache to build first: every chunk simulates from the motion's start.
 
@@ -49,7 +51,8 @@ CLI::App* AddFarmCommand(CLI::App& parent, FarmOptions& options);
 
 // Exit code: 0 ok (with --wait: every job succeeded), 1 usage, 2 bad input
 // (input, range, chunk, render options that farm sets itself), 3 when sbatch
-// cannot be run or refuses, or (with --wait) a job failed.
+// cannot be run or refuses, or (with --wait) a frame or the contact sheet is
+// missing when the jobs have ended.
 int RunFarm(const FarmOptions& options);
 
 // The texts RunFarm writes into the script folder.

@@ -5,7 +5,8 @@
 # folder), renders a rig as a 4-task job array with `patchskin farm slurm
 # --submit --wait`, and checks that the frames are byte-identical to one
 # `patchskin render` of the whole range; then deletes a frame, re-runs that
-# one task with the same script, and checks the frame comes back identical.
+# one task with the same script, and checks the frame comes back identical;
+# and that a failing task makes `farm --wait` exit 3.
 # Every daemon is stopped by its PID and the cluster folder wiped on exit.
 #
 # usage: run_slurm_test.sh PATCHSKIN_BINARY SOURCE_DIR WORK_DIR
@@ -97,6 +98,17 @@ rm "$work/farm/f_0005.png"
 timeout 120 sbatch --wait --quiet --array=2 "$work/farm/slurm/render_array.sbatch"
 if ! cmp -s "$work/single/f_0005.png" "$work/farm/f_0005.png"; then
   echo "FAIL: re-running task 2 did not restore f_0005.png byte-identical"
+  fail=1
+fi
+
+# --- A failing task: the sheet job never runs and farm --wait says so (exit 3) --
+set +e
+timeout 120 "$bin" farm slurm "$rig" --frames 0:3 --chunk 4 --out "$work/broken/f_####.png" \
+  --submit --wait -- --supersample 3 2>"$work/broken.err"
+code=$?
+set -e
+if [ "$code" -ne 3 ] || ! grep -q "the jobs did not finish: 4 of 4 frames missing" "$work/broken.err"; then
+  echo "FAIL: a failing task gave exit $code (expected 3): $(cat "$work/broken.err")"
   fail=1
 fi
 
