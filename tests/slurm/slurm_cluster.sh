@@ -23,10 +23,19 @@ slurm_cluster_have_binaries() {
   return 0
 }
 
-# A TCP port nobody listens on (bound and released at once; collisions are
-# unlikely on a test machine, and start-up fails loudly if one happens).
+# A random TCP port in 20000..59999 that nothing on localhost accepts
+# connections on (bash's /dev/tcp; no python needed). A race with another
+# program taking it meanwhile is unlikely, and start-up then fails loudly.
 _slurm_free_port() {
-  python3 -c 'import socket; s=socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1]); s.close()'
+  local port i
+  for ((i = 0; i < 100; i++)); do
+    port=$((20000 + RANDOM % 40000))
+    if ! (: </dev/tcp/127.0.0.1/"$port") 2>/dev/null; then
+      echo "$port"
+      return 0
+    fi
+  done
+  return 1
 }
 
 _slurm_log_tail() {
