@@ -10,9 +10,11 @@
 
 #include "app/compare_command.h"
 #include "app/export_command.h"
+#include "app/farm_command.h"
 #include "app/elastic_command.h"
 #include "app/inspect_command.h"
 #include "app/render_command.h"
+#include "app/sheet_command.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"patchskin: motion-capture driven layered skinning and software rendering"};
@@ -32,6 +34,10 @@ int main(int argc, char** argv) {
   CLI::App* compare = app::AddCompareCommand(app, &compare_options);
   app::ElasticOptions elastic_options;
   CLI::App* elastic = app::AddElasticCommand(app, elastic_options);
+  app::SheetOptions sheet_options;
+  CLI::App* sheet = app::AddSheetCommand(app, sheet_options);
+  app::FarmOptions farm_options;
+  CLI::App* farm = app::AddFarmCommand(app, farm_options);
 
   try {
     app.parse(argc, argv);
@@ -48,6 +54,8 @@ int main(int argc, char** argv) {
     if (compare->parsed()) return app::RunCompareCommand(compare_options);
     if (export_cmd->parsed()) return app::RunExport(export_options);
     if (elastic->parsed()) return app::RunElastic(elastic_options);
+    if (sheet->parsed()) return app::RunSheet(sheet_options);
+    if (farm->parsed()) return app::RunFarm(farm_options);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "patchskin: internal error: %s\n", e.what());
     return 3;

@@ -9,6 +9,7 @@
 #include <sstream>
 #include <vector>
 
+#include "app/character_motion.h"
 #include "app/demo_data.h"
 #include "app/frame_plan.h"
 #include "app/frame_render.h"
@@ -81,7 +82,18 @@ CLI::App* AddRenderCommand(CLI::App& parent, RenderOptions& o) {
   cmd->add_flag("--no-sheet", o.no_sheet, "Do not write the contact sheet");
   cmd->add_flag("--no-video", o.no_video, "Do not write the preview video");
   cmd->add_flag("--quiet", o.quiet, "No progress output");
+  cmd->add_option("--framing", o.framing,
+                  "A:B[:STEP] frames the camera framing looks at (default: the output frames; "
+                  "chunks of one render pass the whole range)");
+  cmd->add_option("--motion", o.motion,
+                  "BVH motion driving a glTF INPUT (joints matched by name; see README)");
   AddOutputFlags(*cmd, o);
+  // Which options were given: with a rig file they override its settings.
+  cmd->callback([&o, cmd] {
+    for (const CLI::Option* opt : cmd->get_options()) {
+      if (opt->count() > 0) o.given.insert(opt->get_name());
+    }
+  });
   return cmd;
 }
 
@@ -125,21 +137,26 @@ int RunRender(const RenderOptions& options) {
     mocap::Result<Rig> loaded = LoadRig(o.input);
     if (!loaded.ok()) return Fail(loaded.error());
     rig = std::move(*loaded);
-    if (rig->character != "mannequin" && !rig->motion.empty()) {
-      return Fail(mocap::MakeError(mocap::ErrorCode::kUnsupported, {rig->file, 0, 0, "motion"},
-                                   "a glTF character with a separate motion is not supported "
-                                   "yet; leave out \"motion\" to use the glTF's animation"));
-    }
+    // The rig sets what the command line leaves out; an option given wins.
+    const auto given = [&o](const char* name) { return o.given.count(name) > 0; };
     o.input = rig->character == "mannequin" ? rig->motion : rig->character;
-    o.global = rig->global;
-    o.fps = rig->fps;
-    o.size = std::to_string(rig->render.size.x) + "x" + std::to_string(rig->render.size.y);
-    o.camera = rig->render.camera;
-    o.overlay.clear();
-    for (const std::string& item : rig->render.overlays) o.overlay += item + ",";
-    if (o.out.empty()) o.out = rig->render.output;
-    if (o.frames.empty()) o.frames = rig->render.frames;
-    o.split.reset();  // the rig's split is global only | global + patches (below)
+    if (rig->character != "mannequin" && !rig->motion.empty() && !given("--motion")) {
+      o.motion = rig->motion;
+    }
+    if (!given("--global")) o.global = rig->global;
+    if (!given("--fps")) o.fps = rig->fps;
+    if (!given("--size")) {
+      o.size = std::to_string(rig->render.size.x) + "x" + std::to_string(rig->render.size.y);
+    }
+    if (!given("--camera")) o.camera = rig->render.camera;
+    if (!given("--overlay")) {
+      o.overlay.clear();
+      for (const std::string& item : rig->render.overlays) o.overlay += item + ",";
+    }
+    if (!given("--out") || o.out.empty()) o.out = rig->render.output;
+    if (!given("--frames") || o.frames.empty()) o.frames = rig->render.frames;
+    // Without --split the rig's split is global only | global + patches (below).
+    if (!given("--split")) o.split.reset();
   }
 
   // --- Arguments -------------------------------------------------------------
@@ -198,7 +215,21 @@ int RunRender(const RenderOptions& options) {
   const std::string name = demo  ? "demo"
                            : rig ? std::filesystem::path(rig->file).stem().string()
                                  : std::filesystem::path(o.input).stem().string();
-  mocap::Result<Character> character = MakeCharacter(std::move(*src));
+  mocap::Result<Character> character = mocap::MakeError(mocap::ErrorCode::kInternal, {}, "");
+  if (!o.motion.empty()) {
+    // A glTF character driven by a separate BVH (app/character_motion.h).
+    mocap::Result<MotionSource> motion = LoadMotionSource(o.motion, load);
+    if (!motion.ok()) return Fail(motion.error());
+    const std::size_t printed = src->warnings.size();  // the glTF's, printed above
+    character = MakeRetargetedCharacter(std::move(*src), std::move(*motion));
+    if (character.ok() && !o.quiet) {
+      for (std::size_t i = printed; i < character->warnings.size(); ++i) {
+        std::fprintf(stderr, "%s\n", character->warnings[i].ToString().c_str());
+      }
+    }
+  } else {
+    character = MakeCharacter(std::move(*src));
+  }
   if (!character.ok()) return Fail(character.error());
   const Character& ch = *character;
 
@@ -240,7 +271,7 @@ int RunRender(const RenderOptions& options) {
     mocap::Result<std::vector<deform::PatchSetup>> built = BuildRigPatches(*rig, ch);
     if (!built.ok()) return Fail(built.error());
     patches = std::move(*built);
-    if (rig_split) split_left = split_right = *method;
+    if (rig_split && !o.split) split_left = split_right = *method;
   }
   const GlobalMethod main_method = split_left ? *split_left : *method;
   mocap::Result<FramePipeline> pipeline = FramePipeline::Create(ch, main_method, o.threads);
@@ -265,7 +296,18 @@ int RunRender(const RenderOptions& options) {
 
   // --- Framing (app/frame_plan.h) ------------------------------------------------
   DeformedFrame frame, right_frame;
-  mocap::Result<CameraPlan> cameras = CameraPlan::Create(*pipeline, *plan, o.camera,
+  mocap::Result<FramePlan> framing = plan;
+  if (!o.framing.empty() && !turntable) {
+    framing = PlanFrames(ch.motion, {.frames = o.framing, .fps = o.fps});
+    if (!framing.ok()) return Fail(ArgError("--framing", framing.error().message));
+    if (plan->range.first < framing->range.first || plan->range.last > framing->range.last) {
+      return Fail(ArgError("--framing", "expected a range holding every output frame (" +
+                                            std::to_string(plan->range.first) + ".." +
+                                            std::to_string(plan->range.last) + "), found '" +
+                                            o.framing + "'"));
+    }
+  }
+  mocap::Result<CameraPlan> cameras = CameraPlan::Create(*pipeline, *framing, o.camera,
                                                          o.elevation_deg, *size);
   if (!cameras.ok()) return Fail(cameras.error());
   const float ground_y = cameras->ground_y();

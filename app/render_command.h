@@ -6,6 +6,7 @@
 // out/demo/. `patchskin turntable` is `render --camera turntable`.
 
 #include <optional>
+#include <set>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -32,6 +33,14 @@ struct RenderOptions {
   bool quiet = false;
   bool overwrite = false;             // replace existing outputs (else refuse before rendering)
   bool resume = false;                // keep existing frames, render the missing ones
+  // "A:B[:STEP]": the frames the camera framing and the ground height are
+  // computed from; empty = the output frames. Chunks of one render (farm)
+  // pass the whole range so every chunk frames the body the same way.
+  std::string framing;
+  std::string motion;                 // BVH driving a glTF INPUT (retargeted by joint name); empty = its own
+  // Long names ("--size") of the options given on the command line, filled by
+  // the parser: with a rig file, these win over the rig's render settings.
+  std::set<std::string> given;
 };
 
 CLI::App* AddRenderCommand(CLI::App& parent, RenderOptions& options);

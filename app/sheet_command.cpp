@@ -1,0 +1,148 @@
+#include "app/sheet_command.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <regex>
+#include <vector>
+
+#include "app/frame_plan.h"
+#include "render/contact_sheet.h"
+#include "render/image_io.h"
+#include "render/video_writer.h"
+
+namespace app {
+namespace {
+
+// As render: at most this many frames on the sheet.
+constexpr int kMaxSheetFrames = 24;
+// Upper bound on frame numbers (ParseFrames needs a length).
+constexpr int kMaxFrameNumber = 10'000'000;
+
+int Fail(const mocap::Error& e) {
+  std::fprintf(stderr, "%s\n", e.ToString().c_str());
+  return e.code == mocap::ErrorCode::kInternal ? 3 : 2;
+}
+
+}  // namespace
+
+CLI::App* AddSheetCommand(CLI::App& parent, SheetOptions& o) {
+  CLI::App* cmd = parent.add_subcommand(
+      "sheet", "Build the contact sheet and preview video from frames already rendered");
+  cmd->add_option("pattern", o.pattern, "Frame pattern, as given to render --out (#### = number)")
+      ->required();
+  cmd->add_option("--frames", o.frames, "A:B[:STEP] the rendered frames, inclusive")->required();
+  cmd->add_option("--fps", o.fps, "The render's output frame rate")->capture_default_str();
+  cmd->add_flag("--no-sheet", o.no_sheet, "Do not write the contact sheet");
+  cmd->add_flag("--no-video", o.no_video, "Do not write the preview video");
+  cmd->add_flag("--overwrite", o.overwrite, "Replace an existing contact sheet and video");
+  cmd->add_flag("--quiet", o.quiet, "Print nothing on success");
+  return cmd;
+}
+
+int RunSheet(const SheetOptions& o) {
+  static const std::regex kRange(R"(\d+:\d+(:\d+)?)");
+  if (!std::regex_match(o.frames, kRange)) {
+    return Fail(ArgError("--frames", "expected A:B[:STEP] with both ends, found '" + o.frames + "'"));
+  }
+  mocap::Result<FrameRange> range = ParseFrames(o.frames, kMaxFrameNumber);
+  if (!range.ok()) return Fail(range.error());
+  if (!(o.fps > 0.0) || o.fps > 10000.0) return Fail(ArgError("--fps", "expected 0 < fps <= 10000"));
+  if (!render::HasFramePlaceholder(o.pattern)) {
+    return Fail(ArgError("pattern", "the pattern '" + o.pattern +
+                                        "' needs one frame placeholder such as #### or %04d"));
+  }
+
+  // Every frame must exist before anything is written.
+  std::vector<std::pair<int, std::string>> frames;
+  std::string first_missing;
+  int missing = 0;
+  for (int f = range->first; f <= range->last; f += range->step) {
+    mocap::Result<std::string> path = render::ExpandFramePattern(o.pattern, f);
+    if (!path.ok()) return Fail(path.error());
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(*path, ec)) {
+      if (missing++ == 0) first_missing = *path;
+    }
+    frames.emplace_back(f, std::move(*path));
+  }
+  if (missing > 0) {
+    return Fail(mocap::MakeError(mocap::ErrorCode::kIo, {first_missing, 0, 0, {}},
+                                 "frame missing (" + std::to_string(missing) + " of " +
+                                     std::to_string(frames.size()) +
+                                     " frames are missing; render them first)"));
+  }
+  const std::filesystem::path dir = std::filesystem::path(frames.front().second).parent_path();
+  const std::string sheet_path = (dir / "contact_sheet.png").string();
+  const std::string video_path = (dir / "preview.mp4").string();
+  if (!o.overwrite) {
+    for (const auto& [skip, path] : {std::pair{o.no_sheet, sheet_path}, std::pair{o.no_video, video_path}}) {
+      if (!skip && std::filesystem::exists(path)) {
+        return Fail(mocap::MakeError(mocap::ErrorCode::kInvalidArgument, {path, 0, 0, {}},
+                                     "exists; pass --overwrite to replace it"));
+      }
+    }
+  }
+
+  mocap::Result<render::Image> first = render::ReadImage(frames.front().second);
+  if (!first.ok()) return Fail(first.error());
+  const int width = first->width, height = first->height;
+  const int n = static_cast<int>(frames.size());
+  const int sheet_count = std::min(kMaxSheetFrames, n);
+  std::unique_ptr<render::ContactSheetBuilder> sheet;
+  if (!o.no_sheet) {
+    auto b = render::ContactSheetBuilder::Create(sheet_count, width, height);
+    if (!b.ok()) return Fail(b.error());
+    sheet = std::move(*b);
+  }
+  std::unique_ptr<render::VideoWriter> video;
+  if (!o.no_video) {
+    auto v = render::VideoWriter::Open(video_path, width & ~1, height & ~1,
+                                       {.fps = o.fps / range->step});
+    if (!v.ok()) return Fail(v.error());
+    video = std::move(*v);
+  }
+  int next_sheet = 0;
+  for (int i = 0; i < n && (sheet || video); ++i) {
+    // The same frames as render's sheet: index i == n * k / sheet_count.
+    const bool on_sheet = sheet && next_sheet < sheet_count &&
+                          i == static_cast<int>(static_cast<long long>(n) * next_sheet / sheet_count);
+    if (!on_sheet && !video) continue;
+    mocap::Result<render::Image> image =
+        i == 0 ? std::move(first) : render::ReadImage(frames[static_cast<std::size_t>(i)].second);
+    if (!image.ok()) return Fail(image.error());
+    if (image->width != width || image->height != height) {
+      return Fail(mocap::MakeError(
+          mocap::ErrorCode::kInvalidArgument, {frames[static_cast<std::size_t>(i)].second, 0, 0, {}},
+          "expected " + std::to_string(width) + "x" + std::to_string(height) +
+              " like the first frame, found " + std::to_string(image->width) + "x" +
+              std::to_string(image->height)));
+    }
+    if (on_sheet) {
+      const mocap::Status s = sheet->Add(*image, frames[static_cast<std::size_t>(i)].first);
+      if (!s.ok()) return Fail(s.error());
+      ++next_sheet;
+    }
+    if (video) {
+      const mocap::Status s = video->AddFrame(*image);
+      if (!s.ok()) return Fail(s.error());
+    }
+  }
+  if (sheet) {
+    const mocap::Status s = render::WriteImage(sheet->sheet(), sheet_path, {});
+    if (!s.ok()) return Fail(s.error());
+    if (!o.quiet) std::printf("contact sheet: %s\n", sheet_path.c_str());
+  }
+  if (video) {
+    const mocap::Status s = video->Close();
+    if (!s.ok()) return Fail(s.error());
+    if (!o.quiet) {
+      std::printf("video:         %s (%s)\n", video->path().c_str(),
+                  render::VideoCodecName(video->codec()));
+    }
+  }
+  return 0;
+}
+
+}  // namespace app

@@ -1,0 +1,191 @@
+// Command-line options override a rig file's render settings: for each of
+// --size, --camera, --overlay, --split, --out, --frames, --global and
+// --threads, `render RIG --option X` must give what a rig saying X gives (or,
+// where no rig field exists, what the option means), run as a process.
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "render/image_io.h"
+#include "support/data_paths.h"
+#include "support/run_process.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+using testsupport::ProcessResult;
+using testsupport::SlurpFile;
+
+fs::path Dir() {
+  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+  const fs::path d =
+      testsupport::TestOutputPath(std::string("rig_overrides/") + info->name() + "/x").parent_path();
+  fs::remove_all(d);
+  fs::create_directories(d / "logs");
+  return d;
+}
+
+std::string BendBvh() {
+  return (fs::path(TEST_DATA_DIR) / "../../samples/data/bend.bvh").lexically_normal().string();
+}
+
+// A rig on the mannequin bending its elbows (samples/data/bend.bvh), tiny frames.
+json BaseRig(const std::string& output) {
+  return {{"character", "mannequin"},
+          {"motion", {{"file", BendBvh()}}},
+          {"global", "ssd"},
+          {"render",
+           {{"size", {64, 36}}, {"camera", "follow"}, {"frames", "30:31"}, {"output", output}}}};
+}
+
+json WithElbowPatch(json rig) {
+  rig["patches"] = json::array({{{"name", "left_elbow"},
+                                 {"region",
+                                  {{"joint", "LeftForeArm"}, {"radius", 14}, {"side", {0, 0, 1}}}},
+                                 {"grid", {4, 4}},
+                                 {"sampling", {6, 6}}}});
+  return rig;
+}
+
+std::string WriteRig(const fs::path& dir, const std::string& name, const json& rig) {
+  const fs::path path = dir / name;
+  std::ofstream(path) << rig.dump(1);
+  return path.string();
+}
+
+ProcessResult Render(const fs::path& dir, const std::string& rig, std::vector<std::string> extra) {
+  std::vector<std::string> args{"render", rig, "--quiet", "--no-video", "--no-sheet",
+                                "--supersample", "1"};
+  args.insert(args.end(), extra.begin(), extra.end());
+  return testsupport::RunPatchskin(args, dir / "logs");
+}
+
+std::string Bytes(const fs::path& p) {
+  EXPECT_TRUE(fs::exists(p)) << p;
+  return SlurpFile(p);
+}
+
+// Same pixels (the PNG metadata names the rig file, so bytes differ between rigs).
+bool SamePixels(const fs::path& a, const fs::path& b) {
+  const auto ia = render::ReadImage(a.string());
+  const auto ib = render::ReadImage(b.string());
+  EXPECT_TRUE(ia.ok()) << a;
+  EXPECT_TRUE(ib.ok()) << b;
+  return ia.ok() && ib.ok() && ia->width == ib->width && ia->height == ib->height && ia->rgba == ib->rgba;
+}
+
+// Renders `a` with `option` and `b` (the rig that says the same) and expects
+// the same bytes in frame 30 (and frame 31).
+void ExpectSameAsRig(const std::string& name, const json& a, const std::vector<std::string>& option,
+                     const json& b) {
+  const fs::path d = Dir();
+  const std::string rig_a = WriteRig(d, "a.json", a);
+  const std::string rig_b = WriteRig(d, "b.json", b);
+  const ProcessResult ra = Render(d, rig_a, option);
+  ASSERT_EQ(ra.exit_code, 0) << ra.err;
+  const ProcessResult rb = Render(d, rig_b, {});
+  ASSERT_EQ(rb.exit_code, 0) << rb.err;
+  for (const char* frame : {"0030", "0031"}) {
+    EXPECT_TRUE(SamePixels(d / "out_a" / (std::string("f_") + frame + ".png"),
+                           d / "out_b" / (std::string("f_") + frame + ".png")))
+        << name << " frame " << frame;
+  }
+  // And the option really changed something: the rig alone gives other bytes.
+  const ProcessResult plain = Render(d, rig_a, {"--out", (d / "plain/f_####.png").string()});
+  ASSERT_EQ(plain.exit_code, 0) << plain.err;
+  EXPECT_FALSE(SamePixels(d / "plain/f_0030.png", d / "out_b/f_0030.png")) << name;
+}
+
+TEST(RigOverrides, SizeWins) {
+  const fs::path d = Dir();
+  const std::string rig = WriteRig(d, "rig.json", BaseRig("out/f_####.png"));
+  const ProcessResult r = Render(d, rig, {"--size", "80x48"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto image = render::ReadImage((d / "out/f_0030.png").string());
+  ASSERT_TRUE(image.ok()) << image.error().ToString();
+  EXPECT_EQ(image->width, 80);
+  EXPECT_EQ(image->height, 48);
+}
+
+TEST(RigOverrides, CameraWins) {
+  json b = BaseRig("out_b/f_####.png");
+  b["render"]["camera"] = "fixed";
+  ExpectSameAsRig("camera", BaseRig("out_a/f_####.png"), {"--camera", "fixed"}, b);
+}
+
+TEST(RigOverrides, OverlayWins) {
+  json b = BaseRig("out_b/f_####.png");
+  b["render"]["overlays"] = {"skeleton"};
+  ExpectSameAsRig("overlay", BaseRig("out_a/f_####.png"), {"--overlay", "skeleton"}, b);
+}
+
+TEST(RigOverrides, GlobalWins) {
+  json b = BaseRig("out_b/f_####.png");
+  b["global"] = "dqs";
+  ExpectSameAsRig("global", BaseRig("out_a/f_####.png"), {"--global", "dqs"}, b);
+}
+
+TEST(RigOverrides, SplitWins) {
+  // The rig's split: left ssd, right ssd + patches. --split ssd,dqs: left ssd,
+  // right dqs + patches. Same left half, a different right half.
+  const fs::path d = Dir();
+  const std::string rig = WriteRig(d, "rig.json", WithElbowPatch(BaseRig("out/f_####.png")));
+  ASSERT_EQ(Render(d, rig, {"--size", "96x48"}).exit_code, 0);
+  const ProcessResult r =
+      Render(d, rig, {"--size", "96x48", "--split", "ssd,dqs", "--out", (d / "cli/f_####.png").string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto from_rig = render::ReadImage((d / "out/f_0031.png").string());
+  const auto from_cli = render::ReadImage((d / "cli/f_0031.png").string());
+  ASSERT_TRUE(from_rig.ok() && from_cli.ok());
+  ASSERT_EQ(from_rig->width, 96);
+  int left_diff = 0, right_diff = 0;
+  for (int y = 0; y < 48; ++y) {
+    for (int x = 0; x < 96; ++x) {
+      const bool differs = from_rig->at(x, y) != from_cli->at(x, y);
+      (x < 48 ? left_diff : right_diff) += differs ? 1 : 0;
+    }
+  }
+  EXPECT_EQ(left_diff, 0) << "the left half is ssd in both";
+  EXPECT_GT(right_diff, 0) << "the right half is dqs + patches from the command line";
+}
+
+TEST(RigOverrides, OutWins) {
+  const fs::path d = Dir();
+  const std::string rig = WriteRig(d, "rig.json", BaseRig("out/f_####.png"));
+  const ProcessResult r = Render(d, rig, {"--out", (d / "elsewhere/g_####.png").string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(fs::exists(d / "elsewhere/g_0030.png"));
+  EXPECT_TRUE(fs::exists(d / "elsewhere/g_0031.png"));
+  EXPECT_FALSE(fs::exists(d / "out"));
+}
+
+TEST(RigOverrides, FramesWin) {
+  const fs::path d = Dir();
+  const std::string rig = WriteRig(d, "rig.json", BaseRig("out/f_####.png"));
+  const ProcessResult r = Render(d, rig, {"--frames", "5:7:2"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::vector<std::string> names;
+  for (const auto& e : fs::directory_iterator(d / "out")) names.push_back(e.path().filename().string());
+  std::sort(names.begin(), names.end());
+  EXPECT_EQ(names, (std::vector<std::string>{"f_0005.png", "f_0007.png"}));
+}
+
+TEST(RigOverrides, ThreadsAreRead) {
+  const fs::path d = Dir();
+  const std::string rig = WriteRig(d, "rig.json", BaseRig("out/f_####.png"));
+  const ProcessResult bad = Render(d, rig, {"--threads", "999"});
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_NE(bad.FirstErrLine().find("--threads"), std::string::npos) << bad.err;
+  ASSERT_EQ(Render(d, rig, {"--threads", "1", "--out", (d / "t1/f_####.png").string()}).exit_code, 0);
+  ASSERT_EQ(Render(d, rig, {"--threads", "2", "--out", (d / "t2/f_####.png").string()}).exit_code, 0);
+  EXPECT_TRUE(Bytes(d / "t1/f_0031.png") == Bytes(d / "t2/f_0031.png"));
+}
+
+}  // namespace
