@@ -5,6 +5,8 @@
 #include <filesystem>
 #include <memory>
 #include <optional>
+#include <span>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -102,6 +104,10 @@ CLI::App* AddExportCommand(CLI::App& parent, ExportOptions& o) {
   cmd->add_option("--size", o.size, "Image size for --with-camera, WxH")->capture_default_str();
   cmd->add_option("--elevation", o.elevation_deg, "Camera elevation in degrees")
       ->capture_default_str();
+  cmd->add_option("--scale", o.scale,
+                  "Multiply positions (and the camera JSON's lengths) by this, e.g. 0.01 for a "
+                  "capture in centimetres to metres")
+      ->capture_default_str();
   cmd->add_option("--threads", o.threads, "Worker threads (0 = all cores)")->capture_default_str();
   cmd->add_flag("--quiet", o.quiet, "No progress output");
   return cmd;
@@ -133,6 +139,9 @@ int RunExport(const ExportOptions& options) {
   }
   if (o.threads < 0 || o.threads > 256) return Fail(ArgError("--threads", "expected 0..256"));
   if (!(o.fps >= 0.0) || o.fps > 10000.0) return Fail(ArgError("--fps", "expected 0 < fps <= 10000"));
+  if (!(o.scale >= 1e-6f && o.scale <= 1e6f)) {
+    return Fail(ArgError("--scale", "expected a factor in 1e-6..1e6, found " + std::to_string(o.scale)));
+  }
   const mocap::Result<GlobalMethod> method = ParseGlobalMethod(o.global);
   if (!method.ok()) return Fail(method.error());
   const mocap::Result<deform::GltfExportLayout> layout = ParseLayout(o.layout);
@@ -209,20 +218,27 @@ int RunExport(const ExportOptions& options) {
   Progress progress(demo ? "export demo" : "export " + name, static_cast<int>(plan->frames.size()),
                     o.quiet);
   DeformedFrame frame;
+  std::vector<glm::vec3> scaled;  // --scale: the positions written (#V, reused)
   deform::ObjSequenceWriter obj;
   const std::string source = demo ? "demo_walk.bvh (built in)" : rig ? rig->file : o.input;
   for (const OutputFrame& of : plan->frames) {
     mocap::Status s = pipeline->Evaluate(of.time_s, frame);
     if (!s.ok()) return Fail(s.error());
+    std::span<const glm::vec3> positions = frame.positions;
+    if (o.scale != 1.0f) {
+      scaled.resize(frame.positions.size());
+      for (std::size_t i = 0; i < scaled.size(); ++i) scaled[i] = frame.positions[i] * o.scale;
+      positions = scaled;
+    }
     if (gltf) {
-      s = gltf->AddFrame(frame.positions, frame.normals);
+      s = gltf->AddFrame(positions, frame.normals);
     } else {
       const mocap::Result<std::string> path = render::ExpandFramePattern(out, of.number);
       if (!path.ok()) return Fail(path.error());
       char comment[160];
       std::snprintf(comment, sizeof(comment), "frame %d, t = %.6f s, %s skinning", of.number,
                     of.time_s, GlobalMethodName(*method));
-      s = obj.Write({.positions = frame.positions, .normals = frame.normals,
+      s = obj.Write({.positions = positions, .normals = frame.normals,
                      .triangles = bind.triangles,
                      .comment = "patchskin export of " + source + "\n" + comment},
                     *path);
@@ -231,8 +247,14 @@ int RunExport(const ExportOptions& options) {
     if (cameras) {
       char file[32];
       std::snprintf(file, sizeof(file), "camera_%04d.json", of.number);
+      // Scaling the scene and the camera's lengths together gives the same picture.
+      render::Camera camera = cameras->At(of);
+      camera.eye *= o.scale;
+      camera.target *= o.scale;
+      camera.near_plane *= o.scale;
+      camera.far_plane *= o.scale;
       s = deform::WriteFileAtomic((out_dir / file).string(),
-                                  CameraJson(cameras->At(of), *size, cameras->ground_y(),
+                                  CameraJson(camera, *size, cameras->ground_y() * o.scale,
                                              of.number, of.time_s));
       if (!s.ok()) return Fail(s.error());
     }

@@ -37,6 +37,9 @@ struct ExportOptions {
   std::string camera = "follow";  // follow | fixed (as render)
   std::string size = "1280x720";  // image size the camera JSON is for
   float elevation_deg = 15.0f;    // camera elevation (as render)
+  float scale = 1.0f;             // factor on positions and the camera JSON's lengths
+                                  // (eye, target, near, far, ground_y), 1e-6..1e6;
+                                  // e.g. 0.01: a capture in cm exported in metres
   int threads = 0;                // 0 = hardware concurrency
   bool quiet = false;
 };

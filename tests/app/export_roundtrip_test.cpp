@@ -270,4 +270,62 @@ TEST(ExportRoundTrip, PatchRigObjIsWhatRenderDrew) {
   EXPECT_EQ(differing, 0);
 }
 
+// --scale multiplies the written positions and the camera's lengths: the
+// scaled scene seen by the scaled camera projects every vertex where the
+// unscaled one did.
+TEST(ExportRoundTrip, ScaleMultipliesPositionsAndCameraLengths) {
+  const fs::path dir = Dir();
+  for (const std::string scale : {"1", "0.01"}) {
+    const testsupport::ProcessResult run = testsupport::RunPatchskin(
+        {"export", BendBvh(), "--frames", "20:20", "--with-camera", "--scale", scale, "--quiet", "--out",
+         (dir / scale / "mesh_####.obj").string()},
+        dir);
+    ASSERT_EQ(run.exit_code, 0) << run.err;
+  }
+  const testsupport::ParsedObj a = testsupport::ParseObjFile((dir / "1" / "mesh_0020.obj").string());
+  const testsupport::ParsedObj b = testsupport::ParseObjFile((dir / "0.01" / "mesh_0020.obj").string());
+  ASSERT_TRUE(a.error.empty() && b.error.empty()) << a.error << b.error;
+  ASSERT_EQ(a.positions.size(), b.positions.size());
+  for (std::size_t v = 0; v < a.positions.size(); ++v) ASSERT_EQ(b.positions[v], a.positions[v] * 0.01f) << v;
+  EXPECT_EQ(a.normals, b.normals);
+  const nlohmann::json ja = nlohmann::json::parse(testsupport::SlurpFile(dir / "1" / "camera_0020.json"));
+  const nlohmann::json jb = nlohmann::json::parse(testsupport::SlurpFile(dir / "0.01" / "camera_0020.json"));
+  EXPECT_EQ(jb["near"].get<float>(), ja["near"].get<float>() * 0.01f);
+  EXPECT_EQ(jb["ground_y"].get<float>(), ja["ground_y"].get<float>() * 0.01f);
+  auto matrix = [](const nlohmann::json& j) {
+    glm::mat4 m;
+    for (int c = 0; c < 4; ++c)
+      for (int r = 0; r < 4; ++r) m[c][r] = j[static_cast<std::size_t>(4 * c + r)].get<float>();
+    return m;
+  };
+  const glm::mat4 clip_a = matrix(ja["projection"]) * matrix(ja["view"]);
+  const glm::mat4 clip_b = matrix(jb["projection"]) * matrix(jb["view"]);
+  for (std::size_t v = 0; v < a.positions.size(); v += 97) {
+    const glm::vec4 pa = clip_a * glm::vec4(a.positions[v], 1.0f);
+    const glm::vec4 pb = clip_b * glm::vec4(b.positions[v], 1.0f);
+    EXPECT_NEAR(pa.x / pa.w, pb.x / pb.w, testsupport::kFloatTol * 10.0f) << v;
+    EXPECT_NEAR(pa.y / pa.w, pb.y / pb.w, testsupport::kFloatTol * 10.0f) << v;
+  }
+  const testsupport::ProcessResult bad = testsupport::RunPatchskin(
+      {"export", BendBvh(), "--scale", "0", "--quiet", "--out", (dir / "bad.glb").string()}, dir);
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_NE(bad.FirstErrLine().find("--scale"), std::string::npos) << bad.err;
+  EXPECT_FALSE(fs::exists(dir / "bad.glb"));
+}
+
+TEST(ExportRoundTrip, BadRigIsRefusedWithoutOutput) {
+  const fs::path dir = Dir();
+  const fs::path rig = dir / "bad.json";
+  std::ofstream(rig) << R"({"character": "mannequin", "motion": {"file": ")" << BendBvh()
+                     << R"("}, "patches": [{"name": "e", "region": {"joint": "Elbow", "radius": 9}}]})";
+  const testsupport::ProcessResult run = testsupport::RunPatchskin(
+      {"export", rig.string(), "--quiet", "--out", (dir / "out.glb").string()}, dir);
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_NE(run.FirstErrLine().find("bad.json: patches[0].region.joint: error:"), std::string::npos) << run.err;
+  EXPECT_FALSE(fs::exists(dir / "out.glb"));
+  for (const auto& e : fs::directory_iterator(dir)) {
+    EXPECT_EQ(e.path().filename().string().find(".patchskin-glb"), std::string::npos) << e.path();
+  }
+}
+
 }  // namespace
