@@ -230,7 +230,11 @@ class Renderer::SampleShader {
  public:
   SampleShader(const Rasterizer& raster, std::span<const SceneMesh> meshes,
                const RenderSettings& settings, const Renderer& renderer)
-      : raster_(raster), meshes_(meshes), settings_(settings), r_(renderer) {}
+      : raster_(raster), meshes_(meshes), settings_(settings), r_(renderer) {
+    const ShadingContext& ctx = r_.context_;
+    ground_light_ = ctx.ambient + ctx.key_radiance * std::max(ctx.key_dir.y, 0.0f) +
+                    ctx.fill_radiance * std::max(ctx.fill_dir.y, 0.0f);
+  }
 
   [[gnu::always_inline]] glm::vec3 Shade(std::uint32_t id, int sx, int sy) {
     Entry& t = cache_[id & (kCacheSize - 1)];
@@ -249,9 +253,7 @@ class Renderer::SampleShader {
       const glm::vec3 albedo = GroundAlbedo(settings_.ground_style, r_.grid_spacing_, p, ctx.eye);
       const float shadow = ContactShadowFactor(r_.shadows_, p);
       if (model == LightingModel::kUnlit) return albedo * shadow;
-      return albedo * (ctx.ambient + ctx.key_radiance * std::max(ctx.key_dir.y, 0.0f) +
-                       ctx.fill_radiance * std::max(ctx.fill_dir.y, 0.0f)) *
-             shadow;
+      return albedo * ground_light_ * shadow;
     }
     if (t.lambert_plane) return LambertPlane(t, fx, fy);
     glm::vec3 albedo = t.albedo;
@@ -458,6 +460,7 @@ class Renderer::SampleShader {
   std::span<const SceneMesh> meshes_;
   const RenderSettings& settings_;
   const Renderer& r_;
+  glm::vec3 ground_light_{0.0f};  // ambient + key and fill diffuse on the (up-facing) ground
   Entry cache_[kCacheSize];
 };
 
