@@ -25,6 +25,7 @@
 #include "render/image_io.h"
 #include "render/overlay.h"
 #include "render/renderer.h"
+#include "render/serial_task_queue.h"
 #include "render/video_writer.h"
 
 namespace app {
@@ -34,6 +35,9 @@ constexpr int kMaxSheetFrames = 24;
 // Most samples per frame (width * height * supersample^2): 8K UHD at 2x2 fits;
 // beyond it the sample buffers alone would take several GiB.
 constexpr std::int64_t kMaxFrameSamples = std::int64_t{1} << 27;
+// A tent resolve holds the frame's samples (16 bytes each): 1920x1080 or
+// 3840x2160 at 2x2 fit (33 million samples, 530 MB).
+constexpr std::int64_t kMaxTentSamples = 40'000'000;
 
 std::vector<std::string> SplitList(const std::string& text) {
   std::vector<std::string> out;
@@ -77,6 +81,9 @@ CLI::App* AddRenderCommand(CLI::App& parent, RenderOptions& o) {
   cmd->add_option("--threads", o.threads, "Worker threads (0 = all cores)")->capture_default_str();
   cmd->add_option("--supersample", o.supersample, "Anti-aliasing samples per axis: 1, 2 or 4")
       ->capture_default_str();
+  cmd->add_option("--resolve", o.resolve,
+                  "Supersample filter: box (the pixel's own samples) or tent (radius one pixel, softer)")
+      ->capture_default_str();
   cmd->add_option("--png-compression", o.png_compression, "PNG zlib level 0..9")
       ->capture_default_str();
   cmd->add_flag("--no-sheet", o.no_sheet, "Do not write the contact sheet");
@@ -112,6 +119,7 @@ CLI::App* AddTurntableCommand(CLI::App& parent, RenderOptions& o) {
   cmd->add_option("--overlay", o.overlay, "Comma list: skeleton, wire");
   cmd->add_option("--threads", o.threads, "Worker threads (0 = all cores)");
   cmd->add_option("--supersample", o.supersample, "Anti-aliasing samples per axis: 1, 2 or 4");
+  cmd->add_option("--resolve", o.resolve, "Supersample filter: box or tent");
   cmd->add_flag("--no-sheet", o.no_sheet, "Do not write the contact sheet");
   cmd->add_flag("--no-video", o.no_video, "Do not write the preview video");
   cmd->add_flag("--quiet", o.quiet, "No progress output");
@@ -169,6 +177,16 @@ int RunRender(const RenderOptions& options) {
     return Fail(ArgError("--size", "expected at most " + std::to_string(kMaxFrameSamples) +
                                        " samples per frame (width x height x supersample^2), found " +
                                        o.size + " at supersample " + std::to_string(o.supersample)));
+  }
+  if (o.resolve != "box" && o.resolve != "tent") {
+    return Fail(ArgError("--resolve", "expected box or tent, found '" + o.resolve + "'"));
+  }
+  if (o.resolve == "tent" && o.supersample > 1 &&
+      std::int64_t{size->x} * size->y * o.supersample * o.supersample > kMaxTentSamples) {
+    return Fail(ArgError("--resolve", "a tent resolve keeps every sample: expected at most " +
+                                          std::to_string(kMaxTentSamples) +
+                                          " samples per frame, found " + o.size +
+                                          " at supersample " + std::to_string(o.supersample)));
   }
   if (o.png_compression < 0 || o.png_compression > 9) {
     return Fail(ArgError("--png-compression", "expected 0..9"));
@@ -330,6 +348,7 @@ int RunRender(const RenderOptions& options) {
   settings.width = size->x;
   settings.height = size->y;
   settings.supersample = o.supersample;
+  settings.resolve = o.resolve == "tent" ? render::ResolveFilter::kTent : render::ResolveFilter::kBox;
   settings.threads = o.threads;
   settings.ground_at_scene_min = false;
   settings.ground_y = ground_y;
@@ -369,6 +388,16 @@ int RunRender(const RenderOptions& options) {
     if (video) return video->AddFrame(img);
     return mocap::Status::Ok();
   };
+  // The sheet and the H.264 preview take frames in order on their own thread,
+  // so encoding the video overlaps rendering the next frame (each task holds
+  // its own copy of the frame; at most two are pending).
+  render::SerialTaskQueue side({.max_queued = 2});
+  auto feed_async = [&](std::size_t i, int number, std::shared_ptr<const render::Image> img) {
+    if (!sheet && !video) return mocap::Status::Ok();
+    return side.Submit([&feed_sheet_and_video, i, number, img = std::move(img)] {
+      return feed_sheet_and_video(i, number, *img);
+    });
+  };
   int frames_done = guard.num_skipped();
   int last_done_number = -1;
   for (std::size_t i = 0; i < frames.size(); ++i) {
@@ -390,7 +419,7 @@ int RunRender(const RenderOptions& options) {
       if (!done_path.ok()) return Fail(done_path.error());
       mocap::Result<render::Image> done = render::ReadImage(*done_path);
       if (!done.ok()) return Fail(done.error());
-      s = feed_sheet_and_video(i, of.number, *done);
+      s = feed_async(i, of.number, std::make_shared<const render::Image>(std::move(*done)));
       if (!s.ok()) return Fail(s.error());
       continue;
     }
@@ -403,7 +432,7 @@ int RunRender(const RenderOptions& options) {
     s = DrawCharacterFrame(ch, frame, right_pipeline ? &right_frame : nullptr, camera, settings,
                            draw, renderer, right_renderer, right_image, image);
     if (!s.ok()) return Fail(s.error());
-    s = feed_sheet_and_video(i, of.number, image);
+    s = feed_async(i, of.number, std::make_shared<const render::Image>(image));
     if (!s.ok()) return Fail(s.error());
     const mocap::Result<std::string> path = render::ExpandFramePattern(pattern, of.number);
     if (!path.ok()) return Fail(path.error());
@@ -416,6 +445,8 @@ int RunRender(const RenderOptions& options) {
   }
   // Every frame handed to the writer is finished (so none is left half-written).
   mocap::Status s = writer.Finish();
+  if (!s.ok()) return Fail(s.error());
+  s = side.Finish();
   if (!s.ok()) return Fail(s.error());
   progress.Finish();
   if (guard.interrupted()) {

@@ -18,7 +18,7 @@ namespace {
 // products below 2^53, comfortably inside int64.
 constexpr float kGuardLimitSamples = 131072.0f;
 constexpr int kMaxRasterSize = 16384;
-constexpr int kMaxClipVertices = 9;  // a triangle clipped by 5 planes
+constexpr int kMaxClipVertices = 10;  // a triangle clipped by 6 planes has at most 9
 // Triangles whose vertices span less than this (fixed point) use the int32 loop.
 constexpr std::int32_t kSmallTriangleExtent = 48 * kSubpixelScale;
 
@@ -44,14 +44,15 @@ struct ClipVertex {
 };
 
 // Signed distance to clip plane `p` (>= 0 inside): 0 near (z >= -w), then the
-// guard band x <= g w, x >= -g w, y <= g w, y >= -g w.
+// guard band x <= g w, x >= -g w, y <= g w, y >= -g w, then 5 far (z <= w).
 float PlaneDistance(const glm::vec4& c, int p, float guard) {
   switch (p) {
     case 0: return c.z + c.w;
     case 1: return guard * c.w - c.x;
     case 2: return guard * c.w + c.x;
     case 3: return guard * c.w - c.y;
-    default: return guard * c.w + c.y;
+    case 4: return guard * c.w + c.y;
+    default: return c.w - c.z;
   }
 }
 
@@ -143,7 +144,7 @@ void Rasterizer::EmitClipped(const glm::vec4 (&clip)[3], std::uint32_t mesh,
     buffers[0][i].weights[i] = 1.0f;
   }
   int src = 0;
-  for (int plane = 0; plane < 5 && count > 0; ++plane) {
+  for (int plane = 0; plane < num_planes_ && count > 0; ++plane) {
     const ClipVertex* in = buffers[src];
     ClipVertex* result = buffers[1 - src];
     int n = 0;
@@ -221,6 +222,7 @@ bool Rasterizer::Setup(std::span<const ClipMesh> meshes, const RasterSettings& s
   width_ = settings.width;
   height_ = settings.height;
   cull_ = settings.cull_back_faces;
+  num_planes_ = settings.clip_far ? 6 : 5;
   tiles_x_ = (width_ + kTileSize - 1) / kTileSize;
   tiles_y_ = (height_ + kTileSize - 1) / kTileSize;
   // Clip to half the limit so vertices created on a guard plane, after
@@ -243,7 +245,7 @@ bool Rasterizer::Setup(std::span<const ClipMesh> meshes, const RasterSettings& s
       const std::size_t end = clip.size() * static_cast<std::size_t>(t + 1) / static_cast<std::size_t>(vertex_threads);
       for (std::size_t i = begin; i < end; ++i) {
         unsigned code = 0;
-        for (int p = 0; p < 5; ++p)
+        for (int p = 0; p < num_planes_; ++p)
           if (!(PlaneDistance(clip[i], p, guard_) >= 0.0f)) code |= 1u << p;
         SnappedVertex& v = snapped_[vertex_offsets_[m] + i];
         // Inside every plane yet not snappable cannot happen; be safe anyway.

@@ -11,8 +11,9 @@
 //
 // Coordinates: "samples" are the pixels of the (possibly supersampled) raster,
 // row 0 at the top; sample (x, y) is tested at its centre (x + 0.5, y + 0.5).
-// Front faces are counter-clockwise in NDC (OpenGL). There is no far-plane
-// clipping: geometry beyond the far plane is drawn.
+// Front faces are counter-clockwise in NDC (OpenGL). Far-plane clipping is
+// optional (RasterSettings::clip_far); without it geometry beyond the far plane
+// is drawn.
 //
 // Determinism: each tile's bin lists its triangles in input order and a tile is
 // rasterized by one thread, so the output is identical for any thread count.
@@ -57,6 +58,10 @@ struct RasterSettings {
   int width = 0;               // raster size in samples, 1..16384
   int height = 0;              // raster size in samples, 1..16384
   bool cull_back_faces = false;
+  // Clip at the far plane (clip z <= w, i.e. view depth <= the camera's far
+  // plane) as at the near plane: what lies beyond is not drawn, triangles
+  // crossing it are cut. Off: the far plane limits nothing.
+  bool clip_far = false;
   int threads = 1;             // >= 1; setup and binning split over this many threads
 };
 
@@ -149,6 +154,7 @@ class Rasterizer {
 
   int width_ = 0, height_ = 0, tiles_x_ = 0, tiles_y_ = 0;
   bool cull_ = false;
+  int num_planes_ = 5;  // clip planes in use: near, 4 guard-band planes, [far]
   float guard_ = 1.0f;  // NDC guard band: |x|,|y| <= guard_ * w keeps fixed point in range
   std::vector<PerThread> per_thread_;
   std::vector<std::size_t> vertex_offsets_;   // per mesh, into snapped_ / outcodes_

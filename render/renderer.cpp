@@ -8,6 +8,7 @@
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
+#include <xmmintrin.h>
 #endif
 
 #include "render/internal/parallel.h"
@@ -16,6 +17,7 @@ namespace render {
 namespace {
 
 constexpr int kMaxSamplesPerAxis = 16384;
+constexpr float kInf = std::numeric_limits<float>::infinity();
 
 // The image is written once per frame and not read back by this thread:
 // non-temporal stores skip the read-for-ownership of every output cache line.
@@ -41,6 +43,31 @@ inline void StreamFence() {
 #if defined(__SSE2__)
   _mm_sfence();
 #endif
+}
+
+// View depth (1 / stored 1/w, +inf where empty) of `n` samples of one tile row.
+void WriteDepthRow(const float* inv_w, const std::uint32_t* ids, int n, float* out) {
+  int i = 0;
+#if defined(__SSE2__)
+  const __m128 one = _mm_set1_ps(1.0f);
+  const __m128 inf = _mm_set1_ps(std::numeric_limits<float>::infinity());
+  const __m128i empty = _mm_set1_epi32(static_cast<int>(kNoTriangle));
+  const bool aligned = (reinterpret_cast<std::uintptr_t>(out) & 15u) == 0;
+  for (; i + 4 <= n; i += 4) {
+    const __m128 miss = _mm_castsi128_ps(_mm_cmpeq_epi32(
+        _mm_loadu_si128(reinterpret_cast<const __m128i*>(ids + i)), empty));  // all ones = empty
+    // Empty samples hold 1/w = 0: divide 1 by 1 there instead, then select inf.
+    const __m128 d = _mm_div_ps(one, _mm_or_ps(_mm_andnot_ps(miss, _mm_loadu_ps(inv_w + i)),
+                                               _mm_and_ps(miss, one)));
+    const __m128 v = _mm_or_ps(_mm_and_ps(miss, inf), _mm_andnot_ps(miss, d));
+    if (aligned) {
+      _mm_stream_ps(out + i, v);
+    } else {
+      _mm_storeu_ps(out + i, v);
+    }
+  }
+#endif
+  for (; i < n; ++i) StreamStore(out + i, ids[i] != kNoTriangle ? 1.0f / inv_w[i] : kInf);
 }
 
 mocap::JobStatus Fail(mocap::JobStatus::Code code, const char* what) { return {code, what}; }
@@ -132,6 +159,7 @@ mocap::JobStatus Renderer::Render(const Camera& camera, std::span<const SceneMes
   raster.width = settings.width * ss;
   raster.height = settings.height * ss;
   raster.cull_back_faces = settings.cull_back_faces;
+  raster.clip_far = settings.clip_far;
   raster.threads = threads;
   if (!rasterizer_.Setup(clip_meshes, raster))
     return Fail(mocap::JobStatus::kOutOfRange, "raster size out of range");
@@ -150,6 +178,12 @@ mocap::JobStatus Renderer::Render(const Camera& camera, std::span<const SceneMes
   else
     image.depth.clear();
 
+  const bool tent = settings.resolve == ResolveFilter::kTent && ss > 1;
+  if (tent) {
+    samples_.resize(static_cast<std::size_t>(raster.width) * static_cast<std::size_t>(raster.height));
+  } else {
+    samples_.clear();
+  }
   scratch_.resize(static_cast<std::size_t>(threads));
   for (TileScratch& s : scratch_) {
     s.depth.resize(kTileBufferSize);
@@ -166,6 +200,13 @@ mocap::JobStatus Renderer::Render(const Camera& camera, std::span<const SceneMes
     rasterizer_.RasterizeTile(tile, s.depth, s.ids);
     ShadeTile(tile, settings, meshes, s, image);
   });
+  if (tent) {
+    // Every sample is shaded before any pixel reads its neighbours' samples.
+    internal::RunOnThreads(threads, [&](int t) {
+      const int row0 = settings.height * t / threads, row1 = settings.height * (t + 1) / threads;
+      TentResolveRows(row0, row1, settings, image);
+    });
+  }
 
   // Overlays, in a fixed order, on the resolved image.
   if (overlays.wireframe) {
@@ -189,7 +230,11 @@ class Renderer::SampleShader {
  public:
   SampleShader(const Rasterizer& raster, std::span<const SceneMesh> meshes,
                const RenderSettings& settings, const Renderer& renderer)
-      : raster_(raster), meshes_(meshes), settings_(settings), r_(renderer) {}
+      : raster_(raster), meshes_(meshes), settings_(settings), r_(renderer) {
+    const ShadingContext& ctx = r_.context_;
+    ground_light_ = ctx.ambient + ctx.key_radiance * std::max(ctx.key_dir.y, 0.0f) +
+                    ctx.fill_radiance * std::max(ctx.fill_dir.y, 0.0f);
+  }
 
   [[gnu::always_inline]] glm::vec3 Shade(std::uint32_t id, int sx, int sy) {
     Entry& t = cache_[id & (kCacheSize - 1)];
@@ -208,10 +253,9 @@ class Renderer::SampleShader {
       const glm::vec3 albedo = GroundAlbedo(settings_.ground_style, r_.grid_spacing_, p, ctx.eye);
       const float shadow = ContactShadowFactor(r_.shadows_, p);
       if (model == LightingModel::kUnlit) return albedo * shadow;
-      return albedo * (ctx.ambient + ctx.key_radiance * std::max(ctx.key_dir.y, 0.0f) +
-                       ctx.fill_radiance * std::max(ctx.fill_dir.y, 0.0f)) *
-             shadow;
+      return albedo * ground_light_ * shadow;
     }
+    if (t.lambert_plane) return LambertPlane(t, fx, fy);
     glm::vec3 albedo = t.albedo;
     const bool need_weights = t.interpolate_color || model == LightingModel::kBlinnPhong;
     float l0 = w0, l1 = w1, l2 = w2;
@@ -238,18 +282,91 @@ class Renderer::SampleShader {
     return ShadeSurface(ctx, albedo, n, p);
   }
 
+  // Shade() as RGBA (alpha 1) for the single-sample path, which stores it as is.
+  [[gnu::always_inline]] glm::vec4 ShadeRgba(std::uint32_t id, int sx, int sy) {
+    Entry& t = cache_[id & (kCacheSize - 1)];
+    if (t.id != id) Load(id, t);
+    if (t.lambert_plane) {
+      return LambertPlane(t, static_cast<float>(sx - t.ref_x), static_cast<float>(sy - t.ref_y),
+                          1.0f);
+    }
+    return glm::vec4(Shade(id, sx, sy), 1.0f);
+  }
+
+#if defined(__SSE2__)
+  // The terms of a sample's colour, base + key * max(D, 0) / |N|: for a
+  // plane-lit triangle its (N, D) and the entry's lit_base / lit_key; for any
+  // other the shaded colour (alpha 1) in `base`, zero `key` and zero (N, D).
+  [[gnu::always_inline]] void ShadeTerms(std::uint32_t id, int sx, int sy, float* nd, float* base,
+                                         float* key) {
+    Entry& t = cache_[id & (kCacheSize - 1)];
+    if (t.id != id) Load(id, t);
+    if (t.lambert_plane) {
+      const float fx = static_cast<float>(sx - t.ref_x), fy = static_cast<float>(sy - t.ref_y);
+      _mm_store_ps(nd, _mm_add_ps(_mm_add_ps(_mm_load_ps(t.plane_c),
+                                             _mm_mul_ps(_mm_load_ps(t.plane_a), _mm_set1_ps(fx))),
+                                  _mm_mul_ps(_mm_load_ps(t.plane_b), _mm_set1_ps(fy))));
+      _mm_store_ps(base, _mm_load_ps(t.lit_base));
+      _mm_store_ps(key, _mm_load_ps(t.lit_key));
+      return;
+    }
+    const glm::vec3 c = Shade(id, sx, sy);
+    _mm_store_ps(base, _mm_set_ps(1.0f, c.z, c.y, c.x));
+    _mm_store_ps(key, _mm_setzero_ps());
+    _mm_store_ps(nd, _mm_setzero_ps());
+  }
+#endif
+
  private:
   static constexpr std::uint32_t kCacheSize = 64;
   struct Entry {
     std::uint32_t id = kNoTriangle;
     bool ground = false, smooth = false, interpolate_color = false;
+    // Lambert with one albedo per triangle: the unnormalized normal N and
+    // D = N . key_dir are linear in the sample position, so they are stored
+    // as planes and a sample costs two plane evaluations, |N| and one divide:
+    //   (N, D) = plane_c + plane_a * (x - ref_x) + plane_b * (y - ref_y),
+    //   colour = lit_base + lit_key * max(D, 0) / |N|   (= albedo * (ambient + key * N.L)).
+    bool lambert_plane = false;
+    alignas(16) float plane_a[4] = {}, plane_b[4] = {}, plane_c[4] = {};  // (Nx, Ny, Nz, D)
+    alignas(16) float lit_base[4] = {}, lit_key[4] = {};  // (albedo * ambient, 1), (albedo * key, 0)
     int ref_x = 0, ref_y = 0;  // reference sample (the triangle's bounds corner)
     float wa[3] = {}, wb[3] = {}, wc[3] = {};  // weight_i = wc + wa * (x - ref_x) + wb * (y - ref_y)
     glm::vec3 n[3], col[3], p[3], face_normal{0.0f, 0.0f, 1.0f}, albedo{1.0f};
   };
 
+
+  // Lambert from the entry's planes; `alpha` is the w of the result.
+  [[gnu::always_inline]] static glm::vec4 LambertPlane(const Entry& t, float fx, float fy,
+                                                       float alpha) {
+#if defined(__SSE2__)
+    const __m128 v = _mm_add_ps(_mm_add_ps(_mm_load_ps(t.plane_c),
+                                           _mm_mul_ps(_mm_load_ps(t.plane_a), _mm_set1_ps(fx))),
+                                _mm_mul_ps(_mm_load_ps(t.plane_b), _mm_set1_ps(fy)));
+    alignas(16) float nd[4];
+    _mm_store_ps(nd, v);
+    const float len2 = nd[0] * nd[0] + nd[1] * nd[1] + nd[2] * nd[2];
+    const float n_dot_l = nd[3] > 0.0f && len2 > 0.0f ? nd[3] / std::sqrt(len2) : 0.0f;
+    alignas(16) float out[4];
+    _mm_store_ps(out, _mm_add_ps(_mm_load_ps(t.lit_base),
+                                 _mm_mul_ps(_mm_load_ps(t.lit_key), _mm_set1_ps(n_dot_l))));
+    return {out[0], out[1], out[2], alpha};
+#else
+    float nd[4];
+    for (int k = 0; k < 4; ++k) nd[k] = t.plane_c[k] + t.plane_a[k] * fx + t.plane_b[k] * fy;
+    const float len2 = nd[0] * nd[0] + nd[1] * nd[1] + nd[2] * nd[2];
+    const float n_dot_l = nd[3] > 0.0f && len2 > 0.0f ? nd[3] / std::sqrt(len2) : 0.0f;
+    return {t.lit_base[0] + t.lit_key[0] * n_dot_l, t.lit_base[1] + t.lit_key[1] * n_dot_l,
+            t.lit_base[2] + t.lit_key[2] * n_dot_l, alpha};
+#endif
+  }
+  static glm::vec3 LambertPlane(const Entry& t, float fx, float fy) {
+    return glm::vec3(LambertPlane(t, fx, fy, 1.0f));
+  }
+
   [[gnu::noinline]] void Load(std::uint32_t id, Entry& t) const {
     t.id = id;
+    t.lambert_plane = false;
     const RasterTriangle& tri = raster_.triangle(id);
     t.ref_x = tri.min_x;
     t.ref_y = tri.min_y;
@@ -309,17 +426,46 @@ class Renderer::SampleShader {
       for (int k = 0; k < 3; ++k) corner[k] = mesh.vertex_colors[v[k]];
       to_vertices(corner, t.col);
     }
+    t.lambert_plane = r_.context_.model == LightingModel::kLambert && !t.interpolate_color;
+    if (t.lambert_plane) {
+      const ShadingContext& ctx = r_.context_;
+      for (int k = 0; k < 3; ++k) {
+        t.plane_a[k] = t.plane_b[k] = 0.0f;
+        t.plane_c[k] = t.face_normal[k];
+      }
+      if (t.smooth) {
+        for (int k = 0; k < 3; ++k) {
+          t.plane_a[k] = t.wa[0] * t.n[0][k] + t.wa[1] * t.n[1][k] + t.wa[2] * t.n[2][k];
+          t.plane_b[k] = t.wb[0] * t.n[0][k] + t.wb[1] * t.n[1][k] + t.wb[2] * t.n[2][k];
+          t.plane_c[k] = t.wc[0] * t.n[0][k] + t.wc[1] * t.n[1][k] + t.wc[2] * t.n[2][k];
+        }
+      }
+      const glm::vec3 a(t.plane_a[0], t.plane_a[1], t.plane_a[2]);
+      const glm::vec3 b(t.plane_b[0], t.plane_b[1], t.plane_b[2]);
+      const glm::vec3 c(t.plane_c[0], t.plane_c[1], t.plane_c[2]);
+      t.plane_a[3] = glm::dot(a, ctx.key_dir);
+      t.plane_b[3] = glm::dot(b, ctx.key_dir);
+      t.plane_c[3] = glm::dot(c, ctx.key_dir);
+      const glm::vec3 base = t.albedo * ctx.ambient, key = t.albedo * ctx.key_radiance;
+      for (int k = 0; k < 3; ++k) {
+        t.lit_base[k] = base[k];
+        t.lit_key[k] = key[k];
+      }
+      t.lit_base[3] = 1.0f;
+      t.lit_key[3] = 0.0f;
+    }
   }
 
   const Rasterizer& raster_;
   std::span<const SceneMesh> meshes_;
   const RenderSettings& settings_;
   const Renderer& r_;
+  glm::vec3 ground_light_{0.0f};  // ambient + key and fill diffuse on the (up-facing) ground
   Entry cache_[kCacheSize];
 };
 
 void Renderer::ShadeTile(int tile, const RenderSettings& settings,
-                         std::span<const SceneMesh> meshes, TileScratch& s, Image& image) const {
+                         std::span<const SceneMesh> meshes, TileScratch& s, Image& image) {
   const int ss = settings.supersample;
   const int x0 = (tile % rasterizer_.tiles_x()) * kTileSize;
   const int y0 = (tile / rasterizer_.tiles_x()) * kTileSize;
@@ -338,13 +484,54 @@ void Renderer::ShadeTile(int tile, const RenderSettings& settings,
       const std::size_t row = static_cast<std::size_t>(sy - y0) * kTileSize;
       glm::vec4* rgba = image.rgba.data() + image.index(x0, sy);
       float* depth = write_depth ? image.depth.data() + image.index(x0, sy) : nullptr;
+#if defined(__SSE2__)
+      // Two passes over the row so the square roots and divides of plane-lit
+      // samples run four at a time: first each sample's (N, D) and colour
+      // terms (other samples get their final colour in `base`, key 0), then
+      // colour = base + key * max(D, 0) / |N| as in LambertPlane, same order
+      // of operations, so the bytes equal the one-sample path's.
+      alignas(16) float nd[kTileSize][4], base[kTileSize][4], key[kTileSize][4];
+      const int n = x1 - x0;
+      for (int i = 0; i < n; ++i) {
+        const std::uint32_t id = s.ids[row + static_cast<std::size_t>(i)];
+        if (id == kNoTriangle) {
+          _mm_store_ps(base[i], _mm_set_ps(bg.w, bg.z, bg.y, bg.x));
+          _mm_store_ps(key[i], _mm_setzero_ps());
+          _mm_store_ps(nd[i], _mm_setzero_ps());
+        } else {
+          shader.ShadeTerms(id, x0 + i, sy, nd[i], base[i], key[i]);
+        }
+      }
+      for (int i = n; i < ((n + 3) & ~3); ++i) _mm_store_ps(nd[i], _mm_setzero_ps());
+      for (int i = 0; i < n; i += 4) {
+        __m128 x = _mm_load_ps(nd[i]), y = _mm_load_ps(nd[i + 1]), z = _mm_load_ps(nd[i + 2]),
+               d = _mm_load_ps(nd[i + 3]);
+        _MM_TRANSPOSE4_PS(x, y, z, d);
+        const __m128 len2 =
+            _mm_add_ps(_mm_add_ps(_mm_mul_ps(x, x), _mm_mul_ps(y, y)), _mm_mul_ps(z, z));
+        const __m128 zero = _mm_setzero_ps();
+        const __m128 lit = _mm_and_ps(_mm_cmpgt_ps(d, zero), _mm_cmpgt_ps(len2, zero));
+        alignas(16) float n_dot_l[4];
+        _mm_store_ps(n_dot_l, _mm_and_ps(lit, _mm_div_ps(d, _mm_sqrt_ps(len2))));
+        for (int j = 0; j < 4 && i + j < n; ++j) {
+          const __m128 c = _mm_add_ps(_mm_load_ps(base[i + j]),
+                                      _mm_mul_ps(_mm_load_ps(key[i + j]), _mm_set1_ps(n_dot_l[j])));
+          if ((reinterpret_cast<std::uintptr_t>(rgba + i + j) & 15u) == 0) {
+            _mm_stream_ps(reinterpret_cast<float*>(rgba + i + j), c);
+          } else {
+            _mm_storeu_ps(reinterpret_cast<float*>(rgba + i + j), c);
+          }
+        }
+      }
+#else
       for (int sx = x0; sx < x1; ++sx, ++rgba) {
         const std::size_t at = row + static_cast<std::size_t>(sx - x0);
         const std::uint32_t id = s.ids[at];
         const bool hit = id != kNoTriangle;
-        StreamStore(rgba, hit ? glm::vec4(shader.Shade(id, sx, sy), 1.0f) : bg);
-        if (depth != nullptr) StreamStore(depth++, hit ? 1.0f / s.depth[at] : inf);
+        StreamStore(rgba, hit ? shader.ShadeRgba(id, sx, sy) : bg);
       }
+#endif
+      if (depth != nullptr) WriteDepthRow(s.depth.data() + row, s.ids.data() + row, x1 - x0, depth);
     }
     StreamFence();
     return;
@@ -355,6 +542,8 @@ void Renderer::ShadeTile(int tile, const RenderSettings& settings,
   const int out_stride = kTileSize / ss;
   std::fill(s.accum.begin(), s.accum.end(), glm::vec4(0.0f));
   std::fill(s.nearest.begin(), s.nearest.end(), inf);
+  const std::size_t sample_stride = static_cast<std::size_t>(rasterizer_.width());
+  glm::vec4* samples = samples_.empty() ? nullptr : samples_.data() + static_cast<std::size_t>(y0) * sample_stride;
   for (int sy = y0; sy < y1; ++sy) {
     const glm::vec3 bg = background_rows_[static_cast<std::size_t>(sy)];
     const std::size_t row = static_cast<std::size_t>(sy - y0) * kTileSize;
@@ -363,14 +552,18 @@ void Renderer::ShadeTile(int tile, const RenderSettings& settings,
       const std::size_t at = row + static_cast<std::size_t>(sx - x0);
       const std::uint32_t id = s.ids[at];
       glm::vec4& acc = s.accum[out_row + static_cast<std::size_t>((sx - x0) / ss)];
+      glm::vec4 sample(0.0f);
       if (id == kNoTriangle) {
-        if (!transparent) acc += glm::vec4(bg, 0.0f);
+        if (!transparent) sample = glm::vec4(bg, 0.0f);
       } else {
-        acc += glm::vec4(shader.Shade(id, sx, sy), 1.0f);
+        sample = glm::vec4(shader.Shade(id, sx, sy), 1.0f);
         float& nearest = s.nearest[out_row + static_cast<std::size_t>((sx - x0) / ss)];
         nearest = std::min(nearest, 1.0f / s.depth[at]);
       }
+      if (id != kNoTriangle || !transparent) acc += sample;
+      if (samples != nullptr) samples[static_cast<std::size_t>(sx)] = sample;
     }
+    if (samples != nullptr) samples += sample_stride;
   }
   const float inv_n = 1.0f / static_cast<float>(ss * ss);
   for (int oy = oy0; oy < oy1; ++oy) {
@@ -391,10 +584,23 @@ void Renderer::ShadeTile(int tile, const RenderSettings& settings,
   }
 }
 
-void Renderer::FillBackgroundTile(int tile, const RenderSettings& settings, Image& image) const {
+void Renderer::FillBackgroundTile(int tile, const RenderSettings& settings, Image& image) {
   // Same values the shading path gives an empty pixel: the box average of the
   // background rows it covers (transparent: zero colour and alpha).
   const int ss = settings.supersample;
+  if (!samples_.empty()) {
+    const int x0 = (tile % rasterizer_.tiles_x()) * kTileSize;
+    const int y0 = (tile / rasterizer_.tiles_x()) * kTileSize;
+    const int x1 = std::min(x0 + kTileSize, rasterizer_.width());
+    const int y1 = std::min(y0 + kTileSize, rasterizer_.height());
+    for (int sy = y0; sy < y1; ++sy) {
+      const glm::vec4 sample = settings.background.transparent
+                                   ? glm::vec4(0.0f)
+                                   : glm::vec4(background_rows_[static_cast<std::size_t>(sy)], 0.0f);
+      glm::vec4* row = samples_.data() + static_cast<std::size_t>(sy) * static_cast<std::size_t>(rasterizer_.width());
+      std::fill(row + x0, row + x1, sample);
+    }
+  }
   const int ox0 = (tile % rasterizer_.tiles_x()) * kTileSize / ss;
   const int oy0 = (tile / rasterizer_.tiles_x()) * kTileSize / ss;
   const int ox1 = std::min(ox0 + kTileSize / ss, image.width);
@@ -420,6 +626,48 @@ void Renderer::FillBackgroundTile(int tile, const RenderSettings& settings, Imag
     }
   }
   StreamFence();
+}
+
+void Renderer::TentResolveRows(int row0, int row1, const RenderSettings& settings,
+                               Image& image) const {
+  // Per axis, the samples from half a pixel before the pixel to half a pixel
+  // after it: 2 * ss of them, sample k (from that first one) at offset
+  // (k + 0.5) / ss - 1 output pixels from the pixel centre.
+  const int ss = settings.supersample, taps = 2 * ss;
+  float weight[8];
+  for (int k = 0; k < taps; ++k) {
+    const float d = (static_cast<float>(k) + 0.5f) / static_cast<float>(ss) - 1.0f;
+    weight[k] = 1.0f - std::abs(d);
+  }
+  const int sw = rasterizer_.width(), sh = rasterizer_.height();
+  const bool transparent = settings.background.transparent;
+  for (int oy = row0; oy < row1; ++oy) {
+    const int sy0 = oy * ss - ss / 2;
+    for (int ox = 0; ox < settings.width; ++ox) {
+      const int sx0 = ox * ss - ss / 2;
+      glm::vec4 sum(0.0f);  // sum of weight * (rgb, coverage)
+      float total = 0.0f;   // sum of the weights of samples inside the raster
+      for (int j = 0; j < taps; ++j) {
+        const int sy = sy0 + j;
+        if (sy < 0 || sy >= sh) continue;
+        const glm::vec4* row = samples_.data() + static_cast<std::size_t>(sy) * static_cast<std::size_t>(sw);
+        for (int i = 0; i < taps; ++i) {
+          const int sx = sx0 + i;
+          if (sx < 0 || sx >= sw) continue;
+          const float w = weight[j] * weight[i];
+          sum += w * row[sx];
+          total += w;
+        }
+      }
+      glm::vec4& out = image.rgba[image.index(ox, oy)];
+      if (transparent) {
+        // Straight colour of the covered samples (empty ones hold zero rgb).
+        out = sum.w > 0.0f ? glm::vec4(glm::vec3(sum) / sum.w, sum.w / total) : glm::vec4(0.0f);
+      } else {
+        out = glm::vec4(glm::vec3(sum) / total, 1.0f);
+      }
+    }
+  }
 }
 
 Image Render(const Camera& camera, std::span<const SceneMesh> meshes, const Overlays& overlays,

@@ -3,6 +3,10 @@
 #include <algorithm>
 #include <cmath>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 namespace render {
 
 namespace {
@@ -31,6 +35,21 @@ ShadingContext MakeShadingContext(const LightRig& rig, LightingModel model,
   return ctx;
 }
 
+namespace {
+
+// x^n by repeated squaring (n >= 1): a handful of multiplies instead of powf.
+float PowInteger(float x, unsigned n) {
+  float result = 1.0f;
+  while (n != 0) {
+    if ((n & 1u) != 0) result *= x;
+    x *= x;
+    n >>= 1;
+  }
+  return result;
+}
+
+}  // namespace
+
 glm::vec3 ShadeSurface(const ShadingContext& ctx, const glm::vec3& albedo,
                        const glm::vec3& normal, const glm::vec3& position) {
   switch (ctx.model) {
@@ -44,6 +63,10 @@ glm::vec3 ShadeSurface(const ShadingContext& ctx, const glm::vec3& albedo,
       break;
   }
   const glm::vec3 view = glm::normalize(ctx.eye - position);
+  // Whole exponents (the default 32) by squaring; others through powf.
+  const bool whole = ctx.shininess >= 1.0f && ctx.shininess <= 1024.0f &&
+                     ctx.shininess == std::floor(ctx.shininess);
+  const auto exponent = whole ? static_cast<unsigned>(ctx.shininess) : 0u;
   glm::vec3 diffuse = ctx.ambient;
   glm::vec3 spec(0.0f);
   const glm::vec3* dirs[3] = {&ctx.key_dir, &ctx.fill_dir, &ctx.rim_dir};
@@ -55,21 +78,44 @@ glm::vec3 ShadeSurface(const ShadingContext& ctx, const glm::vec3& albedo,
     if (ctx.specular > 0.0f) {
       const glm::vec3 half = glm::normalize(*dirs[i] + view);
       const float n_dot_h = glm::dot(normal, half);
-      if (n_dot_h > 0.0f) spec += *radiance[i] * (ctx.specular * std::pow(n_dot_h, ctx.shininess));
+      if (n_dot_h > 0.0f) {
+        const float lobe = whole ? PowInteger(n_dot_h, exponent) : std::pow(n_dot_h, ctx.shininess);
+        spec += *radiance[i] * (ctx.specular * lobe);
+      }
     }
   }
   return albedo * diffuse + spec;
 }
+
+namespace {
+
+// |x - round(x)|, the distance to the nearest integer, without a libm call:
+// rounding to nearest-even only differs from round() at ties, where the
+// distance is 0.5 either way. Floats of magnitude >= 2^23 are integers.
+float DistanceToInteger(float x) {
+  if (!(std::abs(x) < 8388608.0f)) return 0.0f;
+#if defined(__SSE2__)
+  return std::abs(x - static_cast<float>(_mm_cvtss_si32(_mm_set_ss(x))));
+#else
+  return std::abs(x - std::nearbyint(x));
+#endif
+}
+
+}  // namespace
 
 glm::vec3 GroundAlbedo(const GroundStyle& style, float grid_spacing, const glm::vec3& position,
                        const glm::vec3& eye) {
   if (!(grid_spacing > 0.0f)) return style.color;
   const float half_width = 0.5f * style.line_width;
   const float u = position.x / grid_spacing, v = position.z / grid_spacing;
-  const float du = std::abs(u - std::round(u)), dv = std::abs(v - std::round(v));
+  const float du = DistanceToInteger(u), dv = DistanceToInteger(v);
   // Soft-edged lines: full line colour inside the width, fading over the same width.
   const float d = std::min(du, dv);
-  float line = 1.0f - std::clamp((d - half_width) / std::max(half_width, 1e-6f), 0.0f, 1.0f);
+  const float soft = std::max(half_width, 1e-6f);
+  // Most of the ground is between lines: there (d - w) / soft >= 1, the line
+  // weight below is exactly 0 and the colour exactly style.color.
+  if (d - half_width >= soft) return style.color;
+  float line = 1.0f - std::clamp((d - half_width) / soft, 0.0f, 1.0f);
   const float distance = glm::length(position - eye) / grid_spacing;
   const float fade_start = std::max(style.fade_start, 1e-3f);
   line *= 1.0f - std::clamp((distance - fade_start) / fade_start, 0.0f, 1.0f);

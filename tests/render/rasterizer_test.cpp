@@ -336,6 +336,72 @@ TEST(RasterizerTest, SupersampledHalfPlaneHasAnalyticCoverage) {
   }
 }
 
+TEST(RasterizerTest, FarPlaneClipsOnlyWhenAsked) {
+  const int w = 80, h = 60;
+  render::Camera cam;
+  cam.eye = glm::vec3(0.0f);
+  cam.target = glm::vec3(0.0f, 0.0f, -1.0f);
+  cam.near_plane = 0.1f;
+  cam.far_plane = 10.0f;
+  cam.aspect = static_cast<float>(w) / static_cast<float>(h);
+  // A floor y = -1 from z = -1 to z = -100 (crossing the far plane), and a
+  // triangle wholly beyond it, in front of the floor's horizon.
+  const std::vector<glm::vec3> p = {{-60.0f, -1.0f, -1.0f}, {60.0f, -1.0f, -1.0f},
+                                    {60.0f, -1.0f, -100.0f}, {-60.0f, -1.0f, -100.0f},
+                                    {-3.0f, 0.5f, -20.0f},   {3.0f, 0.5f, -20.0f},
+                                    {0.0f, 4.0f, -20.0f}};
+  const std::vector<glm::uvec3> tri = {{0u, 1u, 2u}, {0u, 2u, 3u}, {4u, 5u, 6u}};
+  const render::SceneMesh mesh{.positions = p, .triangles = tri, .base_color = glm::vec3(1.0f)};
+  for (bool clip_far : {false, true}) {
+    render::RenderSettings s;
+    s.width = w;
+    s.height = h;
+    s.lighting = render::LightingModel::kUnlit;
+    s.ground = false;
+    s.background.transparent = true;
+    s.clip_far = clip_far;
+    const render::Image image = render::Render(cam, {&mesh, 1}, {}, s);
+    int near_floor = 0, far_floor = 0, far_triangle = 0;
+    for (int y = 0; y < h; ++y) {
+      for (int x = 0; x < w; ++x) {
+        const rendertest::Ray ray = rendertest::PixelRay(cam, w, h, x, y);
+        const bool covered = image.at(x, y).a > 0.0f;
+        // The triangle at view depth 20: where the ray crosses z = -20.
+        const glm::dvec3 q = ray.origin + 20.0 * ray.dir;
+        const bool on_triangle = q.y > 0.6 && q.y < 3.8 && std::abs(q.x) < 2.9 * (4.0 - q.y) / 3.5;
+        if (on_triangle) {
+          ASSERT_EQ(covered, !clip_far) << x << "," << y;
+          far_triangle += covered ? 1 : 0;
+          continue;
+        }
+        if (ray.dir.y >= 0.0) continue;
+        const double t = -1.0 / ray.dir.y;  // view depth where the ray meets the floor
+        if (t < 1.1 || t > 99.0) continue;  // near the floor's own ends
+        if (t < cam.far_plane * 0.98) {
+          ASSERT_TRUE(covered) << x << "," << y;
+          ASSERT_NEAR(image.depth[image.index(x, y)], static_cast<float>(t), 1e-3f * static_cast<float>(t));
+          ++near_floor;
+        } else if (t > cam.far_plane * 1.02) {
+          ASSERT_EQ(covered, !clip_far) << x << "," << y << " depth " << t;
+          far_floor += covered ? 1 : 0;
+        }
+      }
+    }
+    EXPECT_GT(near_floor, 200);
+    if (clip_far) {
+      EXPECT_EQ(far_floor + far_triangle, 0);
+      for (float d : image.depth) {
+        if (std::isfinite(d)) {
+          ASSERT_LE(d, cam.far_plane * (1.0f + testsupport::kClipDepthRelTol));
+        }
+      }
+    } else {
+      EXPECT_GT(far_floor, 20);
+      EXPECT_GT(far_triangle, 20);
+    }
+  }
+}
+
 TEST(RasterizerTest, OutputIsIdenticalFor1And2And8Threads) {
   const int w = 200, h = 150;
   const rendertest::TriMesh a = rendertest::MakeSphere(glm::vec3(0.0f, 1.0f, 0.0f), 1.0f, 30, 50);

@@ -88,6 +88,9 @@ inline constexpr float kPolygonAreaRatioTol = 0.01f;
 // Rendered colour against an analytic value where only float round-off and
 // 1/256-pixel vertex snapping differ (perspective-correct interpolation).
 inline constexpr float kRenderTol = 2e-3f;
+// Relative view-depth error of a vertex the rasterizer created on a clip plane
+// (float interpolation in clip space, then 1 / (1/w)).
+inline constexpr float kClipDepthRelTol = 1e-5f;
 // Shading of a tessellated sphere against the analytic sphere's N.L (the
 // interpolated normal of a 64x128 UV sphere is off by well under 1 degree).
 inline constexpr float kTessellatedShadingTol = 5e-3f;
