@@ -8,6 +8,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "app/bench_command.h"
 #include "app/compare_command.h"
 #include "app/export_command.h"
 #include "app/elastic_command.h"
@@ -32,6 +33,8 @@ int main(int argc, char** argv) {
   CLI::App* compare = app::AddCompareCommand(app, &compare_options);
   app::ElasticOptions elastic_options;
   CLI::App* elastic = app::AddElasticCommand(app, elastic_options);
+  app::BenchOptions bench_options;
+  CLI::App* bench = app::AddBenchCommand(app, bench_options);
 
   try {
     app.parse(argc, argv);
@@ -48,6 +51,7 @@ int main(int argc, char** argv) {
     if (compare->parsed()) return app::RunCompareCommand(compare_options);
     if (export_cmd->parsed()) return app::RunExport(export_options);
     if (elastic->parsed()) return app::RunElastic(elastic_options);
+    if (bench->parsed()) return app::RunBench(bench_options);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "patchskin: internal error: %s\n", e.what());
     return 3;
