@@ -27,16 +27,14 @@
 #include <assimp/scene.h>
 #endif
 
+#include "app/bench_table1.h"
+#include "app/bench_timing.h"
 #include "app/demo_data.h"
 #include "app/frame_plan.h"
 #include "app/frame_render.h"
 #include "app/motion_source.h"
 #include "app/pipeline.h"
-#include "deform/direct_manipulation.h"
-#include "deform/mass_spring.h"
 #include "deform/patch_binding.h"
-#include "deform/patch_fit.h"
-#include "deform/pose_space.h"
 #include "deform/skinning_job.h"
 #include "mocap/bvh_reader.h"
 #include "mocap/bvh_writer.h"
@@ -54,230 +52,15 @@
 namespace app {
 namespace {
 
-// ---------------------------------------------------------------- timing ---
+using bench::Budget;
+using bench::Clock;
+using bench::ClockName;
+using bench::Now;
+using bench::Rates;
+using bench::Row;
+using bench::Table1Row;
 
-enum class Clock { kCpu, kWall };  // the calling thread's CPU time | elapsed time
-
-const char* ClockName(Clock c) { return c == Clock::kCpu ? "cpu" : "wall"; }
-
-double Now(Clock c) {
-  timespec ts{};
-  clock_gettime(c == Clock::kCpu ? CLOCK_THREAD_CPUTIME_ID : CLOCK_MONOTONIC, &ts);
-  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
-
-struct Budget {
-  int runs = 7;             // repetitions (median, min, max over them)
-  double min_time_s = 0.3;  // each repetition lasts at least this long on its clock
-};
-
-// `items` / (seconds per call of `op`), once per repetition. The number of
-// calls per repetition is calibrated first so that reading the clock (a system
-// call for CPU time) stays out of sub-microsecond operations.
-std::vector<double> Rates(const Budget& b, Clock clock, double items, const std::function<void()>& op) {
-  std::int64_t batch = 1;
-  double dt = 0.0;
-  for (;;) {
-    const double t0 = Now(clock);
-    for (std::int64_t i = 0; i < batch; ++i) op();
-    dt = Now(clock) - t0;
-    if (dt >= b.min_time_s / 8.0 || batch >= (std::int64_t{1} << 30)) break;
-    batch *= 2;
-  }
-  batch = std::max<std::int64_t>(
-      1, static_cast<std::int64_t>(static_cast<double>(batch) * b.min_time_s / std::max(dt, 1e-9)));
-  std::vector<double> rates;
-  for (int r = 0; r < b.runs; ++r) {
-    const double t0 = Now(clock);
-    for (std::int64_t i = 0; i < batch; ++i) op();
-    rates.push_back(items * static_cast<double>(batch) / std::max(Now(clock) - t0, 1e-12));
-  }
-  return rates;
-}
-
-// One reported figure: a rate (or size) per repetition and what it compares to.
-struct Row {
-  std::string key;             // stable name (JSON key, first table column)
-  std::string unit;
-  Clock clock = Clock::kCpu;
-  std::vector<double> runs;    // one value per repetition (one for sizes)
-  double reference = 0.0;      // figure compared with; 0 = none
-  std::string reference_name;  // "paper", "Assimp", ...
-  std::string note;
-
-  double Median() const {
-    std::vector<double> v = runs;
-    std::sort(v.begin(), v.end());
-    const std::size_t n = v.size();
-    return n == 0 ? 0.0 : n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-  }
-  double Min() const { return runs.empty() ? 0.0 : *std::min_element(runs.begin(), runs.end()); }
-  double Max() const { return runs.empty() ? 0.0 : *std::max_element(runs.begin(), runs.end()); }
-};
-
-// ---------------------------------------------------------- Table 1 rows ---
-
-// The paper's Table 1 (Core 2, 2.4 GHz); 0 where our sources do not give it.
-struct PatchCase {
-  const char* name;
-  int m, n;                // control grid
-  int around, along;       // tube vertices: around x along ~ the paper's vertex count
-  bool simulated;          // update = mass-spring step (else the pose-space RBF)
-  double paper_update, paper_rebuild, paper_total;  // per second
-};
-constexpr PatchCase kPatches[] = {
-    {"elbow", 9, 10, 46, 25, false, 3195.0, 688.0, 581.0},
-    {"shoulder", 9, 6, 54, 25, false, 5348.0, 660.0, 532.0},
-    {"abdomen", 5, 5, 11, 5, true, 1122.0, 0.0, 0.0},
-    {"face", 7, 7, 25, 10, true, 400.0, 0.0, 0.0},
-};
-
-// Part of a cylinder about z (200 degrees, radius 4, height 20): the region.
-deform::Mesh Tube(int around, int along) {
-  deform::Mesh m;
-  for (int i = 0; i < around; ++i) {
-    const float phi = glm::radians(-90.0f + 200.0f * static_cast<float>(i) / static_cast<float>(around - 1));
-    for (int j = 0; j < along; ++j) {
-      const float h = 20.0f * static_cast<float>(j) / static_cast<float>(along - 1);
-      m.positions.emplace_back(4.0f * std::cos(phi), 4.0f * std::sin(phi), h);
-    }
-  }
-  for (int i = 0; i + 1 < around; ++i) {
-    for (int j = 0; j + 1 < along; ++j) {
-      const auto a = static_cast<unsigned>(i * along + j), b = static_cast<unsigned>((i + 1) * along + j);
-      m.triangles.emplace_back(a, b, b + 1);
-      m.triangles.emplace_back(a, b + 1, a + 1);
-    }
-  }
-  return m;
-}
-
-struct BoundPatch {
-  deform::BSplineSurface surface;
-  deform::PatchBinding binding;
-};
-
-mocap::Result<BoundPatch> FitAndBind(const PatchCase& c) {
-  const deform::Mesh mesh = Tube(c.around, c.along);
-  std::vector<int> region(mesh.positions.size());
-  for (std::size_t i = 0; i < region.size(); ++i) region[i] = static_cast<int>(i);
-  auto param = deform::ParametrizeCylinder(mesh.positions, region, mesh.triangles, glm::dvec3(0.0),
-                                           glm::dvec3(0, 0, 1));
-  if (!param.ok()) return param.error();
-  auto samples = deform::SampleRegion(mesh.positions, mesh.triangles, *param,
-                                      deform::UniformParameters(c.m + 4),
-                                      deform::UniformParameters(c.n + 4));
-  if (!samples.ok()) return samples.error();
-  auto fit = deform::FitSurface(*samples, {.num_u = c.m, .num_v = c.n});
-  if (!fit.ok()) return fit.error();
-  BoundPatch p;
-  p.surface = std::move(fit->surface);
-  deform::OrientNormal(p.surface, *param);
-  auto bound = deform::BindPatch(p.surface, mesh.positions, param->region, param->uv);
-  if (!bound.ok()) return bound.error();
-  p.binding = std::move(bound->binding);
-  return p;
-}
-
-// 5 example poses (6 features: two rotation vectors) with random displacements.
-mocap::Result<deform::RbfModel> FitRbf(int num_control) {
-  std::mt19937 rng(1);
-  std::uniform_real_distribution<float> uni(-1.0f, 1.0f);
-  std::vector<deform::PoseExample> examples;
-  for (int e = 0; e < 5; ++e) {
-    deform::PoseExample ex;
-    ex.name = "example" + std::to_string(e);
-    for (int d = 0; d < 6; ++d) ex.features.push_back(uni(rng));
-    for (int k = 0; k < num_control; ++k) ex.displacement.emplace_back(uni(rng), uni(rng), uni(rng));
-    examples.push_back(std::move(ex));
-  }
-  return deform::RbfPoseSpace::Fit(examples, 6, num_control);
-}
-
-struct Table1Row {
-  const PatchCase* patch = nullptr;
-  int bound = 0;
-  Row update, rebuild, total;
-};
-
-mocap::Result<Table1Row> MeasurePatch(const PatchCase& c, const Budget& b) {
-  mocap::Result<BoundPatch> p = FitAndBind(c);
-  if (!p.ok()) return p.error();
-  const auto count = static_cast<std::size_t>(c.m * c.n);
-  std::vector<glm::vec3> control = deform::ControlPointsAsFloat(p->surface);
-  for (glm::vec3& q : control) q *= 1.01f;  // a deformed frame
-  Table1Row row;
-  row.patch = &c;
-  row.bound = static_cast<int>(p->binding.size());
-  const std::string key = c.name;
-
-  std::vector<glm::vec3> displacement(count), out(count);
-  std::function<void()> update;
-  deform::RbfModel rbf;
-  deform::MassSpringNetwork net;
-  deform::MassSpringState state;
-  std::vector<float> features = {0.1f, 0.2f, -0.3f, 0.4f, 0.0f, 0.1f};
-  const std::vector<glm::quat> frames(count, glm::angleAxis(0.3f, glm::vec3(0, 0, 1)));
-  const std::function<deform::DrivingFrame(double)> drive = [](double t) {
-    const auto s = static_cast<float>(std::sin(7.0 * t)), co = static_cast<float>(std::cos(7.0 * t));
-    return deform::DrivingFrame{glm::angleAxis(0.2f * s, glm::vec3(0, 1, 0)),
-                                glm::vec3(300.0f * s, 100.0f * co, 0), glm::vec3(0, 1.4f * co, 0),
-                                glm::vec3(0, -9.8f * s, 0)};
-  };
-  int frame = 0;
-  bool failed = false;
-  if (c.simulated) {
-    auto built = deform::BuildMassSpringNetwork(
-        {.rows = c.m, .cols = c.n, .rest_points = control, .max_angular_speed_rad_s = 2.0f});
-    if (!built.ok()) return built.error();
-    net = std::move(*built);
-    state.Resize(net);
-    // One 30 fps output frame of simulation (8 RK4 steps at h = 1/240 s).
-    update = [&] {
-      failed |= !deform::MassSpringStepJob{.network = &net, .state = &state,
-                                           .time_s = frame++ / 30.0, .driving = &drive,
-                                           .displacements = displacement}
-                     .Run()
-                     .ok();
-    };
-  } else {
-    auto fitted = FitRbf(c.m * c.n);
-    if (!fitted.ok()) return fitted.error();
-    rbf = std::move(*fitted);
-    // dS(theta) from the RBF, then Q = G + A dS.
-    update = [&] {
-      features[0] += 1e-7f;
-      failed |= !deform::PoseSpaceJob{.model = &rbf, .features = features, .displacement = displacement}
-                     .Run()
-                     .ok();
-      failed |= !deform::PoseSpaceApplyJob{.global = control, .rotations = frames,
-                                           .displacement = displacement, .control = out}
-                     .Run()
-                     .ok();
-    };
-  }
-  std::vector<glm::vec3> positions(p->binding.size());
-  const deform::PatchRebuildJob rebuild_job{.control = control, .bindings = p->binding.view(),
-                                            .positions = positions};
-  const auto rebuild = [&] { failed |= !rebuild_job.Run().ok(); };
-
-  row.update = {key + "_update_per_s", "1/s", Clock::kCpu, Rates(b, Clock::kCpu, 1.0, update),
-                c.paper_update, "paper", c.simulated ? "mass-spring, one 30 fps frame" : "RBF dS + Q"};
-  row.rebuild = {key + "_rebuild_per_s", "1/s", Clock::kCpu, Rates(b, Clock::kCpu, 1.0, rebuild),
-                 c.paper_rebuild, "paper", std::to_string(row.bound) + " bound vertices"};
-  row.total = {key + "_total_per_s", "1/s", Clock::kCpu, {}, c.paper_total, "paper",
-               "one update + one rebuild"};
-  for (std::size_t r = 0; r < row.update.runs.size(); ++r) {
-    row.total.runs.push_back(1.0 / (1.0 / row.update.runs[r] + 1.0 / row.rebuild.runs[r]));
-  }
-  if (failed) {
-    return mocap::MakeError(mocap::ErrorCode::kInternal, {"bench", 0, 0, {}},
-                            std::string("a job refused to run in the ") + c.name + " workload");
-  }
-  return row;
-}
-
-// ------------------------------------------------------------- the rest ---
+// ------------------------------------------------------------ workloads ---
 
 std::string GeneratedBvh(int frames) {
   const mocap::Skeleton skel = mocap::MakeHumanoidSkeleton();
@@ -479,8 +262,8 @@ int RunBench(const BenchOptions& o) {
 
   // --- Table 1 --------------------------------------------------------------------
   std::vector<Table1Row> table1;
-  for (const PatchCase& c : kPatches) {
-    mocap::Result<Table1Row> row = MeasurePatch(c, budget);
+  for (const bench::PatchCase& c : bench::kPatches) {
+    mocap::Result<Table1Row> row = bench::MeasurePatch(c, budget);
     if (!row.ok()) return Fail(row.error());
     table1.push_back(std::move(*row));
   }
@@ -588,8 +371,10 @@ int RunBench(const BenchOptions& o) {
   Row e2e{"demo_end_to_end_fps", "frames/s", Clock::kWall, {}, 0.0, "",
           std::to_string(e2e_frames) + " demo frames, 1280x720, 2x2 samples, PNG level 1, " +
               std::to_string(threads) + " threads"};
+  Row e2e_cpu{"demo_end_to_end_per_cpu_s", "frames/s", Clock::kProcess, {}, 0.0, "",
+              "the same frames per CPU second of all threads (insensitive to load)"};
   for (int r = 0; r < (o.quick ? 1 : 3); ++r) {
-    const double t0 = Now(Clock::kWall);
+    const double t0 = Now(Clock::kWall), c0 = Now(Clock::kProcess);
     render::AsyncImageWriter writer({.num_workers = 2, .max_in_flight = 4});
     for (const OutputFrame& of : plan->frames) {
       mocap::Status s = pipeline->Evaluate(of.time_s, frame);
@@ -608,6 +393,7 @@ int RunBench(const BenchOptions& o) {
     }
     if (mocap::Status s = writer.Finish(); !s.ok()) return Fail(s.error());
     e2e.runs.push_back(e2e_frames / std::max(Now(Clock::kWall) - t0, 1e-9));
+    e2e_cpu.runs.push_back(e2e_frames / std::max(Now(Clock::kProcess) - c0, 1e-9));
   }
   const std::string png_path = (out_dir / "encode.png").string();
   Row encode{"png_encode_fps", "frames/s", Clock::kCpu, {}, 0.0, "",
@@ -616,6 +402,7 @@ int RunBench(const BenchOptions& o) {
                       [&] { failed |= !render::WriteImage(image, png_path, png).ok(); });
   std::filesystem::remove_all(out_dir, ec);
   rows.push_back(std::move(e2e));
+  rows.push_back(std::move(e2e_cpu));
   rows.push_back(std::move(encode));
   rows.push_back({"bytes_per_bound_vertex", "bytes", Clock::kCpu,
                   {static_cast<double>(deform::PatchBinding::kStoredBytesPerVertex)}, 0.0, "",

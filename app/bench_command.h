@@ -22,8 +22,9 @@
 //
 // Every figure is the median of repeated runs, with min and max. Single-thread
 // figures use the thread's CPU time (steady on a shared machine); figures that
-// use several threads use wall-clock time. The header names the CPU, cores,
-// load average, build type and compiler. A build without NDEBUG (not Release)
+// use several threads use wall-clock time (the end-to-end row also per CPU
+// second of all the process's threads, which load does not inflate). The
+// header names the CPU, cores, load average, build type and compiler. A build without NDEBUG (not Release)
 // is refused unless --allow-debug is given (its figures mean nothing).
 //
 // Exit codes: 0 ok, 1 usage, 2 bad argument or unwritable --json, 3 internal.

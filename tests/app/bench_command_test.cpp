@@ -65,7 +65,8 @@ TEST(BenchCommand, QuickRunPrintsEveryRowAndWritesPositiveFigures) {
               row.at("rebuild_per_s").at("max").get<double>());
   }
   for (const char* key : {"bvh_parse_generated", "ssd_1_thread", "ssd_2_threads", "raster_fps_1280x720",
-                          "raster_fps_1920x1080", "demo_end_to_end_fps", "png_encode_fps",
+                          "raster_fps_1920x1080", "demo_end_to_end_fps", "demo_end_to_end_per_cpu_s",
+                          "png_encode_fps",
                           "bytes_per_bound_vertex", "peak_memory"}) {
     ExpectFigure(j.at("figures").at(key), key);
     EXPECT_NE(r.out.find(key), std::string::npos) << key << " missing from the table";
