@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -32,15 +33,21 @@ TEST(BenchCommand, QuickRunPrintsEveryRowAndWritesPositiveFigures) {
   fs::remove_all(dir);
   fs::create_directories(dir);
   const fs::path json_path = dir / "bench.json";
-  const testsupport::ProcessResult r = testsupport::RunPatchskin(
-      {"bench", "--quick", "--threads", "2", "--json", json_path.string()}, dir / "logs");
+  std::vector<std::string> args{"bench", "--quick", "--threads", "2", "--json", json_path.string()};
+#ifndef NDEBUG
+  args.push_back("--allow-debug");  // the dev preset: the command refuses Debug builds otherwise
+  const bool release = false;
+#else
+  const bool release = true;
+#endif
+  const testsupport::ProcessResult r = testsupport::RunPatchskin(args, dir / "logs");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("machine: "), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("build:   "), std::string::npos) << r.out;
 
   std::ifstream in(json_path);
   const nlohmann::json j = nlohmann::json::parse(in);
-  EXPECT_TRUE(j.at("header").at("release").get<bool>());
+  EXPECT_EQ(j.at("header").at("release").get<bool>(), release);
   EXPECT_FALSE(j.at("header").at("cpu").get<std::string>().empty());
 
   const nlohmann::json& table1 = j.at("table1");
