@@ -80,7 +80,10 @@ TEST(LongCapture, PeakMemoryGrowsOnlyWithTheMotionDataAndTheFirstFrameComesAtOnc
   }
   // Start-up: parsing ~50 MB and three small frames, not a pass over 100,000
   // frames (each evaluation of the 20k-vertex body costs ~0.3 ms: 30 s).
+  // Optimized builds only: a sanitized Debug build parses ~10x slower.
+#ifdef NDEBUG
   EXPECT_LT(runs.back().cpu_s, 3.0);
+#endif
 }
 
 }  // namespace
