@@ -2,9 +2,12 @@
 
 #include <algorithm>
 #include <climits>
+#include <cstdint>
 #include <cmath>
 #include <optional>
 #include <sstream>
+
+#include "mocap/check.h"
 
 namespace app {
 
@@ -93,16 +96,22 @@ mocap::Result<CameraPlan> CameraPlan::Create(FramePipeline& pipeline, const Fram
   if (plan.frames.empty()) return ArgError("--frames", "no frames to frame");
   CameraPlan cp;
   cp.mode_ = mode;
-  const std::vector<OutputFrame>& frames = plan.frames;
-  // Framing: a pre-pass over up to 64 frames of the range.
-  DeformedFrame frame;
+  cp.frame_time_s_ = plan.frame_time_s;
+  mocap::Result<FramePipeline> tracker =
+      FramePipeline::Create(pipeline.character(), GlobalMethod::kSsd, pipeline.threads());
+  if (!tracker.ok()) return std::move(tracker).error();
+  cp.tracker_ = std::make_unique<FramePipeline>(std::move(*tracker));
+  // Framing: output frames spread evenly over the whole motion, both ends
+  // included, the same whatever --frames asks for.
+  DeformedFrame& frame = cp.scratch_;
   deform::Bounds all_bounds;
   glm::vec3 largest_extent(0.0f);
   float ground_y = 1e30f;
-  const int samples = std::min<int>(64, static_cast<int>(frames.size()));
-  for (int i = 0; i < samples; ++i) {
-    const std::size_t k = frames.size() * static_cast<std::size_t>(i) / static_cast<std::size_t>(samples);
-    const mocap::Status s = pipeline.Evaluate(frames[k].time_s, frame);
+  const std::int64_t last = std::max(0, plan.motion_frames - 1);
+  const std::int64_t samples = std::min<std::int64_t>(kFramingSamples, last + 1);
+  for (std::int64_t i = 0; i < samples; ++i) {
+    const std::int64_t f = samples > 1 ? last * i / (samples - 1) : 0;
+    const mocap::Status s = cp.tracker_->Evaluate(static_cast<double>(f) * plan.frame_time_s, frame);
     if (!s.ok()) return s.error();
     all_bounds.Extend(frame.bounds.min);
     all_bounds.Extend(frame.bounds.max);
@@ -116,12 +125,12 @@ mocap::Result<CameraPlan> CameraPlan::Create(FramePipeline& pipeline, const Fram
   const glm::vec3 view_dir = -glm::normalize(glm::vec3(0.45f, 0.0f, 1.0f) * std::cos(elevation) +
                                              glm::vec3(0.0f, std::sin(elevation), 0.0f));
   if (mode == "turntable") {
-    const mocap::Status s = pipeline.Evaluate(frames.front().time_s, frame);
+    const mocap::Status s = cp.tracker_->Evaluate(plan.frames.front().time_s, frame);
     if (!s.ok()) return s.error();
     const render::Camera framed = render::FrameBounds(frame.bounds, kFovYDeg, aspect, view_dir);
     cp.turntable_ = render::TurntablePath(frame.bounds.center(),
                                           glm::length(framed.eye - framed.target), elevation_deg,
-                                          static_cast<int>(frames.size()));
+                                          static_cast<int>(plan.frames.size()));
     for (render::Camera& c : cp.turntable_) {
       c.fov_y_deg = kFovYDeg;
       c.aspect = aspect;
@@ -140,13 +149,7 @@ mocap::Result<CameraPlan> CameraPlan::Create(FramePipeline& pipeline, const Fram
     follow.near_plane = framed.near_plane;
     follow.far_plane = framed.far_plane * 4.0f;
     follow.frame_time_s = static_cast<float>(plan.frame_time_s);
-    cp.centre_base_ = std::max(0, plan.range.first - follow.window_frames);
-    // Centres of the body's bounds at every output frame the filter can see.
-    for (int f = cp.centre_base_; f <= plan.range.last; ++f) {
-      const mocap::Status s = pipeline.Evaluate(f * plan.frame_time_s, frame);
-      if (!s.ok()) return s.error();
-      cp.centres_.push_back(frame.bounds.center());
-    }
+    cp.centres_.reserve(static_cast<std::size_t>(follow.window_frames) + 1);
   }
   return cp;
 }
@@ -154,7 +157,26 @@ mocap::Result<CameraPlan> CameraPlan::Create(FramePipeline& pipeline, const Fram
 render::Camera CameraPlan::At(const OutputFrame& frame) const {
   if (mode_ == "turntable") return turntable_[static_cast<std::size_t>(frame.camera)];
   if (mode_ == "fixed") return fixed_;
-  return follow_.At(centres_, frame.camera - centre_base_);
+  // The window of centres frame - window .. frame: keep what is already
+  // evaluated, drop what fell out, evaluate the rest in ascending order.
+  const int f = frame.camera;
+  const int first = std::max(0, f - std::max(follow_.window_frames, 0));
+  const int cached_end = centre_base_ + static_cast<int>(centres_.size());
+  if (first < centre_base_ || first > cached_end) {
+    centres_.clear();
+    centre_base_ = first;
+  } else if (first > centre_base_) {
+    centres_.erase(centres_.begin(), centres_.begin() + (first - centre_base_));
+    centre_base_ = first;
+  }
+  for (int g = centre_base_ + static_cast<int>(centres_.size()); g <= f; ++g) {
+    // Evaluate() only fails on sizes, which Create() already checked with
+    // the same pipeline.
+    const mocap::Status s = tracker_->Evaluate(g * frame_time_s_, scratch_);
+    PATCHSKIN_CHECK(s.ok());
+    centres_.push_back(scratch_.bounds.center());
+  }
+  return follow_.At(centres_, f - centre_base_);
 }
 
 }  // namespace app

@@ -4,6 +4,7 @@
 // camera each output frame is seen from. Keeping these in one place is what
 // makes an exported frame and its camera JSON match the rendered image.
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -63,17 +64,38 @@ mocap::Result<FramePlan> PlanFrames(const mocap::Motion& motion, const FramePlan
 
 // The camera of every output frame, as `render` uses it: "follow" (a smoothed
 // follow camera framing the body's largest extent), "fixed" (one camera
-// framing the bounds of up to 64 frames of the range) or "turntable" (an orbit
-// of the first frame). Built by evaluating the pipeline (a pre-pass).
+// framing the bounds of the whole motion) or "turntable" (an orbit of the
+// first frame of the range).
+//
+// Nothing here depends on the requested frame range beyond the frame being
+// asked for, so a render split into chunks (--frames 0:9, 10:19, ...) gets the
+// same cameras and ground as one whole render:
+// - framing (extent, fixed bounds, ground height) samples at most
+//   kFramingSamples output frames spread evenly over the WHOLE motion
+//   (deterministic, independent of --frames);
+// - the follow camera of frame f reads the bounds centres of frames
+//   max(0, f - window) .. f only (render::FollowCamera), evaluated on demand and
+//   kept in a sliding window, so memory is constant and the first frame needs
+//   at most window + 1 evaluations, however long the capture.
+// Bodies are evaluated with a private global-only SSD pipeline of the same
+// character (patches and the elastic layer move the surface by a few
+// percent of the body; the caller's pipeline and its state are never touched).
 class CameraPlan {
  public:
+  // Output frames of the whole motion sampled for framing and ground height.
+  static constexpr int kFramingSamples = 64;
+
   // mode: follow | fixed | turntable; elevation in degrees; size in pixels.
+  // `pipeline` only supplies the character and thread count; it must outlive
+  // nothing here (the character must outlive the CameraPlan).
   // Errors: kInvalidArgument (mode), and the pipeline's errors.
   static mocap::Result<CameraPlan> Create(FramePipeline& pipeline, const FramePlan& plan,
                                           const std::string& mode, float elevation_deg,
                                           glm::ivec2 size);
 
-  // The camera of `frame` (one of the plan's frames).
+  // The camera of `frame` (one of the plan's frames). Follow: evaluates the
+  // frames of its window not seen yet, so ascending frames cost one body
+  // evaluation each. Not thread-safe (a cache is updated).
   render::Camera At(const OutputFrame& frame) const;
   // Lowest point of the sampled frames (world Y): where render draws the ground.
   float ground_y() const { return ground_y_; }
@@ -83,8 +105,11 @@ class CameraPlan {
   std::vector<render::Camera> turntable_;
   render::Camera fixed_;
   render::FollowCamera follow_;
-  std::vector<glm::vec3> centres_;  // follow: bounds centre per output frame from centre_base_
-  int centre_base_ = 0;
+  double frame_time_s_ = 1.0 / 30.0;           // output frame f is at f * frame_time_s_
+  std::unique_ptr<FramePipeline> tracker_;     // global-only SSD body for bounds
+  mutable std::vector<glm::vec3> centres_;     // follow: bounds centres of frames centre_base_..
+  mutable int centre_base_ = 0;
+  mutable DeformedFrame scratch_;
   float ground_y_ = 0.0f;
 };
 

@@ -8,6 +8,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "app/bench_command.h"
 #include "app/compare_command.h"
 #include "app/export_command.h"
 #include "app/farm_command.h"
@@ -38,6 +39,8 @@ int main(int argc, char** argv) {
   CLI::App* sheet = app::AddSheetCommand(app, sheet_options);
   app::FarmOptions farm_options;
   CLI::App* farm = app::AddFarmCommand(app, farm_options);
+  app::BenchOptions bench_options;
+  CLI::App* bench = app::AddBenchCommand(app, bench_options);
 
   try {
     app.parse(argc, argv);
@@ -56,6 +59,7 @@ int main(int argc, char** argv) {
     if (elastic->parsed()) return app::RunElastic(elastic_options);
     if (sheet->parsed()) return app::RunSheet(sheet_options);
     if (farm->parsed()) return app::RunFarm(farm_options);
+    if (bench->parsed()) return app::RunBench(bench_options);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "patchskin: internal error: %s\n", e.what());
     return 3;

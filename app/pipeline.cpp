@@ -164,6 +164,8 @@ FramePipeline& FramePipeline::operator=(FramePipeline&&) noexcept = default;
 FramePipeline::~FramePipeline() = default;
 
 GlobalMethod FramePipeline::method() const { return impl_->method; }
+const Character& FramePipeline::character() const { return *impl_->character; }
+int FramePipeline::threads() const { return impl_->threads; }
 
 int FramePipeline::num_patches() const { return static_cast<int>(impl_->patches.size()); }
 

@@ -86,6 +86,10 @@ class FramePipeline {
   mocap::Status Evaluate(double time_s, DeformedFrame& out);
 
   GlobalMethod method() const;
+  // The character this pipeline deforms (the one given to Create) and its
+  // worker count (resolved: >= 1).
+  const Character& character() const;
+  int threads() const;
 
   // Adds the patch layer (ALGORITHMS.md 0, 3.7, 3.8), applied after the global
   // step: control points carried by the same method (SSD or DQS), bound

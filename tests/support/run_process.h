@@ -7,6 +7,7 @@
 #include <fcntl.h>
 #include <signal.h>
 #include <spawn.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -23,6 +24,8 @@ namespace testsupport {
 struct ProcessResult {
   int exit_code = -1;  // the child's exit status; -1 when a signal ended it
   int term_signal = 0; // the signal that ended it, or 0
+  long max_rss_kb = 0;  // the child's peak resident set (getrusage ru_maxrss, KiB)
+  double cpu_s = 0.0;   // the child's user + system CPU time, seconds
   std::string out;
   std::string err;
 
@@ -67,7 +70,11 @@ inline ProcessResult WaitFor(const RunningProcess& p) {
   ProcessResult r;
   if (p.pid <= 0) return r;
   int status = 0;
-  waitpid(p.pid, &status, 0);
+  rusage usage{};
+  wait4(p.pid, &status, 0, &usage);
+  r.max_rss_kb = usage.ru_maxrss;
+  r.cpu_s = static_cast<double>(usage.ru_utime.tv_sec + usage.ru_stime.tv_sec) +
+            1e-6 * static_cast<double>(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
   if (WIFEXITED(status)) r.exit_code = WEXITSTATUS(status);
   if (WIFSIGNALED(status)) r.term_signal = WTERMSIG(status);
   r.out = SlurpFile(p.out);

@@ -1,0 +1,457 @@
+#include "app/bench_command.h"
+
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <iterator>
+#include <random>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <glm/gtc/matrix_transform.hpp>
+#include <nlohmann/json.hpp>
+
+#ifdef PATCHSKIN_HAVE_ASSIMP
+#include <assimp/Importer.hpp>
+#include <assimp/scene.h>
+#endif
+
+#include "app/bench_table1.h"
+#include "app/bench_timing.h"
+#include "app/demo_data.h"
+#include "app/frame_plan.h"
+#include "app/frame_render.h"
+#include "app/motion_source.h"
+#include "app/pipeline.h"
+#include "deform/patch_binding.h"
+#include "deform/skinning_job.h"
+#include "mocap/bvh_reader.h"
+#include "mocap/bvh_writer.h"
+#include "mocap/synthetic.h"
+#include "render/async_writer.h"
+#include "render/image_io.h"
+
+#ifndef PATCHSKIN_BUILD_TYPE
+#define PATCHSKIN_BUILD_TYPE "unknown"
+#endif
+#ifndef PATCHSKIN_DATA_DIR
+#define PATCHSKIN_DATA_DIR ""
+#endif
+
+namespace app {
+namespace {
+
+using bench::Budget;
+using bench::Clock;
+using bench::ClockName;
+using bench::Now;
+using bench::Rates;
+using bench::Row;
+using bench::Table1Row;
+
+// ------------------------------------------------------------ workloads ---
+
+std::string GeneratedBvh(int frames) {
+  const mocap::Skeleton skel = mocap::MakeHumanoidSkeleton();
+  mocap::WalkOptions walk;
+  walk.frame_time_s = 1.0 / 120.0;
+  walk.num_cycles = std::max(1, frames / 120);
+  const mocap::Result<mocap::Motion> motion = mocap::MakeWalkMotion(skel, walk);
+  if (!motion.ok()) return {};
+  mocap::Result<std::string> text = mocap::FormatBvh(skel, *motion);
+  return text.ok() ? std::move(*text) : std::string();
+}
+
+Row BvhParseRow(const std::string& key, const std::string& text, const std::string& name,
+                const Budget& b, bool& failed) {
+  const double mb = static_cast<double>(text.size()) * 1e-6;
+  Row row{key, "MB/s", Clock::kCpu, {}, 0.0, "", name};
+  row.runs = Rates(b, Clock::kCpu, mb, [&] {
+    failed |= !mocap::ParseBvh(text, name).ok();
+  });
+  char note[128];
+  std::snprintf(note, sizeof(note), " (%.2f MB)", mb);
+  row.note += note;
+  return row;
+}
+
+// 100k vertices, 4 influences, 60 joints, positions + normals.
+struct SsdFixture {
+  static constexpr int kVertices = 100000;
+  static constexpr int kJoints = 60;
+  std::vector<glm::vec3> rest_p, rest_n, out_p, out_n;
+  deform::SkinWeights weights;
+  std::vector<glm::mat4> palette;
+
+  SsdFixture() {
+    std::mt19937 rng(42);
+    std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+    std::uniform_int_distribution<int> near(0, 3);
+    weights.influences = 4;
+    for (int v = 0; v < kVertices; ++v) {
+      rest_p.emplace_back(u(rng), u(rng), u(rng));
+      rest_n.push_back(glm::normalize(glm::vec3(u(rng), u(rng), u(rng)) + 1e-3f));
+      const int base = (v * kJoints) / kVertices;  // neighbouring vertices share joints
+      for (int i = 0; i < 4; ++i) {
+        weights.joints.push_back(static_cast<std::uint16_t>((base + near(rng)) % kJoints));
+        weights.weights.push_back(0.1f + 0.5f * (u(rng) + 1.0f));
+      }
+    }
+    deform::NormalizeSkinWeights(weights);
+    for (int j = 0; j < kJoints; ++j) {
+      const glm::vec3 axis = glm::normalize(glm::vec3(u(rng), u(rng), u(rng)) + 1e-3f);
+      palette.push_back(glm::rotate(glm::translate(glm::mat4(1.0f), glm::vec3(u(rng), u(rng), u(rng))),
+                                    u(rng), axis));
+    }
+    out_p.resize(kVertices);
+    out_n.resize(kVertices);
+  }
+
+  // Vertices [b, e).
+  bool Skin(std::size_t b, std::size_t e) {
+    const std::size_t n = e - b;
+    return deform::SkinningJob{.model_from_bind = palette, .influences = 4,
+                               .joint_indices = std::span<const std::uint16_t>(weights.joints).subspan(4 * b, 4 * n),
+                               .joint_weights = std::span<const float>(weights.weights).subspan(4 * b, 4 * n),
+                               .rest_positions = std::span<const glm::vec3>(rest_p).subspan(b, n),
+                               .rest_normals = std::span<const glm::vec3>(rest_n).subspan(b, n),
+                               .positions = std::span<glm::vec3>(out_p).subspan(b, n),
+                               .normals = std::span<glm::vec3>(out_n).subspan(b, n)}
+        .Run()
+        .ok();
+  }
+};
+
+// Two threads each skin their half `batch` times; wall-clock rate per run.
+std::vector<double> SsdTwoThreads(SsdFixture& f, const Budget& b, bool& failed) {
+  const std::size_t half = SsdFixture::kVertices / 2;
+  const auto run = [&](std::int64_t batch) {
+    bool bad0 = false, bad1 = false;
+    const double t0 = Now(Clock::kWall);
+    std::thread other([&] {
+      for (std::int64_t i = 0; i < batch; ++i) bad1 |= !f.Skin(half, SsdFixture::kVertices);
+    });
+    for (std::int64_t i = 0; i < batch; ++i) bad0 |= !f.Skin(0, half);
+    other.join();
+    failed |= bad0 || bad1;
+    return Now(Clock::kWall) - t0;
+  };
+  std::int64_t batch = 1;
+  double dt = run(batch);
+  while (dt < b.min_time_s / 8.0) dt = run(batch *= 2);
+  batch = std::max<std::int64_t>(1, static_cast<std::int64_t>(static_cast<double>(batch) * b.min_time_s / dt));
+  std::vector<double> rates;
+  for (int r = 0; r < b.runs; ++r) {
+    rates.push_back(static_cast<double>(SsdFixture::kVertices) * static_cast<double>(batch) / run(batch));
+  }
+  return rates;
+}
+
+std::string CpuModel() {
+  std::ifstream in("/proc/cpuinfo");
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind("model name", 0) == 0) {
+      const std::size_t colon = line.find(':');
+      return colon == std::string::npos ? line : line.substr(colon + 2);
+    }
+  }
+  return "unknown CPU";
+}
+
+std::string LoadAverage() {
+  std::ifstream in("/proc/loadavg");
+  double a = 0, b = 0, c = 0;
+  if (!(in >> a >> b >> c)) return "unknown";
+  char text[64];
+  std::snprintf(text, sizeof(text), "%.2f %.2f %.2f", a, b, c);
+  return text;
+}
+
+double PeakRssMb() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return static_cast<double>(usage.ru_maxrss) / 1024.0;  // kilobytes on Linux
+}
+
+void PrintRow(const Row& r) {
+  std::printf("%-30s %12.4g %12.4g %12.4g  %-10s %-4s", r.key.c_str(), r.Median(), r.Min(), r.Max(),
+              r.unit.c_str(), ClockName(r.clock));
+  if (r.reference > 0.0) {
+    std::printf(" %10.4g %8.1fx", r.reference, r.Median() / r.reference);
+  } else {
+    std::printf(" %10s %9s", "-", "-");
+  }
+  std::printf("  %s\n", r.note.c_str());
+}
+
+nlohmann::json RowJson(const Row& r) {
+  nlohmann::json j = {{"median", r.Median()}, {"min", r.Min()},   {"max", r.Max()},
+                      {"unit", r.unit},       {"clock", ClockName(r.clock)},
+                      {"runs", r.runs},       {"note", r.note}};
+  if (r.reference > 0.0) {
+    j[r.reference_name] = r.reference;
+    j["ratio"] = r.Median() / r.reference;
+  }
+  return j;
+}
+
+int Fail(const mocap::Error& e) {
+  std::fprintf(stderr, "%s\n", e.ToString().c_str());
+  return e.code == mocap::ErrorCode::kInternal ? 3 : 2;
+}
+
+}  // namespace
+
+CLI::App* AddBenchCommand(CLI::App& parent, BenchOptions& o) {
+  CLI::App* cmd = parent.add_subcommand(
+      "bench", "Measure the paper's Table 1 and every speed figure (run in a Release build)");
+  cmd->add_flag("--quick", o.quick, "A few short runs (seconds); figures are rough");
+  cmd->add_option("--json", o.json, "Also write the figures as JSON to this file");
+  cmd->add_option("--threads", o.threads, "Workers of the end-to-end row (0 = all cores)")
+      ->capture_default_str();
+  cmd->add_option("--data", o.data_dir, "Shared data folder (for bvh/cmu_cgspeed/01_01.bvh)");
+  cmd->add_flag("--allow-debug", o.allow_debug, "Run even in a non-Release build");
+  return cmd;
+}
+
+int RunBench(const BenchOptions& o) {
+  if (o.threads < 0 || o.threads > 256) return Fail(ArgError("--threads", "expected 0..256"));
+#ifndef NDEBUG
+  std::fprintf(stderr,
+               "bench: WARNING: this is not a Release build (%s, assertions on); its figures are "
+               "meaningless. Build with -DCMAKE_BUILD_TYPE=Release.\n",
+               PATCHSKIN_BUILD_TYPE);
+  if (!o.allow_debug) return 1;
+  const bool release = false;
+#else
+  const bool release = true;
+#endif
+  const Budget budget = o.quick ? Budget{3, 0.02} : Budget{7, 0.3};
+  const int threads = o.threads > 0 ? o.threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  bool failed = false;
+
+  // --- Header -----------------------------------------------------------------
+  const std::time_t now = std::time(nullptr);
+  char date[64];
+  std::strftime(date, sizeof(date), "%Y-%m-%d %H:%M UTC", std::gmtime(&now));
+  const std::string cpu = CpuModel();
+  const unsigned cores = std::thread::hardware_concurrency();
+  const std::string load = LoadAverage();
+  std::printf("patchskin bench%s, %s\n", o.quick ? " --quick" : "", date);
+  std::printf("machine: %s, %u cores, load average %s\n", cpu.c_str(), cores, load.c_str());
+  std::printf("build:   %s%s, %s %s\n", PATCHSKIN_BUILD_TYPE, release ? "" : " (NOT RELEASE)",
+#ifdef __clang__
+              "clang",
+#else
+              "GCC",
+#endif
+              __VERSION__);
+  std::printf("figures: median, min, max of %d runs; cpu = the thread's CPU time, wall = elapsed\n\n",
+              budget.runs);
+
+  // --- Table 1 --------------------------------------------------------------------
+  std::vector<Table1Row> table1;
+  for (const bench::PatchCase& c : bench::kPatches) {
+    mocap::Result<Table1Row> row = bench::MeasurePatch(c, budget);
+    if (!row.ok()) return Fail(row.error());
+    table1.push_back(std::move(*row));
+  }
+  std::printf("%-30s %12s %12s %12s  %-10s %-4s %10s %9s  %s\n", "Table 1 (per patch)", "median",
+              "min", "max", "unit", "clk", "paper", "ratio", "note");
+  for (const Table1Row& t : table1) {
+    PrintRow(t.update);
+    PrintRow(t.rebuild);
+    PrintRow(t.total);
+  }
+
+  // --- Other figures ----------------------------------------------------------------
+  std::vector<Row> rows;
+  const std::string generated = GeneratedBvh(o.quick ? 1200 : 12000);
+  if (generated.empty()) {
+    return Fail(mocap::MakeError(mocap::ErrorCode::kInternal, {"bench", 0, 0, {}},
+                                 "could not generate the BVH workload"));
+  }
+  rows.push_back(BvhParseRow("bvh_parse_generated", generated, "generated walk, 120 fps", budget, failed));
+  const std::string data_dir = o.data_dir.empty() ? PATCHSKIN_DATA_DIR : o.data_dir;
+  const std::filesystem::path cmu = std::filesystem::path(data_dir) / "bvh/cmu_cgspeed/01_01.bvh";
+  std::error_code ec;
+  if (!data_dir.empty() && std::filesystem::is_regular_file(cmu, ec)) {
+    std::ifstream in(cmu, std::ios::binary);
+    const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+    rows.push_back(BvhParseRow("bvh_parse_cmu_01_01", text, "CMU 01_01.bvh", budget, failed));
+  } else {
+    std::fprintf(stderr, "bench: %s not found; the CMU parse row is skipped\n", cmu.string().c_str());
+  }
+#ifdef PATCHSKIN_HAVE_ASSIMP
+  {
+    Row assimp{"bvh_parse_assimp", "MB/s", Clock::kCpu, {}, 0.0, "", "Assimp's BVH importer, generated walk"};
+    const Budget once{std::min(budget.runs, 3), budget.min_time_s};
+    assimp.runs = Rates(once, Clock::kCpu, static_cast<double>(generated.size()) * 1e-6, [&] {
+      Assimp::Importer importer;
+      failed |= importer.ReadFileFromMemory(generated.data(), generated.size(), 0, "bvh") == nullptr;
+    });
+    rows.front().reference = assimp.Median();
+    rows.front().reference_name = "Assimp";
+    rows.push_back(std::move(assimp));
+  }
+#endif
+
+  SsdFixture ssd;
+  rows.push_back({"ssd_1_thread", "vertices/s", Clock::kCpu,
+                  Rates(budget, Clock::kCpu, SsdFixture::kVertices,
+                        [&] { failed |= !ssd.Skin(0, SsdFixture::kVertices); }),
+                  0.0, "", "100k vertices, 4 influences, positions + normals"});
+  rows.push_back({"ssd_2_threads", "vertices/s", Clock::kWall, SsdTwoThreads(ssd, budget, failed), 0.0,
+                  "", "two halves on two threads"});
+
+  // The demo body (the walk on the generated mannequin).
+  mocap::Result<MotionSource> src = LoadBvhText(DemoBvhText(), "demo_walk.bvh", {.y_up = true});
+  if (!src.ok()) return Fail(src.error());
+  mocap::Result<Character> character = MakeCharacter(std::move(*src));
+  if (!character.ok()) return Fail(character.error());
+  const Character& ch = *character;
+  const int e2e_frames = o.quick ? 4 : 24;
+  mocap::Result<FramePlan> plan = PlanFrames(ch.motion, {.frames = "0:" + std::to_string(e2e_frames - 1)});
+  if (!plan.ok()) return Fail(plan.error());
+  mocap::Result<FramePipeline> pipeline = FramePipeline::Create(ch, GlobalMethod::kSsd, threads);
+  if (!pipeline.ok()) return Fail(pipeline.error());
+  mocap::Result<CameraPlan> cameras = CameraPlan::Create(*pipeline, *plan, "follow", 15.0f, {1280, 720});
+  if (!cameras.ok()) return Fail(cameras.error());
+  DeformedFrame frame;
+  if (mocap::Status s = pipeline->Evaluate(0.0, frame); !s.ok()) return Fail(s.error());
+  render::Renderer renderer, right_renderer;
+  render::Image image, scratch;
+  const auto draw_settings = [&](int w, int h, int ss, int nthreads) {
+    render::RenderSettings s;
+    s.width = w;
+    s.height = h;
+    s.supersample = ss;
+    s.threads = nthreads;
+    s.ground_at_scene_min = false;
+    s.ground_y = cameras->ground_y();
+    return s;
+  };
+  const std::string triangles = std::to_string(ch.mesh.bind.num_triangles()) + " triangles";
+  for (const glm::ivec2 size : {glm::ivec2(1280, 720), glm::ivec2(1920, 1080)}) {
+    const render::RenderSettings s = draw_settings(size.x, size.y, 1, 1);
+    render::Camera camera = cameras->At(plan->frames.front());
+    camera.aspect = static_cast<float>(size.x) / static_cast<float>(size.y);
+    rows.push_back({"raster_fps_" + std::to_string(size.x) + "x" + std::to_string(size.y), "frames/s",
+                    Clock::kCpu, Rates(budget, Clock::kCpu, 1.0, [&] {
+                      failed |= !DrawCharacterFrame(ch, frame, nullptr, camera, s, {}, renderer,
+                                                    right_renderer, scratch, image)
+                                     .ok();
+                    }),
+                    0.0, "", "demo body, " + triangles + ", 1 thread, no supersampling"});
+  }
+
+  // End to end: pipeline, follow camera, render at the command's defaults
+  // (1280x720, 2x2 supersampling), PNG level 1 through the async writer.
+  const std::filesystem::path out_dir =
+      std::filesystem::temp_directory_path() / ("patchskin_bench_" + std::to_string(getpid()));
+  std::filesystem::create_directories(out_dir, ec);
+  if (ec) {
+    return Fail(mocap::MakeError(mocap::ErrorCode::kIo, {out_dir.string(), 0, 0, {}},
+                                 "cannot create a temporary folder: " + ec.message()));
+  }
+  const render::RenderSettings e2e_settings = draw_settings(1280, 720, 2, threads);
+  render::WriteOptions png;
+  png.png_compression = 1;
+  Row e2e{"demo_end_to_end_fps", "frames/s", Clock::kWall, {}, 0.0, "",
+          std::to_string(e2e_frames) + " demo frames, 1280x720, 2x2 samples, PNG level 1, " +
+              std::to_string(threads) + " threads"};
+  Row e2e_cpu{"demo_end_to_end_per_cpu_s", "frames/s", Clock::kProcess, {}, 0.0, "",
+              "the same frames per CPU second of all threads (insensitive to load)"};
+  for (int r = 0; r < (o.quick ? 1 : 3); ++r) {
+    const double t0 = Now(Clock::kWall), c0 = Now(Clock::kProcess);
+    render::AsyncImageWriter writer({.num_workers = 2, .max_in_flight = 4});
+    for (const OutputFrame& of : plan->frames) {
+      mocap::Status s = pipeline->Evaluate(of.time_s, frame);
+      if (s.ok()) {
+        FrameDrawOptions draw;
+        draw.frame_number = of.number;
+        s = DrawCharacterFrame(ch, frame, nullptr, cameras->At(of), e2e_settings, draw, renderer,
+                               right_renderer, scratch, image);
+      }
+      if (s.ok()) {
+        char name[32];
+        std::snprintf(name, sizeof(name), "frame_%04d.png", of.number);
+        s = writer.Submit(image, (out_dir / name).string(), png);
+      }
+      if (!s.ok()) return Fail(s.error());
+    }
+    if (mocap::Status s = writer.Finish(); !s.ok()) return Fail(s.error());
+    e2e.runs.push_back(e2e_frames / std::max(Now(Clock::kWall) - t0, 1e-9));
+    e2e_cpu.runs.push_back(e2e_frames / std::max(Now(Clock::kProcess) - c0, 1e-9));
+  }
+  const std::string png_path = (out_dir / "encode.png").string();
+  Row encode{"png_encode_fps", "frames/s", Clock::kCpu, {}, 0.0, "",
+             "one 1280x720 frame, level 1, no filter (encode + write only)"};
+  encode.runs = Rates({std::min(budget.runs, 5), budget.min_time_s}, Clock::kCpu, 1.0,
+                      [&] { failed |= !render::WriteImage(image, png_path, png).ok(); });
+  std::filesystem::remove_all(out_dir, ec);
+  rows.push_back(std::move(e2e));
+  rows.push_back(std::move(e2e_cpu));
+  rows.push_back(std::move(encode));
+  rows.push_back({"bytes_per_bound_vertex", "bytes", Clock::kCpu,
+                  {static_cast<double>(deform::PatchBinding::kStoredBytesPerVertex)}, 0.0, "",
+                  "stored; the rebuild reads " +
+                      std::to_string(deform::PatchBinding::kRebuildBytesPerVertex)});
+  rows.push_back({"peak_memory", "MB", Clock::kCpu, {PeakRssMb()}, 0.0, "",
+                  "getrusage ru_maxrss of this process"});
+  if (failed) {
+    return Fail(mocap::MakeError(mocap::ErrorCode::kInternal, {"bench", 0, 0, {}},
+                                 "a measured operation failed"));
+  }
+
+  std::printf("\n%-30s %12s %12s %12s  %-10s %-4s %10s %9s  %s\n", "figure", "median", "min", "max",
+              "unit", "clk", "reference", "ratio", "note");
+  for (const Row& r : rows) PrintRow(r);
+
+  if (!o.json.empty()) {
+    nlohmann::json j;
+    j["header"] = {{"date", date},        {"cpu", cpu},          {"cores", cores},
+                   {"load_average", load}, {"build_type", PATCHSKIN_BUILD_TYPE},
+                   {"release", release},  {"compiler", __VERSION__}, {"quick", o.quick},
+                   {"runs", budget.runs}};
+    nlohmann::json t1 = nlohmann::json::array();
+    for (const Table1Row& t : table1) {
+      t1.push_back({{"patch", t.patch->name},
+                    {"grid", std::to_string(t.patch->m) + "x" + std::to_string(t.patch->n)},
+                    {"bound_vertices", t.bound},
+                    {"update_kind", t.patch->simulated ? "simulation" : "rbf"},
+                    {"update_per_s", RowJson(t.update)},
+                    {"rebuild_per_s", RowJson(t.rebuild)},
+                    {"total_per_s", RowJson(t.total)}});
+    }
+    j["table1"] = t1;
+    for (const Row& r : rows) j["figures"][r.key] = RowJson(r);
+    const std::string tmp = o.json + ".tmp";
+    {
+      std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+      out << j.dump(2) << "\n";
+      if (!out) {
+        return Fail(mocap::MakeError(mocap::ErrorCode::kIo, {o.json, 0, 0, {}}, "cannot write the JSON file"));
+      }
+    }
+    std::filesystem::rename(tmp, o.json, ec);
+    if (ec) {
+      return Fail(mocap::MakeError(mocap::ErrorCode::kIo, {o.json, 0, 0, {}}, ec.message()));
+    }
+    std::printf("\njson: %s\n", o.json.c_str());
+  }
+  return 0;
+}
+
+}  // namespace app
