@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <climits>
 #include <cmath>
+#include <cstdint>
 #include <optional>
 #include <sstream>
 
@@ -94,15 +95,18 @@ mocap::Result<CameraPlan> CameraPlan::Create(FramePipeline& pipeline, const Fram
   CameraPlan cp;
   cp.mode_ = mode;
   const std::vector<OutputFrame>& frames = plan.frames;
-  // Framing: a pre-pass over up to 64 frames of the range.
+  // Framing: a pre-pass over up to 64 frames spread over the whole motion (not
+  // just the range), so every camera depends on the frame number alone and a
+  // render of frames A:B gives the same images as those frames of a whole render.
   DeformedFrame frame;
   deform::Bounds all_bounds;
   glm::vec3 largest_extent(0.0f);
   float ground_y = 1e30f;
-  const int samples = std::min<int>(64, static_cast<int>(frames.size()));
+  const int span = std::max(1, plan.motion_frames);
+  const int samples = std::min(64, span);
   for (int i = 0; i < samples; ++i) {
-    const std::size_t k = frames.size() * static_cast<std::size_t>(i) / static_cast<std::size_t>(samples);
-    const mocap::Status s = pipeline.Evaluate(frames[k].time_s, frame);
+    const int number = static_cast<int>(static_cast<std::int64_t>(span) * i / samples);
+    const mocap::Status s = pipeline.Evaluate(number * plan.frame_time_s, frame);
     if (!s.ok()) return s.error();
     all_bounds.Extend(frame.bounds.min);
     all_bounds.Extend(frame.bounds.max);

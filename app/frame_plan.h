@@ -63,8 +63,11 @@ mocap::Result<FramePlan> PlanFrames(const mocap::Motion& motion, const FramePlan
 
 // The camera of every output frame, as `render` uses it: "follow" (a smoothed
 // follow camera framing the body's largest extent), "fixed" (one camera
-// framing the bounds of up to 64 frames of the range) or "turntable" (an orbit
-// of the first frame). Built by evaluating the pipeline (a pre-pass).
+// framing the bounds of up to 64 frames spread over the whole motion) or
+// "turntable" (an orbit of the first frame). Built by evaluating the pipeline
+// (a pre-pass). The extents and the ground come from frames of the whole
+// motion, not of the range, so the camera of a frame does not depend on the
+// range rendered (chunked renders give the same images).
 class CameraPlan {
  public:
   // mode: follow | fixed | turntable; elevation in degrees; size in pixels.
