@@ -153,6 +153,9 @@ struct FramePipeline::Impl {
   std::vector<std::vector<glm::vec3>> carried;          // per patch, #M x #N
   std::vector<std::span<const glm::vec3>> carried_views;
   deform::PatchLayerScratch patch_scratch;
+  std::unique_ptr<ElasticLayer> elastic;                // null: no elastic patches
+  std::vector<std::vector<glm::vec3>> displacement;     // per patch, empty or #M x #N (model)
+  std::vector<std::span<const glm::vec3>> displacement_views;
   std::optional<deform::SwdRig> swd_rig;
   std::vector<glm::quat> swd_rotations;  // #threads x #J scratch
   std::vector<glm::vec3> swd_joints;     // #threads x #J scratch
@@ -183,7 +186,22 @@ mocap::Status FramePipeline::SetPatches(std::vector<deform::PatchSetup> patches)
     m.carried_views.emplace_back(m.carried[k]);
   }
   m.patch_scratch.Prepare(m.patches, m.character->mesh.bind.num_vertices());
+  m.elastic.reset();
+  m.displacement.assign(m.patches.size(), {});
+  m.displacement_views.assign(m.patches.size(), {});
   return mocap::Status::Ok();
+}
+
+mocap::Status FramePipeline::SetElastic(std::vector<ElasticPatchSpec> specs) {
+  Impl& m = *impl_;
+  auto layer = ElasticLayer::Create(*m.character, m.patches, std::move(specs));
+  if (!layer.ok()) return std::move(layer).error();
+  m.elastic = std::move(*layer);
+  return mocap::Status::Ok();
+}
+
+std::vector<ElasticPatchReport> FramePipeline::elastic_report() const {
+  return impl_->elastic ? impl_->elastic->Report() : std::vector<ElasticPatchReport>();
 }
 
 mocap::Result<FramePipeline> FramePipeline::Create(const Character& character, GlobalMethod method,
@@ -278,7 +296,7 @@ mocap::Status FramePipeline::Evaluate(double time_s, DeformedFrame& out) {
   }
   if (!m.patches.empty()) {
     // Patch layer: carry the control points like skin vertices, rebuild and
-    // blend (no displacements yet: dS, dE come with issues 6 and 7).
+    // blend, with the elastic displacements dE (dS comes with issue 6).
     for (std::size_t p = 0; p < m.patches.size(); ++p) {
       const bool dqs = m.method == GlobalMethod::kDqs;
       s = deform::CarryControlPointsJob{
@@ -290,8 +308,16 @@ mocap::Status FramePipeline::Evaluate(double time_s, DeformedFrame& out) {
               .Run();
       if (!s) return JobError(c, s, "patch control points");
     }
-    const mocap::Status layered =
-        deform::ApplyPatchLayer(m.patches, m.carried_views, {}, m.patch_scratch, out.positions);
+    std::span<const std::span<const glm::vec3>> displacements;
+    if (m.elastic) {
+      // dE: the mass-spring networks advanced to this frame's time (state carried).
+      const mocap::Status advanced = m.elastic->Advance(time_s, m.model_from_joint, m.displacement);
+      if (!advanced.ok()) return advanced;
+      for (std::size_t p = 0; p < m.patches.size(); ++p) m.displacement_views[p] = m.displacement[p];
+      displacements = m.displacement_views;
+    }
+    const mocap::Status layered = deform::ApplyPatchLayer(m.patches, m.carried_views, displacements,
+                                                          m.patch_scratch, out.positions);
     if (!layered.ok()) return layered;
     deform::ComputeVertexNormals(out.positions, mesh.bind.triangles, out.normals);
   } else if (has_normals) {

@@ -19,6 +19,7 @@
 
 #include <glm/glm.hpp>
 
+#include "app/elastic_layer.h"
 #include "deform/mannequin.h"
 #include "deform/mesh.h"
 #include "deform/patch_layer.h"
@@ -98,6 +99,16 @@ class FramePipeline {
   // (its control-point binding is not wired yet).
   mocap::Status SetPatches(std::vector<deform::PatchSetup> patches);
   int num_patches() const;
+
+  // Adds the elastic layer dE (ALGORITHMS.md 6, app/elastic_layer.h) to some of
+  // the patches set by SetPatches (call it after them): each frame, before the
+  // rebuild, the carried control points of patch spec.patch get R_drv e. The
+  // state is carried across Evaluate calls; an earlier time than the last one
+  // re-simulates from the motion's start, so any frame order gives the same
+  // frames. Errors: those of ElasticLayer::Create.
+  mocap::Status SetElastic(std::vector<ElasticPatchSpec> specs);
+  // One report per elastic patch (empty without them), as of the last Evaluate.
+  std::vector<ElasticPatchReport> elastic_report() const;
 
  private:
   struct Impl;

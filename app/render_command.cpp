@@ -303,8 +303,20 @@ int RunRender(const RenderOptions& options) {
   if (!patches.empty()) {
     // Split: the left half stays global only, the right half gets the patches.
     FramePipeline& layered = right_pipeline ? *right_pipeline : *pipeline;
-    const mocap::Status s = layered.SetPatches(std::move(patches));
+    mocap::Result<std::vector<ElasticPatchSpec>> elastic = ResolveRigElastic(*rig, ch, patches);
+    if (!elastic.ok()) return Fail(elastic.error());
+    mocap::Status s = layered.SetPatches(std::move(patches));
     if (!s.ok()) return Fail(s.error());
+    s = layered.SetElastic(std::move(*elastic));
+    if (!s.ok()) return Fail(s.error());
+    if (!o.quiet) {
+      for (const ElasticPatchReport& r : layered.elastic_report()) {
+        for (const std::string& note : r.messages) {
+          std::fprintf(stderr, "%s: patches[%d].elastic: note: %s\n", rig->file.c_str(), r.patch,
+                       note.c_str());
+        }
+      }
+    }
   }
   const std::string right_label =
       !right_pipeline ? ""
@@ -456,6 +468,22 @@ int RunRender(const RenderOptions& options) {
                  guard.StopMessage(last_done_number, frames_done, static_cast<int>(frames.size()))
                      .c_str());
     return guard.exit_code();
+  }
+  // The elastic layer says when it had to limit anything (ALGORITHMS.md 6).
+  for (const FramePipeline* p : {&*pipeline, right_pipeline ? &*right_pipeline : nullptr}) {
+    if (p == nullptr) continue;
+    for (const ElasticPatchReport& r : p->elastic_report()) {
+      if (r.counters.any_limit() == 0) continue;
+      std::fprintf(stderr,
+                   "%s: warning: elastic patch \"%s\" was limited: %lld acceleration clamps, "
+                   "%lld displacement clamps, %lld non-finite inputs, %lld non-finite resets\n",
+                   write_options.source_file.c_str(),
+                   rig ? rig->patches[static_cast<std::size_t>(r.patch)].name.c_str() : "?",
+                   static_cast<long long>(r.counters.acceleration_clamps),
+                   static_cast<long long>(r.counters.displacement_clamps),
+                   static_cast<long long>(r.counters.non_finite_inputs),
+                   static_cast<long long>(r.counters.non_finite_resets));
+    }
   }
   std::printf("frames:        %s (%zu)\n", pattern.c_str(), frames.size());
   if (sheet) {

@@ -8,6 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "app/internal/rig_elastic_parse.h"
 #include "app/output_guard.h"
 
 namespace app {
@@ -208,11 +209,9 @@ std::optional<mocap::Error> ParsePatch(const Ctx& c, const json& v, const std::s
                                         "border_width", "examples", "elastic"})) {
     return e;
   }
-  for (const char* later : {"examples", "elastic"}) {
+  for (const char* later : {"examples"}) {
     if (v.contains(later)) {
-      return c.Fail(Join(path, later),
-                    std::string(later) + " are not supported yet (" +
-                        (std::string(later) == "examples" ? "issue 6" : "issue 7") + ")",
+      return c.Fail(Join(path, later), std::string(later) + " are not supported yet (issue 6)",
                     mocap::ErrorCode::kUnsupported);
     }
   }
@@ -242,6 +241,13 @@ std::optional<mocap::Error> ParsePatch(const Ctx& c, const json& v, const std::s
   }
   if (v.contains("border_width")) {
     if (auto e = GetFloat(c, v["border_width"], path + ".border_width", 0, 0.5, p.border_width)) {
+      return e;
+    }
+  }
+  if (v.contains("elastic")) {
+    p.elastic.emplace();
+    if (auto e = ParseRigElastic(v["elastic"], c.file, Join(path, "elastic"), p.grid.x, p.grid.y,
+                                 *p.elastic)) {
       return e;
     }
   }

@@ -133,8 +133,39 @@ const BadRig kBadRigs[] = {
         "region": {"joint": "J", "radius": 5}, "examples": []}]})",
      "r.json: patches[0].examples: error: examples are not supported yet (issue 6)"},
     {R"({"character": "mannequin", "motion": {"file": "m.bvh"}, "patches": [{"name": "a",
-        "region": {"joint": "J", "radius": 5}, "elastic": {}}]})",
-     "r.json: patches[0].elastic: error: elastic are not supported yet (issue 7)"},
+        "region": {"joint": "J", "radius": 5}, "elastic": 3}]})",
+     "r.json: patches[0].elastic: error: expected an object, found 3"},
+    {R"({"character": "mannequin", "motion": {"file": "m.bvh"}, "patches": [{"name": "a",
+        "region": {"joint": "J", "radius": 5}, "elastic": {"stiffness": 3}}]})",
+     "r.json: patches[0].elastic.stiffness: error: unknown field (expected one of: joint, mass, "
+     "frequency_hz, damping_ratio, structural_ratio, shear_ratio, bending_ratio, "
+     "spring_damping_s, time_step_s, gain, gravity, preroll_s, max_displacement, "
+     "max_acceleration_mps2, units_per_metre, cutoff_hz, force_model)"},
+    {R"({"character": "mannequin", "motion": {"file": "m.bvh"}, "patches": [{"name": "a",
+        "region": {"joint": "J", "radius": 5}, "elastic": {"frequency_hz": 0}}]})",
+     "r.json: patches[0].elastic.frequency_hz: error: expected a number in 0.1..30, found 0"},
+    {R"({"character": "mannequin", "motion": {"file": "m.bvh"}, "patches": [{"name": "a",
+        "region": {"joint": "J", "radius": 5}, "elastic": {"damping_ratio": "high"}}]})",
+     "r.json: patches[0].elastic.damping_ratio: error: expected a number in 0..10, found "
+     "\"high\""},
+    {R"({"character": "mannequin", "motion": {"file": "m.bvh"}, "patches": [{"name": "a",
+        "region": {"joint": "J", "radius": 5}, "elastic": {"time_step_s": 1}}]})",
+     "r.json: patches[0].elastic.time_step_s: error: expected a number in 0.0001..0.05, found 1"},
+    {R"({"character": "mannequin", "motion": {"file": "m.bvh"}, "patches": [{"name": "a",
+        "region": {"joint": "J", "radius": 5}, "elastic": {"gravity": 1}}]})",
+     "r.json: patches[0].elastic.gravity: error: expected true or false, found 1"},
+    {R"({"character": "mannequin", "motion": {"file": "m.bvh"}, "patches": [{"name": "a",
+        "region": {"joint": "J", "radius": 5}, "elastic": {"joint": ""}}]})",
+     "r.json: patches[0].elastic.joint: error: expected a non-empty string, found \"\""},
+    {R"({"character": "mannequin", "motion": {"file": "m.bvh"}, "patches": [{"name": "a",
+        "region": {"joint": "J", "radius": 5}, "elastic": {"force_model": "cubic"}}]})",
+     "r.json: patches[0].elastic.force_model: error: expected one of \"linear\", \"length\", "
+     "found \"cubic\""},
+    {R"({"character": "mannequin", "motion": {"file": "m.bvh"}, "patches": [{"name": "a",
+        "region": {"joint": "J", "radius": 5}, "grid": [20, 8], "sampling": [20, 8],
+        "elastic": {}}]})",
+     "r.json: patches[0].elastic: error: expected a grid of at most 16x16 control points for an "
+     "elastic patch, found 20x8"},
     {R"({"character": "mannequin", "motion": {"file": "m.bvh"}, "patches": [{"name": "a",
         "region": {"joint": "J", "radius": 5}}, {"name": "a", "region": {"joint": "K",
         "radius": 5}}]})",
@@ -158,6 +189,55 @@ const BadRig kBadRigs[] = {
      "r.json: render.output: error: expected a relative path inside the rig's output folder, "
      "found '/tmp/x_####.png' (an absolute path)"},
 };
+
+TEST(RigFile, ElasticDefaultsAndEveryField) {
+  const auto defaults = app::ParseRig(R"({"character": "mannequin", "motion": {"file": "m.bvh"},
+      "patches": [{"name": "a", "region": {"joint": "J", "radius": 5}, "elastic": {}},
+                  {"name": "b", "region": {"joint": "J", "radius": 5}}]})",
+                                      "r.json");
+  ASSERT_TRUE(defaults.ok()) << defaults.error().ToString();
+  ASSERT_TRUE(defaults->patches[0].elastic.has_value());
+  EXPECT_FALSE(defaults->patches[1].elastic.has_value());
+  const app::RigElastic& d = *defaults->patches[0].elastic;
+  const deform::MassSpringParams library;
+  EXPECT_EQ(d.joint, "");
+  EXPECT_EQ(d.units_per_metre, 0.0f);
+  EXPECT_EQ(d.cutoff_hz, 10.0);
+  EXPECT_EQ(d.params.frequency_hz, library.frequency_hz);
+  EXPECT_EQ(d.params.damping_ratio, library.damping_ratio);
+  EXPECT_EQ(d.params.time_step_s, library.time_step_s);
+  EXPECT_EQ(d.params.preroll_s, 1.0);  // the rig's default: start settled
+  EXPECT_TRUE(d.params.gravity);
+
+  const auto full = app::ParseRig(R"({"character": "mannequin", "motion": {"file": "m.bvh"},
+      "patches": [{"name": "a", "region": {"joint": "J", "radius": 5}, "grid": [5, 7],
+        "elastic": {"joint": "Hips", "mass": 2, "frequency_hz": 5, "damping_ratio": 0.25,
+                    "structural_ratio": 2, "shear_ratio": 0.75, "bending_ratio": 0.5,
+                    "spring_damping_s": 0.002, "time_step_s": 0.002, "gain": 1.5,
+                    "gravity": false, "preroll_s": 2, "max_displacement": 4,
+                    "max_acceleration_mps2": 300, "units_per_metre": 1, "cutoff_hz": 0,
+                    "force_model": "length"}}]})",
+                                  "r.json");
+  ASSERT_TRUE(full.ok()) << full.error().ToString();
+  const app::RigElastic& e = *full->patches[0].elastic;
+  EXPECT_EQ(e.joint, "Hips");
+  EXPECT_EQ(e.params.mass, 2.0f);
+  EXPECT_EQ(e.params.frequency_hz, 5.0f);
+  EXPECT_EQ(e.params.damping_ratio, 0.25f);
+  EXPECT_EQ(e.params.structural_ratio, 2.0f);
+  EXPECT_EQ(e.params.shear_ratio, 0.75f);
+  EXPECT_EQ(e.params.bending_ratio, 0.5f);
+  EXPECT_EQ(e.params.spring_damping_s, 0.002f);
+  EXPECT_EQ(e.params.time_step_s, 0.002);
+  EXPECT_EQ(e.params.gain, 1.5f);
+  EXPECT_FALSE(e.params.gravity);
+  EXPECT_EQ(e.params.preroll_s, 2.0);
+  EXPECT_EQ(e.params.max_displacement, 4.0f);
+  EXPECT_EQ(e.params.max_acceleration_mps2, 300.0f);
+  EXPECT_EQ(e.units_per_metre, 1.0f);
+  EXPECT_EQ(e.cutoff_hz, 0.0);
+  EXPECT_EQ(e.params.force_model, deform::SpringForceModel::kLength);
+}
 
 TEST(RigFile, BadRigsGiveExactMessages) {
   for (const BadRig& bad : kBadRigs) {

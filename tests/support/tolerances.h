@@ -208,3 +208,16 @@ inline constexpr double kFrameRateAgreement60 = 0.03;
 inline constexpr double kPrerollSettledRel = 0.01;
 
 }  // namespace testsupport
+
+namespace testsupport {
+
+// Elastic layer in the pipeline (tests/app/elastic_pipeline_test.cpp).
+// The sample belly's peak displacement after the jump's landing must be at
+// least this (cm): visible at a normal framing (the landing pushes ~15 m/s^2,
+// ~2.3 cm static at 4 Hz).
+inline constexpr float kElasticVisiblePeakCm = 1.0f;
+// After the body stands still for 1.5 s, the jiggle must have decayed below this
+// fraction of the landing peak (damping ratio 0.15 at 4 Hz: 5 % after ~0.8 s).
+inline constexpr float kElasticSettledFraction = 0.05f;
+
+}  // namespace testsupport

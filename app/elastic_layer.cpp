@@ -1,0 +1,265 @@
+#include "app/elastic_layer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "app/pipeline.h"
+#include "app/rig_file.h"
+
+namespace app {
+namespace {
+
+mocap::Error ElasticError(const Character& c, int patch, const std::string& field,
+                          const std::string& message,
+                          mocap::ErrorCode code = mocap::ErrorCode::kInvalidArgument) {
+  return mocap::MakeError(code,
+                          {c.source, 0, 0, "patches[" + std::to_string(patch) + "].elastic" + field},
+                          message);
+}
+
+// Rotation part of a joint matrix with any scale removed.
+glm::quat RotationOf(const glm::mat4& m) {
+  glm::mat3 r(m);
+  for (int i = 0; i < 3; ++i) {
+    const float len = glm::length(r[i]);
+    if (len > 0.0f) r[i] /= len;
+  }
+  return glm::normalize(glm::quat_cast(r));
+}
+
+// The skeleton joint whose bones carry the largest total weight over the
+// patch's control points (ALGORITHMS.md 6 default driving joint).
+int DominantJoint(const Character& c, const deform::PatchSetup& patch) {
+  std::vector<double> total(c.mesh.skin_joints.size(), 0.0);
+  const deform::SkinWeights& w = patch.control_weights;
+  for (std::size_t i = 0; i < w.weights.size(); ++i) {
+    if (w.joints[i] < total.size()) total[w.joints[i]] += w.weights[i];
+  }
+  const auto best = std::max_element(total.begin(), total.end());
+  if (best == total.end()) return 0;
+  return c.mesh.skin_joints[static_cast<std::size_t>(best - total.begin())];
+}
+
+}  // namespace
+
+mocap::Result<std::vector<mocap::JointKinematics>> DrivingKinematics(
+    const mocap::Skeleton& skeleton, const mocap::Motion& motion, double cutoff_hz,
+    const glm::mat4& model_from_root) {
+  const std::size_t nj = static_cast<std::size_t>(skeleton.num_joints());
+  const std::size_t nf = static_cast<std::size_t>(motion.num_frames);
+  std::vector<mocap::JointTransform> locals(nj);
+  std::vector<glm::mat4> raw(nj * nf);
+  std::vector<mocap::JointKinematics> kin(nj * nf);
+  std::vector<mocap::JobStatus> statuses;
+  statuses.push_back(mocap::ModelMatricesJob{.skeleton = &skeleton, .motion = &motion,
+                                             .model_from_root = model_from_root,
+                                             .locals = locals, .model_from_joint = raw}
+                         .Run());
+  if (cutoff_hz > 0.0 && statuses.back()) {
+    std::vector<glm::mat4> smooth(nj * nf);
+    statuses.push_back(mocap::SmoothTrajectoriesJob{.model_from_joint = raw,
+                                                    .num_joints = skeleton.num_joints(),
+                                                    .frame_time_s = motion.frame_time_s,
+                                                    .cutoff_hz = cutoff_hz,
+                                                    .output = smooth}
+                           .Run());
+    raw = std::move(smooth);
+  }
+  if (statuses.back()) {
+    statuses.push_back(mocap::KinematicsJob{.model_from_joint = raw,
+                                            .num_joints = skeleton.num_joints(),
+                                            .frame_time_s = motion.frame_time_s,
+                                            .output = kin}
+                           .Run());
+  }
+  for (const mocap::JobStatus& s : statuses) {
+    if (!s) {
+      return mocap::MakeError(mocap::ErrorCode::kInvalidArgument,
+                              {skeleton.info.source_file, 0, 0, {}},
+                              std::string("joint kinematics: ") + s.what);
+    }
+  }
+  return kin;
+}
+
+mocap::Result<std::vector<ElasticPatchSpec>> ResolveRigElastic(
+    const Rig& rig, const Character& character, std::span<const deform::PatchSetup> patches) {
+  std::vector<ElasticPatchSpec> specs;
+  for (std::size_t i = 0; i < rig.patches.size() && i < patches.size(); ++i) {
+    const RigPatch& p = rig.patches[i];
+    if (!p.elastic) continue;
+    const std::string field = "patches[" + std::to_string(i) + "].elastic.joint";
+    ElasticPatchSpec spec;
+    spec.patch = static_cast<int>(i);
+    spec.cutoff_hz = p.elastic->cutoff_hz;
+    spec.params = p.elastic->params;
+    spec.params.units_per_metre = p.elastic->units_per_metre > 0.0f
+                                      ? p.elastic->units_per_metre
+                                      : UnitsPerMetre(character.skeleton.info.detected_units,
+                                                      character.skeleton.info.rest_height);
+    const std::string& name = !p.elastic->joint.empty() ? p.elastic->joint
+                              : p.region.kind == RigRegion::Kind::kJoint ? p.region.joint
+                                                                          : std::string();
+    if (name.empty()) {
+      spec.joint = DominantJoint(character, patches[i]);
+    } else {
+      spec.joint = character.skeleton.FindJoint(name);
+      if (spec.joint < 0) {
+        return mocap::MakeError(mocap::ErrorCode::kNotFound, {rig.file, 0, 0, field},
+                                "expected a joint of " + character.source + ", found \"" + name +
+                                    "\"");
+      }
+    }
+    specs.push_back(spec);
+  }
+  return specs;
+}
+
+mocap::Result<std::unique_ptr<ElasticLayer>> ElasticLayer::Create(
+    const Character& c, std::span<const deform::PatchSetup> patches,
+    std::vector<ElasticPatchSpec> specs) {
+  auto layer = std::unique_ptr<ElasticLayer>(new ElasticLayer());
+  layer->character_ = &c;
+  layer->duration_s_ = c.motion.duration_s();
+  if (specs.empty()) return layer;
+  if (c.motion.num_frames < 1 || !(c.motion.frame_time_s > 0.0)) {
+    return ElasticError(c, specs.front().patch, "", "expected a motion with frames to drive it");
+  }
+  mocap::Result<std::vector<glm::mat4>> bind = BindModelFromJoint(c);
+  if (!bind.ok()) return std::move(bind).error();
+  const std::size_t nj = static_cast<std::size_t>(c.skeleton.num_joints());
+  for (ElasticPatchSpec& spec : specs) {
+    if (spec.patch < 0 || static_cast<std::size_t>(spec.patch) >= patches.size()) {
+      return ElasticError(c, spec.patch, "", "patch index out of range");
+    }
+    if (spec.joint < 0 || static_cast<std::size_t>(spec.joint) >= nj) {
+      return ElasticError(c, spec.patch, ".joint", "driving joint out of range");
+    }
+    const deform::PatchSetup& ps = patches[static_cast<std::size_t>(spec.patch)];
+    Patch p;
+    p.spec = spec;
+    p.kinematics = -1;
+    for (std::size_t k = 0; k < layer->kinematics_.size(); ++k) {
+      if (layer->kinematics_[k].cutoff_hz == spec.cutoff_hz) p.kinematics = static_cast<int>(k);
+    }
+    if (p.kinematics < 0) {
+      auto kin = DrivingKinematics(c.skeleton, c.motion, spec.cutoff_hz, c.world_from_model);
+      if (!kin.ok()) return std::move(kin).error();
+      layer->kinematics_.push_back({spec.cutoff_hz, std::move(*kin)});
+      p.kinematics = static_cast<int>(layer->kinematics_.size() - 1);
+    }
+    const std::vector<mocap::JointKinematics>& kin =
+        layer->kinematics_[static_cast<std::size_t>(p.kinematics)].frames;
+    float max_w = 0.0f;
+    for (std::size_t f = 0; f < static_cast<std::size_t>(c.motion.num_frames); ++f) {
+      max_w = std::max(max_w, glm::length(kin[f * nj + static_cast<std::size_t>(spec.joint)]
+                                              .local_angular_velocity));
+    }
+    // Rest control points in the driving joint's (rigid) bind frame.
+    const glm::mat4& model_from_joint = (*bind)[static_cast<std::size_t>(spec.joint)];
+    const glm::quat bind_rotation = RotationOf(model_from_joint);
+    const glm::vec3 origin(model_from_joint[3]);
+    std::vector<glm::vec3> rest(ps.rest_control.size());
+    for (std::size_t k = 0; k < rest.size(); ++k) {
+      rest[k] = glm::conjugate(bind_rotation) * (ps.rest_control[k] - origin);
+    }
+    auto network = deform::BuildMassSpringNetwork(
+        {.rows = ps.fit.surface.num_u(), .cols = ps.fit.surface.num_v(), .rest_points = rest,
+         .bind_rotation = bind_rotation, .max_angular_speed_rad_s = max_w},
+        spec.params);
+    if (!network.ok()) {
+      mocap::Error e = std::move(network).error();
+      e.loc.file = c.source;
+      e.loc.field_path = "patches[" + std::to_string(spec.patch) + "].elastic";
+      return e;
+    }
+    p.network = std::move(*network);
+    p.state.Resize(p.network);
+    p.local.assign(rest.size(), glm::vec3(0.0f));
+    layer->piece_s_ = std::min(layer->piece_s_, 0.5 * static_cast<double>(spec.params.max_time_gap_s));
+    layer->patches_.push_back(std::move(p));
+  }
+  return layer;
+}
+
+mocap::Status ElasticLayer::RunAll(double time_s) {
+  const Character& c = *character_;
+  for (Patch& p : patches_) {
+    const mocap::JobStatus s =
+        deform::MassSpringStepJob{.network = &p.network,
+                                  .state = &p.state,
+                                  .time_s = time_s,
+                                  .kinematics = kinematics_[static_cast<std::size_t>(p.kinematics)].frames,
+                                  .num_joints = c.skeleton.num_joints(),
+                                  .joint = p.spec.joint,
+                                  .frame_time_s = c.motion.frame_time_s,
+                                  .displacements = p.local}
+            .Run();
+    if (!s) {
+      return mocap::MakeError(mocap::ErrorCode::kInternal, {c.source, 0, 0, {}},
+                              std::string("elastic layer refused to run: ") + s.what);
+    }
+  }
+  return mocap::Status::Ok();
+}
+
+mocap::Status ElasticLayer::Advance(double time_s, std::span<const glm::mat4> model_from_joint,
+                                    std::vector<std::vector<glm::vec3>>& displacements) {
+  if (patches_.empty()) return mocap::Status::Ok();
+  constexpr double kEps = 1e-9;
+  time_s = std::clamp(time_s, 0.0, duration_s_);
+  if (!started_ || time_s < time_s_ - kEps) {
+    // (Re)start: zero state, preroll at the first frame, then t = 0.
+    for (Patch& p : patches_) {
+      p.state.Reset();
+      p.baseline = p.state.counters;
+    }
+    if (mocap::Status s = RunAll(0.0); !s.ok()) return s;
+    started_ = true;
+    time_s_ = 0.0;
+  }
+  // Forward in pieces shorter than the networks' gap reset; the step grid, so
+  // the state, does not depend on where the pieces end.
+  while (time_s_ < time_s - kEps) {
+    const double t = std::min(time_s, time_s_ + piece_s_);
+    if (mocap::Status s = RunAll(t); !s.ok()) return s;
+    time_s_ = t;
+  }
+  for (Patch& p : patches_) {
+    const glm::quat r = RotationOf(model_from_joint[static_cast<std::size_t>(p.spec.joint)]);
+    std::vector<glm::vec3>& out = displacements[static_cast<std::size_t>(p.spec.patch)];
+    out.resize(p.local.size());
+    float largest = 0.0f;
+    for (std::size_t k = 0; k < p.local.size(); ++k) {
+      out[k] = r * p.local[k];
+      largest = std::max(largest, glm::length(p.local[k]));
+    }
+    p.displacement = largest;
+  }
+  return mocap::Status::Ok();
+}
+
+std::vector<ElasticPatchReport> ElasticLayer::Report() const {
+  std::vector<ElasticPatchReport> out;
+  for (const Patch& p : patches_) {
+    ElasticPatchReport r;
+    r.patch = p.spec.patch;
+    r.joint = p.spec.joint;
+    r.time_step_s = p.network.time_step_s;
+    r.max_displacement = p.network.params.max_displacement;
+    r.displacement = p.displacement;
+    const deform::MassSpringCounters& now = p.state.counters;
+    r.counters.steps = now.steps - p.baseline.steps;
+    r.counters.displacement_clamps = now.displacement_clamps - p.baseline.displacement_clamps;
+    r.counters.acceleration_clamps = now.acceleration_clamps - p.baseline.acceleration_clamps;
+    r.counters.non_finite_inputs = now.non_finite_inputs - p.baseline.non_finite_inputs;
+    r.counters.non_finite_resets = now.non_finite_resets - p.baseline.non_finite_resets;
+    r.counters.time_resets = now.time_resets - p.baseline.time_resets;
+    r.messages = p.network.messages;
+    out.push_back(std::move(r));
+  }
+  return out;
+}
+
+}  // namespace app
