@@ -8,6 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "app/internal/rig_examples_parse.h"
 #include "app/output_guard.h"
 
 namespace app {
@@ -205,14 +206,12 @@ std::optional<mocap::Error> ParseRegion(const Ctx& c, const json& v, const std::
 std::optional<mocap::Error> ParsePatch(const Ctx& c, const json& v, const std::string& path,
                                        RigPatch& p) {
   if (auto e = CheckObject(c, v, path, {"name", "region", "parametrization", "sampling", "grid",
-                                        "border_width", "examples", "elastic"})) {
+                                        "border_width", "examples", "pose_space", "elastic"})) {
     return e;
   }
-  for (const char* later : {"examples", "elastic"}) {
+  for (const char* later : {"elastic"}) {
     if (v.contains(later)) {
-      return c.Fail(Join(path, later),
-                    std::string(later) + " are not supported yet (" +
-                        (std::string(later) == "examples" ? "issue 6" : "issue 7") + ")",
+      return c.Fail(Join(path, later), std::string(later) + " are not supported yet (issue 7)",
                     mocap::ErrorCode::kUnsupported);
     }
   }
@@ -245,7 +244,7 @@ std::optional<mocap::Error> ParsePatch(const Ctx& c, const json& v, const std::s
       return e;
     }
   }
-  return std::nullopt;
+  return internal::ParsePatchExamples(c.file, v, path, p);
 }
 
 std::optional<mocap::Error> ParseRender(const Ctx& c, const json& v, RigRender& r) {

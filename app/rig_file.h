@@ -18,7 +18,8 @@
 // names are checked when the patches are built). Errors name the file, the
 // field path (e.g. "patches[1].grid") and what was expected:
 //   rig.json: error: patches[1].grid: expected an array of two integers in 4..64, found "6x6"
-// `examples` (issue 6) and `elastic` (issue 7) are recognised per patch and
+// `examples` and `pose_space` per patch are parsed by app/rig_examples.cpp
+// (types in app/rig_examples.h); `elastic` (issue 7) is recognised and
 // rejected as not supported yet.
 
 #include <optional>
@@ -27,6 +28,7 @@
 
 #include <glm/glm.hpp>
 
+#include "app/rig_examples.h"
 #include "mocap/error.h"
 
 namespace app {
@@ -56,6 +58,8 @@ struct RigPatch {
   glm::ivec2 sampling{8, 8};         // S x T, each 4..256 and >= the grid
   glm::ivec2 grid{6, 6};             // M x N, each 4..64
   float border_width = 0.1f;         // parameter units, [0, 0.5]
+  std::vector<RigExample> examples;  // example shapes (app/rig_examples.h); empty = none
+  RigPoseSpace pose_space;           // how the examples are interpolated over theta
 };
 
 struct RigRender {
