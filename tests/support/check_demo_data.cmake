@@ -1,6 +1,7 @@
 # Regenerates the demo motion and checks the committed samples/data copy is
 # byte for byte what the generator writes (the demo inputs stay honest).
-execute_process(COMMAND ${GEN} ${OUT} RESULT_VARIABLE rc)
+# MODE (optional): the generator's motion flag, e.g. --shoulder.
+execute_process(COMMAND ${GEN} ${MODE} ${OUT} RESULT_VARIABLE rc)
 if(NOT rc EQUAL 0)
   message(FATAL_ERROR "generate_demo_data failed with ${rc}")
 endif()
