@@ -1,6 +1,7 @@
 #include "deform/example_shapes.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <sstream>
 
@@ -14,6 +15,11 @@ using mocap::ErrorCode;
 mocap::Error EditError(const ExampleEdit& e, const std::string& message) {
   return mocap::MakeError(ErrorCode::kInvalidArgument, e.loc, message);
 }
+
+// Most skin joints the fast SSD rotation path keeps on the stack.
+constexpr std::size_t kMaxFastBones = 256;
+// Largest |R^T R - I| entry for a palette matrix to count as a rotation.
+constexpr double kRigidTol = 1e-4;
 
 bool Finite(const glm::dvec3& v) {
   return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
@@ -30,7 +36,81 @@ mocap::JobStatus PatchControlRotations(const PatchSetup& patch, const ExamplePos
   if (!pose.dq_palette.empty()) {
     return DqsControlRotations(pose.dq_palette, w.influences, w.joints, w.weights, rotations);
   }
-  return SsdControlRotations(pose.model_from_bind, w.influences, w.joints, w.weights, rotations);
+  const std::size_t num_skin = pose.model_from_bind.size();
+  const int k = w.influences;
+  if (k < 1 || k > kMaxInfluences || num_skin > kMaxFastBones ||
+      w.joints.size() != rotations.size() * static_cast<std::size_t>(k) ||
+      w.weights.size() != w.joints.size()) {
+    return SsdControlRotations(pose.model_from_bind, k, w.joints, w.weights, rotations);
+  }
+  // Bone rotations as quaternions, converted once per call and only for the
+  // bones this patch uses; a palette matrix that is not a rotation (scale,
+  // shear) sends the whole patch to the general polar decomposition.
+  std::array<glm::dquat, kMaxFastBones> bone;
+  std::array<std::uint8_t, kMaxFastBones> have{};
+  for (std::size_t slot = 0; slot < w.joints.size(); ++slot) {
+    const std::uint16_t b = w.joints[slot];
+    if (w.weights[slot] == 0.0f || have[b]) continue;
+    if (b >= num_skin) return {mocap::JobStatus::kOutOfRange, "joint index beyond the palette"};
+    const glm::dmat3 r(glm::mat3(pose.model_from_bind[b]));
+    const glm::dmat3 rtr = glm::transpose(r) * r;
+    double off = 0.0;
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) off = std::max(off, std::abs(rtr[i][j] - (i == j ? 1.0 : 0.0)));
+    }
+    if (off > kRigidTol || glm::determinant(r) <= 0.0) {
+      return SsdControlRotations(pose.model_from_bind, k, w.joints, w.weights, rotations);
+    }
+    bone[b] = glm::normalize(glm::quat_cast(r));
+    have[b] = 1;
+  }
+  for (std::size_t c = 0; c < rotations.size(); ++c) {
+    // The (at most two) influences with nonzero weight.
+    int n = 0;
+    std::size_t slots[2] = {0, 0};
+    for (int i = 0; i < k; ++i) {
+      const std::size_t slot = c * static_cast<std::size_t>(k) + static_cast<std::size_t>(i);
+      if (w.weights[slot] == 0.0f) continue;
+      if (n < 2) slots[n] = slot;
+      ++n;
+    }
+    if (n == 1) {
+      rotations[c] = glm::quat(bone[w.joints[slots[0]]]);
+      continue;
+    }
+    const glm::dquat q1 = bone[w.joints[slots[0]]];
+    glm::dquat rel = glm::conjugate(q1) * bone[w.joints[slots[1]]];  // R1^T R2 = Rot(a, theta)
+    if (rel.w < 0.0) rel = -rel;
+    const double s = glm::length(glm::dvec3(rel.x, rel.y, rel.z));
+    const double w1 = w.weights[slots[0]], w2 = w.weights[slots[1]];
+    // theta from rel = (cos(theta/2), sin(theta/2) a): sin theta = 2 s c,
+    // cos theta = 2 c^2 - 1 (no trigonometric calls).
+    const double y = 2.0 * w2 * s * rel.w, x = w1 + w2 * (2.0 * rel.w * rel.w - 1.0);
+    const double rho = std::sqrt(x * x + y * y);
+    if (n > 2 || rho < 1e-6 || rho + x < 1e-9) {
+      // More bones, or two opposite rotations at equal weight: the general
+      // (SVD) polar decomposition of this control point alone.
+      const std::size_t first = c * static_cast<std::size_t>(k);
+      const mocap::JobStatus st = SsdControlRotations(
+          pose.model_from_bind, k,
+          std::span<const std::uint16_t>(w.joints).subspan(first, static_cast<std::size_t>(k)),
+          std::span<const float>(w.weights).subspan(first, static_cast<std::size_t>(k)),
+          rotations.subspan(c, 1));
+      if (!st) return st;
+      continue;
+    }
+    if (s < 1e-12) {
+      rotations[c] = glm::quat(q1);
+      continue;
+    }
+    // w1 I + w2 Rot(a, theta) is normal with eigenvalues 1 and w1 + w2 e^(+-i theta)
+    // = rho e^(+-i phi), so its orthogonal polar factor is Rot(a, phi); as a
+    // quaternion (cos(phi/2), sin(phi/2) a) ~ (rho + x, y a), normalized.
+    const glm::dvec3 axis = glm::dvec3(rel.x, rel.y, rel.z) / s;
+    const glm::dquat turn = glm::normalize(glm::dquat(rho + x, y * axis));
+    rotations[c] = glm::quat(glm::normalize(q1 * turn));
+  }
+  return mocap::kJobOk;
 }
 
 mocap::Result<SculptedExample> SculptExample(const PatchSetup& patch, const SkinnedMesh& mesh,

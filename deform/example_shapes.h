@@ -82,8 +82,13 @@ mocap::Result<SculptedExample> SculptExample(const PatchSetup& patch, const Skin
                                              int iterations = 4);
 
 // The rotations A_c (#C unit quaternions) the control points of `patch` move
-// with under the global layer: SsdControlRotations, or DqsControlRotations
-// when pose.dq_palette is set.
+// with under the global layer: DqsControlRotations when pose.dq_palette is
+// set; otherwise the SSD polar rotation of sum_b W_c,b R_b (4.3), the same
+// rotation SsdControlRotations gives (to round-off) but in closed form for a
+// control point with one or two bones: with R1^T R2 = Rot(a, theta),
+// polar(w1 R1 + w2 R2) = R1 Rot(a, atan2(w2 sin theta, w1 + w2 cos theta)).
+// Control points with more bones, or a palette that is not rigid, take the
+// SVD. Never allocates.
 [[nodiscard]] mocap::JobStatus PatchControlRotations(const PatchSetup& patch,
                                                      const ExamplePose& pose,
                                                      std::span<glm::quat> rotations);

@@ -16,6 +16,7 @@
 #include "app/rig_file.h"
 #include "app/rig_patches.h"
 #include "deform/example_shapes.h"
+#include "deform/skinning_job.h"
 #include "mocap/pose.h"
 #include "support/data_paths.h"
 #include "support/tolerances.h"
@@ -390,6 +391,41 @@ TEST(RigExamples, TwoExamplesAreExactAndContinuousBetween) {
   EXPECT_GT(coarse, 0.0);
   EXPECT_GT(coarse / fine, 1.6) << "coarse " << coarse << " fine " << fine;
   EXPECT_LT(coarse, 0.25 * glm::length(m30));
+}
+
+}  // namespace
+
+namespace {
+
+// The closed-form SSD control-point rotations (one or two bones) agree with
+// the SVD polar decomposition of SsdControlRotations, at every pose of the
+// bend.
+TEST(RigExamples, ControlRotationsMatchThePolarDecomposition) {
+  const auto f = Load();
+  ASSERT_TRUE(f.has_value());
+  const app::Character& ch = f->character;
+  const deform::PatchSetup& p = f->patches[0];
+  const auto nj = static_cast<std::size_t>(ch.skeleton.num_joints());
+  std::vector<mocap::JointTransform> locals(nj);
+  std::vector<glm::mat4> model(nj), palette(ch.mesh.skin_joints.size());
+  std::vector<glm::quat> fast(p.rest_control.size()), svd(p.rest_control.size());
+  double worst = 0.0;
+  for (int frame = 0; frame < ch.motion.num_frames; frame += 5) {
+    ASSERT_TRUE((mocap::LocalPoseJob{&ch.skeleton, ch.motion.frame(frame), locals}.Run()));
+    ASSERT_TRUE((mocap::LocalToModelJob{.parents = ch.skeleton.parents, .locals = locals,
+                                        .model_from_joint = model}.Run()));
+    ASSERT_TRUE(deform::BuildSkinningPalette(model, ch.mesh, palette));
+    ASSERT_TRUE(deform::PatchControlRotations(p, {.model_from_bind = palette}, fast));
+    const deform::SkinWeights& w = p.control_weights;
+    ASSERT_TRUE(deform::SsdControlRotations(palette, w.influences, w.joints, w.weights, svd));
+    for (std::size_t c = 0; c < fast.size(); ++c) {
+      // Angle between the rotations ~ 2 |q1 - (+-q2)| (no acos: it amplifies round-off).
+      const glm::quat sign = glm::dot(fast[c], svd[c]) < 0.0f ? -svd[c] : svd[c];
+      const glm::quat diff = fast[c] - sign;
+      worst = std::max(worst, 2.0 * static_cast<double>(glm::length(glm::vec4(diff.x, diff.y, diff.z, diff.w))));
+    }
+  }
+  EXPECT_LT(worst, testsupport::kRotationTolRad);
 }
 
 }  // namespace
