@@ -1,18 +1,22 @@
 // Writes the motions the project ships in samples/data, from the synthetic
 // humanoid (mocap/synthetic.h), as BVH:
-//   generate_demo_data OUT.bvh          three cycles of the walk (the built-in demo)
-//   generate_demo_data --bend OUT.bvh   elbows and left knee bending 0 -> 150 degrees
-//                                       over 2 s (samples/data/bend.bvh, for the
-//                                       elbow_knee.json rig)
-//   generate_demo_data --jump OUT.bvh   the synthetic vertical jump at 30 fps, then
-//                                       1.5 s standing still (samples/data/jump.bvh,
-//                                       for belly_jump.json: the belly jiggles after
-//                                       landing and settles while the body stands)
-//   generate_demo_data --shake OUT.bvh  standing still, the head shaking "no"
-//                                       (3 Hz, +-25 degrees about the neck's and
-//                                       head's Y axes) from 0.5 to 1.5 s, then still
-//                                       for 1.5 s (samples/data/head_shake.bvh, for
-//                                       jowl.json); the shake stops at full speed
+//   generate_demo_data OUT.bvh              three cycles of the walk (the built-in demo)
+//   generate_demo_data --bend OUT.bvh       elbows and left knee bending 0 -> 150 degrees
+//                                           over 2 s (samples/data/bend.bvh: the
+//                                           elbow_knee, elbow, biceps and knee rigs)
+//   generate_demo_data --shoulder OUT.bvh   the left arm visiting five poses from the
+//                                           T-pose (samples/data/shoulder.bvh)
+//   generate_demo_data --hip OUT.bvh        the left leg stretching back, then lifting
+//                                           forward (samples/data/hip.bvh)
+//   generate_demo_data --jump OUT.bvh       the synthetic vertical jump at 30 fps, then
+//                                           1.5 s standing still (samples/data/jump.bvh,
+//                                           for belly_jump.json: the belly jiggles after
+//                                           landing and settles while the body stands)
+//   generate_demo_data --shake OUT.bvh      standing still, the head shaking "no"
+//                                           (3 Hz, +-25 degrees about the neck's and
+//                                           head's Y axes) from 0.5 to 1.5 s, then still
+//                                           for 1.5 s (samples/data/head_shake.bvh, for
+//                                           jowl.json); the shake stops at full speed
 
 #include <cmath>
 #include <cstdio>
@@ -80,8 +84,9 @@ mocap::Result<mocap::Motion> MakeHeadShake(const mocap::Skeleton& skeleton) {
 
 int main(int argc, char** argv) {
   const std::string mode = argc == 3 ? std::string(argv[1]) : std::string();
-  if (argc != 2 && mode != "--bend" && mode != "--jump" && mode != "--shake") {
-    std::fprintf(stderr, "usage: generate_demo_data [--bend | --jump | --shake] OUT.bvh\n");
+  if (argc != 2 && mode != "--bend" && mode != "--jump" && mode != "--shake" &&
+      mode != "--shoulder" && mode != "--hip") {
+    std::fprintf(stderr, "usage: generate_demo_data [--bend | --jump | --shake | --shoulder | --hip] OUT.bvh\n");
     return 1;
   }
   const mocap::Skeleton skeleton = mocap::MakeHumanoidSkeleton();
@@ -89,6 +94,8 @@ int main(int argc, char** argv) {
   walk.num_cycles = 3;
   mocap::Result<mocap::Motion> motion = mocap::MakeWalkMotion(skeleton, walk);
   if (mode == "--bend") motion = mocap::MakeBendRamp(skeleton, 150.0f, 2.0);
+  if (mode == "--shoulder") motion = mocap::MakeShoulderSweep(skeleton);
+  if (mode == "--hip") motion = mocap::MakeHipSwing(skeleton);
   if (mode == "--shake") motion = MakeHeadShake(skeleton);
   if (mode == "--jump") {
     motion = mocap::MakeJumpMotion(skeleton, {});

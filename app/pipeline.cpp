@@ -156,6 +156,11 @@ struct FramePipeline::Impl {
   std::unique_ptr<ElasticLayer> elastic;                // null: no elastic patches
   std::vector<std::vector<glm::vec3>> displacement;     // per patch, empty or #M x #N (model)
   std::vector<std::span<const glm::vec3>> displacement_views;
+  // Example shapes (empty: none): per patch, and scratch for the largest.
+  std::vector<deform::PatchPoseSpace> pose_spaces;
+  std::vector<float> pose_features;       // max #X
+  std::vector<glm::vec3> pose_ds;         // max #M x #N, dS in the local frames
+  std::vector<glm::quat> pose_rotations;  // max #M x #N, A
   std::optional<deform::SwdRig> swd_rig;
   std::vector<glm::quat> swd_rotations;  // #threads x #J scratch
   std::vector<glm::vec3> swd_joints;     // #threads x #J scratch
@@ -189,6 +194,7 @@ mocap::Status FramePipeline::SetPatches(std::vector<deform::PatchSetup> patches)
   m.elastic.reset();
   m.displacement.assign(m.patches.size(), {});
   m.displacement_views.assign(m.patches.size(), {});
+  m.pose_spaces.clear();
   return mocap::Status::Ok();
 }
 
@@ -202,6 +208,61 @@ mocap::Status FramePipeline::SetElastic(std::vector<ElasticPatchSpec> specs) {
 
 std::vector<ElasticPatchReport> FramePipeline::elastic_report() const {
   return impl_->elastic ? impl_->elastic->Report() : std::vector<ElasticPatchReport>();
+}
+
+mocap::Status FramePipeline::SetPoseSpaces(std::vector<deform::PatchPoseSpace> spaces) {
+  Impl& m = *impl_;
+  const mocap::FileLoc loc{m.character->source, 0, 0, {}};
+  if (!spaces.empty() && spaces.size() != m.patches.size()) {
+    return mocap::MakeError(mocap::ErrorCode::kInvalidArgument, loc,
+                            "expected one pose space per patch (" + std::to_string(m.patches.size()) +
+                                "), found " + std::to_string(spaces.size()));
+  }
+  std::size_t max_x = 0, max_c = 0;
+  for (std::size_t p = 0; p < spaces.size(); ++p) {
+    if (!spaces[p].active()) continue;
+    const deform::RbfModel& model = spaces[p].model;
+    const int dim = deform::PoseFeatureDimension(m.character->skeleton, spaces[p].features);
+    if (model.dimension != dim || model.num_values != 3 * m.patches[p].num_control()) {
+      return mocap::MakeError(mocap::ErrorCode::kInvalidArgument, loc,
+                              "pose space " + std::to_string(p) +
+                                  " does not fit its patch (features or control points)");
+    }
+    max_x = std::max(max_x, static_cast<std::size_t>(dim));
+    max_c = std::max(max_c, m.patches[p].rest_control.size());
+  }
+  m.pose_spaces = std::move(spaces);
+  m.pose_features.resize(max_x);
+  m.pose_ds.resize(max_c);
+  m.pose_rotations.resize(max_c);
+  return mocap::Status::Ok();
+}
+
+// Q = G + A dS(theta) for patch p, in place on its carried control points.
+mocap::JobStatus FramePipeline::AddExampleShapes(Impl& m, std::size_t p) {
+  const deform::PatchPoseSpace& space = m.pose_spaces[p];
+  const std::size_t nc = m.patches[p].rest_control.size();
+  const std::span<float> features =
+      std::span<float>(m.pose_features).first(static_cast<std::size_t>(space.model.dimension));
+  const std::span<glm::vec3> ds = std::span<glm::vec3>(m.pose_ds).first(nc);
+  const std::span<glm::quat> rotations = std::span<glm::quat>(m.pose_rotations).first(nc);
+  if (!deform::ComputePoseFeatures(m.character->skeleton, space.features, m.locals, features).ok()) {
+    return {mocap::JobStatus::kSizeMismatch, "pose features"};
+  }
+  mocap::JobStatus s =
+      deform::PoseSpaceJob{.model = &space.model, .features = features, .displacement = ds}.Run();
+  if (!s) return s;
+  const bool dqs = m.method == GlobalMethod::kDqs;
+  s = deform::PatchControlRotations(
+      m.patches[p],
+      {.model_from_bind = m.palette,
+       .dq_palette = dqs ? std::span<const deform::DualQuat>(m.dq_palette)
+                         : std::span<const deform::DualQuat>()},
+      rotations);
+  if (!s) return s;
+  return deform::PoseSpaceApplyJob{
+      .global = m.carried[p], .rotations = rotations, .displacement = ds, .control = m.carried[p]}
+      .Run();
 }
 
 mocap::Result<FramePipeline> FramePipeline::Create(const Character& character, GlobalMethod method,
@@ -295,8 +356,9 @@ mocap::Status FramePipeline::Evaluate(double time_s, DeformedFrame& out) {
     if (!r) return JobError(c, r, GlobalMethodName(m.method));
   }
   if (!m.patches.empty()) {
-    // Patch layer: carry the control points like skin vertices, rebuild and
-    // blend, with the elastic displacements dE (dS comes with issue 6).
+    // Patch layer: carry the control points like skin vertices, add the
+    // example shapes dS (in the frames the control points move with) and the
+    // elastic displacements dE, rebuild and blend.
     for (std::size_t p = 0; p < m.patches.size(); ++p) {
       const bool dqs = m.method == GlobalMethod::kDqs;
       s = deform::CarryControlPointsJob{
@@ -307,6 +369,10 @@ mocap::Status FramePipeline::Evaluate(double time_s, DeformedFrame& out) {
           .control = m.carried[p]}
               .Run();
       if (!s) return JobError(c, s, "patch control points");
+      if (p < m.pose_spaces.size() && m.pose_spaces[p].active()) {
+        s = AddExampleShapes(m, p);
+        if (!s) return JobError(c, s, "pose space");
+      }
     }
     std::span<const std::span<const glm::vec3>> displacements;
     if (m.elastic) {

@@ -20,6 +20,7 @@
 #include <glm/glm.hpp>
 
 #include "app/elastic_layer.h"
+#include "deform/example_shapes.h"
 #include "deform/mannequin.h"
 #include "deform/mesh.h"
 #include "deform/patch_layer.h"
@@ -100,6 +101,13 @@ class FramePipeline {
   mocap::Status SetPatches(std::vector<deform::PatchSetup> patches);
   int num_patches() const;
 
+  // Adds example shapes to the patches (ALGORITHMS.md 0 step 2, 4.3, 5): per
+  // frame and patch, theta from the sampled local pose -> dS(theta) by the
+  // patch's RBF -> Q = G + A dS on the carried control points, before any
+  // elastic displacement and the rebuild. One entry per patch set by
+  // SetPatches (inactive entries: no examples); kInvalidArgument otherwise or
+  // when a model's size disagrees with its patch. Empty clears them.
+  mocap::Status SetPoseSpaces(std::vector<deform::PatchPoseSpace> spaces);
   // Adds the elastic layer dE (ALGORITHMS.md 6, app/elastic_layer.h) to some of
   // the patches set by SetPatches (call it after them): each frame, before the
   // rebuild, the carried control points of patch spec.patch get R_drv e. The
@@ -113,6 +121,7 @@ class FramePipeline {
  private:
   struct Impl;
   explicit FramePipeline(std::unique_ptr<Impl> impl);
+  static mocap::JobStatus AddExampleShapes(Impl& m, std::size_t patch);
   std::unique_ptr<Impl> impl_;
 };
 

@@ -17,6 +17,7 @@
 #include "app/output_guard.h"
 #include "app/pipeline.h"
 #include "app/progress.h"
+#include "app/rig_examples.h"
 #include "app/rig_file.h"
 #include "app/rig_patches.h"
 #include "render/async_writer.h"
@@ -141,6 +142,7 @@ int RunRender(const RenderOptions& options) {
   // --- A rig file (README "Rig files") sets the inputs and render settings ---
   RenderOptions o = options;
   std::optional<Rig> rig;
+  const bool cli_split = o.split.has_value();
   if (std::filesystem::path(o.input).extension() == ".json") {
     mocap::Result<Rig> loaded = LoadRig(o.input);
     if (!loaded.ok()) return Fail(loaded.error());
@@ -284,12 +286,21 @@ int RunRender(const RenderOptions& options) {
 
   // --- Pipelines ---------------------------------------------------------------
   std::vector<deform::PatchSetup> patches;
-  const bool rig_split = rig && !rig->patches.empty() && rig->render.split;
+  std::vector<deform::PatchPoseSpace> pose_spaces;
+  // --split on the command line turns a rig's split on (global only | patches).
+  const bool rig_split = rig && !rig->patches.empty() && (rig->render.split || cli_split);
   if (rig) {
     mocap::Result<std::vector<deform::PatchSetup>> built = BuildRigPatches(*rig, ch);
     if (!built.ok()) return Fail(built.error());
     patches = std::move(*built);
     if (rig_split && !o.split) split_left = split_right = *method;
+    mocap::Result<RigPoseSpaces> spaces = BuildRigPoseSpaces(*rig, ch, patches, *method);
+    if (!spaces.ok()) return Fail(spaces.error());
+    if (!o.quiet) {
+      for (const std::string& note : spaces->notes) std::fprintf(stderr, "examples: %s\n", note.c_str());
+      for (const mocap::Warning& w : spaces->warnings) std::fprintf(stderr, "%s\n", w.ToString().c_str());
+    }
+    pose_spaces = std::move(spaces->patches);
   }
   const GlobalMethod main_method = split_left ? *split_left : *method;
   mocap::Result<FramePipeline> pipeline = FramePipeline::Create(ch, main_method, o.threads);
@@ -306,6 +317,8 @@ int RunRender(const RenderOptions& options) {
     mocap::Result<std::vector<ElasticPatchSpec>> elastic = ResolveRigElastic(*rig, ch, patches);
     if (!elastic.ok()) return Fail(elastic.error());
     mocap::Status s = layered.SetPatches(std::move(patches));
+    if (!s.ok()) return Fail(s.error());
+    s = layered.SetPoseSpaces(std::move(pose_spaces));
     if (!s.ok()) return Fail(s.error());
     s = layered.SetElastic(std::move(*elastic));
     if (!s.ok()) return Fail(s.error());

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/internal/rig_elastic_parse.h"
+#include "app/internal/rig_examples_parse.h"
 #include "app/output_guard.h"
 
 namespace app {
@@ -206,14 +207,8 @@ std::optional<mocap::Error> ParseRegion(const Ctx& c, const json& v, const std::
 std::optional<mocap::Error> ParsePatch(const Ctx& c, const json& v, const std::string& path,
                                        RigPatch& p) {
   if (auto e = CheckObject(c, v, path, {"name", "region", "parametrization", "sampling", "grid",
-                                        "border_width", "examples", "elastic"})) {
+                                        "border_width", "examples", "pose_space", "elastic"})) {
     return e;
-  }
-  for (const char* later : {"examples"}) {
-    if (v.contains(later)) {
-      return c.Fail(Join(path, later), std::string(later) + " are not supported yet (issue 6)",
-                    mocap::ErrorCode::kUnsupported);
-    }
   }
   if (!v.contains("name")) return c.Fail(path + ".name", "missing (a non-empty string)");
   if (auto e = GetString(c, v["name"], path + ".name", p.name)) return e;
@@ -251,7 +246,7 @@ std::optional<mocap::Error> ParsePatch(const Ctx& c, const json& v, const std::s
       return e;
     }
   }
-  return std::nullopt;
+  return internal::ParsePatchExamples(c.file, v, path, p);
 }
 
 std::optional<mocap::Error> ParseRender(const Ctx& c, const json& v, RigRender& r) {

@@ -18,8 +18,8 @@
 // names are checked when the patches are built). Errors name the file, the
 // field path (e.g. "patches[1].grid") and what was expected:
 //   rig.json: error: patches[1].grid: expected an array of two integers in 4..64, found "6x6"
-// `examples` (issue 6) is recognised per patch and rejected as not supported
-// yet; `elastic` (issue 7) is parsed by app/rig_elastic.cpp.
+// `examples` and `pose_space` per patch are parsed by app/rig_examples.cpp
+// (types in app/rig_examples.h); `elastic` by app/rig_elastic.cpp.
 
 #include <optional>
 #include <string>
@@ -28,6 +28,7 @@
 #include <glm/glm.hpp>
 
 #include "app/rig_elastic.h"
+#include "app/rig_examples.h"
 #include "mocap/error.h"
 
 namespace app {
@@ -58,6 +59,8 @@ struct RigPatch {
   glm::ivec2 grid{6, 6};             // M x N, each 4..64
   float border_width = 0.1f;         // parameter units, [0, 0.5]
   std::optional<RigElastic> elastic; // the elastic layer (mass-spring dE); none = no dE
+  std::vector<RigExample> examples;  // example shapes (app/rig_examples.h); empty = none
+  RigPoseSpace pose_space;           // how the examples are interpolated over theta
 };
 
 struct RigRender {

@@ -344,6 +344,61 @@ Result<Motion> MakeBendRamp(const Skeleton& humanoid, float end_deg, double dura
   return writer->Take();
 }
 
+namespace {
+
+// Cosine ease of the move from key k to k + 1 at time t: (k, s), s in [0, 1],
+// zero speed at both keys; t past the last key gives the last key.
+std::pair<int, double> EasedSegment(double t, double segment_s, int num_keys) {
+  const double x = std::clamp(t / segment_s, 0.0, static_cast<double>(num_keys - 1));
+  const int k = std::min(static_cast<int>(std::floor(x)), num_keys - 2);
+  const double y = x - k;
+  return {k, 0.5 - 0.5 * std::cos(kPi * y)};
+}
+
+}  // namespace
+
+Result<Motion> MakeShoulderSweep(const Skeleton& humanoid, double segment_s,
+                                 double frame_time_s) {
+  if (!(segment_s > 0.0)) return MakeError(ErrorCode::kInvalidArgument, {}, "expected segment_s > 0");
+  const glm::quat t_pose(1.0f, 0.0f, 0.0f, 0.0f);
+  const glm::quat poses[5] = {Zxy(-75, 0, 0), Zxy(60, 0, 0), Zxy(0, 0, -90), Zxy(0, 0, 40),
+                              Zxy(-60, 0, -50)};
+  std::vector<glm::quat> keys = {t_pose};
+  for (const glm::quat& q : poses) {
+    keys.push_back(q);
+    keys.push_back(t_pose);
+  }
+  const int num_keys = static_cast<int>(keys.size());
+  auto writer = MotionWriter::Create(humanoid, frame_time_s,
+                                     FramesFor((num_keys - 1) * segment_s, frame_time_s));
+  if (!writer.ok()) return std::move(writer).error();
+  for (int f = 0; f < writer->num_frames(); ++f) {
+    const auto [k, w] = EasedSegment(f * frame_time_s, segment_s, num_keys);
+    HumanoidPose p;
+    p.rotations[kLArm] = glm::slerp(keys[static_cast<std::size_t>(k)],
+                                    keys[static_cast<std::size_t>(k + 1)], static_cast<float>(w));
+    writer->Write(f, p);
+  }
+  return writer->Take();
+}
+
+Result<Motion> MakeHipSwing(const Skeleton& humanoid, double segment_s, double frame_time_s) {
+  if (!(segment_s > 0.0)) return MakeError(ErrorCode::kInvalidArgument, {}, "expected segment_s > 0");
+  // (thigh X, knee X) in degrees: stand, stretched back, stand, lifted, stand.
+  const double keys[5][2] = {{0, 0}, {40, 0}, {0, 0}, {-80, 90}, {0, 0}};
+  auto writer = MotionWriter::Create(humanoid, frame_time_s, FramesFor(4 * segment_s, frame_time_s));
+  if (!writer.ok()) return std::move(writer).error();
+  for (int f = 0; f < writer->num_frames(); ++f) {
+    const auto [k, w] = EasedSegment(f * frame_time_s, segment_s, 5);
+    const auto a = static_cast<std::size_t>(k), b = a + 1;
+    HumanoidPose p;  // the foot follows the shin (no ankle blend to lose volume)
+    p.rotations[kLUpLeg] = Zxy(0, keys[a][0] + w * (keys[b][0] - keys[a][0]), 0);
+    p.rotations[kLLeg] = Zxy(0, keys[a][1] + w * (keys[b][1] - keys[a][1]), 0);
+    writer->Write(f, p);
+  }
+  return writer->Take();
+}
+
 Result<Motion> MakeTwistRamp(const Skeleton& humanoid, float end_deg, double duration_s,
                              double frame_time_s) {
   auto writer = MotionWriter::Create(humanoid, frame_time_s, FramesFor(duration_s, frame_time_s));

@@ -63,6 +63,24 @@ Result<Motion> MakeWalkMotion(const Skeleton& humanoid, const WalkOptions& optio
 Result<Motion> MakeBendRamp(const Skeleton& humanoid, float end_deg = 150.0f,
                             double duration_s = 2.0, double frame_time_s = 1.0 / 30.0);
 
+// The left upper arm (joint LeftArm) visits five poses, returning to the
+// T-pose between them: down at the side (Z -75), raised (Z +60), forward
+// (Y -90), back (Y +40) and down in front (Z -60 then Y -50: R = Rz * Ry, the
+// arm lowered then swung forward). Each move takes segment_s with a cosine ease
+// (zero speed at both ends), so pose k (0..4) is reached exactly at
+// (2k + 1) * segment_s and the motion lasts 10 * segment_s. Angles in degrees
+// about the joint's own axes, composed in its ZXY order (pose.h).
+Result<Motion> MakeShoulderSweep(const Skeleton& humanoid, double segment_s = 0.5,
+                                 double frame_time_s = 1.0 / 30.0);
+
+// The left leg stretches back (thigh 40 degrees behind, knee straight), returns
+// to standing, lifts forward (thigh 80 degrees forward, knee 90 degrees bent)
+// and returns; the foot follows the shin (ankle and right leg still). Each move takes
+// segment_s with a cosine ease; the stretched-back pose is reached exactly at
+// segment_s and the lifted pose at 3 * segment_s; 4 * segment_s in all.
+Result<Motion> MakeHipSwing(const Skeleton& humanoid, double segment_s = 0.5,
+                            double frame_time_s = 1.0 / 30.0);
+
 // Both forearms twist about their bone axis (X) linearly from 0 to end_deg
 // (mirrored: the right forearm by -end_deg about +X), arms in T-pose.
 Result<Motion> MakeTwistRamp(const Skeleton& humanoid, float end_deg = 180.0f,

@@ -130,8 +130,8 @@ const BadRig kBadRigs[] = {
      "r.json: patches[0].parametrization: error: expected one of \"cylinder\", \"plane\", found "
      "\"sphere\""},
     {R"({"character": "mannequin", "motion": {"file": "m.bvh"}, "patches": [{"name": "a",
-        "region": {"joint": "J", "radius": 5}, "examples": []}]})",
-     "r.json: patches[0].examples: error: examples are not supported yet (issue 6)"},
+        "region": {"joint": "J", "radius": 5}, "examples": {}}]})",
+     "r.json: patches[0].examples: error: expected an array of examples, found an object"},
     {R"({"character": "mannequin", "motion": {"file": "m.bvh"}, "patches": [{"name": "a",
         "region": {"joint": "J", "radius": 5}, "elastic": 3}]})",
      "r.json: patches[0].elastic: error: expected an object, found 3"},

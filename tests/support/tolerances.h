@@ -11,6 +11,10 @@ inline constexpr float kPositionTol = 1e-3f;
 inline constexpr float kAngleTolDeg = 1e-3f;
 // Double-precision solves (fits, RBF, projections).
 inline constexpr double kDoubleTol = 1e-9;
+// Example shapes at the rest pose, relative to the patch diagonal: dS(rest) = 0
+// holds in exact arithmetic; the float RBF sum leaves round-off of its
+// weights (~1e-7 x the displacements) times a few control points.
+inline constexpr double kRestRoundoffRel = 1e-5;
 
 // Euler angles (degrees) extracted from a float quaternion and compared with the
 // angles that built it: float quaternion round-off (~6e-8) amplified by the
