@@ -88,10 +88,11 @@ class FramePipeline {
   GlobalMethod method() const;
 
   // Adds the patch layer (ALGORITHMS.md 0, 3.7, 3.8), applied after the global
-  // step: control points carried by the same method (SSD or DQS), bound
+  // step: control points carried by the same method (SSD, DQS or SWD), bound
   // vertices rebuilt and blended, then normals recomputed from the mesh.
-  // Patches must be built on this character's bind mesh. kUnsupported with SWD
-  // (its control-point binding is not wired yet).
+  // Patches must be built on this character's bind mesh. With SWD every control
+  // point is bound to the sweeps of its nearest region vertex
+  // (deform::BindPointsLikeVertices) and carried by deform::SwdJob.
   mocap::Status SetPatches(std::vector<deform::PatchSetup> patches);
   int num_patches() const;
 
