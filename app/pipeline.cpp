@@ -2,12 +2,15 @@
 
 #include <algorithm>
 #include <array>
+#include <limits>
 #include <optional>
+#include <string>
 #include <thread>
 
 #include "app/motion_source.h"
 #include "deform/dqs_job.h"
 #include "deform/skinning_job.h"
+#include "deform/swd_job.h"
 #include "deform/swd_rig.h"
 #include "mocap/bvh_reader.h"
 #include "mocap/pose.h"
@@ -164,6 +167,8 @@ struct FramePipeline::Impl {
   std::optional<deform::SwdRig> swd_rig;
   std::vector<glm::quat> swd_rotations;  // #threads x #J scratch
   std::vector<glm::vec3> swd_joints;     // #threads x #J scratch
+  // SWD only: per patch, its control points bound to the sweeps (#M x #N).
+  std::vector<std::vector<deform::SweepVertexBinding>> swd_control;
 };
 
 FramePipeline::FramePipeline(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -179,10 +184,34 @@ int FramePipeline::num_patches() const { return static_cast<int>(impl_->patches.
 
 mocap::Status FramePipeline::SetPatches(std::vector<deform::PatchSetup> patches) {
   Impl& m = *impl_;
-  if (!patches.empty() && m.method == GlobalMethod::kSwd) {
-    return mocap::MakeError(mocap::ErrorCode::kUnsupported, {m.character->source, 0, 0, {}},
-                            "patches on --global swd are not available in this build yet");
+  std::vector<std::vector<deform::SweepVertexBinding>> swd_control;
+  if (m.method == GlobalMethod::kSwd) {
+    // Each control point follows the sweeps of the region vertex nearest it (the part
+    // of the body its surface approximates), bound like a vertex (ALGORITHMS.md 2.3).
+    const std::span<const glm::vec3> rest = m.character->mesh.bind.positions;
+    for (std::size_t p = 0; p < patches.size(); ++p) {
+      const deform::PatchSetup& patch = patches[p];
+      std::vector<int> guides(patch.rest_control.size(), -1);
+      for (std::size_t i = 0; i < guides.size(); ++i) {
+        float best = std::numeric_limits<float>::max();
+        for (const int v : patch.region) {
+          if (v < 0 || static_cast<std::size_t>(v) >= rest.size()) continue;
+          const glm::vec3 d = rest[static_cast<std::size_t>(v)] - patch.rest_control[i];
+          if (glm::dot(d, d) < best) best = glm::dot(d, d), guides[i] = v;
+        }
+      }
+      mocap::Result<std::vector<deform::SweepVertexBinding>> bound =
+          deform::BindPointsLikeVertices(*m.swd_rig, patch.rest_control, guides);
+      if (!bound.ok()) {
+        mocap::Error e = std::move(bound).error();
+        e.loc.file = m.character->source;
+        e.message = "patch " + std::to_string(p) + ": " + e.message;
+        return e;
+      }
+      swd_control.push_back(std::move(*bound));
+    }
   }
+  m.swd_control = std::move(swd_control);
   m.patches = std::move(patches);
   m.carried.assign(m.patches.size(), {});
   m.carried_views.clear();
@@ -221,6 +250,12 @@ mocap::Status FramePipeline::SetPoseSpaces(std::vector<deform::PatchPoseSpace> s
   std::size_t max_x = 0, max_c = 0;
   for (std::size_t p = 0; p < spaces.size(); ++p) {
     if (!spaces[p].active()) continue;
+    if (m.method == GlobalMethod::kSwd) {
+      // The frames A that carry dS (ALGORITHMS.md 4.3) are defined here for
+      // SSD and DQS only; refuse rather than drop the examples silently.
+      return mocap::MakeError(mocap::ErrorCode::kUnsupported, loc,
+                              "example shapes need global ssd or dqs (not available with swd yet)");
+    }
     const deform::RbfModel& model = spaces[p].model;
     const int dim = deform::PoseFeatureDimension(m.character->skeleton, spaces[p].features);
     if (model.dimension != dim || model.num_values != 3 * m.patches[p].num_control()) {
@@ -359,7 +394,27 @@ mocap::Status FramePipeline::Evaluate(double time_s, DeformedFrame& out) {
     // Patch layer: carry the control points like skin vertices, add the
     // example shapes dS (in the frames the control points move with) and the
     // elastic displacements dE, rebuild and blend.
-    for (std::size_t p = 0; p < m.patches.size(); ++p) {
+    if (m.method == GlobalMethod::kSwd) {
+      // The joint state the vertex pass used, once more for the control points.
+      const int nj = static_cast<int>(m.model_from_joint.size());
+      const std::span<glm::quat> rotations = Sub(m.swd_rotations, 0, 1, nj);
+      const std::span<glm::vec3> joints = Sub(m.swd_joints, 0, 1, nj);
+      s = deform::ComputeSwdJointState(*m.swd_rig, m.model_from_joint, rotations, joints);
+      for (std::size_t p = 0; s && p < m.patches.size(); ++p) {
+        s = deform::SwdJob{.chains = m.swd_rig->chains(),
+                           .joint_rotations = rotations,
+                           .joint_positions = joints,
+                           .bindings = m.swd_control[p],
+                           .rest_normals = {},
+                           .keep_volume = false,
+                           .section_scales = {},
+                           .positions = m.carried[p],
+                           .normals = {}}
+                .Run();
+      }
+      if (!s) return JobError(c, s, "patch control points (swd)");
+    }
+    for (std::size_t p = 0; m.method != GlobalMethod::kSwd && p < m.patches.size(); ++p) {
       const bool dqs = m.method == GlobalMethod::kDqs;
       s = deform::CarryControlPointsJob{
           .patch = &m.patches[p],

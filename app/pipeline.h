@@ -94,10 +94,11 @@ class FramePipeline {
   int threads() const;
 
   // Adds the patch layer (ALGORITHMS.md 0, 3.7, 3.8), applied after the global
-  // step: control points carried by the same method (SSD or DQS), bound
+  // step: control points carried by the same method (SSD, DQS or SWD), bound
   // vertices rebuilt and blended, then normals recomputed from the mesh.
-  // Patches must be built on this character's bind mesh. kUnsupported with SWD
-  // (its control-point binding is not wired yet).
+  // Patches must be built on this character's bind mesh. With SWD every control
+  // point is bound to the sweeps of its nearest region vertex
+  // (deform::BindPointsLikeVertices) and carried by deform::SwdJob.
   mocap::Status SetPatches(std::vector<deform::PatchSetup> patches);
   int num_patches() const;
 
@@ -106,7 +107,8 @@ class FramePipeline {
   // patch's RBF -> Q = G + A dS on the carried control points, before any
   // elastic displacement and the rebuild. One entry per patch set by
   // SetPatches (inactive entries: no examples); kInvalidArgument otherwise or
-  // when a model's size disagrees with its patch. Empty clears them.
+  // when a model's size disagrees with its patch; kUnsupported with SWD (its
+  // control-point frames A are not defined yet). Empty clears them.
   mocap::Status SetPoseSpaces(std::vector<deform::PatchPoseSpace> spaces);
   // Adds the elastic layer dE (ALGORITHMS.md 6, app/elastic_layer.h) to some of
   // the patches set by SetPatches (call it after them): each frame, before the

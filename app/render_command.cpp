@@ -20,6 +20,7 @@
 #include "app/rig_examples.h"
 #include "app/rig_file.h"
 #include "app/rig_patches.h"
+#include "app/rig_setup.h"
 #include "render/async_writer.h"
 #include "render/camera.h"
 #include "render/contact_sheet.h"
@@ -285,23 +286,10 @@ int RunRender(const RenderOptions& options) {
   }
 
   // --- Pipelines ---------------------------------------------------------------
-  std::vector<deform::PatchSetup> patches;
-  std::vector<deform::PatchPoseSpace> pose_spaces;
   // --split on the command line turns a rig's split on (global only | patches).
-  const bool rig_split = rig && !rig->patches.empty() && (rig->render.split || cli_split);
-  if (rig) {
-    mocap::Result<std::vector<deform::PatchSetup>> built = BuildRigPatches(*rig, ch);
-    if (!built.ok()) return Fail(built.error());
-    patches = std::move(*built);
-    if (rig_split && !o.split) split_left = split_right = *method;
-    mocap::Result<RigPoseSpaces> spaces = BuildRigPoseSpaces(*rig, ch, patches, *method);
-    if (!spaces.ok()) return Fail(spaces.error());
-    if (!o.quiet) {
-      for (const std::string& note : spaces->notes) std::fprintf(stderr, "examples: %s\n", note.c_str());
-      for (const mocap::Warning& w : spaces->warnings) std::fprintf(stderr, "%s\n", w.ToString().c_str());
-    }
-    pose_spaces = std::move(spaces->patches);
-  }
+  const bool has_layers = rig && !rig->patches.empty();
+  const bool rig_split = has_layers && (rig->render.split || cli_split);
+  if (rig_split && !o.split) split_left = split_right = *method;
   const GlobalMethod main_method = split_left ? *split_left : *method;
   mocap::Result<FramePipeline> pipeline = FramePipeline::Create(ch, main_method, o.threads);
   if (!pipeline.ok()) return Fail(pipeline.error());
@@ -311,24 +299,14 @@ int RunRender(const RenderOptions& options) {
     if (!p.ok()) return Fail(p.error());
     right_pipeline.emplace(std::move(*p));
   }
-  if (!patches.empty()) {
-    // Split: the left half stays global only, the right half gets the patches.
+  if (has_layers) {
+    // Split: the left half stays global only, the right half gets the layers
+    // (patches, example shapes, elastic), set up as `export` sets them up.
     FramePipeline& layered = right_pipeline ? *right_pipeline : *pipeline;
-    mocap::Result<std::vector<ElasticPatchSpec>> elastic = ResolveRigElastic(*rig, ch, patches);
-    if (!elastic.ok()) return Fail(elastic.error());
-    mocap::Status s = layered.SetPatches(std::move(patches));
-    if (!s.ok()) return Fail(s.error());
-    s = layered.SetPoseSpaces(std::move(pose_spaces));
-    if (!s.ok()) return Fail(s.error());
-    s = layered.SetElastic(std::move(*elastic));
-    if (!s.ok()) return Fail(s.error());
+    std::vector<std::string> notes;
+    if (mocap::Status s = ApplyRigLayers(*rig, ch, layered, &notes); !s.ok()) return Fail(s.error());
     if (!o.quiet) {
-      for (const ElasticPatchReport& r : layered.elastic_report()) {
-        for (const std::string& note : r.messages) {
-          std::fprintf(stderr, "%s: patches[%d].elastic: note: %s\n", rig->file.c_str(), r.patch,
-                       note.c_str());
-        }
-      }
+      for (const std::string& note : notes) std::fprintf(stderr, "%s\n", note.c_str());
     }
   }
   const std::string right_label =

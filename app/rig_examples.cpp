@@ -379,6 +379,13 @@ mocap::Result<RigPoseSpaces> BuildRigPoseSpaces(const Rig& rig, const Character&
     const RigPatch& rp = rig.patches[i];
     if (rp.examples.empty()) continue;
     const std::string path = "patches[" + std::to_string(i) + "]";
+    if (method == GlobalMethod::kSwd) {
+      // dS lives in control-point frames A (ALGORITHMS.md 4.3), defined here
+      // for SSD and DQS only: say so instead of dropping the examples.
+      return mocap::MakeError(mocap::ErrorCode::kUnsupported, {rig.file, 0, 0, path + ".examples"},
+                              "example shapes need \"global\": \"ssd\" or \"dqs\" (not available "
+                              "with swd yet)");
+    }
     const deform::PatchSetup& patch = patches[i];
     mocap::Result<deform::PoseFeatureSpec> spec = FeatureSpec(rig, ch, rp, path, patch);
     if (!spec.ok()) return std::move(spec).error();

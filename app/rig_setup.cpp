@@ -1,5 +1,7 @@
 #include "app/rig_setup.h"
 
+#include "app/elastic_layer.h"
+#include "app/rig_examples.h"
 #include "app/rig_patches.h"
 
 namespace app {
@@ -13,11 +15,32 @@ mocap::Result<std::string> RigInputFile(const Rig& rig) {
   return rig.character == "mannequin" ? rig.motion : rig.character;
 }
 
-mocap::Status ApplyRigLayers(const Rig& rig, const Character& character, FramePipeline& pipeline) {
+mocap::Status ApplyRigLayers(const Rig& rig, const Character& character, FramePipeline& pipeline,
+                             std::vector<std::string>* notes) {
   mocap::Result<std::vector<deform::PatchSetup>> patches = BuildRigPatches(rig, character);
   if (!patches.ok()) return std::move(patches).error();
   if (patches->empty()) return mocap::Status::Ok();
-  return pipeline.SetPatches(std::move(*patches));
+  // Example shapes are sculpted in the frames of the method this pipeline
+  // carries the control points with; the elastic specs need the patches too.
+  mocap::Result<RigPoseSpaces> spaces =
+      BuildRigPoseSpaces(rig, character, *patches, pipeline.method());
+  if (!spaces.ok()) return std::move(spaces).error();
+  mocap::Result<std::vector<ElasticPatchSpec>> elastic = ResolveRigElastic(rig, character, *patches);
+  if (!elastic.ok()) return std::move(elastic).error();
+  if (mocap::Status s = pipeline.SetPatches(std::move(*patches)); !s.ok()) return s;
+  if (mocap::Status s = pipeline.SetPoseSpaces(std::move(spaces->patches)); !s.ok()) return s;
+  if (mocap::Status s = pipeline.SetElastic(std::move(*elastic)); !s.ok()) return s;
+  if (notes != nullptr) {
+    for (const std::string& note : spaces->notes) notes->push_back("examples: " + note);
+    for (const mocap::Warning& w : spaces->warnings) notes->push_back(w.ToString());
+    for (const ElasticPatchReport& r : pipeline.elastic_report()) {
+      for (const std::string& note : r.messages) {
+        notes->push_back(rig.file + ": patches[" + std::to_string(r.patch) +
+                         "].elastic: note: " + note);
+      }
+    }
+  }
+  return mocap::Status::Ok();
 }
 
 }  // namespace app

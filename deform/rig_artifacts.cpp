@@ -46,6 +46,21 @@ std::vector<std::uint32_t> NearestRing(std::span<const glm::vec3> rest,
 }
 
 // SSD, DQS and SWD positions of `mesh` under model_from_joint.
+// The topmost of the joints that sit where `joint` sits (zero-length helpers such as
+// CMU's LeftFingerBase under LeftHand): the joint a user turns to bend or twist there.
+int TopJointAt(const mocap::Skeleton& skeleton, std::span<const glm::mat4> bind, int joint) {
+  const glm::vec3 at(bind[static_cast<std::size_t>(joint)][3]);
+  const float scale = std::max(1e-6f, glm::length(at));
+  while (true) {
+    const int parent = skeleton.parents[static_cast<std::size_t>(joint)];
+    if (parent < 0 ||
+        glm::distance(glm::vec3(bind[static_cast<std::size_t>(parent)][3]), at) > 1e-5f * scale) {
+      return joint;
+    }
+    joint = parent;
+  }
+}
+
 mocap::Status DeformAll(const SkinnedMesh& mesh, const SwdRig& rig,
                         std::span<const glm::mat4> model, std::vector<glm::vec3> out[3]) {
   const std::size_t nv = mesh.bind.positions.size();
@@ -136,7 +151,8 @@ mocap::Result<std::vector<LimbArtifacts>> MeasureLimbArtifacts(
     const double lmin = std::min(c.rest_length(k - 1), c.rest_length(k));
     LimbArtifacts limb_out;
     limb_out.arm = limb.arm;
-    limb_out.joint = skeleton.names[static_cast<std::size_t>(c.joint(k))];
+    const int bent = TopJointAt(skeleton, bind, c.joint(k));
+    limb_out.joint = skeleton.names[static_cast<std::size_t>(bent)];
     // Bend axis: across the bone, horizontal when the bone is not vertical.
     glm::vec3 axis = glm::cross(a_out, up);
     if (glm::length(axis) < 0.3f) axis = glm::cross(a_out, glm::vec3(up.y, up.z, up.x));
@@ -152,7 +168,7 @@ mocap::Result<std::vector<LimbArtifacts>> MeasureLimbArtifacts(
     for (double deg : bend_degrees) {
       const glm::quat q = glm::angleAxis(static_cast<float>(glm::radians(deg)), axis);
       std::copy(bind.begin(), bind.end(), model.begin());
-      TurnSubtree(skeleton, c.joint(k), q, joint, model);
+      TurnSubtree(skeleton, bent, q, joint, model);
       if (mocap::Status s = DeformAll(mesh, rig, model, deformed); !s.ok()) return s.error();
       ring.plane = BisectorPlane(joint, a_in, q * a_out);
       mocap::Result<MethodFigures> f = Figures(rest, deformed, std::span(&ring, 1));
@@ -162,7 +178,8 @@ mocap::Result<std::vector<LimbArtifacts>> MeasureLimbArtifacts(
     if (limb.arm && limb.has_end) {
       const int w = k + 1;
       const glm::vec3 wrist(c.rest_pose().points[static_cast<std::size_t>(w)]);
-      limb_out.end_joint = skeleton.names[static_cast<std::size_t>(c.joint(w))];
+      const int twisted = TopJointAt(skeleton, bind, c.joint(w));
+      limb_out.end_joint = skeleton.names[static_cast<std::size_t>(twisted)];
       std::vector<ArtifactRing> rings;
       const double len = c.rest_length(k);
       for (double s : {0.5, 0.6, 0.7, 0.8, 0.9, 1.0}) {
@@ -181,7 +198,7 @@ mocap::Result<std::vector<LimbArtifacts>> MeasureLimbArtifacts(
       for (double deg : twist_degrees) {
         const glm::quat q = glm::angleAxis(static_cast<float>(glm::radians(deg)), a_out);
         std::copy(bind.begin(), bind.end(), model.begin());
-        TurnSubtree(skeleton, c.joint(w), q, wrist, model);
+        TurnSubtree(skeleton, twisted, q, wrist, model);
         if (mocap::Status s = DeformAll(mesh, rig, model, deformed); !s.ok()) return s.error();
         mocap::Result<MethodFigures> f = Figures(rest, deformed, rings);
         if (!f.ok()) return std::move(f).error();

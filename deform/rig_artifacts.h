@@ -1,7 +1,8 @@
 #pragma once
 // Artifact figures of a rigged body (ALGORITHMS.md 2.3, "Artifact figures") for SSD, DQS
 // and SWD side by side, under synthetic poses applied to the joints the SWD rig found by
-// topology (deform/swd_rig.h: elbow/knee = SwdLimb::middle, wrist = the joint after it):
+// topology (deform/swd_rig.h: elbow/knee = SwdLimb::middle, wrist = the joint after it;
+// of zero-length helpers at the same place, the topmost is turned and named):
 // - collapse: the elbow or knee bent by each angle (the joint's subtree turned about the
 //   joint, about an axis across the bone); ring = the mesh ring nearest the rest bisector
 //   plane among the vertices bound to that limb's sweep, within 0.6 Lmin of the joint.

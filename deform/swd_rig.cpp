@@ -23,16 +23,21 @@ struct Piece {
   int last = 0;
 };
 
-// The interior joint of `lengths` (bone lengths, #K) whose two bones are both the
-// longest (largest shorter bone of the pair: a long clavicle beside the upper arm does
-// not win over upper arm and forearm); 0 when the chain has fewer than two bones.
-int LongestPairJoint(const std::vector<double>& lengths) {
+// The elbow or knee of a limb chain with bone lengths `lengths` (#K >= 2): the interior
+// joint whose shorter bone is the longest (upper arm and forearm, thigh and shin). Bone 0
+// leaves the trunk (a clavicle, or pelvis to hip): it is the junction zone, not a limb
+// segment, and a clavicle can be as long as the forearm (CMU: 3.58 against 3.48), so
+// joint 1 (the shoulder) wins only when its pair is more than twice as long as the best
+// pair further out: a limb without a clavicle (upper arm, forearm, then a short hand).
+int LimbMiddleJoint(const std::vector<double>& lengths) {
+  auto pair = [&](std::size_t k) { return std::min(lengths[k - 1], lengths[k]); };
+  if (lengths.size() < 2) return 0;
   int best = 0;
-  double best_sum = -1.0;
-  for (std::size_t k = 1; k < lengths.size(); ++k) {
-    const double sum = std::min(lengths[k - 1], lengths[k]);
-    if (sum > best_sum) best_sum = sum, best = static_cast<int>(k);
+  double best_pair = -1.0;
+  for (std::size_t k = 2; k < lengths.size(); ++k) {
+    if (pair(k) > best_pair) best_pair = pair(k), best = static_cast<int>(k);
   }
+  if (best == 0 || pair(1) > 2.0 * best_pair) return 1;
   return best;
 }
 
@@ -115,11 +120,12 @@ mocap::Result<std::vector<SweepVertexBinding>> BindByComponent(
       }
     }
     const int trunk = trunk_of[static_cast<std::size_t>(family.front())];
-    if (trunk >= 0) family.push_back(trunk);
+    if (trunk >= 0) family.push_back(-1 - trunk);  // the trunk: junction blends only
     int inside = 0;
-    for (int c : family) inside += count[static_cast<std::size_t>(c)];
+    for (int c : family) inside += count[static_cast<std::size_t>(c < 0 ? -1 - c : c)];
     const bool restrict = several_parts ||
                           static_cast<float>(inside) >= kFamilyShare * static_cast<float>(count.back());
+    // Chains as indices; a negative entry -1 - c is chain c taken for junctions only.
     const std::vector<int>& set = restrict ? family : all;
     std::size_t g = 0;
     while (g < groups.size() && groups[g] != set) ++g;
@@ -130,10 +136,15 @@ mocap::Result<std::vector<SweepVertexBinding>> BindByComponent(
   for (std::size_t g = 0; g < groups.size(); ++g) {
     const std::vector<int>& set = groups[g];
     std::vector<SweepChain> sub;
+    std::vector<std::uint8_t> primary_ok;
     std::vector<int> local(chains.size(), -1);
-    for (int c : set) {
+    std::vector<int> global;  // sub index -> rig chain
+    for (int entry : set) {
+      const int c = entry < 0 ? -1 - entry : entry;
       local[static_cast<std::size_t>(c)] = static_cast<int>(sub.size());
       sub.push_back(chains[static_cast<std::size_t>(c)]);
+      primary_ok.push_back(entry < 0 ? 0 : 1);
+      global.push_back(c);
     }
     std::vector<SweepJunction> sub_junctions;
     for (SweepJunction j : junctions) {
@@ -149,12 +160,13 @@ mocap::Result<std::vector<SweepVertexBinding>> BindByComponent(
       members.push_back(static_cast<std::uint32_t>(v));
       positions.push_back(mesh.positions[v]);
     }
-    mocap::Result<std::vector<SweepVertexBinding>> b = BindToSweeps(sub, sub_junctions, positions);
+    mocap::Result<std::vector<SweepVertexBinding>> b =
+        BindToSweeps(sub, sub_junctions, positions, primary_ok);
     if (!b.ok()) return std::move(b).error();
     for (std::size_t i = 0; i < members.size(); ++i) {
       SweepVertexBinding vb = (*b)[i];
-      vb.primary.chain = static_cast<std::uint16_t>(set[vb.primary.chain]);
-      vb.secondary.chain = static_cast<std::uint16_t>(set[vb.secondary.chain]);
+      vb.primary.chain = static_cast<std::uint16_t>(global[vb.primary.chain]);
+      vb.secondary.chain = static_cast<std::uint16_t>(global[vb.secondary.chain]);
       out[members[i]] = vb;
     }
   }
@@ -233,7 +245,7 @@ mocap::Result<SwdRig> BuildSwdRig(const mocap::Skeleton& skeleton,
     if (limb && k_bones >= 2) {
       SwdLimb l;
       l.chain = static_cast<int>(p);
-      l.middle = LongestPairJoint(lengths);
+      l.middle = LimbMiddleJoint(lengths);
       l.has_end = l.middle + 1 < k_bones;
       if (l.has_end) spec.twist_spread[static_cast<std::size_t>(l.middle + 1)] = TwistSpread::kUpstream;
       const BodyChain& parent = body[static_cast<std::size_t>(chain.parent_chain)];
@@ -297,6 +309,83 @@ mocap::Result<SwdRig> BuildSwdRig(const mocap::Skeleton& skeleton,
   return rig;
 }
 
+mocap::Result<std::vector<SweepVertexBinding>> BindPointsLikeVertices(
+    const SwdRig& rig, std::span<const glm::vec3> points, std::span<const int> guides) {
+  if (points.size() != guides.size()) {
+    return MakeError(ErrorCode::kInvalidArgument, {},
+                     "SWD: expected one guide vertex per point (" + std::to_string(points.size()) +
+                         "), found " + std::to_string(guides.size()));
+  }
+  std::vector<int> trunk_of(rig.chains().size(), -1);
+  for (const SweepJunction& j : rig.junctions()) {
+    trunk_of[static_cast<std::size_t>(j.branch)] = j.trunk;
+  }
+  std::vector<SweepVertexBinding> out(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const int g = guides[i];
+    if (g < 0 || g >= rig.num_vertices()) {
+      return MakeError(ErrorCode::kInvalidArgument, {},
+                       "SWD: point " + std::to_string(i) + " has guide vertex " +
+                           std::to_string(g) + ", expected 0.." +
+                           std::to_string(rig.num_vertices() - 1));
+    }
+    // The guide's sweeps: its own, its junction's trunk, and its second sweep.
+    const SweepVertexBinding& guide = rig.bindings()[static_cast<std::size_t>(g)];
+    std::vector<int> set{guide.primary.chain};
+    const int trunk = trunk_of[guide.primary.chain];
+    if (trunk >= 0) set.push_back(trunk);
+    if (guide.weight < 1.0f && std::find(set.begin(), set.end(), guide.secondary.chain) == set.end()) {
+      set.push_back(guide.secondary.chain);
+    }
+    std::vector<SweepChain> sub;
+    for (int c : set) sub.push_back(rig.chains()[static_cast<std::size_t>(c)]);
+    std::vector<std::uint8_t> primary_ok(set.size(), 0);
+    primary_ok[0] = 1;  // the guide's own sweep; the others through its junction only
+    std::vector<SweepJunction> sub_junctions;
+    for (SweepJunction j : rig.junctions()) {
+      const auto b = std::find(set.begin(), set.end(), j.branch);
+      const auto t = std::find(set.begin(), set.end(), j.trunk);
+      if (b == set.end() || t == set.end()) continue;
+      j.branch = static_cast<int>(b - set.begin());
+      j.trunk = static_cast<int>(t - set.begin());
+      sub_junctions.push_back(j);
+    }
+    mocap::Result<std::vector<SweepVertexBinding>> b =
+        BindToSweeps(sub, sub_junctions, points.subspan(i, 1), primary_ok);
+    if (!b.ok()) {
+      mocap::Error e = std::move(b).error();
+      e.message = "SWD: point " + std::to_string(i) + ": " + e.message;
+      return e;
+    }
+    SweepVertexBinding vb = (*b)[0];
+    vb.primary.chain = static_cast<std::uint16_t>(set[vb.primary.chain]);
+    vb.secondary.chain = static_cast<std::uint16_t>(set[vb.secondary.chain]);
+    out[i] = vb;
+  }
+  return out;
+}
+
+JobStatus ComputeSwdJointState(const SwdRig& rig, std::span<const glm::mat4> model_from_joint,
+                               std::span<glm::quat> joint_rotations,
+                               std::span<glm::vec3> joint_positions) {
+  const auto nj = static_cast<std::size_t>(rig.num_joints());
+  if (model_from_joint.size() != nj || joint_rotations.size() != nj ||
+      joint_positions.size() != nj) {
+    return {JobStatus::kSizeMismatch, "SWD joint state: spans are not one entry per rig joint"};
+  }
+  for (std::size_t j = 0; j < nj; ++j) {
+    const glm::mat4 delta = model_from_joint[j] * rig.joint_from_bind()[j];
+    glm::mat3 r(delta);
+    for (int c = 0; c < 3; ++c) {  // drop any scale: dQ is a rotation
+      const float len = glm::length(r[c]);
+      if (len > 0.0f) r[c] /= len;
+    }
+    joint_rotations[j] = glm::normalize(glm::quat_cast(r));
+    joint_positions[j] = glm::vec3(model_from_joint[j][3]);
+  }
+  return {};
+}
+
 JobStatus SwdRigJob::Run() const {
   if (rig == nullptr) return {JobStatus::kMissingInput, "SwdRigJob without a rig"};
   const auto nj = static_cast<std::size_t>(rig->num_joints());
@@ -317,16 +406,9 @@ JobStatus SwdRigJob::Run() const {
   if (!normals.empty() && rig->rest_normals().empty()) {
     return {JobStatus::kMissingInput, "normal output but the rig's mesh has no normals"};
   }
-  for (std::size_t j = 0; j < nj; ++j) {
-    const glm::mat4 delta = model_from_joint[j] * rig->joint_from_bind()[j];
-    glm::mat3 r(delta);
-    for (int c = 0; c < 3; ++c) {  // drop any scale: dQ is a rotation
-      const float len = glm::length(r[c]);
-      if (len > 0.0f) r[c] /= len;
-    }
-    joint_rotations[j] = glm::normalize(glm::quat_cast(r));
-    joint_positions[j] = glm::vec3(model_from_joint[j][3]);
-  }
+  const JobStatus state =
+      ComputeSwdJointState(*rig, model_from_joint, joint_rotations, joint_positions);
+  if (!state) return state;
   const auto begin = static_cast<std::size_t>(vertex_begin);
   return SwdJob{.chains = rig->chains(),
                 .joint_rotations = joint_rotations,

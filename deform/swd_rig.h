@@ -18,7 +18,9 @@
 //   of its vertices plus that chain's trunk, so the inner side of a thigh never follows
 //   the other leg; a single welded skin is bound to all sweeps (nearest bone segment).
 // - Limbs (for artifact figures): in a limb chain, the interior joint whose shorter bone
-//   is the longest is its elbow/knee; the next joint is its wrist/ankle.
+//   is the longest is its elbow/knee, not counting the joint at the end of the chain's
+//   first bone (clavicle, pelvis to hip) unless its pair is more than twice as long as
+//   any other (a limb without a clavicle); the next joint is its wrist/ankle.
 //   Limbs leaving the first point of a spine are legs, other limbs are arms.
 //
 // Per frame, SwdRigJob turns model-space joint matrices into positions and normals.
@@ -81,6 +83,26 @@ class SwdRig {
                                                std::span<const glm::mat4> bind_model_from_joint,
                                                const Mesh& bind_mesh,
                                                const SwdRigOptions& options = {});
+
+// Binds extra rest points (bind model space), e.g. patch control points, to the rig's
+// sweeps the way mesh vertices are (ALGORITHMS.md 2.3: "patch control points bind to
+// sweeps exactly like vertices"): point i may use only the sweeps of vertex guides[i]
+// (its nearest surface vertex, so the point follows the body part it approximates): that
+// vertex's sweep, the trunk of its junction if it has one, and its second sweep. Within
+// that set the nearest rest bone segment, the root of g(u) and the junction weight follow
+// BindToSweeps. At the bind pose SwdJob rebuilds each point exactly (up to float).
+// Errors (kInvalidArgument): sizes that differ, a guide outside 0..#V-1, non-finite points.
+[[nodiscard]] mocap::Result<std::vector<SweepVertexBinding>> BindPointsLikeVertices(
+    const SwdRig& rig, std::span<const glm::vec3> points, std::span<const int> guides);
+
+// The per-frame joint state SwdJob reads, from #J rigid model-space joint matrices W_j:
+// rotations dQ_j = rotation of W_j B_j^-1 (scale dropped, unit) and positions (W_j's
+// translation). SwdRigJob does this first; call it to carry other bindings (patch control
+// points) with SwdJob in the same pose. kSizeMismatch when a span is not #J.
+[[nodiscard]] mocap::JobStatus ComputeSwdJointState(const SwdRig& rig,
+                                                    std::span<const glm::mat4> model_from_joint,
+                                                    std::span<glm::quat> joint_rotations,
+                                                    std::span<glm::vec3> joint_positions);
 
 // One frame of the rig over vertices [vertex_begin, vertex_begin + #n). Recomputes the
 // joint rotations dQ_j = rotation(W_j B_j^-1) and positions into the caller's scratch, so

@@ -211,27 +211,41 @@ struct SweepJunction {
   float u_end = 1.0f;     // junction zone end, > u_start
   // Width (model units) of a seam fade at the boundary where the trunk becomes the
   // nearest chain [ours]: om is multiplied by sm((d_trunk - d_branch) / seam_band), so
-  // it is 0 on both sides of that boundary. 0 (the default) keeps the plain rule, which
-  // leaves a jump there when the branch starts part-way along the trunk (a clavicle on
-  // the chest); a band of about the branch's first bone length removes it.
+  // it is 0 on both sides of that boundary. d_trunk counts only the two trunk bones at
+  // the branch point, so a branch lying against a far part of the trunk in the bind
+  // pose (a forearm raised beside the head) is not blended with it. 0 (the default)
+  // keeps the plain rule, which leaves a jump there when the branch starts part-way
+  // along the trunk (a clavicle on the chest); a band of about the branch's first bone
+  // length removes it.
   float seam_band = 0.0f;
 };
 
 // Binds one rest point to one chain: roots of g(u) = dot(p0 - c0(u), hat(c0'(u))),
-// sampled 64 times per bone, bracketed and bisected to 1e-9 in u (double); the root
-// nearest p0 wins; no root clamps u to 0 or K (the nearer end).
-SweepBinding BindToSweep(const SweepChain& chain, int chain_index, const glm::dvec3& rest_point);
+// sampled 64 times per bone, bracketed and bisected to 1e-9 in u (double); of those roots
+// and the chain's ends u = 0 and u = K, the one whose c0(u) is nearest p0 wins (so a
+// point beyond an end binds to that end even when the normal plane of a distant part of
+// the chain passes through it).
+// [u_min, u_max] (clamped to [0, K]; u_max < 0 means K) limits the search to part of the
+// chain, whose ends then play the chain's ends' part.
+SweepBinding BindToSweep(const SweepChain& chain, int chain_index, const glm::dvec3& rest_point,
+                         double u_min = 0.0, double u_max = -1.0);
 
 // Binds every rest vertex (#V, bind model space) to the chain whose rest bone segment is
 // nearest; a vertex on a junction's branch with u in [u_start, u_end) is also bound to
-// the trunk. Then sets the section_axis of every binding inside a joint region: the
-// offsets bound in that region give a second-moment matrix sum(o o^T), whose principal
-// direction in the vertex's section plane is e_a. (The spec's E0(u) is the PCA of the
-// ring at u; pooling over the region keeps e_a continuous in u and defined for nearly
-// round rings, and equals it when the region's rings are alike.) Errors (kInvalidArgument) for empty or oversized chain lists, bad junction
-// indices or intervals, non-finite positions.
+// the trunk (on the trunk's two bones at the branch point only). Then sets the
+// section_axis of every binding inside a joint region: the offsets bound in that region
+// give a second-moment matrix sum(o o^T), whose principal direction in the vertex's
+// section plane is e_a. (The spec's E0(u) is the PCA of the ring at u; pooling over the
+// region keeps e_a continuous in u and defined for nearly round rings, and equals it when
+// the region's rings are alike.)
+// `primary_ok` (#C, or empty: all) marks the chains a vertex may take as its nearest
+// (primary) chain; a branch's body part passes its trunk as not ok, so the trunk moves
+// its vertices only through the junction weight (a forearm raised beside the head in
+// the bind pose must not follow the head). Errors (kInvalidArgument) for empty or
+// oversized chain lists, bad junction indices or intervals, non-finite positions, a
+// primary_ok list of another size or with no chain ok.
 mocap::Result<std::vector<SweepVertexBinding>> BindToSweeps(
     std::span<const SweepChain> chains, std::span<const SweepJunction> junctions,
-    std::span<const glm::vec3> rest_positions);
+    std::span<const glm::vec3> rest_positions, std::span<const std::uint8_t> primary_ok = {});
 
 }  // namespace deform

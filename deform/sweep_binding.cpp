@@ -29,11 +29,18 @@ double PointSegmentDistance(const glm::dvec3& p, const glm::dvec3& a, const glm:
 }
 
 
-// Distance from p to the nearest rest bone segment of the chain.
-double NearestBoneDistance(const SweepChain& chain, const glm::dvec3& p) {
+// Bones [first, last] of a chain.
+struct BoneRange {
+  int first = 0;
+  int last = std::numeric_limits<int>::max();
+};
+
+// Distance from p to the nearest rest bone segment of the chain (of `bones` only).
+double NearestBoneDistance(const SweepChain& chain, const glm::dvec3& p, BoneRange bones = {}) {
   const BasicSweepPose<double>& rest = chain.rest_pose();
   double nearest = std::numeric_limits<double>::max();
-  for (int k = 0; k < chain.num_bones(); ++k) {
+  const int last = std::min(bones.last, chain.num_bones() - 1);
+  for (int k = std::max(0, bones.first); k <= last; ++k) {
     const auto ks = static_cast<std::size_t>(k);
     nearest = std::min(nearest, PointSegmentDistance(p, rest.points[ks], rest.points[ks + 1]));
   }
@@ -94,9 +101,13 @@ void AssignSectionAxes(std::span<const SweepChain> chains,
 
 }  // namespace
 
-SweepBinding BindToSweep(const SweepChain& chain, int chain_index, const glm::dvec3& rest_point) {
+SweepBinding BindToSweep(const SweepChain& chain, int chain_index, const glm::dvec3& rest_point,
+                         double u_min, double u_max) {
   const BasicSweepPose<double>& rest = chain.rest_pose();
   const int num_bones = chain.num_bones();
+  const double u_lo = std::clamp(u_min, 0.0, static_cast<double>(num_bones));
+  const double u_hi = u_max < 0.0 ? static_cast<double>(num_bones)
+                                  : std::clamp(u_max, u_lo, static_cast<double>(num_bones));
   constexpr int kSamplesPerBone = 64;
   constexpr double kRootTolerance = 1e-9;
   auto g = [&](double u) {
@@ -114,11 +125,12 @@ SweepBinding BindToSweep(const SweepChain& chain, int chain_index, const glm::dv
     }
   };
   const int num_samples = kSamplesPerBone * num_bones;
-  double u_prev = 0.0;
-  double g_prev = g(0.0);
-  if (g_prev == 0.0) consider(0.0);
+  double u_prev = u_lo;
+  double g_prev = g(u_lo);
+  if (g_prev == 0.0) consider(u_lo);
   for (int i = 1; i <= num_samples; ++i) {
-    const double u = static_cast<double>(i) / kSamplesPerBone;
+    const double u = std::min(u_hi, static_cast<double>(i) / kSamplesPerBone);
+    if (u <= u_prev) continue;  // before the range, or past its end
     const double g_u = g(u);
     if (g_u == 0.0) {
       consider(u);
@@ -139,10 +151,13 @@ SweepBinding BindToSweep(const SweepChain& chain, int chain_index, const glm::dv
     u_prev = u;
     g_prev = g_u;
   }
-  if (best_distance == std::numeric_limits<double>::max()) {
-    consider(0.0);  // beyond a chain end: clamp to the nearer end
-    consider(static_cast<double>(num_bones));
-  }
+  // The chain's ends compete with the roots, not only when there is no root: a point
+  // beyond an end (a toe or finger tip, a cap) can also lie in the normal plane of a
+  // distant, bent part of the chain (the thigh, the upper arm). That root is a
+  // critical point of the distance but not the nearest point of the curve; binding to it
+  // gave offsets of half the body, swung by every turn of the limb (a torn foot or hand).
+  consider(u_lo);
+  consider(u_hi);
   SweepBinding binding;
   binding.u = static_cast<float>(best_u);
   // The offset is measured from c0 at the stored (float-rounded) u, so the rebuild at the
@@ -155,10 +170,16 @@ SweepBinding BindToSweep(const SweepChain& chain, int chain_index, const glm::dv
 
 mocap::Result<std::vector<SweepVertexBinding>> BindToSweeps(
     std::span<const SweepChain> chains, std::span<const SweepJunction> junctions,
-    std::span<const glm::vec3> rest_positions) {
+    std::span<const glm::vec3> rest_positions, std::span<const std::uint8_t> primary_ok) {
   if (chains.empty() || chains.size() > std::numeric_limits<std::uint16_t>::max()) {
     return MakeError(ErrorCode::kInvalidArgument, {},
                      "expected 1..65535 sweep chains, found " + std::to_string(chains.size()));
+  }
+  if (!primary_ok.empty() &&
+      (primary_ok.size() != chains.size() ||
+       std::find(primary_ok.begin(), primary_ok.end(), std::uint8_t{1}) == primary_ok.end())) {
+    return MakeError(ErrorCode::kInvalidArgument, {},
+                     "expected one primary flag per chain, at least one set");
   }
   const int num_chains = static_cast<int>(chains.size());
   std::vector<const SweepJunction*> junction_of(chains.size(), nullptr);
@@ -189,6 +210,21 @@ mocap::Result<std::vector<SweepVertexBinding>> BindToSweeps(
     }
     junction_of[static_cast<std::size_t>(junction.branch)] = &junction;
   }
+  // Per branch: the two trunk bones meeting at the trunk point nearest the branch's
+  // start (its branch point), which alone count for the seam fade.
+  std::vector<BoneRange> trunk_bones(chains.size());
+  for (const SweepJunction& junction : junctions) {
+    const SweepChain& trunk = chains[static_cast<std::size_t>(junction.trunk)];
+    const glm::dvec3 start = chains[static_cast<std::size_t>(junction.branch)].rest_pose().points[0];
+    int at = 0;
+    for (int k = 1; k <= trunk.num_bones(); ++k) {
+      if (glm::distance(trunk.rest_pose().points[static_cast<std::size_t>(k)], start) <
+          glm::distance(trunk.rest_pose().points[static_cast<std::size_t>(at)], start)) {
+        at = k;
+      }
+    }
+    trunk_bones[static_cast<std::size_t>(junction.branch)] = {at - 1, at};
+  }
   std::vector<SweepVertexBinding> bindings(rest_positions.size());
   for (std::size_t v = 0; v < rest_positions.size(); ++v) {
     if (!Finite(rest_positions[v])) {
@@ -199,6 +235,7 @@ mocap::Result<std::vector<SweepVertexBinding>> BindToSweeps(
     int nearest = 0;
     double nearest_distance = std::numeric_limits<double>::max();
     for (int c = 0; c < num_chains; ++c) {
+      if (!primary_ok.empty() && primary_ok[static_cast<std::size_t>(c)] == 0) continue;
       const double d = NearestBoneDistance(chains[static_cast<std::size_t>(c)], p);
       if (d < nearest_distance) {
         nearest_distance = d;
@@ -213,15 +250,24 @@ mocap::Result<std::vector<SweepVertexBinding>> BindToSweeps(
       binding.weight = Smoothstep(x);
       if (junction->seam_band > 0.0f) {
         // Fade to the trunk where the trunk becomes the nearest chain, so the weight is
-        // 0 on both sides of that boundary (ours; the spec's rule jumps there).
+        // 0 on both sides of that boundary (ours; the spec's rule jumps there). Only the
+        // trunk bones at the branch point count: a branch lying against a far part of
+        // the trunk in the bind pose (a forearm raised beside the head, a foot kicked up
+        // to it) must not blend with it; that tore the body apart when they separated.
         const double trunk_distance =
-            NearestBoneDistance(chains[static_cast<std::size_t>(junction->trunk)], p);
+            NearestBoneDistance(chains[static_cast<std::size_t>(junction->trunk)], p,
+                                trunk_bones[static_cast<std::size_t>(nearest)]);
         binding.weight *= Smoothstep(
             static_cast<float>((trunk_distance - nearest_distance) / junction->seam_band));
       }
       if (binding.weight < 1.0f) {
+        // On the trunk near the branch point only: the nearest point of the whole trunk
+        // can be a far part lying against the branch in the bind pose (the head beside
+        // a raised arm, a hanging hand beside the hip).
+        const BoneRange near = trunk_bones[static_cast<std::size_t>(nearest)];
         binding.secondary =
-            BindToSweep(chains[static_cast<std::size_t>(junction->trunk)], junction->trunk, p);
+            BindToSweep(chains[static_cast<std::size_t>(junction->trunk)], junction->trunk, p,
+                        std::max(0, near.first), near.last + 1.0);
       }
     }
   }

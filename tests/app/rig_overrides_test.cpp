@@ -189,3 +189,18 @@ TEST(RigOverrides, ThreadsAreRead) {
 }
 
 }  // namespace
+
+// --global swd on a rig with example shapes is refused with the rig's field
+// path (their frames A exist for SSD and DQS only), not rendered without them.
+TEST(RigOverrides, GlobalSwdRefusesExampleShapes) {
+  const fs::path dir = Dir();
+  const std::string rig =
+      (fs::path(TEST_DATA_DIR) / "../../samples/data/elbow.json").lexically_normal().string();
+  const ProcessResult r = Render(dir, rig, {"--global", "swd", "--frames", "0:0", "--out",
+                                            (dir / "f_####.png").string()});
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("elbow.json"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("patches[0].examples"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("not available with swd"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "f_0000.png"));
+}

@@ -1,7 +1,8 @@
 // `--global swd` through FramePipeline on every BVH of ../shared/data (skipped when
 // absent) and on the synthetic humanoid (deterministic for any thread count, finite; the
-// walk does not tear; the captures' largest edge growth is printed, not yet asserted); the mannequin of every such BVH is closed and
-// its weights are valid; `patchskin inspect --artifacts` prints the figures.
+// walk does not tear, nor do the captures: largest edge growth under 3% of the body size
+// but for three known defects, each bounded; printed too); the mannequin of every such BVH
+// is closed and its weights are valid; `patchskin inspect --artifacts` prints the figures.
 
 #include <sys/wait.h>
 
@@ -33,12 +34,30 @@ namespace {
 
 namespace fs = std::filesystem;
 
-const char* const kSharedBvh[] = {
-    "bvh/cmu_cgspeed/01_01.bvh",           "bvh/cmu_cgspeed/01_03.bvh",
-    "bvh/bandai_namco/dataset-1_walk_normal_001.bvh",
-    "bvh/bandai_namco/dataset-2_run_active_034.bvh",
-    "bvh/lafan1_resolved/Geno_bind.bvh",   "bvh/lafan1_resolved/Geno_stance.bvh",
-    "bvh/bvh_python/test_freebvh.bvh",     "bvh/bvh_python/test_mocapbank.bvh",
+// Every shared capture with its bound on the largest edge growth (fraction of the body
+// size). Before the binding fixes (chain ends compete with far roots; a branch part never
+// takes its trunk as nearest chain; the seam fade and the trunk binding look only at the
+// trunk bones at the branch point) the figures were 0.015-0.017 (CMU), 0.06-0.09
+// (LAFAN), 0.12-0.16 (Bandai walk), 0.70-0.87 (Bandai run), 0.31-0.51 (mocapbank).
+struct SharedCapture {
+  const char* file;
+  float max_growth;
+};
+const SharedCapture kSharedBvh[] = {
+    {"bvh/cmu_cgspeed/01_01.bvh", testsupport::kSwdCaptureMaxEdgeGrowthFraction},
+    {"bvh/cmu_cgspeed/01_03.bvh", testsupport::kSwdCaptureMaxEdgeGrowthFraction},
+    {"bvh/bandai_namco/dataset-1_walk_normal_001.bvh", testsupport::kSwdCaptureMaxEdgeGrowthFraction},
+    {"bvh/lafan1_resolved/Geno_stance.bvh", testsupport::kSwdCaptureMaxEdgeGrowthFraction},
+    {"bvh/bvh_python/test_freebvh.bvh", testsupport::kSwdCaptureMaxEdgeGrowthFraction},
+    // Known open defects, bounded so they cannot get worse (measured 0.035, 0.11, 0.19):
+    // LAFAN's rest pose has the arms raised beside the head, so the upper arm lies
+    // against the neck bone it branches from and blends with it; Bandai's run is bound
+    // at frame 0 with a knee raised to the shoulder; mocapbank's spine chain runs on into
+    // an arm (BuildBodyChains picks the straightest child), so its torso tube follows
+    // the elbow.
+    {"bvh/lafan1_resolved/Geno_bind.bvh", 0.04f},
+    {"bvh/bandai_namco/dataset-2_run_active_034.bvh", 0.13f},
+    {"bvh/bvh_python/test_mocapbank.bvh", 0.22f},
 };
 
 // Every edge in exactly two triangles.
@@ -70,7 +89,8 @@ float MaxEdgeGrowth(const deform::Mesh& rest, const std::vector<glm::vec3>& pos)
   return worst / std::max({e.x, e.y, e.z});
 }
 
-void CheckCharacter(const app::Character& c, const std::string& what, bool check_tears) {
+// max_growth: bound on MaxEdgeGrowth at the first, middle and last frame (0: print only).
+void CheckCharacter(const app::Character& c, const std::string& what, float max_growth) {
   {  // At the bind pose the rig rebuilds the mesh (ALGORITHMS.md 2.3).
     auto bind = app::BindModelFromJoint(c);
     ASSERT_TRUE(bind.ok());
@@ -113,15 +133,15 @@ void CheckCharacter(const app::Character& c, const std::string& what, bool check
     // No tearing: no edge of the closed body gets much longer (shoulders, hips).
     const float growth = MaxEdgeGrowth(c.mesh.bind, a.positions);
     std::printf("%s t = %.2f s: largest edge growth %.4f of the body size\n", what.c_str(), t, growth);
-    // Known open defect (see the SWD report): captures still tear at hands and feet.
-    if (check_tears) {
-      EXPECT_LT(growth, testsupport::kSwdMaxEdgeGrowthFraction) << what << " at t = " << t;
+    if (max_growth > 0.0f) {
+      EXPECT_LT(growth, max_growth) << what << " at t = " << t;
     }
   }
 }
 
 TEST(SwdPipeline, EveryBvhOfTheSharedData) {
-  for (const char* rel : kSharedBvh) {
+  for (const SharedCapture& capture : kSharedBvh) {
+    const char* rel = capture.file;
     const fs::path path = testsupport::SharedDataPath(rel);
     PATCHSKIN_REQUIRE_SHARED_FILE(path);
     app::MotionSourceOptions load;
@@ -130,7 +150,7 @@ TEST(SwdPipeline, EveryBvhOfTheSharedData) {
     ASSERT_TRUE(src.ok()) << src.error().ToString();
     auto c = app::MakeCharacter(std::move(*src));
     ASSERT_TRUE(c.ok()) << c.error().ToString();
-    CheckCharacter(*c, rel, false);
+    CheckCharacter(*c, rel, capture.max_growth);
   }
 }
 
@@ -144,7 +164,10 @@ TEST(SwdPipeline, SyntheticHumanoidWalkAndBend) {
     src.motion = std::move(*motion);
     auto c = app::MakeCharacter(std::move(src));
     ASSERT_TRUE(c.ok());
-    CheckCharacter(*c, which == 0 ? "walk" : "bend ramp", which == 0);
+        // The bend ramp's growth is printed only: at 150 degrees the outer elbow and knee
+    // stretch by design (SwdRig.BentElbowsAndKneesDoNotTear checks 120 degrees).
+    CheckCharacter(*c, which == 0 ? "walk" : "bend ramp",
+                   which == 0 ? testsupport::kSwdMaxEdgeGrowthFraction : 0.0f);
   }
 }
 
@@ -169,6 +192,15 @@ TEST(SwdPipeline, InspectPrintsArtifactFigures) {
   EXPECT_NE(out.find("bend 150"), std::string::npos) << out;
   EXPECT_NE(out.find("twist 180"), std::string::npos) << out;
   EXPECT_NE(out.find("SWD"), std::string::npos) << out;
+  // CMU's clavicle (3.58) is longer than its forearm (3.48): the elbow is still found,
+  // and the twisted wrist is LeftHand, not the zero-length LeftFingerBase under it.
+  for (const char* line : {"arm      LeftForeArm              bend 150",
+                           "arm      RightForeArm             bend 150",
+                           "leg      LeftLeg                  bend 150",
+                           "arm      LeftHand                 twist 180"}) {
+    EXPECT_NE(out.find(line), std::string::npos) << line << "\n" << out;
+  }
+  EXPECT_EQ(out.find("LeftArm "), std::string::npos) << out;
 }
 
 }  // namespace

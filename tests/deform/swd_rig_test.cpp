@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <cstring>
 #include <map>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -160,6 +161,82 @@ TEST(SwdRig, SyntheticHumanoidHasFiveSweepsFourLimbsAndFourJunctions) {
   ExpectRestAndRigid(r);
 }
 
+// CMU's naming and proportions (model units ~ CMU's): zero-length helpers (LHipJoint,
+// LeftShoulder, LeftFingerBase), a clavicle (3.6) longer than the forearm (3.5) and
+// folded fingers. The elbow must be LeftForeArm's joint, not the shoulder.
+std::vector<testsupport::JointSpec> CmuNamedSkeleton() {
+  std::vector<testsupport::JointSpec> j;
+  const auto add = [&](const std::string& name, int parent, glm::vec3 pos) {
+    j.push_back({name, parent, pos});
+    return static_cast<int>(j.size()) - 1;
+  };
+  const int hips = add("Hips", -1, {0, 18, 0});
+  for (int side = 0; side < 2; ++side) {
+    const float x = side == 0 ? 1.0f : -1.0f;
+    const std::string s = side == 0 ? "L" : "R", full = side == 0 ? "Left" : "Right";
+    int p = add(s + "HipJoint", hips, {0, 18, 0});
+    p = add(full + "UpLeg", p, {1.4f * x, 16.2f, 0.8f});
+    p = add(full + "Leg", p, {1.6f * x, 9.0f, 0.8f});
+    p = add(full + "Foot", p, {1.8f * x, 1.6f, 0.8f});
+    add(full + "ToeBase", p, {1.9f * x, 1.2f, 3.1f});
+  }
+  int p = add("LowerBack", hips, {0, 18, 0});
+  p = add("Spine", p, {0, 20, -0.2f});
+  const int chest = add("Spine1", p, {0, 22.1f, -0.2f});
+  p = add("Neck", chest, {0, 22.1f, -0.2f});
+  p = add("Neck1", p, {0, 23.9f, 0});
+  add("Head", p, {0, 25.6f, -0.1f});
+  for (int side = 0; side < 2; ++side) {
+    const float x = side == 0 ? 1.0f : -1.0f;
+    const std::string full = side == 0 ? "Left" : "Right", s = side == 0 ? "L" : "R";
+    p = add(full + "Shoulder", chest, {0, 22.1f, -0.2f});
+    p = add(full + "Arm", p, {3.4f * x, 23.3f, -0.5f});
+    p = add(full + "ForeArm", p, {8.4f * x, 23.3f, -0.5f});
+    const int hand = add(full + "Hand", p, {11.9f * x, 23.3f, -0.5f});
+    p = add(full + "FingerBase", hand, {11.9f * x, 23.3f, -0.5f});
+    add(s + "Fingers", p, {12.6f * x, 23.3f, -0.5f});
+    add(s + "Thumb", hand, {11.9f * x, 23.3f, -0.5f});
+  }
+  return j;
+}
+
+// Names of the elbow/knee joints the rig found, arms first.
+std::vector<std::string> LimbJointNames(const Rigged& r) {
+  std::vector<std::string> names;
+  for (bool arms : {true, false}) {
+    for (const deform::SwdLimb& l : r.rig.limbs()) {
+      if (l.arm != arms) continue;
+      const deform::SweepChain& c = r.rig.chains()[static_cast<std::size_t>(l.chain)];
+      names.push_back(r.b.skeleton.names[static_cast<std::size_t>(c.joint(l.middle))]);
+    }
+  }
+  return names;
+}
+
+TEST(SwdRig, CmuNamedSkeletonFindsElbowsNotShoulders) {
+  const Rigged r = MakeRigged(SkeletonFrom(CmuNamedSkeleton(), false, 0.6f));
+  std::vector<std::string> names = LimbJointNames(r);
+  ASSERT_EQ(names.size(), 4u);
+  std::sort(names.begin(), names.begin() + 2);
+  std::sort(names.begin() + 2, names.end());
+  EXPECT_EQ(names, (std::vector<std::string>{"LeftForeArm", "RightForeArm", "LeftLeg", "RightLeg"}));
+  ExpectRestAndRigid(r);
+}
+
+TEST(SwdRig, ArmWithoutClavicleKeepsItsFirstJoint) {
+  // Upper arm, forearm and a short hand leave the chest directly: joint 1 is the elbow.
+  const Rigged r = MakeRigged(SkeletonFrom(
+      {{"root", -1, {0, 0, 0}},      {"chest", 0, {0, 20, 0}},     {"head", 1, {0, 30, 0}},
+       {"upper_l", 1, {0, 20, 0}},   {"fore_l", 3, {12, 20, 0}},   {"hand_l", 4, {23, 20, 0}},
+       {"upper_r", 1, {0, 20, 0}},   {"fore_r", 6, {-12, 20, 0}},  {"hand_r", 7, {-23, 20, 0}},
+       {"thigh_l", 0, {3, 0, 0}},    {"shin_l", 9, {3, -12, 0}},   {"foot_l", 10, {3, -24, 0}},
+       {"thigh_r", 0, {-3, 0, 0}},   {"shin_r", 12, {-3, -12, 0}}, {"foot_r", 13, {-3, -24, 0}}},
+      false, 3.0f));
+  for (const std::string& name : LimbJointNames(r)) {
+    EXPECT_TRUE(name.rfind("fore_", 0) == 0 || name.rfind("shin_", 0) == 0) << name;
+  }
+}
+
 TEST(SwdRig, BodiesOfOtherShapes) {
   ExpectRestAndRigid(MakeRigged(SkeletonFrom(testsupport::Humanoid(1.0f, true, false, ""), false, 5.0f)));
   ExpectRestAndRigid(MakeRigged(SkeletonFrom(testsupport::Humanoid(1.0f, false, true, ""), true, 2.0f)));
@@ -206,6 +283,66 @@ TEST(SwdRig, BentElbowsAndKneesDoNotTear) {
   }
   const std::vector<glm::vec3> pos = Deform(r.rig, model, 2);
   EXPECT_LT(MaxEdgeGrowth(r.mesh.bind, pos), testsupport::kSwdMaxEdgeGrowthFraction);
+}
+
+TEST(SwdRig, PointsBoundLikeVerticesMatchTheVertexBindings) {
+  const Rigged r = MakeRigged(SyntheticHumanoid());
+  // Each vertex, bound as an extra point guided by itself, gets its own binding back:
+  // the guide's sweeps hold the vertex's nearest one, and the same rules apply.
+  std::vector<glm::vec3> points;
+  std::vector<int> guides;
+  for (int v = 0; v < r.rig.num_vertices(); v += 7) {
+    points.push_back(r.mesh.bind.positions[static_cast<std::size_t>(v)]);
+    guides.push_back(v);
+  }
+  auto bound = deform::BindPointsLikeVertices(r.rig, points, guides);
+  ASSERT_TRUE(bound.ok()) << bound.error().ToString();
+  int junction_points = 0;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const deform::SweepVertexBinding& a = (*bound)[i];
+    const deform::SweepVertexBinding& b = r.rig.bindings()[static_cast<std::size_t>(guides[i])];
+    ASSERT_EQ(a.primary.chain, b.primary.chain) << guides[i];
+    EXPECT_EQ(a.primary.u, b.primary.u) << guides[i];
+    EXPECT_EQ(a.primary.offset, b.primary.offset) << guides[i];
+    EXPECT_EQ(a.weight, b.weight) << guides[i];
+    if (b.weight < 1.0f) {
+      ++junction_points;
+      EXPECT_EQ(a.secondary.chain, b.secondary.chain) << guides[i];
+      EXPECT_EQ(a.secondary.u, b.secondary.u) << guides[i];
+    }
+  }
+  EXPECT_GT(junction_points, 0);
+  // Points off the surface still rebuild exactly at the bind pose.
+  std::vector<glm::vec3> off;
+  for (const glm::vec3& p : points) off.push_back(p * 1.01f);
+  auto off_bound = deform::BindPointsLikeVertices(r.rig, off, guides);
+  ASSERT_TRUE(off_bound.ok());
+  std::vector<glm::quat> rot(r.b.model_from_joint.size());
+  std::vector<glm::vec3> joints(rot.size()), rebuilt(off.size());
+  ASSERT_TRUE(deform::ComputeSwdJointState(r.rig, r.b.model_from_joint, rot, joints));
+  ASSERT_TRUE((deform::SwdJob{.chains = r.rig.chains(), .joint_rotations = rot,
+                              .joint_positions = joints, .bindings = *off_bound,
+                              .rest_normals = {}, .keep_volume = false, .section_scales = {},
+                              .positions = rebuilt, .normals = {}}
+                   .Run()));
+  const glm::vec3 e = deform::ComputeBounds(r.mesh.bind.positions).size();
+  const float size = std::max({e.x, e.y, e.z});
+  for (std::size_t i = 0; i < off.size(); ++i) {
+    EXPECT_LT(glm::distance(rebuilt[i], off[i]) / size, testsupport::kSwdRebuildRelTol) << i;
+  }
+  // Errors.
+  EXPECT_EQ(deform::BindPointsLikeVertices(r.rig, points, std::span(guides).first(1)).error().code,
+            mocap::ErrorCode::kInvalidArgument);
+  std::vector<int> bad = guides;
+  bad[0] = r.rig.num_vertices();
+  EXPECT_EQ(deform::BindPointsLikeVertices(r.rig, points, bad).error().code,
+            mocap::ErrorCode::kInvalidArgument);
+  std::vector<glm::vec3> nan = points;
+  nan[0].x = std::nanf("");
+  EXPECT_EQ(deform::BindPointsLikeVertices(r.rig, nan, guides).error().code,
+            mocap::ErrorCode::kInvalidArgument);
+  EXPECT_EQ(deform::ComputeSwdJointState(r.rig, std::span(r.b.model_from_joint).first(2), rot, joints).code,
+            mocap::JobStatus::kSizeMismatch);
 }
 
 TEST(SwdRig, ClearErrors) {

@@ -1,6 +1,7 @@
 #include "deform/sweep.h"
 
 #include <cmath>
+#include <cstdint>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -215,6 +216,37 @@ TEST(SweepBinding, OffsetsAreOrthogonalToABentRestCurve) {
     EXPECT_NEAR(glm::dot(p - c, glm::normalize(tangent)), 0.0, 1e-5);
     EXPECT_NEAR(glm::length(glm::dvec3(b.offset) - (p - c)), 0.0, 1e-5);
   }
+}
+
+TEST(SweepBinding, PointBeyondTheEndBindsToTheEndNotToAFarRoot) {
+  // An L: bone 0 along +x, bone 1 along +y. p lies past the end of bone 1, but also in
+  // the normal plane of bone 0 at x = 4 (a root of g, 11 away); the end is 6.08 away.
+  SweepChainSpec spec;
+  spec.joints = {0, 1};
+  spec.rest_points = {glm::vec3(0, 0, 0), glm::vec3(10, 0, 0), glm::vec3(10, 10, 0)};
+  spec.half_widths = {0.0f, 2.0f, 0.0f};
+  const auto chain = deform::BuildSweepChain(spec);
+  ASSERT_TRUE(chain.ok()) << chain.error().ToString();
+  const glm::dvec3 p(4, 11, 0);
+  const deform::SweepBinding b = deform::BindToSweep(*chain, 0, p);
+  EXPECT_EQ(b.u, 2.0f);
+  EXPECT_NEAR(glm::length(glm::dvec3(b.offset) - (p - glm::dvec3(10, 10, 0))), 0.0, kFloatTol);
+}
+
+TEST(SweepBinding, ChainsNotOkAsPrimaryOnlyBlendThroughJunctions) {
+  const auto arm = testfixture::MakeArm(8, 1);
+  const auto chain = deform::BuildSweepChain(testfixture::ArmChainSpec(arm));
+  ASSERT_TRUE(chain.ok());
+  const std::vector<SweepChain> chains = {*chain, *chain};
+  const std::vector<std::uint8_t> second_only = {0, 1};
+  const auto b = deform::BindToSweeps(chains, {}, arm.mesh.positions, second_only);
+  ASSERT_TRUE(b.ok()) << b.error().ToString();
+  for (const deform::SweepVertexBinding& v : *b) EXPECT_EQ(v.primary.chain, 1);
+  const std::vector<std::uint8_t> none = {0, 0}, short_list = {1};
+  EXPECT_EQ(deform::BindToSweeps(chains, {}, arm.mesh.positions, none).error().code,
+            ErrorCode::kInvalidArgument);
+  EXPECT_EQ(deform::BindToSweeps(chains, {}, arm.mesh.positions, short_list).error().code,
+            ErrorCode::kInvalidArgument);
 }
 
 TEST(SweepBinding, RejectsBadJunctionsAndPoints) {

@@ -2,9 +2,12 @@
 // kinematics, global deformation, normals) and render::Renderer through
 // app::DrawCharacterFrame, the function `patchskin render` draws with.
 // Cases: the built-in demo walk under SWD (first, middle and last frame) and the
-// synthetic elbow/knee bend ramp at its last frame (150 degrees), split SSD | SWD.
+// synthetic elbow/knee bend ramp at its last frame (150 degrees), split SSD | SWD, and
+// split SSD | SWD with the sample rig's elbow and knee patches (samples/data/
+// elbow_knee_swd.json; no displacement yet, control points carried by SWD).
 
 #include <cmath>
+#include <filesystem>
 #include <cstdlib>
 #include <ostream>
 #include <string>
@@ -17,6 +20,8 @@
 #include "app/frame_render.h"
 #include "app/motion_source.h"
 #include "app/pipeline.h"
+#include "app/rig_file.h"
+#include "app/rig_patches.h"
 #include "mocap/synthetic.h"
 #include "render/camera.h"
 #include "support/golden.h"
@@ -48,12 +53,29 @@ app::Character BendRamp() {
   return std::move(*c);
 }
 
-// Renders frame `frame` of `c` (SWD alone, or `left` | SWD when split) with a fixed
-// camera framing that frame from the front-left, as the command's cameras look.
-render::Image Render(const app::Character& c, int frame, bool split) {
+// The sample rig's elbow and knee patches, built on `c`'s bind mesh.
+std::vector<deform::PatchSetup> SampleSwdPatches(const app::Character& c) {
+  const std::filesystem::path rig_file =
+      std::filesystem::path(GOLDEN_DIR) / ".." / ".." / "samples" / "data" / "elbow_knee_swd.json";
+  auto rig = app::LoadRig(rig_file.string());
+  EXPECT_TRUE(rig.ok()) << rig.error().ToString();
+  auto patches = app::BuildRigPatches(*rig, c);
+  EXPECT_TRUE(patches.ok()) << patches.error().ToString();
+  return std::move(*patches);
+}
+
+// Renders frame `frame` of `c` (SWD alone, or `left` | SWD when split; `patches`, if any,
+// on the SWD side) with a fixed camera framing that frame from the front-left, as the
+// command's cameras look.
+render::Image Render(const app::Character& c, int frame, bool split,
+                     std::vector<deform::PatchSetup> patches = {}) {
   const double t = frame * c.motion.frame_time_s;
   auto swd = app::FramePipeline::Create(c, app::GlobalMethod::kSwd, 1);
   EXPECT_TRUE(swd.ok()) << swd.error().ToString();
+  const bool layered = !patches.empty();
+  if (layered) {
+    EXPECT_TRUE(swd->SetPatches(std::move(patches)).ok());
+  }
   app::DeformedFrame right, left;
   EXPECT_TRUE(swd->Evaluate(t, right).ok());
   if (split) {
@@ -77,7 +99,9 @@ render::Image Render(const app::Character& c, int frame, bool split) {
   render::Image image, scratch;
   const app::FrameDrawOptions options{.frame_number = frame,
                                       .left_label = split ? "ssd" : "",
-                                      .right_label = split ? "swd" : ""};
+                                      .right_label = !split    ? ""
+                                                     : layered ? "swd + patches"
+                                                               : "swd"};
   const mocap::Status s =
       split ? app::DrawCharacterFrame(c, left, &right, camera, settings, options, renderer,
                                       right_renderer, scratch, image)
@@ -89,7 +113,7 @@ render::Image Render(const app::Character& c, int frame, bool split) {
 
 struct PipelineCase {
   std::string name;
-  int which;  // 0, 1, 2: demo first/middle/last; 3: bend ramp split
+  int which;  // 0, 1, 2: demo first/middle/last; 3: bend ramp split; 4: same, with patches
 };
 
 void PrintTo(const PipelineCase& c, std::ostream* os) { *os << c.name; }
@@ -106,7 +130,8 @@ TEST_P(PipelineGoldenTest, MatchesReference) {
     image = Render(demo, frame, false);
   } else {
     const app::Character bend = BendRamp();
-    image = Render(bend, bend.motion.num_frames - 1, true);
+    image = Render(bend, bend.motion.num_frames - 1, true,
+                   pc.which == 4 ? SampleSwdPatches(bend) : std::vector<deform::PatchSetup>{});
   }
   testsupport::ExpectMatchesGolden(image, pc.name, {});
 }
@@ -115,7 +140,8 @@ INSTANTIATE_TEST_SUITE_P(Frames, PipelineGoldenTest,
                          ::testing::Values(PipelineCase{"demo_swd_first", 0},
                                            PipelineCase{"demo_swd_middle", 1},
                                            PipelineCase{"demo_swd_last", 2},
-                                           PipelineCase{"bend_split_ssd_swd", 3}),
+                                           PipelineCase{"bend_split_ssd_swd", 3},
+                                           PipelineCase{"bend_split_ssd_swd_patches", 4}),
                          [](const auto& test_info) { return test_info.param.name; });
 
 }  // namespace
