@@ -18,6 +18,8 @@ namespace app {
 
 // Vertical field of view of every render camera, degrees.
 inline constexpr float kFovYDeg = 35.0f;
+// Largest camera elevation (--elevation), degrees either way.
+inline constexpr float kMaxElevationDeg = 89.0f;
 
 // kInvalidArgument naming the command-line option, e.g. "--frames: error: ...".
 mocap::Error ArgError(const std::string& option, const std::string& message);
@@ -67,7 +69,8 @@ mocap::Result<FramePlan> PlanFrames(const mocap::Motion& motion, const FramePlan
 // of the first frame). Built by evaluating the pipeline (a pre-pass).
 class CameraPlan {
  public:
-  // mode: follow | fixed | turntable; elevation in degrees; size in pixels.
+  // mode: follow | fixed | turntable; elevation in degrees, |e| <= kMaxElevationDeg
+  // (else kInvalidArgument naming --elevation); size in pixels.
   // Errors: kInvalidArgument (mode), and the pipeline's errors.
   static mocap::Result<CameraPlan> Create(FramePipeline& pipeline, const FramePlan& plan,
                                           const std::string& mode, float elevation_deg,

@@ -206,7 +206,15 @@ int RunRender(const RenderOptions& options) {
   mocap::Result<FramePlan> plan = PlanFrames(
       ch.motion, {.frames = o.frames, .fps = o.fps, .turntable = turntable,
                   .turntable_frames = o.turntable_frames});
-  if (!plan.ok()) return Fail(plan.error());
+  if (!plan.ok()) {
+    if (rig && options.frames.empty() && !rig->render.frames.empty()) {
+      // The range came from the rig file: name it and its field, not --frames.
+      mocap::Error e = plan.error();
+      e.loc = {rig->file, 0, 0, "render.frames"};
+      return Fail(e);
+    }
+    return Fail(plan.error());
+  }
   const double frame_time = plan->frame_time_s;
   const std::vector<OutputFrame>& frames = plan->frames;
 
