@@ -24,6 +24,7 @@
 #include "render/image_io.h"
 #include "render/overlay.h"
 #include "render/renderer.h"
+#include "render/stored_image.h"
 #include "render/video_writer.h"
 
 namespace app {
@@ -326,10 +327,21 @@ int RunRender(const RenderOptions& options) {
   Progress progress(demo ? "render demo" : "render " + name, static_cast<int>(frames.size()), o.quiet);
   render::Image image, right_image;
   int next_sheet = 0;
-  auto feed_sheet_and_video = [&](std::size_t i, int number, const render::Image& img) {
+  // The sheet gets every frame as its file will read back (render/stored_image.h),
+  // so a --resume that rebuilds it from finished frames on disk gives the same
+  // bytes; formats whose round trip is not modelled (JPEG) use the frame as is.
+  const mocap::Result<render::ImageFormat> frame_format = render::ImageFormatFromPath(pattern);
+  auto feed_sheet_and_video = [&](std::size_t i, int number, const render::Image& img,
+                                  bool read_back) {
     if (sheet && next_sheet < sheet_count &&
         i == frames.size() * static_cast<std::size_t>(next_sheet) / static_cast<std::size_t>(sheet_count)) {
-      if (mocap::Status st = sheet->Add(img, number); !st.ok()) return st;
+      const render::Image* thumb_source = &img;
+      mocap::Result<render::Image> stored = render::Image();
+      if (!read_back && frame_format.ok()) {
+        stored = render::AsStored(img, *frame_format, write_options);
+        if (stored.ok()) thumb_source = &*stored;
+      }
+      if (mocap::Status st = sheet->Add(*thumb_source, number); !st.ok()) return st;
       ++next_sheet;
     }
     if (video) return video->AddFrame(img);
@@ -356,7 +368,7 @@ int RunRender(const RenderOptions& options) {
       if (!done_path.ok()) return Fail(done_path.error());
       mocap::Result<render::Image> done = render::ReadImage(*done_path);
       if (!done.ok()) return Fail(done.error());
-      s = feed_sheet_and_video(i, of.number, *done);
+      s = feed_sheet_and_video(i, of.number, *done, /*read_back=*/true);
       if (!s.ok()) return Fail(s.error());
       continue;
     }
@@ -369,7 +381,7 @@ int RunRender(const RenderOptions& options) {
     s = DrawCharacterFrame(ch, frame, right_pipeline ? &right_frame : nullptr, camera, settings,
                            draw, renderer, right_renderer, right_image, image);
     if (!s.ok()) return Fail(s.error());
-    s = feed_sheet_and_video(i, of.number, image);
+    s = feed_sheet_and_video(i, of.number, image, /*read_back=*/false);
     if (!s.ok()) return Fail(s.error());
     const mocap::Result<std::string> path = render::ExpandFramePattern(pattern, of.number);
     if (!path.ok()) return Fail(path.error());
