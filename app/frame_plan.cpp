@@ -94,6 +94,13 @@ mocap::Result<CameraPlan> CameraPlan::Create(FramePipeline& pipeline, const Fram
     return ArgError("--camera", "expected follow, fixed or turntable, found '" + mode + "'");
   }
   if (plan.frames.empty()) return ArgError("--frames", "no frames to frame");
+  // At +-90 degrees the view looks straight along the up vector (a degenerate
+  // look-at); NaN would reach the rasterizer's float-to-int conversions.
+  if (!(std::abs(elevation_deg) <= kMaxElevationDeg)) {
+    std::ostringstream found;
+    found << elevation_deg;
+    return ArgError("--elevation", "expected degrees in -89..89, found " + found.str());
+  }
   CameraPlan cp;
   cp.mode_ = mode;
   cp.frame_time_s_ = plan.frame_time_s;

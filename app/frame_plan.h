@@ -19,6 +19,8 @@ namespace app {
 
 // Vertical field of view of every render camera, degrees.
 inline constexpr float kFovYDeg = 35.0f;
+// Largest camera elevation (--elevation), degrees either way.
+inline constexpr float kMaxElevationDeg = 89.0f;
 
 // kInvalidArgument naming the command-line option, e.g. "--frames: error: ...".
 mocap::Error ArgError(const std::string& option, const std::string& message);
@@ -85,7 +87,8 @@ class CameraPlan {
   // Output frames of the whole motion sampled for framing and ground height.
   static constexpr int kFramingSamples = 64;
 
-  // mode: follow | fixed | turntable; elevation in degrees; size in pixels.
+  // mode: follow | fixed | turntable; elevation in degrees, |e| <= kMaxElevationDeg
+  // (else kInvalidArgument naming --elevation); size in pixels.
   // `pipeline` only supplies the character and thread count; it must outlive
   // nothing here (the character must outlive the CameraPlan).
   // Errors: kInvalidArgument (mode), and the pipeline's errors.

@@ -28,6 +28,7 @@
 #include "render/overlay.h"
 #include "render/renderer.h"
 #include "render/serial_task_queue.h"
+#include "render/stored_image.h"
 #include "render/video_writer.h"
 
 namespace app {
@@ -258,7 +259,15 @@ int RunRender(const RenderOptions& options) {
   mocap::Result<FramePlan> plan = PlanFrames(
       ch.motion, {.frames = o.frames, .fps = o.fps, .turntable = turntable,
                   .turntable_frames = o.turntable_frames});
-  if (!plan.ok()) return Fail(plan.error());
+  if (!plan.ok()) {
+    if (rig && options.frames.empty() && !rig->render.frames.empty()) {
+      // The range came from the rig file: name it and its field, not --frames.
+      mocap::Error e = plan.error();
+      e.loc = {rig->file, 0, 0, "render.frames"};
+      return Fail(e);
+    }
+    return Fail(plan.error());
+  }
   const double frame_time = plan->frame_time_s;
   const std::vector<OutputFrame>& frames = plan->frames;
 
@@ -382,10 +391,21 @@ int RunRender(const RenderOptions& options) {
   Progress progress(demo ? "render demo" : "render " + name, static_cast<int>(frames.size()), o.quiet);
   render::Image image, right_image;
   int next_sheet = 0;
-  auto feed_sheet_and_video = [&](std::size_t i, int number, const render::Image& img) {
+  // The sheet gets every frame as its file will read back (render/stored_image.h),
+  // so a --resume that rebuilds it from finished frames on disk gives the same
+  // bytes; formats whose round trip is not modelled (JPEG) use the frame as is.
+  const mocap::Result<render::ImageFormat> frame_format = render::ImageFormatFromPath(pattern);
+  auto feed_sheet_and_video = [&](std::size_t i, int number, const render::Image& img,
+                                  bool read_back) {
     if (sheet && next_sheet < sheet_count &&
         i == frames.size() * static_cast<std::size_t>(next_sheet) / static_cast<std::size_t>(sheet_count)) {
-      if (mocap::Status st = sheet->Add(img, number); !st.ok()) return st;
+      const render::Image* thumb_source = &img;
+      mocap::Result<render::Image> stored = render::Image();
+      if (!read_back && frame_format.ok()) {
+        stored = render::AsStored(img, *frame_format, write_options);
+        if (stored.ok()) thumb_source = &*stored;
+      }
+      if (mocap::Status st = sheet->Add(*thumb_source, number); !st.ok()) return st;
       ++next_sheet;
     }
     if (video) return video->AddFrame(img);
@@ -395,10 +415,11 @@ int RunRender(const RenderOptions& options) {
   // so encoding the video overlaps rendering the next frame (each task holds
   // its own copy of the frame; at most two are pending).
   render::SerialTaskQueue side({.max_queued = 2});
-  auto feed_async = [&](std::size_t i, int number, std::shared_ptr<const render::Image> img) {
+  auto feed_async = [&](std::size_t i, int number, std::shared_ptr<const render::Image> img,
+                        bool read_back) {
     if (!sheet && !video) return mocap::Status::Ok();
-    return side.Submit([&feed_sheet_and_video, i, number, img = std::move(img)] {
-      return feed_sheet_and_video(i, number, *img);
+    return side.Submit([&feed_sheet_and_video, i, number, img = std::move(img), read_back] {
+      return feed_sheet_and_video(i, number, *img, read_back);
     });
   };
   int frames_done = guard.num_skipped();
@@ -422,7 +443,8 @@ int RunRender(const RenderOptions& options) {
       if (!done_path.ok()) return Fail(done_path.error());
       mocap::Result<render::Image> done = render::ReadImage(*done_path);
       if (!done.ok()) return Fail(done.error());
-      s = feed_async(i, of.number, std::make_shared<const render::Image>(std::move(*done)));
+      s = feed_async(i, of.number, std::make_shared<const render::Image>(std::move(*done)),
+                     /*read_back=*/true);
       if (!s.ok()) return Fail(s.error());
       continue;
     }
@@ -435,7 +457,7 @@ int RunRender(const RenderOptions& options) {
     s = DrawCharacterFrame(ch, frame, right_pipeline ? &right_frame : nullptr, camera, settings,
                            draw, renderer, right_renderer, right_image, image);
     if (!s.ok()) return Fail(s.error());
-    s = feed_async(i, of.number, std::make_shared<const render::Image>(image));
+    s = feed_async(i, of.number, std::make_shared<const render::Image>(image), /*read_back=*/false);
     if (!s.ok()) return Fail(s.error());
     const mocap::Result<std::string> path = render::ExpandFramePattern(pattern, of.number);
     if (!path.ok()) return Fail(path.error());

@@ -1,6 +1,7 @@
 #include "app/rig_file.h"
 
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <initializer_list>
@@ -17,15 +18,37 @@ namespace {
 
 using nlohmann::json;
 
-// Short description of a JSON value for "found ..." in messages.
+// Short description of a JSON value for "found ..." in messages, at most
+// kMaxDescribed characters. Never serializes a whole container: nlohmann's
+// dump() recurses once per nesting level, and a rig of 10^6 '[' would
+// overflow the stack (found by fuzz/rig_fuzzer.cpp).
+constexpr std::size_t kMaxDescribed = 40;
+
+std::string DescribeScalar(const json& v) {
+  std::string s = v.dump();  // a scalar: no recursion
+  if (s.size() > kMaxDescribed) s = s.substr(0, kMaxDescribed - 3) + "...";
+  return s;
+}
+
 std::string Describe(const json& v) {
-  std::string s = v.dump();
-  if (s.size() > 40) s = s.substr(0, 37) + "...";
   switch (v.type()) {
     case json::value_t::object: return "an object";
-    case json::value_t::array: return "an array " + s;
     case json::value_t::null: return "null";
-    default: return s;
+    case json::value_t::array: {
+      // "[a,b,c]" for an array of scalars, cut short like the scalars; only
+      // the size of an array that holds containers.
+      std::string s = "[";
+      for (const json& e : v) {
+        if (e.is_array() || e.is_object()) {
+          return "an array (" + std::to_string(v.size()) + (v.size() == 1 ? " item)" : " items)");
+        }
+        if (s.size() > 1) s += ',';
+        s += e.dump();
+        if (s.size() > kMaxDescribed) return "an array " + s.substr(0, kMaxDescribed - 3) + "...";
+      }
+      return "an array " + s + "]";
+    }
+    default: return DescribeScalar(v);
   }
 }
 
@@ -307,9 +330,34 @@ mocap::Result<Rig> ParseRig(const std::string& text, const std::string& file) {
       if (text[i] == '\n') ++line, column = 1;
       else ++column;
     }
+    // "[json.exception.parse_error.101] parse error at line 1, column 27: <what>";
+    // the position is ours, the rest may itself hold ": " ("last read: '...'").
     std::string what = e.what();
-    const auto colon = what.rfind(": ");
+    const auto at = what.find("column ");
+    const auto colon = what.find(": ", at == std::string::npos ? 0 : at);
     if (colon != std::string::npos) what = what.substr(colon + 2);
+    return mocap::MakeError(mocap::ErrorCode::kSyntax, {file, line, column, {}},
+                            "invalid JSON: " + what);
+  } catch (const json::exception& e) {
+    // A number too large for a double (out_of_range 406, "number overflow
+    // parsing '1e999'") carries no position: point at the first occurrence of
+    // the token the message quotes. (Found writing fuzz/rig_fuzzer.cpp: the
+    // exception used to escape and end the process in std::terminate.)
+    std::string what = e.what();
+    const auto colon = what.rfind("] ");
+    if (colon != std::string::npos) what = what.substr(colon + 2);
+    int line = 0, column = 0;
+    const auto quote = what.find('\''), end_quote = what.rfind('\'');
+    if (quote != std::string::npos && end_quote > quote + 1) {
+      const std::size_t at = text.find(what.substr(quote + 1, end_quote - quote - 1));
+      if (at != std::string::npos) {
+        line = column = 1;
+        for (std::size_t i = 0; i < at; ++i) {
+          if (text[i] == '\n') ++line, column = 1;
+          else ++column;
+        }
+      }
+    }
     return mocap::MakeError(mocap::ErrorCode::kSyntax, {file, line, column, {}},
                             "invalid JSON: " + what);
   }
@@ -359,15 +407,34 @@ mocap::Result<Rig> ParseRig(const std::string& text, const std::string& file) {
 }
 
 mocap::Result<Rig> LoadRig(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return mocap::MakeError(mocap::ErrorCode::kIo, {path, 0, 0, {}}, "cannot open the rig file");
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (text.str().size() > (1u << 24)) {
-    return mocap::MakeError(mocap::ErrorCode::kLimitExceeded, {path, 0, 0, {}},
-                            "rig file larger than 16 MiB");
+  const mocap::FileLoc loc{path, 0, 0, {}};
+  std::error_code ec;
+  const auto status = std::filesystem::status(path, ec);
+  if (ec || !std::filesystem::exists(status)) {
+    return mocap::MakeError(mocap::ErrorCode::kIo, loc, "no such file");
   }
-  return ParseRig(text.str(), path);
+  if (std::filesystem::is_directory(status)) {
+    return mocap::MakeError(mocap::ErrorCode::kIo, loc, "expected a rig file, found a directory");
+  }
+  if (!std::filesystem::is_regular_file(status)) {
+    return mocap::MakeError(mocap::ErrorCode::kIo, loc, "expected a rig file, found a special file");
+  }
+  // Checked before reading, so a huge file is never loaded into memory.
+  const std::uintmax_t bytes = std::filesystem::file_size(path, ec);
+  if (ec) return mocap::MakeError(mocap::ErrorCode::kIo, loc, "cannot read the rig file: " + ec.message());
+  if (bytes > kMaxRigFileBytes) {
+    return mocap::MakeError(mocap::ErrorCode::kLimitExceeded, loc,
+                            "expected a rig file of at most 16 MiB, found " +
+                                std::to_string(bytes) + " bytes");
+  }
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return mocap::MakeError(mocap::ErrorCode::kIo, loc, "cannot open the rig file");
+  std::string text(static_cast<std::size_t>(bytes), '\0');
+  in.read(text.data(), static_cast<std::streamsize>(text.size()));
+  if (!in || in.gcount() != static_cast<std::streamsize>(text.size())) {
+    return mocap::MakeError(mocap::ErrorCode::kIo, loc, "cannot read the rig file");
+  }
+  return ParseRig(text, path);
 }
 
 }  // namespace app

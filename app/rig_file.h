@@ -21,6 +21,7 @@
 // `examples` and `pose_space` per patch are parsed by app/rig_examples.cpp
 // (types in app/rig_examples.h); `elastic` by app/rig_elastic.cpp.
 
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -82,10 +83,14 @@ struct Rig {
   RigRender render;
 };
 
+// Largest rig file LoadRig reads (rigs are a few kB; this only bounds memory).
+inline constexpr std::uintmax_t kMaxRigFileBytes = std::uintmax_t{1} << 24;
+
 // Parses rig JSON text; `file` names it in messages and its folder resolves
 // relative paths.
 mocap::Result<Rig> ParseRig(const std::string& text, const std::string& file);
-// Reads and parses a rig file (kIo when it cannot be read).
+// Reads and parses a rig file: kIo when it is missing, a directory or cannot
+// be read, kLimitExceeded above kMaxRigFileBytes (checked before reading).
 mocap::Result<Rig> LoadRig(const std::string& path);
 
 }  // namespace app

@@ -207,6 +207,19 @@ TEST(CliBadInput, BadRenderOptions) {
       {{"--turntable-frames", "1000000000"}, "--turntable-frames", "expected 1..100000"},
       {{"--global", "magic"}, "--global", "expected ssd, dqs or swd"},
       {{"--fps", "nan"}, "--fps", "expected 0 < fps"},
+      {{"--fps", "inf"}, "--fps", "expected 0 < fps"},
+      {{"--fps", "-24"}, "--fps", "expected 0 < fps"},
+      {{"--size", "99999x99999"}, "--size", "within 16.."},
+      {{"--size", "-64x36"}, "--size", "within 16.."},
+      {{"--frames", "-5:2"}, "--frames", "outside the motion's frames"},
+      {{"--frames", "0:99999999999"}, "--frames", "expected whole numbers"},
+      {{"--threads", "-1"}, "--threads", "expected 0..256"},
+      {{"--threads", "10000"}, "--threads", "expected 0..256"},
+      {{"--supersample", "0"}, "--supersample", "expected 1, 2 or 4"},
+      {{"--png-compression", "10"}, "--png-compression", "expected 0..9"},
+      {{"--turntable-frames", "0"}, "--turntable-frames", "expected 1..100000"},
+      {{"--elevation", "nan"}, "--elevation", "expected degrees in -89..89"},
+      {{"--elevation", "90"}, "--elevation", "expected degrees in -89..89"},
   };
   for (const auto& c : cases) {
     SCOPED_TRACE(c.args[0] + " " + c.args[1]);

@@ -6,8 +6,10 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -36,12 +38,15 @@ fs::path Dir() {
   return d;
 }
 
-// Renders the built-in demo into `folder`/f_####.png at 320x180.
+// Renders the built-in demo into `folder`/f_####.png at 320x180, without the
+// contact sheet unless `extra` holds "--sheet" (taken out here).
 std::vector<std::string> DemoArgs(const fs::path& folder, const std::string& frames,
                                   std::vector<std::string> extra = {}) {
-  std::vector<std::string> args{"render",     "--size",    "320x180", "--frames", frames,
-                                "--quiet",    "--no-video", "--no-sheet",
-                                "--out",      (folder / "f_####.png").string()};
+  std::vector<std::string> args{"render", "--size",     "320x180", "--frames", frames, "--quiet",
+                                "--no-video", "--out", (folder / "f_####.png").string()};
+  const auto sheet = std::find(extra.begin(), extra.end(), "--sheet");
+  if (sheet != extra.end()) extra.erase(sheet);
+  else args.push_back("--no-sheet");
   args.insert(args.end(), extra.begin(), extra.end());
   return args;
 }
@@ -71,15 +76,41 @@ void ExpectSameFrames(const fs::path& a, const fs::path& b) {
 TEST(RenderOutputs, SameBytesWithOneTwoAndEightThreads) {
   const fs::path d = Dir();
   for (const char* t : {"1", "2", "8"}) {
-    const ProcessResult r = Patchskin(DemoArgs(d / (std::string("threads_") + t), "0:5", {"--threads", t}));
+    const ProcessResult r =
+        Patchskin(DemoArgs(d / (std::string("threads_") + t), "0:5", {"--threads", t, "--sheet"}));
     ASSERT_EQ(r.exit_code, 0) << r.err;
   }
-  ASSERT_EQ(Files(d / "threads_1").size(), 6u);
+  ASSERT_EQ(Files(d / "threads_1").size(), 7u);  // 6 frames and the contact sheet
   ExpectSameFrames(d / "threads_1", d / "threads_2");
   ExpectSameFrames(d / "threads_1", d / "threads_8");
   // And across runs.
-  ASSERT_EQ(Patchskin(DemoArgs(d / "again", "0:5", {"--threads", "2"})).exit_code, 0);
+  ASSERT_EQ(Patchskin(DemoArgs(d / "again", "0:5", {"--threads", "2", "--sheet"})).exit_code, 0);
   ExpectSameFrames(d / "threads_1", d / "again");
+}
+
+// A rig with B-spline patches (the split frame: global | global + patches):
+// the patch rebuild runs on the worker threads too.
+TEST(RenderOutputs, RigWithPatchesGivesTheSameBytesWithOneTwoAndEightThreads) {
+  const fs::path d = Dir();
+  const fs::path bend = (testsupport::TestDataPath("../../samples/data/bend.bvh")).lexically_normal();
+  ASSERT_TRUE(fs::exists(bend)) << bend;
+  const fs::path rig = d / "patches.json";
+  std::ofstream(rig) << R"({"character": "mannequin", "motion": {"file": ")" << bend.string()
+                     << R"("}, "global": "dqs", "patches": [
+      {"name": "left_elbow", "region": {"joint": "LeftForeArm", "radius": 14, "side": [0, 0, 1]},
+       "grid": [6, 6], "sampling": [8, 8]},
+      {"name": "left_knee", "region": {"joint": "LeftLeg", "radius": 20, "side": [0, 0, -1]},
+       "grid": [5, 6], "sampling": [9, 8], "border_width": 0.2}],
+    "render": {"size": [192, 108], "camera": "fixed", "split": true, "frames": "40:47"}})";
+  for (const char* t : {"1", "2", "8"}) {
+    const ProcessResult r =
+        Patchskin({"render", rig.string(), "--threads", t, "--quiet", "--no-video", "--out",
+                   (d / (std::string("threads_") + t) / "f_####.png").string()});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+  }
+  ASSERT_EQ(Files(d / "threads_1").size(), 9u);  // 8 frames and the contact sheet
+  ExpectSameFrames(d / "threads_1", d / "threads_2");
+  ExpectSameFrames(d / "threads_1", d / "threads_8");
 }
 
 TEST(RenderOutputs, RefusesExistingFramesWithoutOverwrite) {
@@ -113,43 +144,57 @@ TEST(RenderOutputs, FolderNamedLikeAFrameIsAnError) {
   EXPECT_FALSE(fs::exists(out / "f_0000.png"));
 }
 
-TEST(RenderOutputs, InterruptedRenderResumesToTheSameFrames) {
+// Killed mid-way by SIGINT (Ctrl-C) and by SIGTERM (kill), then resumed: the
+// frames and the contact sheet (rebuilt from the finished frames read back)
+// are byte-identical to an uninterrupted render's, and no finished frame is redone.
+TEST(RenderOutputs, InterruptedRenderResumesToTheSameFramesAndSheet) {
   const fs::path d = Dir();
   const std::string range = "0:89";  // the whole demo: long enough to interrupt
-  ASSERT_EQ(Patchskin(DemoArgs(d / "reference", range)).exit_code, 0);
+  ASSERT_EQ(Patchskin(DemoArgs(d / "reference", range, {"--sheet"})).exit_code, 0);
   const std::size_t total = Files(d / "reference").size();
-  ASSERT_EQ(total, 90u);
+  ASSERT_EQ(total, 91u);  // 90 frames and the contact sheet
 
-  const fs::path out = d / "interrupted";
-  testsupport::RunningProcess p = testsupport::StartPatchskin(DemoArgs(out, range), d / "logs");
-  ASSERT_GT(p.pid, 0);
-  // Wait for a few finished frames, then interrupt as Ctrl-C would.
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
-  while (Files(out).size() < 3 && std::chrono::steady_clock::now() < deadline) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  int interrupted = 0;
+  for (const int sig : {SIGINT, SIGTERM}) {
+    const std::string name = sig == SIGINT ? "SIGINT" : "SIGTERM";
+    SCOPED_TRACE(name);
+    const fs::path out = d / ("interrupted_" + name);
+    testsupport::RunningProcess p =
+        testsupport::StartPatchskin(DemoArgs(out, range, {"--sheet"}), d / ("logs_" + name));
+    ASSERT_GT(p.pid, 0);
+    // Wait for a few finished frames, then interrupt.
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+    while (Files(out).size() < 3 && std::chrono::steady_clock::now() < deadline) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+    ASSERT_EQ(kill(p.pid, sig), 0);
+    const ProcessResult stopped = testsupport::WaitFor(p);
+    if (stopped.exit_code == 0) continue;  // finished before the signal arrived
+    ++interrupted;
+    EXPECT_EQ(stopped.exit_code, 128 + sig) << stopped.err;
+    EXPECT_NE(stopped.err.find("interrupted by " + name + " after frame"), std::string::npos)
+        << stopped.err;
+    EXPECT_NE(stopped.err.find("--resume"), std::string::npos) << stopped.err;
+
+    // Only complete frames under final names: no temporary file, no sheet.
+    const std::vector<fs::path> partial = Files(out);
+    ASSERT_LT(partial.size(), total);
+    ASSERT_FALSE(partial.empty());
+    EXPECT_FALSE(fs::exists(out / "contact_sheet.png"));
+    for (const fs::path& f : partial) {
+      EXPECT_EQ(f.filename().string().rfind(".", 0), std::string::npos) << "temporary file " << f;
+      EXPECT_EQ(SlurpFile(f), SlurpFile(d / "reference" / f.filename())) << f;
+    }
+
+    // Without --resume the existing frames are refused; with it the rest is rendered.
+    EXPECT_EQ(Patchskin(DemoArgs(out, range, {"--sheet"})).exit_code, 2);
+    const auto first_stamp = fs::last_write_time(partial.front());
+    const ProcessResult resumed = Patchskin(DemoArgs(out, range, {"--sheet", "--resume"}));
+    ASSERT_EQ(resumed.exit_code, 0) << resumed.err;
+    EXPECT_EQ(fs::last_write_time(partial.front()), first_stamp) << "a finished frame was redone";
+    ExpectSameFrames(d / "reference", out);  // the 90 frames and contact_sheet.png
   }
-  ASSERT_EQ(kill(p.pid, SIGINT), 0);
-  const ProcessResult stopped = testsupport::WaitFor(p);
-  if (stopped.exit_code == 0) GTEST_SKIP() << "the render finished before the signal arrived";
-  EXPECT_EQ(stopped.exit_code, 128 + SIGINT) << stopped.err;
-  EXPECT_NE(stopped.err.find("interrupted by SIGINT after frame"), std::string::npos) << stopped.err;
-  EXPECT_NE(stopped.err.find("--resume"), std::string::npos) << stopped.err;
-
-  // Only complete frames under final names, no temporary file left behind.
-  const std::vector<fs::path> partial = Files(out);
-  ASSERT_LT(partial.size(), total);
-  for (const fs::path& f : partial) {
-    EXPECT_EQ(f.filename().string().rfind(".", 0), std::string::npos) << "temporary file " << f;
-    EXPECT_EQ(SlurpFile(f), SlurpFile(d / "reference" / f.filename())) << f;
-  }
-
-  // Without --resume the existing frames are refused; with it the rest is rendered.
-  EXPECT_EQ(Patchskin(DemoArgs(out, range)).exit_code, 2);
-  const auto first_stamp = fs::last_write_time(partial.front());
-  const ProcessResult resumed = Patchskin(DemoArgs(out, range, {"--resume"}));
-  ASSERT_EQ(resumed.exit_code, 0) << resumed.err;
-  EXPECT_EQ(fs::last_write_time(partial.front()), first_stamp) << "a finished frame was redone";
-  ExpectSameFrames(d / "reference", out);
+  if (interrupted == 0) GTEST_SKIP() << "both renders finished before their signal arrived";
 }
 
 }  // namespace

@@ -1,0 +1,184 @@
+// Bad rig files given to `patchskin render`, run as a process: every case of
+// the corpus in tests/data/rig/bad (see its README.md) plus files written here
+// (a folder named like a rig, an unreadable rig, one over the size limit)
+// must exit 2, name the rig file (and the line or field path) and what was
+// expected on the first stderr line, and leave the output folder empty.
+
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "app/rig_file.h"
+#include "support/data_paths.h"
+#include "support/run_process.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using testsupport::ProcessResult;
+
+constexpr int kBadInput = 2;
+
+fs::path Dir() {
+  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+  const fs::path d =
+      testsupport::TestOutputPath(std::string("cli_bad_rig/") + info->name() + "/x").parent_path();
+  static std::string cleaned;
+  if (cleaned != d.string()) {
+    fs::remove_all(d);
+    fs::create_directories(d / "logs");
+    cleaned = d.string();
+  }
+  return d;
+}
+
+fs::path OutDir() { return Dir() / "out"; }
+
+ProcessResult RenderRig(const std::string& rig) {
+  return testsupport::RunPatchskin(
+      {"render", rig, "--quiet", "--out", (OutDir() / "f_####.png").string()}, Dir() / "logs");
+}
+
+void ExpectNoOutput() {
+  if (!fs::exists(OutDir())) return;
+  for (const auto& e : fs::recursive_directory_iterator(OutDir())) {
+    ADD_FAILURE() << "unexpected output " << e.path();
+  }
+}
+
+// Exit 2 and a first stderr line "<file>[:line:col][: field]: error: ..." that
+// starts with `file` and holds `expect`.
+void ExpectBadInput(const ProcessResult& r, const std::string& file, const std::string& expect) {
+  EXPECT_EQ(r.exit_code, kBadInput) << r.err;
+  const std::string first = r.FirstErrLine();
+  EXPECT_EQ(first.rfind(file, 0), 0u) << "first stderr line: " << first;
+  EXPECT_NE(first.find(": error: "), std::string::npos) << "first stderr line: " << first;
+  EXPECT_NE(first.find(expect), std::string::npos) << "first stderr line: " << first;
+}
+
+std::string BadRig(const std::string& name) {
+  return testsupport::TestDataPath("rig/bad/" + name).lexically_normal().string();
+}
+
+struct RigCase {
+  const char* file;
+  const char* expect;  // as in tests/data/rig/bad/README.md
+  // Another file the message names, relative to the rig's folder ("" is the
+  // folder itself); nullptr: the rig.
+  const char* file_in_message = nullptr;
+};
+
+const RigCase kRigCases[] = {
+    {"empty.json", "1:1: error: invalid JSON"},
+    {"truncated.json", ": error: invalid JSON: syntax error"},
+    {"binary.json", "1:1: error: invalid JSON"},
+    {"nan_radius.json",
+     "12:19: error: invalid JSON: syntax error while parsing value - invalid literal"},
+    {"inf_radius.json", "12:19: error: invalid JSON: number overflow parsing '1e999'"},
+    {"size_absurd.json", "render.size: error: expected an array of two integers in 16..16384"},
+    {"size_zero.json", "render.size: error: expected an array of two integers in 16..16384"},
+    {"grid_absurd.json", "patches[0].grid: error: expected an array of two integers in 4..64"},
+    {"sampling_absurd.json",
+     "patches[0].sampling: error: expected an array of two integers in 4..256"},
+    {"radius_negative.json",
+     "patches[0].region.radius: error: expected a number in 1e-06..1e+06, found -5"},
+    {"radius_string.json",
+     "patches[0].region.radius: error: expected a number in 1e-06..1e+06, found \"5\""},
+    {"fps_absurd.json", "motion.fps: error: expected a number in 0..10000, found 1000000000.0"},
+    {"vertex_index_huge.json", "patches[0].region.vertices[2]: error: expected a vertex index"},
+    {"unknown_field.json", "colour: error: unknown field (expected one of: character, motion"},
+    {"unknown_render_field.json", "render.fps: error: unknown field (expected one of: size, camera"},
+    {"too_many_patches.json", "patches: error: expected at most 64 patches"},
+    {"deep_nesting.json", "patches[0]: error: expected an object, found an array (1 item)"},
+    {"patches_not_array.json",
+     "patches: error: expected an array of patch objects, found an object"},
+    {"output_dotdot.json",
+     "render.output: error: expected a relative path inside the rig's output folder"},
+    {"output_absolute.json",
+     "render.output: error: expected a relative path inside the rig's output folder"},
+    {"frames_reversed.json", "render.frames: error: range 9:2 is outside the motion's frames"},
+    {"motion_missing.json", "no_such.bvh: error: no such file", "no_such.bvh"},
+    {"motion_directory.json", "found a directory", ""},
+};
+
+TEST(CliBadRig, EveryCorpusFileIsRefusedWithItsMessage) {
+  std::size_t files = 0;
+  for (const auto& e : fs::directory_iterator(testsupport::TestDataPath("rig/bad"))) {
+    files += e.path().extension() == ".json" ? 1 : 0;
+  }
+  EXPECT_EQ(files, std::size(kRigCases)) << "every corpus file needs a row here";
+  for (const RigCase& c : kRigCases) {
+    SCOPED_TRACE(c.file);
+    const std::string rig = BadRig(c.file);
+    const fs::path folder = fs::path(rig).parent_path();
+    const std::string named = !c.file_in_message ? rig
+                              : *c.file_in_message ? (folder / c.file_in_message).string()
+                                                   : folder.string();
+    ExpectBadInput(RenderRig(rig), named, c.expect);
+    ExpectNoOutput();
+  }
+}
+
+TEST(CliBadRig, FolderWhereTheRigBelongs) {
+  const fs::path folder = Dir() / "rig.json";
+  fs::create_directories(folder);
+  ExpectBadInput(RenderRig(folder.string()), folder.string(),
+                 "error: expected a rig file, found a directory");
+  ExpectNoOutput();
+}
+
+TEST(CliBadRig, MissingRig) {
+  const std::string missing = (Dir() / "missing.json").string();
+  ExpectBadInput(RenderRig(missing), missing, "error: no such file");
+  ExpectNoOutput();
+}
+
+TEST(CliBadRig, UnreadableRig) {
+  const fs::path locked = Dir() / "locked.json";
+  fs::copy_file(BadRig("size_absurd.json"), locked, fs::copy_options::overwrite_existing);
+  ASSERT_EQ(chmod(locked.c_str(), 0), 0);
+  if (access(locked.c_str(), R_OK) == 0) {
+    chmod(locked.c_str(), 0644);
+    GTEST_SKIP() << "running as root (or with CAP_DAC_OVERRIDE): a mode-000 file is still readable";
+  }
+  const ProcessResult r = RenderRig(locked.string());
+  chmod(locked.c_str(), 0644);
+  ExpectBadInput(r, locked.string(), "error: cannot open the rig file");
+  ExpectNoOutput();
+}
+
+TEST(CliBadRig, RigOverTheSizeLimitIsRefusedBeforeReading) {
+  const fs::path huge = Dir() / "huge.json";
+  std::ofstream(huge).close();
+  fs::resize_file(huge, app::kMaxRigFileBytes + 1);  // sparse: no disk used
+  ExpectBadInput(RenderRig(huge.string()), huge.string(),
+                 "error: expected a rig file of at most 16 MiB, found 16777217 bytes");
+  ExpectNoOutput();
+}
+
+// The in-memory reader on the same corpus: never throws, always names the file.
+TEST(CliBadRig, ParseRigAnswersEveryCorpusFileWithAnError) {
+  for (const RigCase& c : kRigCases) {
+    SCOPED_TRACE(c.file);
+    std::ifstream in(BadRig(c.file), std::ios::binary);
+    const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+    const mocap::Result<app::Rig> rig = app::ParseRig(text, "r.json");
+    // The motion and the frame range are checked when rendering, not parsing.
+    const std::string name = c.file;
+    if (name.rfind("motion_", 0) == 0 || name == "frames_reversed.json") {
+      EXPECT_TRUE(rig.ok());
+      continue;
+    }
+    ASSERT_FALSE(rig.ok());
+    EXPECT_EQ(rig.error().ToString().rfind("r.json", 0), 0u) << rig.error().ToString();
+  }
+}
+
+}  // namespace
