@@ -14,7 +14,7 @@
 # when not run as root (the test cluster runs jobs as SlurmUser=root).
 #
 # The rig is one variable: PATCHSKIN_SLURM_RIG=path/to/rig.json renders that
-# rig instead of the default patch rig written below (e.g. an elastic rig).
+# rig instead of the default elastic rig written below.
 set -euo pipefail
 
 bin=$(readlink -f "$1")
@@ -37,8 +37,11 @@ mkdir -p "$work"
 cluster=$(mktemp -d /tmp/patchskin-slurm.XXXXXX)
 trap 'slurm_cluster_stop; rm -rf "$cluster"' EXIT
 
-# --- The rig: a patch on the mannequin's elbow, tiny frames ------------------
-frames=0:7
+# --- The rig: an elastic belly patch on the mannequin's jump, tiny frames -----
+# Frames 40..47 are the landing, where the belly's mass-spring state matters:
+# every chunk after the first must arrive at the same state as the whole render
+# (the layer simulates from the motion's start, app/elastic_layer.h).
+frames=40:47
 chunk=2
 rig=${PATCHSKIN_SLURM_RIG:-}
 if [ -z "$rig" ]; then
@@ -46,10 +49,11 @@ if [ -z "$rig" ]; then
   cat >"$rig" <<RIG
 {
   "character": "mannequin",
-  "motion": {"file": "$src/samples/data/bend.bvh"},
-  "patches": [{"name": "left_elbow",
-               "region": {"joint": "LeftForeArm", "radius": 14, "side": [0, 0, 1]},
-               "grid": [4, 4], "sampling": [6, 6]}],
+  "motion": {"file": "$src/samples/data/jump.bvh"},
+  "patches": [{"name": "belly",
+               "region": {"joint": "Spine1", "radius": 16, "side": [0, 0, 1], "half_angle_deg": 70},
+               "grid": [6, 6], "sampling": [10, 10], "border_width": 0.15,
+               "elastic": {"frequency_hz": 4, "damping_ratio": 0.15, "max_displacement": 8}}],
   "render": {"size": [160, 90], "camera": "follow"}
 }
 RIG
@@ -94,10 +98,10 @@ if ls -A "$work/farm" | grep -q '^\.'; then
 fi
 
 # --- A lost chunk is finished by re-running its task with the same script ----
-rm "$work/farm/f_0005.png"
+rm "$work/farm/f_0045.png"
 timeout 120 sbatch --wait --quiet --array=2 "$work/farm/slurm/render_array.sbatch"
-if ! cmp -s "$work/single/f_0005.png" "$work/farm/f_0005.png"; then
-  echo "FAIL: re-running task 2 did not restore f_0005.png byte-identical"
+if ! cmp -s "$work/single/f_0045.png" "$work/farm/f_0045.png"; then
+  echo "FAIL: re-running task 2 did not restore f_0045.png byte-identical"
   fail=1
 fi
 
@@ -116,5 +120,5 @@ if [ "$fail" -ne 0 ]; then
   echo "--- task logs"; tail -n 5 "$work"/farm/slurm/logs/* || true
   exit 1
 fi
-echo "PASS: 8 frames from a 4-task Slurm array are byte-identical to one render"
+echo "PASS: 8 frames of an elastic rig from a 4-task Slurm array are byte-identical to one render"
 rm -rf "$work"
