@@ -3,8 +3,8 @@
 #include <cmath>
 #include <sstream>
 
-
 #include "app/pipeline.h"
+#include "app/rig_file.h"
 #include "deform/dqs_job.h"
 #include "deform/example_shapes.h"
 #include "deform/skinning_job.h"
