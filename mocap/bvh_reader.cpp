@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <thread>
 
 #include <fcntl.h>
 #include <sys/mman.h>
@@ -64,6 +65,11 @@ class MotionParser {
     // instead of being zeroed first. Each line is parsed into a small buffer
     // that stays in L1 and appended whole once it has exactly #C values.
     motion->values.clear();
+    if (remaining >= options.parallel_min_bytes && static_cast<std::size_t>(declared) == capacity &&
+        TryParseHalves(num_channels, capacity, motion)) {
+      return Status::Ok();
+    }
+    motion->values.clear();
     motion->values.reserve(capacity * static_cast<std::size_t>(num_channels));
     std::vector<float> line_values(static_cast<std::size_t>(num_channels));
     float* out = line_values.data();
@@ -99,6 +105,56 @@ class MotionParser {
   }
 
  private:
+  // Parses every frame from p_ to end_ into `values`, at most `max_frames`;
+  // false on any error or on more frames (the caller then re-reads
+  // sequentially for the exact message).
+  bool ParseAllClean(int num_channels, std::size_t max_frames, std::vector<float>& values,
+                     std::size_t& frames) {
+    std::vector<float> line_values(static_cast<std::size_t>(num_channels));
+    float* out = line_values.data();
+    frames = 0;
+    for (;;) {
+      SkipSpace();
+      if (p_ == end_) return true;
+      if (frames == max_frames) return false;
+      if (!ParseLine(static_cast<long long>(frames) + 1, num_channels, out)) return false;
+      values.insert(values.end(), out, out + num_channels);
+      ++frames;
+    }
+  }
+
+  // The two-half fast path (BvhReadOptions::parallel_min_bytes): splits the
+  // frame data at the first line end after its middle, parses the second half
+  // on a worker thread into its own array while this thread parses the first
+  // half into `motion`, then appends. Taken only when both halves parse
+  // cleanly and hold exactly `frames` frames together, i.e. exactly when the
+  // sequential pass would succeed without a warning; false leaves the caller
+  // to run that pass.
+  bool TryParseHalves(int num_channels, std::size_t frames, Motion* motion) {
+    const char* mid = p_ + (end_ - p_) / 2;
+    while (mid != end_ && !IsLineEnd(*mid)) ++mid;
+    while (mid != end_ && IsLineEnd(*mid)) ++mid;
+    if (mid == end_) return false;
+    MotionParser second = *this;
+    second.p_ = mid;
+    second.line_start_ = mid;
+    MotionParser first = *this;
+    first.end_ = mid;
+    std::vector<float> tail;
+    std::size_t tail_frames = 0;
+    bool tail_ok = false;
+    std::thread worker([&] { tail_ok = second.ParseAllClean(num_channels, frames, tail, tail_frames); });
+    motion->values.reserve(frames * static_cast<std::size_t>(num_channels));
+    std::size_t head_frames = 0;
+    const bool head_ok = first.ParseAllClean(num_channels, frames, motion->values, head_frames);
+    worker.join();
+    if (!head_ok || !tail_ok || head_frames + tail_frames != frames) return false;
+    motion->values.insert(motion->values.end(), tail.begin(), tail.end());
+    motion->num_frames = static_cast<int>(frames);
+    p_ = end_;
+    return true;
+  }
+
   FileLoc Loc(const char* where) const {
     return FileLoc{doc_.file_name, line_, static_cast<int>(where - line_start_) + 1, {}};
   }
