@@ -1,7 +1,9 @@
 #include "app/character_motion.h"
 
+#include <cstdio>
 #include <utility>
 
+#include "app/demo_data.h"
 #include "mocap/retarget.h"
 
 namespace app {
@@ -26,6 +28,30 @@ mocap::Result<Character> MakeRetargetedCharacter(MotionSource&& character, Motio
   for (mocap::Warning& w : motion.warnings) character.warnings.push_back(std::move(w));
   for (mocap::Warning& w : retargeted->warnings) character.warnings.push_back(std::move(w));
   return MakeCharacter(std::move(character));
+}
+
+mocap::Result<Character> LoadCommandCharacter(const std::string& input, const std::string& motion,
+                                              bool quiet) {
+  MotionSourceOptions load;
+  load.y_up = true;  // frames are rendered Y-up with the ground at the feet
+  mocap::Result<MotionSource> src = input.empty()
+                                        ? LoadBvhText(DemoBvhText(), "demo_walk.bvh", load)
+                                        : LoadMotionSource(input, load);
+  if (!src.ok()) return std::move(src).error();
+  const auto print = [quiet](const std::vector<mocap::Warning>& warnings, std::size_t from) {
+    if (quiet) return;
+    for (std::size_t i = from; i < warnings.size(); ++i) {
+      std::fprintf(stderr, "%s\n", warnings[i].ToString().c_str());
+    }
+  };
+  print(src->warnings, 0);
+  if (motion.empty()) return MakeCharacter(std::move(*src));
+  mocap::Result<MotionSource> bvh = LoadMotionSource(motion, load);
+  if (!bvh.ok()) return std::move(bvh).error();
+  const std::size_t printed = src->warnings.size();  // the glTF's, printed above
+  mocap::Result<Character> character = MakeRetargetedCharacter(std::move(*src), std::move(*bvh));
+  if (character.ok()) print(character->warnings, printed);
+  return character;
 }
 
 }  // namespace app

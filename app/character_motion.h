@@ -4,6 +4,8 @@
 // are matched to the skin's joints by name and its rotations retargeted onto
 // the glTF rest pose (conventions in mocap/retarget.h; README "Rig files").
 
+#include <string>
+
 #include "app/motion_source.h"
 #include "app/pipeline.h"
 #include "mocap/error.h"
@@ -17,5 +19,13 @@ namespace app {
 // a glTF or the motion not a BVH, and RetargetMotion's (unmapped required
 // joints, named). The retargeting warnings join the character's.
 mocap::Result<Character> MakeRetargetedCharacter(MotionSource&& character, MotionSource&& motion);
+
+// The character a command evaluates, loaded as `render` and `export` load it:
+// `input` (a BVH, glTF or GLB path; empty = the built-in demo walk) read Y-up,
+// driven by the BVH `motion` when that is not empty (MakeRetargetedCharacter),
+// else by its own motion (MakeCharacter). Load and retarget warnings go to
+// stderr unless `quiet`. Errors: those of LoadMotionSource and the makers.
+mocap::Result<Character> LoadCommandCharacter(const std::string& input, const std::string& motion,
+                                              bool quiet);
 
 }  // namespace app

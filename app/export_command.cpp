@@ -10,7 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "app/demo_data.h"
+#include "app/character_motion.h"
 #include "app/frame_plan.h"
 #include "app/motion_source.h"
 #include "app/pipeline.h"
@@ -148,19 +148,11 @@ int RunExport(const ExportOptions& options) {
   if (!layout.ok()) return Fail(layout.error());
 
   // --- Input (as render) --------------------------------------------------------
-  MotionSourceOptions load;
-  load.y_up = true;
   const bool demo = o.input.empty();
-  mocap::Result<MotionSource> src = demo ? LoadBvhText(DemoBvhText(), "demo_walk.bvh", load)
-                                         : LoadMotionSource(o.input, load);
-  if (!src.ok()) return Fail(src.error());
-  if (!o.quiet) {
-    for (const mocap::Warning& w : src->warnings) std::fprintf(stderr, "%s\n", w.ToString().c_str());
-  }
   const std::string name = demo  ? "demo"
                            : rig ? std::filesystem::path(rig->file).stem().string()
                                  : std::filesystem::path(o.input).stem().string();
-  mocap::Result<Character> character = MakeCharacter(std::move(*src));
+  mocap::Result<Character> character = LoadCommandCharacter(o.input, {}, o.quiet);
   if (!character.ok()) return Fail(character.error());
   const Character& ch = *character;
   mocap::Result<FramePlan> plan = PlanFrames(ch.motion, {.frames = o.frames, .fps = o.fps});

@@ -225,33 +225,11 @@ int RunRender(const RenderOptions& options) {
   }
 
   // --- Input -----------------------------------------------------------------
-  MotionSourceOptions load;
-  load.y_up = true;  // frames are rendered Y-up with the ground at the feet
   const bool demo = o.input.empty();
-  mocap::Result<MotionSource> src = demo ? LoadBvhText(DemoBvhText(), "demo_walk.bvh", load)
-                                         : LoadMotionSource(o.input, load);
-  if (!src.ok()) return Fail(src.error());
-  if (!o.quiet) {
-    for (const mocap::Warning& w : src->warnings) std::fprintf(stderr, "%s\n", w.ToString().c_str());
-  }
   const std::string name = demo  ? "demo"
                            : rig ? std::filesystem::path(rig->file).stem().string()
                                  : std::filesystem::path(o.input).stem().string();
-  mocap::Result<Character> character = mocap::MakeError(mocap::ErrorCode::kInternal, {}, "");
-  if (!o.motion.empty()) {
-    // A glTF character driven by a separate BVH (app/character_motion.h).
-    mocap::Result<MotionSource> motion = LoadMotionSource(o.motion, load);
-    if (!motion.ok()) return Fail(motion.error());
-    const std::size_t printed = src->warnings.size();  // the glTF's, printed above
-    character = MakeRetargetedCharacter(std::move(*src), std::move(*motion));
-    if (character.ok() && !o.quiet) {
-      for (std::size_t i = printed; i < character->warnings.size(); ++i) {
-        std::fprintf(stderr, "%s\n", character->warnings[i].ToString().c_str());
-      }
-    }
-  } else {
-    character = MakeCharacter(std::move(*src));
-  }
+  mocap::Result<Character> character = LoadCommandCharacter(o.input, o.motion, o.quiet);
   if (!character.ok()) return Fail(character.error());
   const Character& ch = *character;
 
