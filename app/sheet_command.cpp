@@ -4,7 +4,6 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
-#include <regex>
 #include <vector>
 
 #include "app/frame_plan.h"
@@ -41,9 +40,31 @@ CLI::App* AddSheetCommand(CLI::App& parent, SheetOptions& o) {
   return cmd;
 }
 
+namespace {
+
+// True for "A:B" or "A:B:STEP" with every part a non-empty run of digits: a sheet
+// needs both ends of the range, which ParseFrames lets a render leave open.
+bool IsClosedRange(const std::string& text) {
+  int parts = 1;
+  bool digit_in_part = false;
+  for (const char c : text) {
+    if (c == ':') {
+      if (!digit_in_part) return false;
+      ++parts;
+      digit_in_part = false;
+    } else if (c >= '0' && c <= '9') {
+      digit_in_part = true;
+    } else {
+      return false;
+    }
+  }
+  return digit_in_part && (parts == 2 || parts == 3);
+}
+
+}  // namespace
+
 int RunSheet(const SheetOptions& o) {
-  static const std::regex kRange(R"(\d+:\d+(:\d+)?)");
-  if (!std::regex_match(o.frames, kRange)) {
+  if (!IsClosedRange(o.frames)) {
     return Fail(ArgError("--frames", "expected A:B[:STEP] with both ends, found '" + o.frames + "'"));
   }
   mocap::Result<FrameRange> range = ParseFrames(o.frames, kMaxFrameNumber);

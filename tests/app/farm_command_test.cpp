@@ -159,8 +159,17 @@ TEST(SheetCommand, RefusesMissingFramesAndExistingSheet) {
   r = Patchskin(d, {"sheet", (d / "f_####.png").string(), "--frames", "0:3", "--no-video"});
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.FirstErrLine().find("--overwrite"), std::string::npos) << r.err;
-  r = Patchskin(d, {"sheet", (d / "f_####.png").string(), "--frames", "0:", "--no-video"});
-  EXPECT_EQ(r.exit_code, 2);
+  // A sheet needs a closed range: open ends, empty parts and stray characters are refused
+  // with the option named; a step is accepted.
+  for (const char* bad : {"0:", ":3", "0:3:", "0::2", "a:b", "0:3:1:1", "0:3 ", ""}) {
+    r = Patchskin(d, {"sheet", (d / "f_####.png").string(), "--frames", bad, "--no-video",
+                      "--overwrite"});
+    EXPECT_EQ(r.exit_code, 2) << "'" << bad << "'";
+    EXPECT_NE(r.FirstErrLine().find("--frames"), std::string::npos) << "'" << bad << "': " << r.err;
+  }
+  r = Patchskin(d, {"sheet", (d / "f_####.png").string(), "--frames", "0:3:3", "--no-video",
+                    "--overwrite"});
+  EXPECT_EQ(r.exit_code, 0) << r.err;
 }
 
 }  // namespace
