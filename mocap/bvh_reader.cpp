@@ -178,7 +178,10 @@ class MotionParser {
     bool failed = false;
     const auto work = [&] {
       MotionParser parser = *this;
+      // Room for a block's values (at least two bytes each) without regrowing;
+      // only the pages written are ever resident.
       std::vector<float> values;
+      values.reserve(block_bytes / 2 + static_cast<std::size_t>(num_channels));
       for (;;) {
         const char* begin = nullptr;
         const char* stop = nullptr;
