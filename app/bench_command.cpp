@@ -27,6 +27,7 @@
 #include <assimp/scene.h>
 #endif
 
+#include "app/bench_long_capture.h"
 #include "app/bench_table1.h"
 #include "app/bench_timing.h"
 #include "app/demo_data.h"
@@ -410,6 +411,7 @@ int RunBench(const BenchOptions& o) {
                       std::to_string(deform::PatchBinding::kRebuildBytesPerVertex)});
   rows.push_back({"peak_memory", "MB", Clock::kCpu, {PeakRssMb()}, 0.0, "",
                   "getrusage ru_maxrss of this process"});
+  bench::AddLongCaptureRows(o.quick, rows, &failed);
   if (failed) {
     return Fail(mocap::MakeError(mocap::ErrorCode::kInternal, {"bench", 0, 0, {}},
                                  "a measured operation failed"));

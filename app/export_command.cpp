@@ -155,7 +155,7 @@ int RunExport(const ExportOptions& options) {
   mocap::Result<Character> character = LoadCommandCharacter(o.input, {}, o.quiet);
   if (!character.ok()) return Fail(character.error());
   const Character& ch = *character;
-  mocap::Result<FramePlan> plan = PlanFrames(ch.motion, {.frames = o.frames, .fps = o.fps});
+  mocap::Result<FramePlan> plan = PlanFrames(ch.motion, {.frames = o.frames, .fps = o.fps, .list_frames = false});
   if (!plan.ok()) return Fail(plan.error());
 
   const std::string out = o.out.empty() ? "out/" + name + "_export/mesh_####.obj" : o.out;
@@ -199,7 +199,7 @@ int RunExport(const ExportOptions& options) {
     go.generator = "patchskin export (" + std::string(GlobalMethodName(*method)) + ")";
     go.scratch_dir = out_dir.empty() ? "." : out_dir.string();
     mocap::Result<deform::GltfSequenceWriter> w = deform::GltfSequenceWriter::Create(
-        bind.triangles, bind.colors, bind.num_vertices(), static_cast<int>(plan->frames.size()), go);
+        bind.triangles, bind.colors, bind.num_vertices(), static_cast<int>(plan->count()), go);
     if (!w.ok()) return Fail(w.error());
     gltf.emplace(std::move(*w));
   }
@@ -207,13 +207,16 @@ int RunExport(const ExportOptions& options) {
   // --- The frame loop: one frame in memory (OBJ) ---------------------------------------
   // Every planned frame is evaluated in order by the one pipeline, as render
   // does, so state carried from frame to frame (the elastic layer) is the same.
-  Progress progress(demo ? "export demo" : "export " + name, static_cast<int>(plan->frames.size()),
+  Progress progress(demo ? "export demo" : "export " + name, static_cast<int>(plan->count()),
                     o.quiet);
   DeformedFrame frame;
   std::vector<glm::vec3> scaled;  // --scale: the positions written (#V, reused)
   deform::ObjSequenceWriter obj;
   const std::string source = demo ? "demo_walk.bvh (built in)" : rig ? rig->file : o.input;
-  for (const OutputFrame& of : plan->frames) {
+  // Frames are computed one at a time (plan->At): an export of every frame of
+  // an hour-long capture holds no per-frame list (issue 8).
+  for (std::size_t index = 0; index < plan->count(); ++index) {
+    const OutputFrame of = plan->At(index);
     mocap::Status s = pipeline->Evaluate(of.time_s, frame);
     if (!s.ok()) return Fail(s.error());
     std::span<const glm::vec3> positions = frame.positions;
@@ -257,10 +260,10 @@ int RunExport(const ExportOptions& options) {
   }
   progress.Finish();
   if (glb) {
-    std::printf("glb:     %s (%zu frames, %s layout)\n", out.c_str(), plan->frames.size(),
+    std::printf("glb:     %s (%zu frames, %s layout)\n", out.c_str(), plan->count(),
                 deform::GltfExportLayoutName(gltf->layout()));
   } else {
-    std::printf("obj:     %s (%zu frames)\n", out.c_str(), plan->frames.size());
+    std::printf("obj:     %s (%zu frames)\n", out.c_str(), plan->count());
   }
   if (cameras) std::printf("cameras: %s\n", (out_dir / "camera_####.json").string().c_str());
   return 0;

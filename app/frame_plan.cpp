@@ -75,16 +75,29 @@ mocap::Result<FramePlan> PlanFrames(const mocap::Motion& motion, const FramePlan
   mocap::Result<FrameRange> range = ParseFrames(o.frames, plan.motion_frames);
   if (!range.ok()) return range.error();
   plan.range = *range;
-  if (o.turntable) {
-    for (int k = 0; k < o.turntable_frames; ++k) {
-      plan.frames.push_back({k, plan.range.first * plan.frame_time_s, k});
-    }
-  } else {
-    for (int f = plan.range.first; f <= plan.range.last; f += plan.range.step) {
-      plan.frames.push_back({f, f * plan.frame_time_s, f});
-    }
+  plan.turntable = o.turntable;
+  plan.turntable_frames = o.turntable ? o.turntable_frames : 0;
+  if (o.list_frames) {
+    const std::size_t n = plan.count();
+    plan.frames.reserve(n);
+    for (std::size_t i = 0; i < n; ++i) plan.frames.push_back(plan.At(i));
   }
   return plan;
+}
+
+std::size_t FramePlan::count() const {
+  if (turntable) return static_cast<std::size_t>(std::max(turntable_frames, 0));
+  if (range.last < range.first || range.step < 1) return 0;
+  return static_cast<std::size_t>((std::int64_t{range.last} - range.first) / range.step) + 1;
+}
+
+OutputFrame FramePlan::At(std::size_t i) const {
+  if (turntable) {
+    const int k = static_cast<int>(i);
+    return {k, range.first * frame_time_s, k};
+  }
+  const int f = static_cast<int>(range.first + static_cast<std::int64_t>(i) * range.step);
+  return {f, f * frame_time_s, f};
 }
 
 mocap::Result<CameraPlan> CameraPlan::Create(FramePipeline& pipeline, const FramePlan& plan,
@@ -93,7 +106,7 @@ mocap::Result<CameraPlan> CameraPlan::Create(FramePipeline& pipeline, const Fram
   if (mode != "follow" && mode != "fixed" && mode != "turntable") {
     return ArgError("--camera", "expected follow, fixed or turntable, found '" + mode + "'");
   }
-  if (plan.frames.empty()) return ArgError("--frames", "no frames to frame");
+  if (plan.count() == 0) return ArgError("--frames", "no frames to frame");
   // At +-90 degrees the view looks straight along the up vector (a degenerate
   // look-at); NaN would reach the rasterizer's float-to-int conversions.
   if (!(std::abs(elevation_deg) <= kMaxElevationDeg)) {
@@ -132,12 +145,12 @@ mocap::Result<CameraPlan> CameraPlan::Create(FramePipeline& pipeline, const Fram
   const glm::vec3 view_dir = -glm::normalize(glm::vec3(0.45f, 0.0f, 1.0f) * std::cos(elevation) +
                                              glm::vec3(0.0f, std::sin(elevation), 0.0f));
   if (mode == "turntable") {
-    const mocap::Status s = cp.tracker_->Evaluate(plan.frames.front().time_s, frame);
+    const mocap::Status s = cp.tracker_->Evaluate(plan.At(0).time_s, frame);
     if (!s.ok()) return s.error();
     const render::Camera framed = render::FrameBounds(frame.bounds, kFovYDeg, aspect, view_dir);
     cp.turntable_ = render::TurntablePath(frame.bounds.center(),
                                           glm::length(framed.eye - framed.target), elevation_deg,
-                                          static_cast<int>(plan.frames.size()));
+                                          static_cast<int>(plan.count()));
     for (render::Camera& c : cp.turntable_) {
       c.fov_y_deg = kFovYDeg;
       c.aspect = aspect;

@@ -51,6 +51,10 @@ struct FramePlanOptions {
   double fps = 0.0;           // output frame rate; 0 = the motion's own (30 when unknown)
   bool turntable = false;     // frames are turntable views of range.first
   int turntable_frames = 36;  // views of a turntable
+  // Fill FramePlan::frames. A render of every frame of an hour-long capture
+  // has ~430,000 output frames; commands that walk the plan with count() and
+  // At() (render) turn this off so the plan's memory stays constant.
+  bool list_frames = true;
 };
 
 // The output frames of a command.
@@ -58,7 +62,16 @@ struct FramePlan {
   double frame_time_s = 1.0 / 30.0;  // seconds between output frame numbers
   int motion_frames = 1;             // output frames the motion spans (numbers 0..N-1)
   FrameRange range;                  // the parsed --frames
-  std::vector<OutputFrame> frames;   // in output order; time_s = number * frame_time_s
+  bool turntable = false;            // frames are turntable views of range.first
+  int turntable_frames = 0;          // views of the turntable (when turntable)
+  // In output order; time_s = number * frame_time_s. Empty when the plan was
+  // made with list_frames = false; count() and At() work either way.
+  std::vector<OutputFrame> frames;
+
+  // Number of output frames (>= 1 for a plan PlanFrames returned).
+  std::size_t count() const;
+  // Output frame i (< count()), computed from the range: the same as frames[i].
+  OutputFrame At(std::size_t i) const;
 };
 
 // Errors: kInvalidArgument from ParseFrames.

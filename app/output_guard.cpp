@@ -78,7 +78,17 @@ OutputGuard::~OutputGuard() {
 
 mocap::Status OutputGuard::Plan(const std::vector<std::string>& frame_paths,
                                 const std::vector<std::string>& other_paths) {
-  skip_.assign(frame_paths.size(), false);
+  return Plan(
+      frame_paths.size(),
+      [&frame_paths](std::size_t i) -> mocap::Result<std::string> { return frame_paths[i]; },
+      other_paths);
+}
+
+mocap::Status OutputGuard::Plan(
+    std::size_t num_frames,
+    const std::function<mocap::Result<std::string>(std::size_t)>& frame_path,
+    const std::vector<std::string>& other_paths) {
+  skip_.assign(num_frames, false);
   num_skipped_ = 0;
   int existing = 0;
   std::string first_existing;
@@ -100,8 +110,10 @@ mocap::Status OutputGuard::Plan(const std::vector<std::string>& frame_paths,
     ++existing;
     return mocap::Status::Ok();
   };
-  for (std::size_t i = 0; i < frame_paths.size(); ++i) {
-    if (mocap::Status s = check(frame_paths[i], true, i); !s) return s;
+  for (std::size_t i = 0; i < num_frames; ++i) {
+    mocap::Result<std::string> path = frame_path(i);
+    if (!path.ok()) return path.error();
+    if (mocap::Status s = check(*path, true, i); !s) return s;
   }
   if (!options_.resume) {
     for (const std::string& p : other_paths) {
@@ -112,7 +124,7 @@ mocap::Status OutputGuard::Plan(const std::vector<std::string>& frame_paths,
     return mocap::MakeError(
         mocap::ErrorCode::kInvalidArgument, {first_existing, 0, 0, {}},
         "output file exists (" + std::to_string(existing) + " of this render's " +
-            std::to_string(frame_paths.size() + other_paths.size()) +
+            std::to_string(num_frames + other_paths.size()) +
             " outputs do); expected a free output path: pass --overwrite to replace them or "
             "--resume to render only the missing frames");
   }

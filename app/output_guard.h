@@ -20,6 +20,7 @@
 //   own choice and are not restricted.
 
 #include <cstddef>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -59,6 +60,13 @@ class OutputGuard {
   // frame). Call before rendering anything.
   [[nodiscard]] mocap::Status Plan(const std::vector<std::string>& frame_paths,
                                    const std::vector<std::string>& other_paths);
+  // The same for `num_frames` frames whose paths frame_path(i) gives one at a
+  // time (an error from it is returned as is), so a render of ~430,000 frames
+  // holds no list of their names: memory is one bit per frame.
+  [[nodiscard]] mocap::Status Plan(
+      std::size_t num_frames,
+      const std::function<mocap::Result<std::string>(std::size_t)>& frame_path,
+      const std::vector<std::string>& other_paths);
 
   // After Plan: true when frame i (index into frame_paths) is already done
   // and --resume skips it.

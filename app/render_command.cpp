@@ -1,6 +1,7 @@
 #include "app/render_command.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -92,6 +93,8 @@ CLI::App* AddRenderCommand(CLI::App& parent, RenderOptions& o) {
   cmd->add_flag("--no-sheet", o.no_sheet, "Do not write the contact sheet");
   cmd->add_flag("--no-video", o.no_video, "Do not write the preview video");
   cmd->add_flag("--quiet", o.quiet, "No progress output");
+  cmd->add_flag("--stats", o.stats,
+                "Print when the first frame was ready and the peak memory (long captures)");
   cmd->add_option("--framing", o.framing,
                   "A:B[:STEP] frames the camera framing looks at (default: the output frames; "
                   "chunks of one render pass the whole range)");
@@ -138,9 +141,24 @@ int Fail(const mocap::Error& e) {
   return e.code == mocap::ErrorCode::kInternal ? 3 : 2;
 }
 
+// This process's peak resident memory in MB (VmHWM of /proc/self/status), 0 if unknown.
+double PeakResidentMb() {
+  std::FILE* f = std::fopen("/proc/self/status", "r");
+  if (f == nullptr) return 0.0;
+  char line[256];
+  long kb = 0;
+  while (std::fgets(line, sizeof(line), f) != nullptr) {
+    if (std::sscanf(line, "VmHWM: %ld kB", &kb) == 1) break;
+  }
+  std::fclose(f);
+  return static_cast<double>(kb) * 1024.0 / 1e6;
+}
+
 }  // namespace
 
 int RunRender(const RenderOptions& options) {
+  const auto started = std::chrono::steady_clock::now();
+  double first_frame_s = -1.0;  // --stats: when the first frame went to the writer
   // --- A rig file (README "Rig files") sets the inputs and render settings ---
   RenderOptions o = options;
   std::optional<Rig> rig;
@@ -236,7 +254,7 @@ int RunRender(const RenderOptions& options) {
   const bool turntable = o.camera == "turntable";
   mocap::Result<FramePlan> plan = PlanFrames(
       ch.motion, {.frames = o.frames, .fps = o.fps, .turntable = turntable,
-                  .turntable_frames = o.turntable_frames});
+                  .turntable_frames = o.turntable_frames, .list_frames = false});
   if (!plan.ok()) {
     if (rig && options.frames.empty() && !rig->render.frames.empty()) {
       // The range came from the rig file: name it and its field, not --frames.
@@ -247,7 +265,9 @@ int RunRender(const RenderOptions& options) {
     return Fail(plan.error());
   }
   const double frame_time = plan->frame_time_s;
-  const std::vector<OutputFrame>& frames = plan->frames;
+  // The output frames are computed one at a time (plan->At): a render of
+  // every frame of an hour-long capture holds no per-frame list (issue 8).
+  const std::size_t num_frames = plan->count();
 
   std::string pattern = o.out;
   if (pattern.empty()) pattern = "out/" + name + (turntable ? "_turntable" : "") + "/frame_####.png";
@@ -258,17 +278,16 @@ int RunRender(const RenderOptions& options) {
   // Existing outputs are refused (or, with --resume, skipped) before anything renders.
   OutputGuard guard({.overwrite = o.overwrite, .resume = o.resume});
   {
-    std::vector<std::string> frame_paths;
-    for (const OutputFrame& f : frames) {
-      mocap::Result<std::string> p = render::ExpandFramePattern(pattern, f.number);
-      if (!p.ok()) return Fail(p.error());
-      frame_paths.push_back(std::move(*p));
-    }
-    const std::filesystem::path dir = std::filesystem::path(frame_paths.front()).parent_path();
+    const auto frame_path = [&pattern, &plan](std::size_t i) {
+      return render::ExpandFramePattern(pattern, plan->At(i).number);
+    };
+    const mocap::Result<std::string> first_path = frame_path(0);
+    if (!first_path.ok()) return Fail(first_path.error());
+    const std::filesystem::path dir = std::filesystem::path(*first_path).parent_path();
     std::vector<std::string> others;
     if (!o.no_sheet) others.push_back((dir / "contact_sheet.png").string());
     if (!o.no_video) others.push_back((dir / "preview.mp4").string());
-    const mocap::Status planned = guard.Plan(frame_paths, others);
+    const mocap::Status planned = guard.Plan(num_frames, frame_path, others);
     if (!planned.ok()) return Fail(planned.error());
   }
 
@@ -306,7 +325,7 @@ int RunRender(const RenderOptions& options) {
   DeformedFrame frame, right_frame;
   mocap::Result<FramePlan> framing = plan;
   if (!o.framing.empty() && !turntable) {
-    framing = PlanFrames(ch.motion, {.frames = o.framing, .fps = o.fps});
+    framing = PlanFrames(ch.motion, {.frames = o.framing, .fps = o.fps, .list_frames = false});
     if (!framing.ok()) return Fail(ArgError("--framing", framing.error().message));
     if (plan->range.first < framing->range.first || plan->range.last > framing->range.last) {
       return Fail(ArgError("--framing", "expected a range holding every output frame (" +
@@ -322,7 +341,7 @@ int RunRender(const RenderOptions& options) {
 
   // --- Outputs -------------------------------------------------------------------
   {
-    const mocap::Result<std::string> first = render::ExpandFramePattern(pattern, frames.front().number);
+    const mocap::Result<std::string> first = render::ExpandFramePattern(pattern, plan->At(0).number);
     if (!first.ok()) return Fail(first.error());
     const std::filesystem::path dir = std::filesystem::path(*first).parent_path();
     std::error_code ec;
@@ -349,7 +368,7 @@ int RunRender(const RenderOptions& options) {
   write_options.png_compression = o.png_compression;
   write_options.source_file = demo ? "demo_walk.bvh (built in)" : rig ? rig->file : o.input;
 
-  const int sheet_count = std::min<int>(kMaxSheetFrames, static_cast<int>(frames.size()));
+  const int sheet_count = std::min<int>(kMaxSheetFrames, static_cast<int>(num_frames));
   std::unique_ptr<render::ContactSheetBuilder> sheet;
   if (!o.no_sheet) {
     auto b = render::ContactSheetBuilder::Create(sheet_count, size->x, size->y);
@@ -366,7 +385,7 @@ int RunRender(const RenderOptions& options) {
   }
 
   // --- The frame loop -------------------------------------------------------------
-  Progress progress(demo ? "render demo" : "render " + name, static_cast<int>(frames.size()), o.quiet);
+  Progress progress(demo ? "render demo" : "render " + name, static_cast<int>(num_frames), o.quiet);
   render::Image image, right_image;
   int next_sheet = 0;
   // The sheet gets every frame as its file will read back (render/stored_image.h),
@@ -376,7 +395,7 @@ int RunRender(const RenderOptions& options) {
   auto feed_sheet_and_video = [&](std::size_t i, int number, const render::Image& img,
                                   bool read_back) {
     if (sheet && next_sheet < sheet_count &&
-        i == frames.size() * static_cast<std::size_t>(next_sheet) / static_cast<std::size_t>(sheet_count)) {
+        i == num_frames * static_cast<std::size_t>(next_sheet) / static_cast<std::size_t>(sheet_count)) {
       const render::Image* thumb_source = &img;
       mocap::Result<render::Image> stored = render::Image();
       if (!read_back && frame_format.ok()) {
@@ -402,9 +421,9 @@ int RunRender(const RenderOptions& options) {
   };
   int frames_done = guard.num_skipped();
   int last_done_number = -1;
-  for (std::size_t i = 0; i < frames.size(); ++i) {
+  for (std::size_t i = 0; i < num_frames; ++i) {
     if (guard.interrupted()) break;
-    const OutputFrame& of = frames[i];
+    const OutputFrame of = plan->At(i);
     // Skipped frames are still evaluated: a pipeline that carries state from
     // frame to frame (the elastic layer) must see every frame to give a
     // resumed range the same result.
@@ -443,6 +462,9 @@ int RunRender(const RenderOptions& options) {
     s = writer.Submit(image, *path, write_options);
     if (!s.ok()) return Fail(s.error());
     ++frames_done;
+    if (first_frame_s < 0.0) {
+      first_frame_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    }
     last_done_number = of.number;
     progress.Step(of.number);
   }
@@ -456,7 +478,7 @@ int RunRender(const RenderOptions& options) {
     // The sheet and the video would be partial: the video writer's destructor
     // removes its temporary file; --resume rebuilds both.
     std::fprintf(stderr, "%s: %s\n", pattern.c_str(),
-                 guard.StopMessage(last_done_number, frames_done, static_cast<int>(frames.size()))
+                 guard.StopMessage(last_done_number, frames_done, static_cast<int>(num_frames))
                      .c_str());
     return guard.exit_code();
   }
@@ -476,7 +498,7 @@ int RunRender(const RenderOptions& options) {
                    static_cast<long long>(r.counters.non_finite_resets));
     }
   }
-  std::printf("frames:        %s (%zu)\n", pattern.c_str(), frames.size());
+  std::printf("frames:        %s (%zu)\n", pattern.c_str(), num_frames);
   if (sheet) {
     const std::string sheet_path = (out_dir / "contact_sheet.png").string();
     s = render::WriteImage(sheet->sheet(), sheet_path, {});
@@ -487,6 +509,10 @@ int RunRender(const RenderOptions& options) {
     s = video->Close();
     if (!s.ok()) return Fail(s.error());
     std::printf("video:         %s (%s)\n", video->path().c_str(), render::VideoCodecName(video->codec()));
+  }
+  if (o.stats) {
+    std::printf("stats:         first frame after %.3f s, peak memory %.1f MB\n", first_frame_s,
+                PeakResidentMb());
   }
   return 0;
 }

@@ -32,6 +32,11 @@ struct RenderOptions {
   bool no_sheet = false;
   bool no_video = false;
   bool quiet = false;
+  // --stats: after the render, print to stdout when the first frame was handed
+  // to the writer (seconds since the command started) and the process's peak
+  // resident memory (VmHWM, which, unlike a parent's wait4 ru_maxrss of a
+  // spawned child, never includes the parent's memory).
+  bool stats = false;
   bool overwrite = false;             // replace existing outputs (else refuse before rendering)
   bool resume = false;                // keep existing frames, render the missing ones
   // "A:B[:STEP]": the frames the camera framing and the ground height are

@@ -4,8 +4,10 @@
 #include <array>
 #include <cerrno>
 #include <cmath>
+#include <condition_variable>
 #include <cstring>
 #include <limits>
+#include <mutex>
 #include <thread>
 
 #include <fcntl.h>
@@ -31,17 +33,42 @@ constexpr auto kByteClass = [] {
   return table;
 }();
 
+// Gives pages of a read-only file mapping back to the kernel once they are
+// parsed (madvise MADV_DONTNEED), so a long capture's text never counts in
+// the process's memory all at once; a later read of a released byte (an error
+// message's token) faults the page in again from the page cache. A default
+// one (in-memory text, which is the caller's) does nothing.
+struct PageReleaser {
+  const char* base = nullptr;  // start of the mapping; nullptr = release nothing
+  std::size_t size = 0;        // bytes mapped
+
+  // Releases the whole pages holding bytes of [base, end) from the page that
+  // holds `begin` on: the caller has read everything before `end` (a page that
+  // `end` cuts is kept; it goes with the next call).
+  void Release(const char* begin, const char* end) const {
+    if (base == nullptr || end <= begin) return;
+    static const std::size_t page = static_cast<std::size_t>(sysconf(_SC_PAGESIZE));
+    const std::size_t from = static_cast<std::size_t>(begin - base) / page * page;
+    const std::size_t to = static_cast<std::size_t>(end - base) / page * page;
+    if (to > from) {
+      // Only advice: on failure the pages stay, which costs memory, not correctness.
+      madvise(const_cast<char*>(base) + from, to - from, MADV_DONTNEED);
+    }
+  }
+};
+
 // Reads the frame data: one pass over the buffer, writing straight into the
 // preallocated array. Line numbers are counted as we go; columns are computed
 // only when an error is reported.
 class MotionParser {
  public:
-  MotionParser(std::string_view text, const BvhDocument& doc)
+  MotionParser(std::string_view text, const BvhDocument& doc, PageReleaser release)
       : p_(text.data() + doc.motion_offset),
         end_(text.data() + text.size()),
         line_start_(text.data() + doc.motion_line_start),
         line_(doc.motion_line),
-        doc_(doc) {}
+        doc_(doc),
+        release_(release) {}
 
   Status Run(const BvhReadOptions& options, Motion* motion, std::vector<Warning>* warnings) {
     const int num_channels = doc_.num_channels;
@@ -64,9 +91,10 @@ class MotionParser {
     // reserve, not resize: the pages are touched once, by the copies below,
     // instead of being zeroed first. Each line is parsed into a small buffer
     // that stays in L1 and appended whole once it has exactly #C values.
+    const std::size_t block_bytes = std::max<std::size_t>(options.block_bytes, 1);
     motion->values.clear();
     if (remaining >= options.parallel_min_bytes && static_cast<std::size_t>(declared) == capacity &&
-        TryParseHalves(num_channels, capacity, motion)) {
+        TryParseBlocks(num_channels, capacity, block_bytes, motion)) {
       return Status::Ok();
     }
     motion->values.clear();
@@ -74,11 +102,16 @@ class MotionParser {
     std::vector<float> line_values(static_cast<std::size_t>(num_channels));
     float* out = line_values.data();
     std::size_t frames = 0;
+    const char* released = p_;  // everything before it was given back (release_)
     for (; frames < capacity; ++frames) {
       SkipSpace();
       if (p_ == end_) break;
       if (Status s = ParseLine(static_cast<long long>(frames) + 1, num_channels, out); !s) return s;
       motion->values.insert(motion->values.end(), out, out + num_channels);
+      if (static_cast<std::size_t>(p_ - released) >= block_bytes) {
+        release_.Release(released, p_);
+        released = p_;
+      }
     }
     if (static_cast<long long>(frames) < declared) {
       // Stopped by the size bound: whatever is left cannot be a whole frame,
@@ -123,33 +156,73 @@ class MotionParser {
     }
   }
 
-  // The two-half fast path (BvhReadOptions::parallel_min_bytes): splits the
-  // frame data at the first line end after its middle, parses the second half
-  // on a worker thread into its own array while this thread parses the first
-  // half into `motion`, then appends. Taken only when both halves parse
-  // cleanly and hold exactly `frames` frames together, i.e. exactly when the
-  // sequential pass would succeed without a warning; false leaves the caller
-  // to run that pass.
-  bool TryParseHalves(int num_channels, std::size_t frames, Motion* motion) {
-    const char* mid = p_ + (end_ - p_) / 2;
-    while (mid != end_ && !IsLineEnd(*mid)) ++mid;
-    while (mid != end_ && IsLineEnd(*mid)) ++mid;
-    if (mid == end_) return false;
-    MotionParser second = *this;
-    second.p_ = mid;
-    second.line_start_ = mid;
-    MotionParser first = *this;
-    first.end_ = mid;
-    std::vector<float> tail;
-    std::size_t tail_frames = 0;
-    bool tail_ok = false;
-    std::thread worker([&] { tail_ok = second.ParseAllClean(num_channels, frames, tail, tail_frames); });
+  // The two-thread fast path (BvhReadOptions::parallel_min_bytes): the frame
+  // data is cut into blocks of about block_bytes, each ending at a line end,
+  // handed out in file order to this thread and a worker. Each parses its
+  // block into a small buffer of its own, gives the block's pages back
+  // (release_), then waits for its turn and appends the buffer to `motion`, so
+  // the frames land in file order straight in the final array (reserved once
+  // for `frames`) and at most one block's floats per thread are held on the
+  // side. Taken only when every block parses cleanly and they hold exactly
+  // `frames` frames together, i.e. exactly when the sequential pass would
+  // succeed without a warning; false leaves the caller to run that pass.
+  bool TryParseBlocks(int num_channels, std::size_t frames, std::size_t block_bytes,
+                      Motion* motion) {
     motion->values.reserve(frames * static_cast<std::size_t>(num_channels));
-    std::size_t head_frames = 0;
-    const bool head_ok = first.ParseAllClean(num_channels, frames, motion->values, head_frames);
+    std::mutex mutex;
+    std::condition_variable turn;
+    const char* cursor = p_;      // start of the next block to hand out
+    std::size_t next_ticket = 0;  // the next block's place in file order
+    std::size_t appended = 0;     // blocks appended so far
+    std::size_t total = 0;        // frames appended so far
+    bool failed = false;
+    const auto work = [&] {
+      MotionParser parser = *this;
+      // Room for a block's values (at least two bytes each) without regrowing;
+      // only the pages written are ever resident.
+      std::vector<float> values;
+      values.reserve(block_bytes / 2 + static_cast<std::size_t>(num_channels));
+      for (;;) {
+        const char* begin = nullptr;
+        const char* stop = nullptr;
+        std::size_t ticket = 0;
+        {
+          const std::lock_guard<std::mutex> lock(mutex);
+          if (failed || cursor == end_) return;
+          begin = cursor;
+          stop = begin + std::min(block_bytes, static_cast<std::size_t>(end_ - begin));
+          while (stop != end_ && !IsLineEnd(*stop)) ++stop;
+          while (stop != end_ && IsLineEnd(*stop)) ++stop;
+          cursor = stop;
+          ticket = next_ticket++;
+        }
+        // Line numbers are not known inside a block; they are only needed for
+        // messages, which the sequential pass then gives.
+        parser.p_ = begin;
+        parser.end_ = stop;
+        parser.line_start_ = begin;
+        values.clear();
+        std::size_t block_frames = 0;
+        const bool ok = parser.ParseAllClean(num_channels, frames, values, block_frames);
+        release_.Release(begin, stop);
+        std::unique_lock<std::mutex> lock(mutex);
+        turn.wait(lock, [&] { return failed || appended == ticket; });
+        if (failed) return;
+        if (!ok || total + block_frames > frames) {
+          failed = true;
+          turn.notify_all();
+          return;
+        }
+        motion->values.insert(motion->values.end(), values.begin(), values.end());
+        total += block_frames;
+        ++appended;
+        turn.notify_all();
+      }
+    };
+    std::thread worker(work);
+    work();
     worker.join();
-    if (!head_ok || !tail_ok || head_frames + tail_frames != frames) return false;
-    motion->values.insert(motion->values.end(), tail.begin(), tail.end());
+    if (failed || total != frames) return false;
     motion->num_frames = static_cast<int>(frames);
     p_ = end_;
     return true;
@@ -256,6 +329,7 @@ class MotionParser {
   const char* line_start_;
   int line_;
   const BvhDocument& doc_;
+  PageReleaser release_;
 };
 
 glm::vec3 ZUpToYUp(const glm::vec3& v) { return {v.x, v.z, -v.y}; }
@@ -402,8 +476,12 @@ void ConvertZUpToYUp(Skeleton* skeleton, Motion* motion) {
   skeleton->info.up_axis = UpAxis::kY;
 }
 
-Result<BvhFile> ParseBvh(std::string_view text, const std::string& file_name,
-                         const BvhReadOptions& options) {
+namespace {
+
+// ParseBvh, with the pages of `text` given back as they are parsed when it is
+// a file mapping (`release`).
+Result<BvhFile> ParseBvhText(std::string_view text, const std::string& file_name,
+                             const BvhReadOptions& options, PageReleaser release) {
   if (!(options.scale >= 0.0f) || !std::isfinite(options.scale)) {
     return MakeError(
         ErrorCode::kInvalidArgument, FileLoc{file_name, 0, 0, {}},
@@ -419,7 +497,8 @@ Result<BvhFile> ParseBvh(std::string_view text, const std::string& file_name,
   Result<Skeleton> skeleton = BuildBvhSkeleton(*document, options.position_mode, &file.warnings);
   if (!skeleton) return std::move(skeleton).error();
   file.skeleton = std::move(skeleton).value();
-  if (Status s = MotionParser(text, *document).Run(options, &file.motion, &file.warnings); !s)
+  if (Status s = MotionParser(text, *document, release).Run(options, &file.motion, &file.warnings);
+      !s)
     return s.error();
 
   SkeletonInfo& info = file.skeleton.info;
@@ -448,6 +527,13 @@ Result<BvhFile> ParseBvh(std::string_view text, const std::string& file_name,
   if (options.convert_to_y_up && info.up_axis == UpAxis::kZ)
     ConvertZUpToYUp(&file.skeleton, &file.motion);
   return file;
+}
+
+}  // namespace
+
+Result<BvhFile> ParseBvh(std::string_view text, const std::string& file_name,
+                         const BvhReadOptions& options) {
+  return ParseBvhText(text, file_name, options, PageReleaser{});
 }
 
 namespace {
@@ -486,6 +572,9 @@ class MappedFile {
     return Status::Ok();
   }
 
+  // Gives parsed pages back (see PageReleaser); none for an empty file.
+  PageReleaser releaser() const { return {static_cast<const char*>(data_), size_}; }
+
   std::string_view text() const {
     return data_ == nullptr ? std::string_view()
                             : std::string_view(static_cast<const char*>(data_), size_);
@@ -502,7 +591,7 @@ class MappedFile {
 Result<BvhFile> ReadBvhFile(const std::string& path, const BvhReadOptions& options) {
   MappedFile file;
   if (Status s = file.Open(path); !s) return s.error();
-  return ParseBvh(file.text(), path, options);
+  return ParseBvhText(file.text(), path, options, file.releaser());
 }
 
 }  // namespace mocap

@@ -71,13 +71,21 @@ struct BvhReadOptions {
   bool allow_short_motion = false;
   int max_depth = kDefaultBvhMaxDepth;  // deepest ROOT/JOINT nesting (ROOT = 1)
   int max_joints = kMaxJoints;          // most joints; values above kMaxJoints mean kMaxJoints
-  // Frame data of at least this many bytes is parsed in two halves at once
-  // (split at a line end, the second half on a second thread), so an
-  // hour-long capture loads in about half the time. The result is the
-  // sequential pass's to the bit; any error, short file or extra line falls
-  // back to the sequential pass, whose messages are the reference.
-  // SIZE_MAX turns it off.
+  // Frame data of at least this many bytes is parsed on two threads at once,
+  // block by block (see block_bytes), so an hour-long capture loads in about
+  // half the time. The result is the sequential pass's to the bit; any error,
+  // short file or extra line falls back to the sequential pass, whose
+  // messages are the reference. SIZE_MAX turns it off.
   std::size_t parallel_min_bytes = std::size_t{8} << 20;
+  // Frame data is read in blocks of about this many bytes (a block ends at
+  // the first line end at or after it; 0 counts as 1). The two threads take
+  // blocks in file order and append their frames in that order, so besides
+  // the final #F x #C array at most one block's floats per thread are held.
+  // ReadBvhFile gives each block's pages of the mapped file back once parsed
+  // (the sequential pass too, every block_bytes), so its peak memory is the
+  // frame array plus a few blocks, not the file's size. Results and messages
+  // do not depend on it; small values are for tests.
+  std::size_t block_bytes = std::size_t{4} << 20;
 };
 
 struct BvhFile {
@@ -91,8 +99,10 @@ struct BvhFile {
                                        const std::string& file_name_for_messages,
                                        const BvhReadOptions& options = {});
 
-// Maps `path` into memory (mmap, read-only) and parses it; kIo when it cannot
-// be opened, is not a regular file or cannot be mapped.
+// Maps `path` into memory (mmap, read-only) and parses it, giving the frame
+// data's pages back as they are parsed (BvhReadOptions::block_bytes): peak
+// memory is the motion's floats plus a few blocks. kIo when it cannot be
+// opened, is not a regular file or cannot be mapped.
 [[nodiscard]] Result<BvhFile> ReadBvhFile(const std::string& path,
                                           const BvhReadOptions& options = {});
 

@@ -74,7 +74,11 @@ TEST(BenchCommand, QuickRunPrintsEveryRowAndWritesPositiveFigures) {
   for (const char* key : {"bvh_parse_generated", "ssd_1_thread", "ssd_2_threads", "raster_fps_1280x720",
                           "raster_fps_1920x1080", "demo_end_to_end_fps", "demo_end_to_end_per_cpu_s",
                           "png_encode_fps",
-                          "bytes_per_bound_vertex", "peak_memory"}) {
+                          "bytes_per_bound_vertex", "peak_memory",
+                          // Long captures (issue 8): one child render per capture size.
+                          "long_capture_1000_peak_rss", "long_capture_10000_peak_rss",
+                          "long_capture_100000_peak_rss", "long_capture_1000_start",
+                          "long_capture_100000_start", "long_capture_growth_per_frame"}) {
     ExpectFigure(j.at("figures").at(key), key);
     EXPECT_NE(r.out.find(key), std::string::npos) << key << " missing from the table";
   }
