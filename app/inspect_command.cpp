@@ -167,7 +167,8 @@ int PrintArtifacts(MotionSource&& src, const std::string& file) {
   }
   mocap::Result<std::vector<glm::mat4>> bind = BindModelFromJoint(*ch);
   mocap::Result<deform::SwdRig> rig =
-      bind.ok() ? deform::BuildSwdRig(ch->skeleton, *bind, ch->mesh.bind)
+      bind.ok() ? deform::BuildSwdRig(ch->skeleton, *bind, ch->mesh.bind,
+                                      {.vertex_chains = ch->mesh.body_chain_coords})
                 : mocap::Result<deform::SwdRig>(bind.error());
   if (!rig.ok()) {
     mocap::Error e = std::move(rig).error();

@@ -8,6 +8,7 @@
 #include <thread>
 
 #include "app/motion_source.h"
+#include "deform/bind_pose.h"
 #include "deform/dqs_job.h"
 #include "deform/skinning_job.h"
 #include "deform/swd_job.h"
@@ -126,11 +127,11 @@ mocap::Result<Character> MakeCharacter(MotionSource&& source,
     return c;
   }
   // A rest pose far lower than the first frame's is not a body pose (limbs
-  // folded or lying flat): build and bind the body at frame 0 instead.
-  const mocap::UpAxis up = c.skeleton.info.up_axis;
-  const float rest_h = mocap::RestHeight(c.skeleton, up);
-  const float first_h = mocap::FirstFrameHeight(c.skeleton, c.motion, up);
-  c.bound_at_first_frame = c.motion.num_frames > 0 && first_h > 1.3f * rest_h;
+  // folded or lying flat): build and bind the body at frame 0 instead. Without a
+  // body in either pose BuildMannequin below reports why.
+  mocap::Result<deform::BindPoseChoice> pose =
+      deform::ChooseBindPose(c.skeleton, c.motion, mannequin.min_branch_extent);
+  c.bound_at_first_frame = pose.ok() && pose->frame == 0;
   mocap::Result<std::vector<glm::mat4>> model = BindModelFromJoint(c);
   if (!model.ok()) return std::move(model).error();
   mocap::Result<deform::SkinnedMesh> body = deform::BuildMannequin(c.skeleton, *model, mannequin);
@@ -319,7 +320,9 @@ mocap::Result<FramePipeline> FramePipeline::Create(const Character& character, G
   if (method == GlobalMethod::kSwd) {
     mocap::Result<std::vector<glm::mat4>> bind = BindModelFromJoint(character);
     if (!bind.ok()) return std::move(bind).error();
-    mocap::Result<deform::SwdRig> rig = deform::BuildSwdRig(character.skeleton, *bind, character.mesh.bind);
+    mocap::Result<deform::SwdRig> rig = deform::BuildSwdRig(
+        character.skeleton, *bind, character.mesh.bind,
+        {.vertex_chains = character.mesh.body_chain_coords});
     if (!rig.ok()) {
       mocap::Error e = std::move(rig).error();
       if (e.loc.file.empty()) e.loc.file = character.source;

@@ -54,7 +54,9 @@ struct Character {
 // Builds a Character from a loaded source: glTF keeps its mesh; BVH gets a
 // mannequin, bound at the rest pose unless the rest pose is much lower than the
 // first frame's pose (rest poses that lie flat, e.g. Bandai Namco's), in which
-// case it is bound at frame 0.
+// case it is bound at frame 0 (deform::ChooseBindPose: heights of the body's
+// joints, without a root that only positions it). With SWD each mannequin tube is
+// bound to the sweep of the chain it was generated on (body_chain_coords).
 mocap::Result<Character> MakeCharacter(MotionSource&& source,
                                        const deform::MannequinOptions& mannequin = {});
 

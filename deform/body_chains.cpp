@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <string>
 #include <utility>
 #include <vector>
@@ -15,6 +16,50 @@ using mocap::MakeError;
 
 namespace {
 constexpr float kMergeFraction = 1e-4f;
+// Two subtrees whose total bone lengths differ by less than this fraction (of the
+// longer) can be a mirror pair; captured left and right limbs differ by a few percent.
+constexpr float kMirrorLengthTolerance = 0.2f;
+
+// Total bone length of the subtree under `child`, including the bone into it.
+float SubtreeLength(const std::vector<BodyPoint>& pts, int child) {
+  float total = 0.0f;
+  std::vector<int> stack = {child};
+  while (!stack.empty()) {
+    const BodyPoint& p = pts[static_cast<std::size_t>(stack.back())];
+    stack.pop_back();
+    total += glm::distance(p.pos, pts[static_cast<std::size_t>(p.parent)].pos);
+    for (int g : p.children) stack.push_back(g);
+  }
+  return total;
+}
+
+// Per child of one point: 1 when it belongs to a mirror pair, a sibling whose subtree has
+// as many points and about the same total bone length (left and right arm or leg). A
+// pose-independent test: it reads bone lengths and topology only, never directions, so
+// arms raised beside the head or legs lying along the spine in a rest pose change
+// nothing. When every child is paired (a fork into two equal halves) none is marked.
+std::vector<std::uint8_t> MirrorPaired(const std::vector<BodyPoint>& pts,
+                                       const std::vector<int>& children) {
+  const std::size_t n = children.size();
+  std::vector<std::uint8_t> paired(n, 0);
+  std::vector<float> length(n);
+  for (std::size_t i = 0; i < n; ++i) length[i] = SubtreeLength(pts, children[i]);
+  for (std::size_t a = 0; a < n; ++a) {
+    for (std::size_t b = a + 1; b < n; ++b) {
+      const BodyPoint& pa = pts[static_cast<std::size_t>(children[a])];
+      const BodyPoint& pb = pts[static_cast<std::size_t>(children[b])];
+      const float longer = std::max(length[a], length[b]);
+      if (pa.descendants == pb.descendants &&
+          std::abs(length[a] - length[b]) <= kMirrorLengthTolerance * longer) {
+        paired[a] = paired[b] = 1;
+      }
+    }
+  }
+  if (std::find(paired.begin(), paired.end(), std::uint8_t{0}) == paired.end()) {
+    std::fill(paired.begin(), paired.end(), std::uint8_t{0});
+  }
+  return paired;
+}
 }  // namespace
 
 mocap::Result<BodyChains> BuildBodyChains(const mocap::Skeleton& skeleton,
@@ -176,9 +221,16 @@ mocap::Result<BodyChains> BuildBodyChains(const mocap::Skeleton& skeleton,
     }
     while (!pts[static_cast<std::size_t>(cur)].children.empty()) {
       const std::vector<int>& ch = pts[static_cast<std::size_t>(cur)].children;
+      // A spine never continues into one of a mirror pair (arms, legs): mocapbank's
+      // collars and neck all start at one point, and the straightest of them was an arm.
+      const std::vector<std::uint8_t> paired = job.kind == BodyChainKind::kSpine
+                                                   ? MirrorPaired(pts, ch)
+                                                   : std::vector<std::uint8_t>(ch.size(), 0);
       int best = ch[0];
       float best_dot = -2.0f;
-      for (int k : ch) {
+      for (std::size_t i = 0; i < ch.size(); ++i) {
+        const int k = ch[i];
+        if (paired[i] != 0) continue;
         const float d = glm::dot(glm::normalize(pos_of(k) - pos_of(cur)), dir);
         if (d > best_dot) best_dot = d, best = k;
       }

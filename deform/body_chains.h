@@ -6,8 +6,12 @@
 //  2. A spine starts at each root toward the child with the most descendants (a root
 //     with one child that branches only positions the body and is skipped); at every
 //     branch point a chain continues into the straightest child and each other child
-//     starts a new chain whose first point is the branch point. Side branches reaching
-//     less than `min_branch_extent` S are folded into their chain (fingers, eyes).
+//     starts a new chain whose first point is the branch point. A spine skips children
+//     that form a mirror pair (two subtrees with as many points and total bone lengths
+//     within 20%: arms, legs) when another child is left, so it runs on to the head or
+//     tail whatever the pose (mocapbank's neck starts at the same point as both collars).
+//     Side branches reaching less than `min_branch_extent` S are folded into their chain
+//     (fingers, eyes).
 
 #include <span>
 #include <vector>

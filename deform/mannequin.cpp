@@ -288,6 +288,8 @@ mocap::Result<SkinnedMesh> BuildMannequin(const mocap::Skeleton& skeleton,
       while (k + 2 < n && s > arc[static_cast<std::size_t>(k + 1)]) ++k;
       const float len = std::max(arc[static_cast<std::size_t>(k + 1)] - arc[static_cast<std::size_t>(k)], 1e-12f);
       const float w = Smoothstep((s - arc[static_cast<std::size_t>(k)]) / len);
+      r.chain = static_cast<int>(c);
+      r.chain_u = static_cast<float>(k) + std::clamp((s - arc[static_cast<std::size_t>(k)]) / len, 0.0f, 1.0f);
       r.radius = sh.radius[static_cast<std::size_t>(k)] + w * (sh.radius[static_cast<std::size_t>(k + 1)] - sh.radius[static_cast<std::size_t>(k)]);
       r.flatten = sh.flatten[static_cast<std::size_t>(k)] + w * (sh.flatten[static_cast<std::size_t>(k + 1)] - sh.flatten[static_cast<std::size_t>(k)]);
       // Ring planes follow the curve's chord over +-0.75 radius rather than its
@@ -379,6 +381,8 @@ mocap::Result<SkinnedMesh> BuildMannequin(const mocap::Skeleton& skeleton,
     }
   }
   NormalizeSkinWeights(out.weights);
+  out.body_chain_coords.resize(nv);
+  for (std::size_t v = 0; v < nv; ++v) out.body_chain_coords[v] = {mesh.chains[v], mesh.chain_u[v]};
   out.bind.positions = std::move(mesh.positions);
   out.bind.triangles = std::move(mesh.triangles);
   out.bind.normals.resize(nv);

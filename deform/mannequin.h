@@ -9,7 +9,9 @@
 //     CMU's LHipJoint) merge with it; end sites become leaf points.
 //  2. The point tree splits into chains by topology, never by name: the spine
 //     starts at each root toward the child with the most descendants; at
-//     every branch point a chain continues into the straightest child and each
+//     every branch point a chain continues into the straightest child (for a
+//     spine, the straightest one not of a mirror pair of limbs; see
+//     deform/body_chains.h) and each
 //     other child starts a new chain (arms, legs, tails). Side branches whose
 //     reach is below `min_branch_extent` S (fingers, eyes, small helpers) are
 //     folded into a mitten on their chain.
@@ -28,6 +30,9 @@
 //     joint; around each interior point the weight moves to the next bone with
 //     a smoothstep over +-`blend_width` radii (at most 0.45 of either bone), so
 //     at most 2 of the 4 influences are non-zero. Weights sum to exactly 1.
+//  5. body_chain_coords: per vertex, the chain its tube follows and its ring's
+//     chain coordinate (head vertices: chain -1), so SWD can bind each tube
+//     to the sweep it was made from instead of guessing by distance.
 //
 // The result's skin_joints are skeleton joint indices (sorted), joint_from_bind
 // the inverses of the given rest matrices, and the mesh is in the model space

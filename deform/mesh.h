@@ -46,11 +46,24 @@ struct SkinWeights {
 // A mesh bound to a skeleton: the bind-pose mesh, its weights, and which
 // skeleton joint each skin joint is, with the inverse bind matrices
 // (bind_from_joint maps model-space bind positions into the joint's frame).
+// Where a generated body's vertex came from: the body chain whose tube holds it
+// (index into BuildBodyChains' chains, deform/body_chains.h) and its ring's chain
+// coordinate u = k + t (on bone k, points k -> k+1, t in [0, 1]; caps carry their end
+// ring's u). chain = -1: not on a tube (the mannequin's head).
+struct BodyChainCoord {
+  int chain = -1;
+  float u = 0.0f;
+};
+
 struct SkinnedMesh {
   Mesh bind;
   SkinWeights weights;
   std::vector<int> skin_joints;             // #S skeleton joint index of each skin joint
   std::vector<glm::mat4> joint_from_bind;   // #S inverse bind matrices
+  // #V, or empty (a mesh not generated from the skeleton, e.g. glTF): filled by
+  // BuildMannequin, for the SWD rig to bind each tube to the chain it was made from
+  // (SwdRigOptions::vertex_chains). Valid only for that skeleton in that bind pose.
+  std::vector<BodyChainCoord> body_chain_coords;
 };
 
 // Area-weighted vertex normals of `positions` over `triangles` (zero-area

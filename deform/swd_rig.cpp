@@ -50,6 +50,22 @@ int FindRoot(std::vector<int>& parent, int i) {
   return i;
 }
 
+// Number of connected parts (by shared triangle vertices) of the mesh.
+int CountParts(const Mesh& mesh) {
+  const std::size_t nv = mesh.positions.size();
+  std::vector<int> parent(nv);
+  for (std::size_t v = 0; v < nv; ++v) parent[v] = static_cast<int>(v);
+  for (const glm::uvec3& t : mesh.triangles) {
+    if (t.x >= nv || t.y >= nv || t.z >= nv) continue;
+    const int a = FindRoot(parent, static_cast<int>(t.x));
+    parent[static_cast<std::size_t>(FindRoot(parent, static_cast<int>(t.y)))] = a;
+    parent[static_cast<std::size_t>(FindRoot(parent, static_cast<int>(t.z)))] = a;
+  }
+  int parts = 0;
+  for (std::size_t v = 0; v < nv; ++v) parts += FindRoot(parent, static_cast<int>(v)) == static_cast<int>(v) ? 1 : 0;
+  return parts;
+}
+
 // Squared distance from p to the segment [a, b].
 float SegmentDistance2(const glm::vec3& p, const glm::vec3& a, const glm::vec3& b) {
   const glm::vec3 ab = b - a;
@@ -65,9 +81,11 @@ float SegmentDistance2(const glm::vec3& p, const glm::vec3& a, const glm::vec3& 
 // the body chain nearest most of its vertices (plus its trunk) only: without this, the inner side of a
 // thigh tube, as near the other leg's bone as its own, would follow the other leg.
 // Other parts (a welded skin) are bound to all sweeps.
+// Vertices marked in `skip` (#V, or empty) are left unbound (default bindings) and do
+// not vote.
 mocap::Result<std::vector<SweepVertexBinding>> BindByComponent(
     std::span<const SweepChain> chains, std::span<const SweepJunction> junctions,
-    std::span<const int> piece_chain, const Mesh& mesh) {
+    std::span<const int> piece_chain, const Mesh& mesh, std::span<const std::uint8_t> skip) {
   constexpr float kFamilyShare = 0.75f;
   const std::size_t nv = mesh.positions.size();
   const auto nc = static_cast<int>(chains.size());
@@ -84,6 +102,7 @@ mocap::Result<std::vector<SweepVertexBinding>> BindByComponent(
   for (const SweepJunction& j : junctions) trunk_of[static_cast<std::size_t>(j.branch)] = j.trunk;
   std::vector<std::vector<int>> counts(nv);
   for (std::size_t v = 0; v < nv; ++v) {
+    if (!skip.empty() && skip[v] != 0) continue;
     int best = 0;
     float best_d = 1e38f;
     for (int c = 0; c < nc; ++c) {
@@ -110,7 +129,7 @@ mocap::Result<std::vector<SweepVertexBinding>> BindByComponent(
   for (int c = 0; c < nc; ++c) all[static_cast<std::size_t>(c)] = c;
   for (std::size_t v = 0; v < nv; ++v) {
     const int root = FindRoot(parent, static_cast<int>(v));
-    if (static_cast<std::size_t>(root) != v) continue;
+    if (static_cast<std::size_t>(root) != v || counts[v].empty()) continue;  // skipped parts
     const std::vector<int>& count = counts[v];
     const int top = static_cast<int>(std::max_element(count.begin(), count.end() - 1) - count.begin());
     std::vector<int> family;
@@ -156,6 +175,7 @@ mocap::Result<std::vector<SweepVertexBinding>> BindByComponent(
     std::vector<std::uint32_t> members;
     std::vector<glm::vec3> positions;
     for (std::size_t v = 0; v < nv; ++v) {
+      if (!skip.empty() && skip[v] != 0) continue;
       if (group_of[static_cast<std::size_t>(FindRoot(parent, static_cast<int>(v)))] != static_cast<int>(g)) continue;
       members.push_back(static_cast<std::uint32_t>(v));
       positions.push_back(mesh.positions[v]);
@@ -298,13 +318,80 @@ mocap::Result<SwdRig> BuildSwdRig(const mocap::Skeleton& skeleton,
       rig.junctions_.push_back(junction);
     }
   }
+  // The seam fade keeps the junction weight continuous where the primary sweep switches
+  // between trunk and branch inside one surface. A mesh of several parts binds each part
+  // to one family whose primary is always the branch, so there is no such switch; there
+  // the fade only pulled a limb lying against the trunk bones at its branch point in the
+  // bind pose (LAFAN's upper arm raised beside the neck, mocapbank's forearm hanging
+  // beside the belly) halfway onto the trunk, and tore it off when they separated.
+  if (CountParts(bind_mesh) > 1) {
+    for (SweepJunction& junction : rig.junctions_) junction.seam_band = 0.0f;
+  }
+  // Vertices placed by their generator: the last piece of their chain starting at or
+  // before u (in a piece's first bone the junction blends it with the piece before).
+  const std::size_t nv = bind_mesh.positions.size();
+  std::vector<SweepPlacement> placements;
+  std::vector<std::uint8_t> placed;
+  if (!options.vertex_chains.empty()) {
+    if (options.vertex_chains.size() != nv) {
+      return MakeError(ErrorCode::kInvalidArgument, {},
+                       "SWD rig: expected one body chain coordinate per vertex (" +
+                           std::to_string(nv) + "), found " +
+                           std::to_string(options.vertex_chains.size()));
+    }
+    placements.resize(nv);
+    placed.assign(nv, 0);
+    for (std::size_t v = 0; v < nv; ++v) {
+      const BodyChainCoord& coord = options.vertex_chains[v];
+      if (coord.chain < 0) continue;
+      if (coord.chain >= static_cast<int>(body.size()) || !std::isfinite(coord.u) ||
+          coord.u < 0.0f ||
+          coord.u > static_cast<float>(body[static_cast<std::size_t>(coord.chain)].points.size() - 1)) {
+        return MakeError(ErrorCode::kInvalidArgument, {},
+                         "SWD rig: vertex " + std::to_string(v) + " lies on body chain " +
+                             std::to_string(coord.chain) + " at u = " + std::to_string(coord.u) +
+                             ", which the skeleton's " + std::to_string(body.size()) +
+                             " chains do not have (a mesh made for another skeleton or pose?)");
+      }
+      int p = first_piece[static_cast<std::size_t>(coord.chain)];
+      while (p + 1 < static_cast<int>(pieces.size()) &&
+             pieces[static_cast<std::size_t>(p + 1)].body_chain == coord.chain &&
+             static_cast<float>(pieces[static_cast<std::size_t>(p + 1)].first) <= coord.u) {
+        ++p;
+      }
+      placements[v] = {p, coord.u - static_cast<float>(pieces[static_cast<std::size_t>(p)].first)};
+      placed[v] = 1;
+    }
+  }
   // Bind each connected part of the mesh to its own chains (see BindByComponent).
   std::vector<int> piece_chain(pieces.size());
   for (std::size_t p = 0; p < pieces.size(); ++p) piece_chain[p] = pieces[p].body_chain;
-  mocap::Result<std::vector<SweepVertexBinding>> bindings =
-      BindByComponent(rig.chains_, rig.junctions_, piece_chain, bind_mesh);
-  if (!bindings.ok()) return std::move(bindings).error();
-  rig.bindings_ = std::move(*bindings);
+  const bool all_placed =
+      !placed.empty() && std::find(placed.begin(), placed.end(), std::uint8_t{0}) == placed.end();
+  std::vector<SweepVertexBinding> by_distance(nv);
+  if (!all_placed) {
+    mocap::Result<std::vector<SweepVertexBinding>> bindings =
+        BindByComponent(rig.chains_, rig.junctions_, piece_chain, bind_mesh, placed);
+    if (!bindings.ok()) return std::move(bindings).error();
+    by_distance = std::move(*bindings);
+  }
+  rig.bindings_ = std::move(by_distance);
+  if (!placed.empty()) {
+    std::vector<glm::vec3> positions;
+    std::vector<SweepPlacement> where;
+    for (std::size_t v = 0; v < nv; ++v) {
+      if (placed[v] == 0) continue;
+      positions.push_back(bind_mesh.positions[v]);
+      where.push_back(placements[v]);
+    }
+    mocap::Result<std::vector<SweepVertexBinding>> bound =
+        BindToSweeps(rig.chains_, rig.junctions_, positions, {}, where);
+    if (!bound.ok()) return std::move(bound).error();
+    std::size_t i = 0;
+    for (std::size_t v = 0; v < nv; ++v) {
+      if (placed[v] != 0) rig.bindings_[v] = (*bound)[i++];
+    }
+  }
   rig.rest_normals_ = bind_mesh.normals;
   return rig;
 }

@@ -17,6 +17,9 @@
 //   overlapping tubes) binds each part only to the sweeps of the body chain nearest most
 //   of its vertices plus that chain's trunk, so the inner side of a thigh never follows
 //   the other leg; a single welded skin is bound to all sweeps (nearest bone segment).
+//   With SwdRigOptions::vertex_chains (the mannequin) a tube vertex is bound to the
+//   chain and u it was generated at instead. A mesh of several parts has no seam fade
+//   (SweepJunction::seam_band = 0), see BuildSwdRig.
 // - Limbs (for artifact figures): in a limb chain, the interior joint whose shorter bone
 //   is the longest is its elbow/knee, not counting the joint at the end of the chain's
 //   first bone (clavicle, pelvis to hip) unless its pair is more than twice as long as
@@ -41,6 +44,15 @@ namespace deform {
 struct SwdRigOptions {
   double max_bend_rad = kDefaultMaxBendRad;  // largest expected bend, sets region widths
   float min_branch_extent = 0.15f;           // as MannequinOptions::min_branch_extent
+  // #V, or empty: the body chain and chain coordinate each vertex was generated on
+  // (SkinnedMesh::body_chain_coords of a mannequin built for this skeleton, in this bind
+  // pose, with this min_branch_extent). A vertex with chain >= 0 is bound to the sweep
+  // piece of that chain holding u, at u (offset p0 - c0(u)), so every ring of a tube
+  // moves as one cross-section of its own sweep; distance alone can pick the wrong part
+  // of a thick tube (the inner side of a hanging upper arm lies nearer the arm chain's
+  // start, inside the chest, than its own axis). Vertices with chain -1 (the head) bind
+  // by distance.
+  std::span<const BodyChainCoord> vertex_chains;
 };
 
 // A limb found by topology.

@@ -230,6 +230,13 @@ struct SweepJunction {
 SweepBinding BindToSweep(const SweepChain& chain, int chain_index, const glm::dvec3& rest_point,
                          double u_min = 0.0, double u_max = -1.0);
 
+// A chain and parameter chosen for a vertex by whatever made it (the mannequin's tube and
+// ring), instead of the nearest chain and the root of g(u).
+struct SweepPlacement {
+  int chain = -1;    // index into the chain list; -1: bind by distance as usual
+  float u = 0.0f;    // sweep parameter, clamped to [0, K]
+};
+
 // Binds every rest vertex (#V, bind model space) to the chain whose rest bone segment is
 // nearest; a vertex on a junction's branch with u in [u_start, u_end) is also bound to
 // the trunk (on the trunk's two bones at the branch point only). Then sets the
@@ -244,8 +251,13 @@ SweepBinding BindToSweep(const SweepChain& chain, int chain_index, const glm::dv
 // the bind pose must not follow the head). Errors (kInvalidArgument) for empty or
 // oversized chain lists, bad junction indices or intervals, non-finite positions, a
 // primary_ok list of another size or with no chain ok.
+// `placements` (#V, or empty: none) gives a vertex its primary chain and u outright
+// (offset o = p0 - c0(u)); junction weight and trunk binding follow as above. Errors
+// also for a placement list of another size, a placement chain out of range or a
+// non-finite placement u.
 mocap::Result<std::vector<SweepVertexBinding>> BindToSweeps(
     std::span<const SweepChain> chains, std::span<const SweepJunction> junctions,
-    std::span<const glm::vec3> rest_positions, std::span<const std::uint8_t> primary_ok = {});
+    std::span<const glm::vec3> rest_positions, std::span<const std::uint8_t> primary_ok = {},
+    std::span<const SweepPlacement> placements = {});
 
 }  // namespace deform

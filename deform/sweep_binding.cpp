@@ -170,7 +170,8 @@ SweepBinding BindToSweep(const SweepChain& chain, int chain_index, const glm::dv
 
 mocap::Result<std::vector<SweepVertexBinding>> BindToSweeps(
     std::span<const SweepChain> chains, std::span<const SweepJunction> junctions,
-    std::span<const glm::vec3> rest_positions, std::span<const std::uint8_t> primary_ok) {
+    std::span<const glm::vec3> rest_positions, std::span<const std::uint8_t> primary_ok,
+    std::span<const SweepPlacement> placements) {
   if (chains.empty() || chains.size() > std::numeric_limits<std::uint16_t>::max()) {
     return MakeError(ErrorCode::kInvalidArgument, {},
                      "expected 1..65535 sweep chains, found " + std::to_string(chains.size()));
@@ -182,6 +183,20 @@ mocap::Result<std::vector<SweepVertexBinding>> BindToSweeps(
                      "expected one primary flag per chain, at least one set");
   }
   const int num_chains = static_cast<int>(chains.size());
+  if (!placements.empty() && placements.size() != rest_positions.size()) {
+    return MakeError(ErrorCode::kInvalidArgument, {},
+                     "expected one placement per vertex (" +
+                         std::to_string(rest_positions.size()) + "), found " +
+                         std::to_string(placements.size()));
+  }
+  for (std::size_t v = 0; v < placements.size(); ++v) {
+    if (placements[v].chain >= num_chains || !std::isfinite(placements[v].u)) {
+      return MakeError(ErrorCode::kInvalidArgument, {},
+                       "placement of vertex " + std::to_string(v) +
+                           ": expected a chain below " + std::to_string(num_chains) +
+                           " and a finite u, found chain " + std::to_string(placements[v].chain));
+    }
+  }
   std::vector<const SweepJunction*> junction_of(chains.size(), nullptr);
   for (std::size_t j = 0; j < junctions.size(); ++j) {
     const SweepJunction& junction = junctions[j];
@@ -232,18 +247,29 @@ mocap::Result<std::vector<SweepVertexBinding>> BindToSweeps(
                        "rest vertex " + std::to_string(v) + " is not finite");
     }
     const glm::dvec3 p(rest_positions[v]);
+    SweepVertexBinding& binding = bindings[v];
     int nearest = 0;
     double nearest_distance = std::numeric_limits<double>::max();
-    for (int c = 0; c < num_chains; ++c) {
-      if (!primary_ok.empty() && primary_ok[static_cast<std::size_t>(c)] == 0) continue;
-      const double d = NearestBoneDistance(chains[static_cast<std::size_t>(c)], p);
-      if (d < nearest_distance) {
-        nearest_distance = d;
-        nearest = c;
+    if (!placements.empty() && placements[v].chain >= 0) {
+      nearest = placements[v].chain;
+      const SweepChain& chain = chains[static_cast<std::size_t>(nearest)];
+      nearest_distance = NearestBoneDistance(chain, p);
+      binding.primary.chain = static_cast<std::uint16_t>(nearest);
+      binding.primary.u =
+          std::clamp(placements[v].u, 0.0f, static_cast<float>(chain.num_bones()));
+      binding.primary.offset = glm::vec3(
+          p - SweepCentre<double>(chain, chain.rest_pose(), static_cast<double>(binding.primary.u), nullptr));
+    } else {
+      for (int c = 0; c < num_chains; ++c) {
+        if (!primary_ok.empty() && primary_ok[static_cast<std::size_t>(c)] == 0) continue;
+        const double d = NearestBoneDistance(chains[static_cast<std::size_t>(c)], p);
+        if (d < nearest_distance) {
+          nearest_distance = d;
+          nearest = c;
+        }
       }
+      binding.primary = BindToSweep(chains[static_cast<std::size_t>(nearest)], nearest, p);
     }
-    SweepVertexBinding& binding = bindings[v];
-    binding.primary = BindToSweep(chains[static_cast<std::size_t>(nearest)], nearest, p);
     const SweepJunction* junction = junction_of[static_cast<std::size_t>(nearest)];
     if (junction != nullptr) {
       const float x = (binding.primary.u - junction->u_start) / (junction->u_end - junction->u_start);

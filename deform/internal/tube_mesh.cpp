@@ -43,6 +43,8 @@ std::uint32_t MeshBuilder::AddVertex(const glm::vec3& p, const Ring& r) {
   positions.push_back(p);
   joints.insert(joints.end(), {r.joint[0], r.joint[1]});
   weights.insert(weights.end(), {r.weight[0], r.weight[1]});
+  chains.push_back(r.chain);
+  chain_u.push_back(r.chain_u);
   return static_cast<std::uint32_t>(positions.size() - 1);
 }
 

@@ -21,6 +21,8 @@ struct Ring {
   float flatten = 1.0f;    // short radius / long radius, 1 = circle
   int joint[2] = {0, 0};   // skeleton joints
   float weight[2] = {1.0f, 0.0f};
+  int chain = -1;          // body chain the tube follows (-1: none), see BodyChainCoord
+  float chain_u = 0.0f;    // chain coordinate of the ring (bone index + fraction)
 };
 
 // 3x^2 - 2x^3 on x clamped to [0, 1].
@@ -41,6 +43,8 @@ struct MeshBuilder {
   std::vector<glm::uvec3> triangles;   // #T, counter-clockwise seen from outside
   std::vector<int> joints;             // #V x 2 skeleton joints
   std::vector<float> weights;          // #V x 2
+  std::vector<int> chains;             // #V body chain of the ring (Ring::chain)
+  std::vector<float> chain_u;          // #V chain coordinate of the ring (Ring::chain_u)
 
   std::uint32_t AddVertex(const glm::vec3& p, const Ring& r);
   // Rings in order along their tangents (at least one), closed by a pole

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <map>
 #include <string>
@@ -12,6 +13,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <gtest/gtest.h>
 
+#include "deform/body_chains.h"
 #include "deform/mannequin.h"
 #include "deform/swd_job.h"
 #include "mocap/pose.h"
@@ -157,7 +159,10 @@ TEST(SwdRig, SyntheticHumanoidHasFiveSweepsFourLimbsAndFourJunctions) {
     EXPECT_EQ(name.find("UpLeg"), std::string::npos) << name;
   }
   EXPECT_EQ(arms, 2);
-  for (const deform::SweepJunction& j : r.rig.junctions()) EXPECT_GT(j.seam_band, 0.0f);
+  // The mannequin is made of separate tubes, each bound to one chain family: no seam
+  // where the primary sweep switches, so no seam fade (it pulled limbs lying against
+  // the trunk onto it).
+  for (const deform::SweepJunction& j : r.rig.junctions()) EXPECT_EQ(j.seam_band, 0.0f);
   ExpectRestAndRigid(r);
 }
 
@@ -377,6 +382,116 @@ TEST(SwdRig, ClearErrors) {
                 .Run()
                 .code),
             mocap::JobStatus::kSizeMismatch);
+}
+
+}  // namespace
+
+namespace {
+
+// mocapbank's layout: both collars and the neck leave the chest at one point, well above
+// it, and the arms hang beside the chest (y up, ~170 units tall).
+std::vector<testsupport::JointSpec> SharedCollarPointHangingArms() {
+  std::vector<testsupport::JointSpec> j;
+  const auto add = [&](const std::string& name, int parent, glm::vec3 pos) {
+    j.push_back({name, parent, pos});
+    return static_cast<int>(j.size()) - 1;
+  };
+  const int hips = add("hips", -1, {0, 95, 0});
+  for (float x : {1.0f, -1.0f}) {
+    int p = add(x > 0 ? "hip_l" : "hip_r", hips, {9 * x, 95, 3});
+    p = add(x > 0 ? "knee_l" : "knee_r", p, {9 * x, 50, 3});
+    add(x > 0 ? "ankle_l" : "ankle_r", p, {9 * x, 10, 0});
+  }
+  const int chest = add("chest", add("chest_low", hips, {0, 105, 0}), {0, 121, -2});
+  const glm::vec3 top(0, 138, 0);
+  for (float x : {1.0f, -1.0f}) {
+    int p = add(x > 0 ? "collar_l" : "collar_r", chest, top);
+    p = add(x > 0 ? "shoulder_l" : "shoulder_r", p, {16 * x, 135, 2});
+    p = add(x > 0 ? "elbow_l" : "elbow_r", p, {18.5f * x, 110, 3});
+    add(x > 0 ? "wrist_l" : "wrist_r", p, {21 * x, 88, 4});
+  }
+  add("head", add("neck", chest, top), {0, 150, 4});
+  return j;
+}
+
+int JointNamed(const mocap::Skeleton& s, const std::string& name) {
+  return static_cast<int>(std::find(s.names.begin(), s.names.end(), name) - s.names.begin());
+}
+
+TEST(SwdRig, SpineRunsOnToTheHeadPastCollarsStartingWithTheNeck) {
+  const BuiltSkeleton b = SkeletonFrom(SharedCollarPointHangingArms(), false, 8.0f);
+  auto chains = deform::BuildBodyChains(b.skeleton, b.model_from_joint, 0.15f);
+  ASSERT_TRUE(chains.ok()) << chains.error().ToString();
+  // The neck, both collars start at one point: the straightest was the left arm; the
+  // collars are a mirror pair, so the spine takes the neck.
+  std::string last;
+  for (int p : chains->chains[0].points) {
+    const int j = chains->points[static_cast<std::size_t>(p)].joint;
+    if (j >= 0) last = b.skeleton.names[static_cast<std::size_t>(j)];
+  }
+  EXPECT_EQ(last, "head");
+  EXPECT_EQ(chains->chains.size(), 5u);
+}
+
+TEST(SwdRig, MannequinTubesBindToTheChainTheyWereMadeOn) {
+  Rigged r{SkeletonFrom(SharedCollarPointHangingArms(), false, 8.0f), {}, {}};
+  auto mesh = deform::BuildMannequin(r.b.skeleton, r.b.model_from_joint);
+  ASSERT_TRUE(mesh.ok()) << mesh.error().ToString();
+  r.mesh = std::move(*mesh);
+  const std::vector<deform::BodyChainCoord>& coords = r.mesh.body_chain_coords;
+  ASSERT_EQ(coords.size(), r.mesh.bind.positions.size());
+  auto placed = deform::BuildSwdRig(r.b.skeleton, r.b.model_from_joint, r.mesh.bind,
+                                    {.vertex_chains = coords});
+  ASSERT_TRUE(placed.ok()) << placed.error().ToString();
+  auto by_distance = deform::BuildSwdRig(r.b.skeleton, r.b.model_from_joint, r.mesh.bind);
+  ASSERT_TRUE(by_distance.ok());
+  ASSERT_EQ(placed->chains().size(), 5u);  // no chain is cut: sweep index = chain index
+  int on_tubes = 0;
+  for (std::size_t v = 0; v < coords.size(); ++v) {
+    if (coords[v].chain < 0) continue;
+    ++on_tubes;
+    const deform::SweepBinding& b = placed->bindings()[v].primary;
+    ASSERT_EQ(static_cast<int>(b.chain), coords[v].chain) << "vertex " << v;
+    ASSERT_EQ(b.u, coords[v].u) << "vertex " << v;
+  }
+  EXPECT_GT(on_tubes, r.mesh.bind.num_vertices() / 2);
+  r.rig = std::move(*placed);
+  ExpectRestAndRigid(r);
+  // Arms raised 80 degrees sideways and elbows bent 90: the inner side of each hanging
+  // upper arm lies nearer the arm chain's start (inside the chest) than its own axis, so
+  // distance binding tore it off; bound to its own ring it stays on.
+  std::vector<glm::mat4> model = r.b.model_from_joint;
+  for (float x : {1.0f, -1.0f}) {
+    const std::string side = x > 0 ? "_l" : "_r";
+    model = TurnSubtree(r.b.skeleton, model, JointNamed(r.b.skeleton, "shoulder" + side),
+                        glm::angleAxis(glm::radians(80.0f) * x, glm::vec3(0, 0, 1)));
+    model = TurnSubtree(r.b.skeleton, model, JointNamed(r.b.skeleton, "elbow" + side),
+                        glm::angleAxis(glm::radians(90.0f), glm::vec3(1, 0, 0)));
+  }
+  const float growth = MaxEdgeGrowth(r.mesh.bind, Deform(r.rig, model, 2));
+  const float growth_by_distance = MaxEdgeGrowth(r.mesh.bind, Deform(*by_distance, model, 2));
+  std::printf("arms raised, elbows bent: largest edge growth %.4f (by distance %.4f)\n", growth,
+              growth_by_distance);
+  EXPECT_LT(growth, testsupport::kSwdCaptureMaxEdgeGrowthFraction);
+}
+
+TEST(SwdRig, BodyChainCoordsThatDoNotFitAreRefused) {
+  const BuiltSkeleton b = SkeletonFrom(SharedCollarPointHangingArms(), false, 8.0f);
+  auto mesh = deform::BuildMannequin(b.skeleton, b.model_from_joint);
+  ASSERT_TRUE(mesh.ok());
+  std::vector<deform::BodyChainCoord> coords = mesh->body_chain_coords;
+  coords.pop_back();
+  auto short_list = deform::BuildSwdRig(b.skeleton, b.model_from_joint, mesh->bind, {.vertex_chains = coords});
+  ASSERT_FALSE(short_list.ok());
+  EXPECT_EQ(short_list.error().code, mocap::ErrorCode::kInvalidArgument);
+  coords = mesh->body_chain_coords;
+  coords[0].chain = 99;  // a chain this skeleton does not have
+  auto wrong = deform::BuildSwdRig(b.skeleton, b.model_from_joint, mesh->bind, {.vertex_chains = coords});
+  ASSERT_FALSE(wrong.ok());
+  EXPECT_NE(wrong.error().message.find("vertex 0"), std::string::npos) << wrong.error().message;
+  coords = mesh->body_chain_coords;
+  coords[1] = {0, 1e6f};  // past the chain's end
+  EXPECT_FALSE(deform::BuildSwdRig(b.skeleton, b.model_from_joint, mesh->bind, {.vertex_chains = coords}).ok());
 }
 
 }  // namespace
