@@ -164,6 +164,24 @@ mocap::JobStatus Renderer::Render(const Camera& camera, std::span<const SceneMes
   if (!rasterizer_.Setup(clip_meshes, raster))
     return Fail(mocap::JobStatus::kOutOfRange, "raster size out of range");
 
+  if (settings.ground) {
+    // The ground faces up: ambient plus the key and fill lights' diffuse terms.
+    const ShadingContext& ctx = context_;
+    const glm::vec3 light = ctx.model == LightingModel::kUnlit
+                                ? glm::vec3(1.0f)
+                                : ctx.ambient + ctx.key_radiance * std::max(ctx.key_dir.y, 0.0f) +
+                                      ctx.fill_radiance * std::max(ctx.fill_dir.y, 0.0f);
+    ground_shader_ = GroundShader::Create({.clip_from_world = clip_from_world,
+                                           .eye = ctx.eye,
+                                           .raster_width = raster.width,
+                                           .raster_height = raster.height,
+                                           .ground_y = ground_y,
+                                           .grid_spacing = grid_spacing_,
+                                           .style = settings.ground_style,
+                                           .shadows = shadows_,
+                                           .light = light});
+  }
+
   background_rows_.resize(static_cast<std::size_t>(raster.height));
   for (int y = 0; y < raster.height; ++y)
     background_rows_[static_cast<std::size_t>(y)] = BackgroundColor(
@@ -230,11 +248,7 @@ class Renderer::SampleShader {
  public:
   SampleShader(const Rasterizer& raster, std::span<const SceneMesh> meshes,
                const RenderSettings& settings, const Renderer& renderer)
-      : raster_(raster), meshes_(meshes), settings_(settings), r_(renderer) {
-    const ShadingContext& ctx = r_.context_;
-    ground_light_ = ctx.ambient + ctx.key_radiance * std::max(ctx.key_dir.y, 0.0f) +
-                    ctx.fill_radiance * std::max(ctx.fill_dir.y, 0.0f);
-  }
+      : raster_(raster), meshes_(meshes), settings_(settings), r_(renderer) {}
 
   [[gnu::always_inline]] glm::vec3 Shade(std::uint32_t id, int sx, int sy) {
     Entry& t = cache_[id & (kCacheSize - 1)];
@@ -247,14 +261,7 @@ class Renderer::SampleShader {
     const float w2 = t.wc[2] + t.wa[2] * fx + t.wb[2] * fy;
     const ShadingContext& ctx = r_.context_;
     const LightingModel model = ctx.model;
-    if (t.ground) {
-      const float inv = 1.0f / (w0 + w1 + w2);
-      const glm::vec3 p = (w0 * inv) * t.p[0] + (w1 * inv) * t.p[1] + (w2 * inv) * t.p[2];
-      const glm::vec3 albedo = GroundAlbedo(settings_.ground_style, r_.grid_spacing_, p, ctx.eye);
-      const float shadow = ContactShadowFactor(r_.shadows_, p);
-      if (model == LightingModel::kUnlit) return albedo * shadow;
-      return albedo * ground_light_ * shadow;
-    }
+    if (t.ground) return r_.ground_shader_.Shade(sx, sy);
     if (t.lambert_plane) return LambertPlane(t, fx, fy);
     glm::vec3 albedo = t.albedo;
     const bool need_weights = t.interpolate_color || model == LightingModel::kBlinnPhong;
@@ -297,10 +304,12 @@ class Renderer::SampleShader {
   // The terms of a sample's colour, base + key * max(D, 0) / |N|: for a
   // plane-lit triangle its (N, D) and the entry's lit_base / lit_key; for any
   // other the shaded colour (alpha 1) in `base`, zero `key` and zero (N, D).
-  [[gnu::always_inline]] void ShadeTerms(std::uint32_t id, int sx, int sy, float* nd, float* base,
+  // Returns true, writing nothing, for a ground sample (see GroundShader).
+  [[gnu::always_inline]] bool ShadeTerms(std::uint32_t id, int sx, int sy, float* nd, float* base,
                                          float* key) {
     Entry& t = cache_[id & (kCacheSize - 1)];
     if (t.id != id) Load(id, t);
+    if (t.ground) return true;
     if (t.lambert_plane) {
       const float fx = static_cast<float>(sx - t.ref_x), fy = static_cast<float>(sy - t.ref_y);
       _mm_store_ps(nd, _mm_add_ps(_mm_add_ps(_mm_load_ps(t.plane_c),
@@ -308,14 +317,25 @@ class Renderer::SampleShader {
                                   _mm_mul_ps(_mm_load_ps(t.plane_b), _mm_set1_ps(fy))));
       _mm_store_ps(base, _mm_load_ps(t.lit_base));
       _mm_store_ps(key, _mm_load_ps(t.lit_key));
-      return;
+      return false;
     }
     const glm::vec3 c = Shade(id, sx, sy);
     _mm_store_ps(base, _mm_set_ps(1.0f, c.z, c.y, c.x));
     _mm_store_ps(key, _mm_setzero_ps());
     _mm_store_ps(nd, _mm_setzero_ps());
+    return false;
   }
 #endif
+
+  // Shade() for samples off the ground; returns true, writing nothing, for a
+  // ground sample, which the caller shades four at a time (see GroundShader).
+  [[gnu::always_inline]] bool ShadeOffGround(std::uint32_t id, int sx, int sy, glm::vec3& color) {
+    Entry& t = cache_[id & (kCacheSize - 1)];
+    if (t.id != id) Load(id, t);
+    if (t.ground) return true;
+    color = Shade(id, sx, sy);
+    return false;
+  }
 
  private:
   static constexpr std::uint32_t kCacheSize = 64;
@@ -388,13 +408,8 @@ class Renderer::SampleShader {
       }
     };
     t.ground = tri.mesh == static_cast<std::uint32_t>(meshes_.size());
+    if (t.ground) return;  // shaded by GroundShader from the sample position alone
     glm::vec3 corner[3];
-    if (t.ground) {
-      const glm::uvec3 v = r_.ground_triangles_[tri.triangle];
-      for (int k = 0; k < 3; ++k) corner[k] = r_.ground_positions_[v[k]];
-      to_vertices(corner, t.p);
-      return;
-    }
     const SceneMesh& mesh = meshes_[tri.mesh];
     const glm::uvec3 v = mesh.triangles[tri.triangle];
     t.smooth = settings_.shading == ShadingMode::kSmooth && !mesh.normals.empty();
@@ -460,9 +475,19 @@ class Renderer::SampleShader {
   std::span<const SceneMesh> meshes_;
   const RenderSettings& settings_;
   const Renderer& r_;
-  glm::vec3 ground_light_{0.0f};  // ambient + key and fill diffuse on the (up-facing) ground
   Entry cache_[kCacheSize];
 };
+
+template <class Store>
+void Renderer::ShadeGroundRow(int x0, int sy, int n, const bool* ground, Store&& store) const {
+  for (int i = 0; i < n; i += 4) {
+    if (!(ground[i] || ground[i + 1] || ground[i + 2] || ground[i + 3])) continue;
+    float r[4], g[4], b[4];
+    ground_shader_.Shade4(x0 + i, sy, r, g, b);
+    for (int k = 0; k < 4 && i + k < n; ++k)
+      if (ground[i + k]) store(i + k, glm::vec3(r[k], g[k], b[k]));
+  }
+}
 
 void Renderer::ShadeTile(int tile, const RenderSettings& settings,
                          std::span<const SceneMesh> meshes, TileScratch& s, Image& image) {
@@ -491,6 +516,8 @@ void Renderer::ShadeTile(int tile, const RenderSettings& settings,
       // colour = base + key * max(D, 0) / |N| as in LambertPlane, same order
       // of operations, so the bytes equal the one-sample path's.
       alignas(16) float nd[kTileSize][4], base[kTileSize][4], key[kTileSize][4];
+      bool ground[kTileSize + 3] = {};  // + 3: the last group of four may pass n
+      bool any_ground = false;
       const int n = x1 - x0;
       for (int i = 0; i < n; ++i) {
         const std::uint32_t id = s.ids[row + static_cast<std::size_t>(i)];
@@ -498,10 +525,15 @@ void Renderer::ShadeTile(int tile, const RenderSettings& settings,
           _mm_store_ps(base[i], _mm_set_ps(bg.w, bg.z, bg.y, bg.x));
           _mm_store_ps(key[i], _mm_setzero_ps());
           _mm_store_ps(nd[i], _mm_setzero_ps());
-        } else {
-          shader.ShadeTerms(id, x0 + i, sy, nd[i], base[i], key[i]);
+        } else if (shader.ShadeTerms(id, x0 + i, sy, nd[i], base[i], key[i])) {
+          ground[i] = any_ground = true;
+          _mm_store_ps(key[i], _mm_setzero_ps());
+          _mm_store_ps(nd[i], _mm_setzero_ps());
         }
       }
+      if (any_ground) ShadeGroundRow(x0, sy, n, ground, [&](int i, const glm::vec3& c) {
+        _mm_store_ps(base[i], _mm_set_ps(1.0f, c.z, c.y, c.x));
+      });
       for (int i = n; i < ((n + 3) & ~3); ++i) _mm_store_ps(nd[i], _mm_setzero_ps());
       for (int i = 0; i < n; i += 4) {
         __m128 x = _mm_load_ps(nd[i]), y = _mm_load_ps(nd[i + 1]), z = _mm_load_ps(nd[i + 2]),
@@ -548,6 +580,20 @@ void Renderer::ShadeTile(int tile, const RenderSettings& settings,
     const glm::vec3 bg = background_rows_[static_cast<std::size_t>(sy)];
     const std::size_t row = static_cast<std::size_t>(sy - y0) * kTileSize;
     const std::size_t out_row = static_cast<std::size_t>((sy - y0) / ss) * static_cast<std::size_t>(out_stride);
+    // The row's colours first, so the ground's samples are shaded four at a time.
+    glm::vec3 color[kTileSize];
+    bool ground[kTileSize + 3] = {};
+    bool any_ground = false;
+    for (int sx = x0; sx < x1; ++sx) {
+      const std::uint32_t id = s.ids[row + static_cast<std::size_t>(sx - x0)];
+      const auto i = static_cast<std::size_t>(sx - x0);
+      if (id != kNoTriangle && shader.ShadeOffGround(id, sx, sy, color[i]))
+        ground[i] = any_ground = true;
+    }
+    if (any_ground) {
+      ShadeGroundRow(x0, sy, x1 - x0, ground,
+                     [&](int i, const glm::vec3& c) { color[static_cast<std::size_t>(i)] = c; });
+    }
     for (int sx = x0; sx < x1; ++sx) {
       const std::size_t at = row + static_cast<std::size_t>(sx - x0);
       const std::uint32_t id = s.ids[at];
@@ -556,7 +602,7 @@ void Renderer::ShadeTile(int tile, const RenderSettings& settings,
       if (id == kNoTriangle) {
         if (!transparent) sample = glm::vec4(bg, 0.0f);
       } else {
-        sample = glm::vec4(shader.Shade(id, sx, sy), 1.0f);
+        sample = glm::vec4(color[static_cast<std::size_t>(sx - x0)], 1.0f);
         float& nearest = s.nearest[out_row + static_cast<std::size_t>((sx - x0) / ss)];
         nearest = std::min(nearest, 1.0f / s.depth[at]);
       }
