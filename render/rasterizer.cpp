@@ -351,12 +351,20 @@ void Rasterizer::RasterizeTile(int tile, std::span<float> depth,
         __m128i lane = _mm_setr_epi32(0, 1, 2, 3);
         const __m128i four = _mm_set1_epi32(4);
         for (int i = 0; i < n; i += 4) {
-          const __m128 z = _mm_add_ps(_mm_add_ps(_mm_mul_ps(_mm_cvtepi32_ps(e0), zz0),
-                                                 _mm_mul_ps(_mm_cvtepi32_ps(e1), zz1)),
-                                      _mm_mul_ps(_mm_cvtepi32_ps(e2), zz2));
           const __m128i inside = _mm_and_si128(
               _mm_cmpgt_epi32(_mm_or_si128(_mm_or_si128(e0, e1), e2), minus_one),
               _mm_cmplt_epi32(lane, count));
+          const __m128i f0 = e0, f1 = e1, f2 = e2;  // this group's edge values
+          e0 = _mm_add_epi32(e0, step0);
+          e1 = _mm_add_epi32(e1, step1);
+          e2 = _mm_add_epi32(e2, step2);
+          lane = _mm_add_epi32(lane, four);
+          // About half of a small triangle's bounding box is outside it: skip
+          // the depth test and the stores of groups with no sample inside.
+          if (_mm_movemask_epi8(inside) == 0) continue;
+          const __m128 z = _mm_add_ps(_mm_add_ps(_mm_mul_ps(_mm_cvtepi32_ps(f0), zz0),
+                                                 _mm_mul_ps(_mm_cvtepi32_ps(f1), zz1)),
+                                      _mm_mul_ps(_mm_cvtepi32_ps(f2), zz2));
           const __m128 old_z = _mm_loadu_ps(d + i);
           const __m128 pass = _mm_and_ps(_mm_castsi128_ps(inside), _mm_cmpgt_ps(z, old_z));
           _mm_storeu_ps(d + i, _mm_or_ps(_mm_and_ps(pass, z), _mm_andnot_ps(pass, old_z)));
@@ -364,10 +372,6 @@ void Rasterizer::RasterizeTile(int tile, std::span<float> depth,
           const __m128i pass_i = _mm_castps_si128(pass);
           _mm_storeu_si128(reinterpret_cast<__m128i*>(out + i),
                            _mm_or_si128(_mm_and_si128(pass_i, id4), _mm_andnot_si128(pass_i, old_id)));
-          e0 = _mm_add_epi32(e0, step0);
-          e1 = _mm_add_epi32(e1, step1);
-          e2 = _mm_add_epi32(e2, step2);
-          lane = _mm_add_epi32(lane, four);
         }
 #else
         std::int32_t e0 = row32[0], e1 = row32[1], e2 = row32[2];
