@@ -12,6 +12,7 @@
 #endif
 
 #include "render/internal/parallel.h"
+#include "render/shading4.h"
 
 namespace render {
 namespace {
@@ -250,7 +251,24 @@ class Renderer::SampleShader {
                const RenderSettings& settings, const Renderer& renderer)
       : raster_(raster), meshes_(meshes), settings_(settings), r_(renderer) {}
 
+  // What ShadeSample did with a sample.
+  enum class Kind {
+    kColor,     // `color` holds the sample's colour
+    kGround,    // a ground sample: nothing written (GroundShader shades it)
+    kDeferred,  // Blinn-Phong: ShadeSurface's inputs went to lane i % 4 of deferred[i / 4]
+  };
+
   [[gnu::always_inline]] glm::vec3 Shade(std::uint32_t id, int sx, int sy) {
+    glm::vec3 color;
+    if (ShadeSample(id, sx, sy, color, nullptr, 0) == Kind::kGround)
+      return r_.ground_shader_.Shade(sx, sy);
+    return color;
+  }
+
+  // The colour of sample (sx, sy) of triangle `id`; with `deferred` set,
+  // Blinn-Phong surfaces are left to ShadeSurface4 (four samples at a time).
+  [[gnu::always_inline]] Kind ShadeSample(std::uint32_t id, int sx, int sy, glm::vec3& color,
+                                          SurfacePoints4* deferred, int i) {
     Entry& t = cache_[id & (kCacheSize - 1)];
     if (t.id != id) Load(id, t);
     // Perspective-correct weights up to a common scale: edge function times
@@ -261,8 +279,12 @@ class Renderer::SampleShader {
     const float w2 = t.wc[2] + t.wa[2] * fx + t.wb[2] * fy;
     const ShadingContext& ctx = r_.context_;
     const LightingModel model = ctx.model;
-    if (t.ground) return r_.ground_shader_.Shade(sx, sy);
-    if (t.lambert_plane) return LambertPlane(t, fx, fy);
+    if (t.ground) return Kind::kGround;
+    color = glm::vec3(0.0f);
+    if (t.lambert_plane) {
+      color = LambertPlane(t, fx, fy);
+      return Kind::kColor;
+    }
     glm::vec3 albedo = t.albedo;
     const bool need_weights = t.interpolate_color || model == LightingModel::kBlinnPhong;
     float l0 = w0, l1 = w1, l2 = w2;
@@ -273,7 +295,10 @@ class Renderer::SampleShader {
       l2 = w2 * inv;
     }
     if (t.interpolate_color) albedo = l0 * t.col[0] + l1 * t.col[1] + l2 * t.col[2];
-    if (model == LightingModel::kUnlit) return albedo;
+    if (model == LightingModel::kUnlit) {
+      color = albedo;
+      return Kind::kColor;
+    }
     glm::vec3 n = t.face_normal;
     // Unnormalized weights suffice: the interpolated normal is renormalized.
     if (t.smooth) n = w0 * t.n[0] + w1 * t.n[1] + w2 * t.n[2];
@@ -282,11 +307,23 @@ class Renderer::SampleShader {
       // N.L / |N|, with the square root only for lit samples.
       const float d = glm::dot(n, ctx.key_dir);
       const float n_dot_l = d > 0.0f && len2 > 0.0f ? d / std::sqrt(len2) : 0.0f;
-      return albedo * (ctx.ambient + ctx.key_radiance * n_dot_l);
+      color = albedo * (ctx.ambient + ctx.key_radiance * n_dot_l);
+      return Kind::kColor;
     }
     n = len2 > 0.0f ? n * (1.0f / std::sqrt(len2)) : t.face_normal;
     const glm::vec3 p = l0 * t.p[0] + l1 * t.p[1] + l2 * t.p[2];
-    return ShadeSurface(ctx, albedo, n, p);
+    if (deferred != nullptr) {
+      SurfacePoints4& d = deferred[i >> 2];
+      const int lane = i & 3;
+      for (int c = 0; c < 3; ++c) {
+        d.albedo[c][lane] = albedo[c];
+        d.normal[c][lane] = n[c];
+        d.position[c][lane] = p[c];
+      }
+      return Kind::kDeferred;
+    }
+    color = ShadeSurface(ctx, albedo, n, p);
+    return Kind::kColor;
   }
 
   // Shade() as RGBA (alpha 1) for the single-sample path, which stores it as is.
@@ -304,12 +341,12 @@ class Renderer::SampleShader {
   // The terms of a sample's colour, base + key * max(D, 0) / |N|: for a
   // plane-lit triangle its (N, D) and the entry's lit_base / lit_key; for any
   // other the shaded colour (alpha 1) in `base`, zero `key` and zero (N, D).
-  // Returns true, writing nothing, for a ground sample (see GroundShader).
-  [[gnu::always_inline]] bool ShadeTerms(std::uint32_t id, int sx, int sy, float* nd, float* base,
-                                         float* key) {
+  // kGround and kDeferred as ShadeSample (nothing written to nd, base, key).
+  [[gnu::always_inline]] Kind ShadeTerms(std::uint32_t id, int sx, int sy, float* nd, float* base,
+                                         float* key, SurfacePoints4* deferred, int i) {
     Entry& t = cache_[id & (kCacheSize - 1)];
     if (t.id != id) Load(id, t);
-    if (t.ground) return true;
+    if (t.ground) return Kind::kGround;
     if (t.lambert_plane) {
       const float fx = static_cast<float>(sx - t.ref_x), fy = static_cast<float>(sy - t.ref_y);
       _mm_store_ps(nd, _mm_add_ps(_mm_add_ps(_mm_load_ps(t.plane_c),
@@ -317,25 +354,17 @@ class Renderer::SampleShader {
                                   _mm_mul_ps(_mm_load_ps(t.plane_b), _mm_set1_ps(fy))));
       _mm_store_ps(base, _mm_load_ps(t.lit_base));
       _mm_store_ps(key, _mm_load_ps(t.lit_key));
-      return false;
+      return Kind::kColor;
     }
-    const glm::vec3 c = Shade(id, sx, sy);
+    glm::vec3 c;
+    const Kind kind = ShadeSample(id, sx, sy, c, deferred, i);
+    if (kind != Kind::kColor) return kind;
     _mm_store_ps(base, _mm_set_ps(1.0f, c.z, c.y, c.x));
     _mm_store_ps(key, _mm_setzero_ps());
     _mm_store_ps(nd, _mm_setzero_ps());
-    return false;
+    return Kind::kColor;
   }
 #endif
-
-  // Shade() for samples off the ground; returns true, writing nothing, for a
-  // ground sample, which the caller shades four at a time (see GroundShader).
-  [[gnu::always_inline]] bool ShadeOffGround(std::uint32_t id, int sx, int sy, glm::vec3& color) {
-    Entry& t = cache_[id & (kCacheSize - 1)];
-    if (t.id != id) Load(id, t);
-    if (t.ground) return true;
-    color = Shade(id, sx, sy);
-    return false;
-  }
 
  private:
   static constexpr std::uint32_t kCacheSize = 64;
@@ -489,6 +518,27 @@ void Renderer::ShadeGroundRow(int x0, int sy, int n, const bool* ground, Store&&
   }
 }
 
+template <class Store>
+void Renderer::ShadeSurfaceRow(int n, const bool* surface, SurfacePoints4* deferred,
+                               Store&& store) const {
+  for (int i = 0; i < n; i += 4) {
+    if (!(surface[i] || surface[i + 1] || surface[i + 2] || surface[i + 3])) continue;
+    SurfacePoints4& group = deferred[i >> 2];
+    for (int k = 0; k < 4; ++k) {
+      if (surface[i + k]) continue;  // an unused lane: give it harmless finite inputs
+      for (int c = 0; c < 3; ++c) {
+        group.albedo[c][k] = 0.0f;
+        group.normal[c][k] = c == 1 ? 1.0f : 0.0f;
+        group.position[c][k] = context_.eye[c] + (c == 1 ? 1.0f : 0.0f);
+      }
+    }
+    float out[3][4];
+    ShadeSurface4(context_, group, out);
+    for (int k = 0; k < 4 && i + k < n; ++k)
+      if (surface[i + k]) store(i + k, glm::vec3(out[0][k], out[1][k], out[2][k]));
+  }
+}
+
 void Renderer::ShadeTile(int tile, const RenderSettings& settings,
                          std::span<const SceneMesh> meshes, TileScratch& s, Image& image) {
   const int ss = settings.supersample;
@@ -517,7 +567,9 @@ void Renderer::ShadeTile(int tile, const RenderSettings& settings,
       // of operations, so the bytes equal the one-sample path's.
       alignas(16) float nd[kTileSize][4], base[kTileSize][4], key[kTileSize][4];
       bool ground[kTileSize + 3] = {};  // + 3: the last group of four may pass n
-      bool any_ground = false;
+      bool surface[kTileSize + 3] = {};  // Blinn-Phong samples left to ShadeSurface4
+      SurfacePoints4 deferred[kTileSize / 4];
+      bool any_ground = false, any_surface = false;
       const int n = x1 - x0;
       for (int i = 0; i < n; ++i) {
         const std::uint32_t id = s.ids[row + static_cast<std::size_t>(i)];
@@ -525,15 +577,21 @@ void Renderer::ShadeTile(int tile, const RenderSettings& settings,
           _mm_store_ps(base[i], _mm_set_ps(bg.w, bg.z, bg.y, bg.x));
           _mm_store_ps(key[i], _mm_setzero_ps());
           _mm_store_ps(nd[i], _mm_setzero_ps());
-        } else if (shader.ShadeTerms(id, x0 + i, sy, nd[i], base[i], key[i])) {
-          ground[i] = any_ground = true;
+        } else {
+          const SampleShader::Kind kind =
+              shader.ShadeTerms(id, x0 + i, sy, nd[i], base[i], key[i], deferred, i);
+          if (kind == SampleShader::Kind::kColor) continue;
+          (kind == SampleShader::Kind::kGround ? ground : surface)[i] = true;
+          (kind == SampleShader::Kind::kGround ? any_ground : any_surface) = true;
           _mm_store_ps(key[i], _mm_setzero_ps());
           _mm_store_ps(nd[i], _mm_setzero_ps());
         }
       }
-      if (any_ground) ShadeGroundRow(x0, sy, n, ground, [&](int i, const glm::vec3& c) {
+      auto store_base = [&](int i, const glm::vec3& c) {
         _mm_store_ps(base[i], _mm_set_ps(1.0f, c.z, c.y, c.x));
-      });
+      };
+      if (any_ground) ShadeGroundRow(x0, sy, n, ground, store_base);
+      if (any_surface) ShadeSurfaceRow(n, surface, deferred, store_base);
       for (int i = n; i < ((n + 3) & ~3); ++i) _mm_store_ps(nd[i], _mm_setzero_ps());
       for (int i = 0; i < n; i += 4) {
         __m128 x = _mm_load_ps(nd[i]), y = _mm_load_ps(nd[i + 1]), z = _mm_load_ps(nd[i + 2]),
@@ -582,18 +640,21 @@ void Renderer::ShadeTile(int tile, const RenderSettings& settings,
     const std::size_t out_row = static_cast<std::size_t>((sy - y0) / ss) * static_cast<std::size_t>(out_stride);
     // The row's colours first, so the ground's samples are shaded four at a time.
     glm::vec3 color[kTileSize];
-    bool ground[kTileSize + 3] = {};
-    bool any_ground = false;
+    bool ground[kTileSize + 3] = {}, surface[kTileSize + 3] = {};
+    SurfacePoints4 deferred[kTileSize / 4];
+    bool any_ground = false, any_surface = false;
     for (int sx = x0; sx < x1; ++sx) {
       const std::uint32_t id = s.ids[row + static_cast<std::size_t>(sx - x0)];
-      const auto i = static_cast<std::size_t>(sx - x0);
-      if (id != kNoTriangle && shader.ShadeOffGround(id, sx, sy, color[i]))
-        ground[i] = any_ground = true;
+      const int i = sx - x0;
+      if (id == kNoTriangle) continue;
+      const SampleShader::Kind kind =
+          shader.ShadeSample(id, sx, sy, color[static_cast<std::size_t>(i)], deferred, i);
+      if (kind == SampleShader::Kind::kGround) ground[i] = any_ground = true;
+      if (kind == SampleShader::Kind::kDeferred) surface[i] = any_surface = true;
     }
-    if (any_ground) {
-      ShadeGroundRow(x0, sy, x1 - x0, ground,
-                     [&](int i, const glm::vec3& c) { color[static_cast<std::size_t>(i)] = c; });
-    }
+    auto store_color = [&](int i, const glm::vec3& c) { color[static_cast<std::size_t>(i)] = c; };
+    if (any_ground) ShadeGroundRow(x0, sy, x1 - x0, ground, store_color);
+    if (any_surface) ShadeSurfaceRow(x1 - x0, surface, deferred, store_color);
     for (int sx = x0; sx < x1; ++sx) {
       const std::size_t at = row + static_cast<std::size_t>(sx - x0);
       const std::uint32_t id = s.ids[at];

@@ -26,6 +26,7 @@
 #include "render/overlay.h"
 #include "render/rasterizer.h"
 #include "render/shading.h"
+#include "render/shading4.h"
 
 namespace render {
 
@@ -101,6 +102,12 @@ class Renderer {
   // holds n rounded up to 4 entries), the colour of ground sample (x0 + i, sy).
   template <class Store>
   void ShadeGroundRow(int x0, int sy, int n, const bool* ground, Store&& store) const;
+  // Calls store(i, colour) for every i in [0, n) with surface[i] set: the
+  // Blinn-Phong colour from the ShadeSurface inputs in lane i % 4 of
+  // deferred[i / 4], four at a time (ShadeSurface4). Fills unused lanes.
+  template <class Store>
+  void ShadeSurfaceRow(int n, const bool* surface, SurfacePoints4* deferred,
+                       Store&& store) const;
   void ShadeTile(int tile, const RenderSettings& settings, std::span<const SceneMesh> meshes,
                  TileScratch& scratch, Image& image);
   // Tent resolve of output rows [row0, row1) from samples_ into `image`.
