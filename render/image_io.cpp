@@ -7,10 +7,12 @@
 #include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <limits>
 #include <memory>
 #include <system_error>
+#include <type_traits>
 #include <vector>
 
 #include <OpenImageIO/imageio.h>
@@ -136,17 +138,26 @@ void EncodeSrgb8(const Image& image, int channels, std::vector<std::uint8_t>* ou
   const Srgb8Tables& t = Tables();
   // Runs of equal pixels (background rows, flat ground) reuse the previous
   // pixel's bytes. NaN never compares equal, so it is always converted.
-  glm::vec4 last(std::numeric_limits<float>::quiet_NaN());
-  std::uint8_t bytes[4] = {};
-  for (const glm::vec4& p : image.rgba) {
-    if (!(p == last)) {
-      bytes[0] = ToSrgb8(t, p.r);
-      bytes[1] = ToSrgb8(t, p.g);
-      bytes[2] = ToSrgb8(t, p.b);
-      bytes[3] = AlphaToByte(p.a);
-      last = p;
+  auto encode = [&](auto channel_count) {
+    constexpr int kChannels = decltype(channel_count)::value;
+    glm::vec4 last(std::numeric_limits<float>::quiet_NaN());
+    std::uint8_t bytes[4] = {};
+    for (const glm::vec4& p : image.rgba) {
+      if (!(p == last)) {
+        bytes[0] = ToSrgb8(t, p.r);
+        bytes[1] = ToSrgb8(t, p.g);
+        bytes[2] = ToSrgb8(t, p.b);
+        bytes[3] = AlphaToByte(p.a);
+        last = p;
+      }
+      std::memcpy(dst, bytes, kChannels);  // one store, not one per byte
+      dst += kChannels;
     }
-    for (int c = 0; c < channels; ++c) *dst++ = bytes[c];
+  };
+  if (channels == 4) {
+    encode(std::integral_constant<int, 4>());
+  } else {
+    encode(std::integral_constant<int, 3>());
   }
 }
 
