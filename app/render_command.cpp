@@ -361,6 +361,12 @@ int RunRender(const RenderOptions& options) {
   settings.threads = o.threads;
   settings.ground_at_scene_min = false;
   settings.ground_y = ground_y;
+  // Only EXR frames store depth (their Z channel); the renderer still keeps it
+  // internally while it draws depth-tested overlays.
+  {
+    const mocap::Result<render::ImageFormat> format = render::ImageFormatFromPath(pattern);
+    settings.write_depth = format.ok() && *format == render::ImageFormat::kExr;
+  }
   render::Renderer renderer;
   render::Renderer right_renderer;
   render::AsyncImageWriter writer({.num_workers = 2, .max_in_flight = 4});
@@ -459,8 +465,12 @@ int RunRender(const RenderOptions& options) {
     const mocap::Result<std::string> path = render::ExpandFramePattern(pattern, of.number);
     if (!path.ok()) return Fail(path.error());
     write_options.frame = of.number;
-    s = writer.Submit(image, *path, write_options);
+    // The frame moves to the writer; the next one renders into the buffers
+    // of one already written (when there is one), so no frame-sized buffer is
+    // copied, allocated or first touched per frame.
+    s = writer.Submit(std::move(image), *path, write_options);
     if (!s.ok()) return Fail(s.error());
+    image = writer.TakeSpareImage();
     ++frames_done;
     if (first_frame_s < 0.0) {
       first_frame_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();

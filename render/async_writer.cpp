@@ -57,6 +57,14 @@ Status AsyncImageWriter::Finish() {
   return Status::Ok();
 }
 
+Image AsyncImageWriter::TakeSpareImage() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (spares_.empty()) return Image();
+  Image image = std::move(spares_.back());
+  spares_.pop_back();
+  return image;
+}
+
 std::int64_t AsyncImageWriter::frames_written() const {
   std::lock_guard<std::mutex> lock(mutex_);
   return frames_written_;
@@ -78,8 +86,12 @@ void AsyncImageWriter::WorkerLoop() {
       queue_.pop_front();
     }
     const Status status = WriteImage(job.image, job.path, job.options);
-    job.image = Image();  // release the pixels before signalling a free slot
     std::lock_guard<std::mutex> lock(mutex_);
+    // Keep the buffers for TakeSpareImage, or release them before signalling a free slot.
+    if (static_cast<int>(spares_.size()) < options_.max_in_flight && !stopping_) {
+      spares_.push_back(std::move(job.image));
+    }
+    job.image = Image();
     if (status) {
       ++frames_written_;
     } else if (!first_error_ || job.sequence < first_error_sequence_) {

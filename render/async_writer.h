@@ -52,6 +52,12 @@ class AsyncImageWriter {
   // (or Ok). Calling it again returns the same status.
   [[nodiscard]] Status Finish();
 
+  // An image whose frame has been written, with its buffers' capacity kept
+  // (contents unspecified), or an empty Image when none is free yet. Rendering
+  // the next frame into it saves allocating and first-touching a frame-sized
+  // buffer per frame. At most max_in_flight written images are kept for this.
+  Image TakeSpareImage();
+
   // Frames written successfully so far (thread-safe).
   std::int64_t frames_written() const;
   // Most frames that were queued or encoding at once (<= max_in_flight; thread-safe).
@@ -71,6 +77,7 @@ class AsyncImageWriter {
   std::condition_variable work_ready_;  // a job was queued or stopping_ was set
   std::condition_variable slot_free_;   // in_flight_ dropped
   std::deque<Job> queue_;
+  std::vector<Image> spares_;           // written frames' buffers, for TakeSpareImage
   int in_flight_ = 0;                   // queued + encoding
   int peak_in_flight_ = 0;
   bool stopping_ = false;

@@ -7,9 +7,12 @@
 #include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
+#include <limits>
 #include <memory>
 #include <system_error>
+#include <type_traits>
 #include <vector>
 
 #include <OpenImageIO/imageio.h>
@@ -113,17 +116,48 @@ struct Encoded {
   OIIO::TypeDesc data_type;
 };
 
+// LinearToSrgb8 with the tables passed in (no static-guard check per call).
+inline std::uint8_t ToSrgb8(const Srgb8Tables& t, float linear) {
+  if (!(linear > 0.0f)) return 0;  // also NaN
+  if (linear >= 1.0f) return 255;
+  const auto bucket = static_cast<std::size_t>(linear * Srgb8Tables::kBuckets);
+  int code = t.bucket_start[bucket];
+  while (code < 255 && linear >= t.threshold[static_cast<std::size_t>(code)]) ++code;
+  return static_cast<std::uint8_t>(code);
+}
+
+inline std::uint8_t AlphaToByte(float a) {
+  if (a == 1.0f) return 255;  // opaque frames: skip the libm call
+  const float clamped = std::isnan(a) ? 0.0f : std::clamp(a, 0.0f, 1.0f);
+  return static_cast<std::uint8_t>(std::lround(clamped * 255.0f));
+}
+
 void EncodeSrgb8(const Image& image, int channels, std::vector<std::uint8_t>* out) {
   out->resize(image.rgba.size() * static_cast<std::size_t>(channels));
   std::uint8_t* dst = out->data();
-  for (const glm::vec4& p : image.rgba) {
-    *dst++ = LinearToSrgb8(p.r);
-    *dst++ = LinearToSrgb8(p.g);
-    *dst++ = LinearToSrgb8(p.b);
-    if (channels == 4) {
-      const float a = std::isnan(p.a) ? 0.0f : std::clamp(p.a, 0.0f, 1.0f);
-      *dst++ = static_cast<std::uint8_t>(std::lround(a * 255.0f));
+  const Srgb8Tables& t = Tables();
+  // Runs of equal pixels (background rows, flat ground) reuse the previous
+  // pixel's bytes. NaN never compares equal, so it is always converted.
+  auto encode = [&](auto channel_count) {
+    constexpr int kChannels = decltype(channel_count)::value;
+    glm::vec4 last(std::numeric_limits<float>::quiet_NaN());
+    std::uint8_t bytes[4] = {};
+    for (const glm::vec4& p : image.rgba) {
+      if (!(p == last)) {
+        bytes[0] = ToSrgb8(t, p.r);
+        bytes[1] = ToSrgb8(t, p.g);
+        bytes[2] = ToSrgb8(t, p.b);
+        bytes[3] = AlphaToByte(p.a);
+        last = p;
+      }
+      std::memcpy(dst, bytes, kChannels);  // one store, not one per byte
+      dst += kChannels;
     }
+  };
+  if (channels == 4) {
+    encode(std::integral_constant<int, 4>());
+  } else {
+    encode(std::integral_constant<int, 3>());
   }
 }
 
@@ -263,15 +297,7 @@ float SrgbToLinear(float encoded) {
   return encoded <= 0.04045f ? encoded / 12.92f : std::pow((encoded + 0.055f) / 1.055f, 2.4f);
 }
 
-std::uint8_t LinearToSrgb8(float linear) {
-  if (!(linear > 0.0f)) return 0;
-  if (linear >= 1.0f) return 255;
-  const Srgb8Tables& t = Tables();
-  const auto bucket = static_cast<std::size_t>(linear * Srgb8Tables::kBuckets);
-  int code = t.bucket_start[bucket];
-  while (code < 255 && linear >= t.threshold[static_cast<std::size_t>(code)]) ++code;
-  return static_cast<std::uint8_t>(code);
-}
+std::uint8_t LinearToSrgb8(float linear) { return ToSrgb8(Tables(), linear); }
 
 float Srgb8ToLinear(std::uint8_t code) { return Tables().to_linear[code]; }
 

@@ -351,12 +351,20 @@ void Rasterizer::RasterizeTile(int tile, std::span<float> depth,
         __m128i lane = _mm_setr_epi32(0, 1, 2, 3);
         const __m128i four = _mm_set1_epi32(4);
         for (int i = 0; i < n; i += 4) {
-          const __m128 z = _mm_add_ps(_mm_add_ps(_mm_mul_ps(_mm_cvtepi32_ps(e0), zz0),
-                                                 _mm_mul_ps(_mm_cvtepi32_ps(e1), zz1)),
-                                      _mm_mul_ps(_mm_cvtepi32_ps(e2), zz2));
           const __m128i inside = _mm_and_si128(
               _mm_cmpgt_epi32(_mm_or_si128(_mm_or_si128(e0, e1), e2), minus_one),
               _mm_cmplt_epi32(lane, count));
+          const __m128i f0 = e0, f1 = e1, f2 = e2;  // this group's edge values
+          e0 = _mm_add_epi32(e0, step0);
+          e1 = _mm_add_epi32(e1, step1);
+          e2 = _mm_add_epi32(e2, step2);
+          lane = _mm_add_epi32(lane, four);
+          // About half of a small triangle's bounding box is outside it: skip
+          // the depth test and the stores of groups with no sample inside.
+          if (_mm_movemask_epi8(inside) == 0) continue;
+          const __m128 z = _mm_add_ps(_mm_add_ps(_mm_mul_ps(_mm_cvtepi32_ps(f0), zz0),
+                                                 _mm_mul_ps(_mm_cvtepi32_ps(f1), zz1)),
+                                      _mm_mul_ps(_mm_cvtepi32_ps(f2), zz2));
           const __m128 old_z = _mm_loadu_ps(d + i);
           const __m128 pass = _mm_and_ps(_mm_castsi128_ps(inside), _mm_cmpgt_ps(z, old_z));
           _mm_storeu_ps(d + i, _mm_or_ps(_mm_and_ps(pass, z), _mm_andnot_ps(pass, old_z)));
@@ -364,10 +372,6 @@ void Rasterizer::RasterizeTile(int tile, std::span<float> depth,
           const __m128i pass_i = _mm_castps_si128(pass);
           _mm_storeu_si128(reinterpret_cast<__m128i*>(out + i),
                            _mm_or_si128(_mm_and_si128(pass_i, id4), _mm_andnot_si128(pass_i, old_id)));
-          e0 = _mm_add_epi32(e0, step0);
-          e1 = _mm_add_epi32(e1, step1);
-          e2 = _mm_add_epi32(e2, step2);
-          lane = _mm_add_epi32(lane, four);
         }
 #else
         std::int32_t e0 = row32[0], e1 = row32[1], e2 = row32[2];
@@ -388,6 +392,63 @@ void Rasterizer::RasterizeTile(int tile, std::span<float> depth,
       }
       continue;
     }
+#if defined(__SSE2__)
+    // Large triangle (the ground's two cover most tiles): the same edge values
+    // in double lanes, exact since every |E| < 2^53, four samples per step;
+    // converting them to float rounds once, as the int64 -> float cast does,
+    // so z and the result are those of the scalar loop below.
+    {
+      const int n = bx1 - bx0 + 1;
+      const __m128d zero = _mm_setzero_pd();
+      const __m128 zz0 = _mm_set1_ps(z0), zz1 = _mm_set1_ps(z1), zz2 = _mm_set1_ps(z2);
+      const __m128i count = _mm_set1_epi32(n), four = _mm_set1_epi32(4);
+      const __m128i id4 = _mm_set1_epi32(static_cast<int>(id));
+      __m128d step4[3];
+      for (int i = 0; i < 3; ++i) step4[i] = _mm_set1_pd(static_cast<double>(4 * step_x[i]));
+      for (int sy = by0; sy <= by1; ++sy) {
+        float* d = depth.data() + static_cast<std::size_t>(sy - y0) * kTileSize +
+                   static_cast<std::size_t>(bx0 - x0);
+        std::uint32_t* out = ids.data() + (d - depth.data());
+        __m128d lo[3], hi[3];  // samples (0, 1) and (2, 3) of the group
+        for (int i = 0; i < 3; ++i) {
+          const auto r = static_cast<double>(row[i]), st = static_cast<double>(step_x[i]);
+          lo[i] = _mm_setr_pd(r, r + st);
+          hi[i] = _mm_setr_pd(r + 2.0 * st, r + 3.0 * st);
+        }
+        __m128i lane = _mm_setr_epi32(0, 1, 2, 3);
+        for (int i = 0; i < n; i += 4) {
+          const __m128d in_lo = _mm_and_pd(_mm_and_pd(_mm_cmpge_pd(lo[0], zero), _mm_cmpge_pd(lo[1], zero)),
+                                           _mm_cmpge_pd(lo[2], zero));
+          const __m128d in_hi = _mm_and_pd(_mm_and_pd(_mm_cmpge_pd(hi[0], zero), _mm_cmpge_pd(hi[1], zero)),
+                                           _mm_cmpge_pd(hi[2], zero));
+          const __m128 inside = _mm_and_ps(
+              _mm_shuffle_ps(_mm_castpd_ps(in_lo), _mm_castpd_ps(in_hi), _MM_SHUFFLE(2, 0, 2, 0)),
+              _mm_castsi128_ps(_mm_cmplt_epi32(lane, count)));
+          __m128 f[3];
+          for (int j = 0; j < 3; ++j) f[j] = _mm_movelh_ps(_mm_cvtpd_ps(lo[j]), _mm_cvtpd_ps(hi[j]));
+          for (int j = 0; j < 3; ++j) {
+            lo[j] = _mm_add_pd(lo[j], step4[j]);
+            hi[j] = _mm_add_pd(hi[j], step4[j]);
+          }
+          lane = _mm_add_epi32(lane, four);
+          if (_mm_movemask_ps(inside) == 0) continue;
+          const __m128 z = _mm_add_ps(_mm_add_ps(_mm_mul_ps(f[0], zz0), _mm_mul_ps(f[1], zz1)),
+                                      _mm_mul_ps(f[2], zz2));
+          const __m128 old_z = _mm_loadu_ps(d + i);
+          const __m128 pass = _mm_and_ps(inside, _mm_cmpgt_ps(z, old_z));
+          _mm_storeu_ps(d + i, _mm_or_ps(_mm_and_ps(pass, z), _mm_andnot_ps(pass, old_z)));
+          const __m128i old_id = _mm_loadu_si128(reinterpret_cast<const __m128i*>(out + i));
+          const __m128i pass_i = _mm_castps_si128(pass);
+          _mm_storeu_si128(reinterpret_cast<__m128i*>(out + i),
+                           _mm_or_si128(_mm_and_si128(pass_i, id4), _mm_andnot_si128(pass_i, old_id)));
+        }
+        row[0] += step_y[0];
+        row[1] += step_y[1];
+        row[2] += step_y[2];
+      }
+      continue;
+    }
+#endif
     for (int sy = by0; sy <= by1; ++sy) {
       std::int64_t e0 = row[0], e1 = row[1], e2 = row[2];
       const std::size_t base = static_cast<std::size_t>(sy - y0) * kTileSize;

@@ -12,6 +12,7 @@
 #endif
 
 #include "render/internal/parallel.h"
+#include "render/shading4.h"
 
 namespace render {
 namespace {
@@ -164,6 +165,24 @@ mocap::JobStatus Renderer::Render(const Camera& camera, std::span<const SceneMes
   if (!rasterizer_.Setup(clip_meshes, raster))
     return Fail(mocap::JobStatus::kOutOfRange, "raster size out of range");
 
+  if (settings.ground) {
+    // The ground faces up: ambient plus the key and fill lights' diffuse terms.
+    const ShadingContext& ctx = context_;
+    const glm::vec3 light = ctx.model == LightingModel::kUnlit
+                                ? glm::vec3(1.0f)
+                                : ctx.ambient + ctx.key_radiance * std::max(ctx.key_dir.y, 0.0f) +
+                                      ctx.fill_radiance * std::max(ctx.fill_dir.y, 0.0f);
+    ground_shader_ = GroundShader::Create({.clip_from_world = clip_from_world,
+                                           .eye = ctx.eye,
+                                           .raster_width = raster.width,
+                                           .raster_height = raster.height,
+                                           .ground_y = ground_y,
+                                           .grid_spacing = grid_spacing_,
+                                           .style = settings.ground_style,
+                                           .shadows = shadows_,
+                                           .light = light});
+  }
+
   background_rows_.resize(static_cast<std::size_t>(raster.height));
   for (int y = 0; y < raster.height; ++y)
     background_rows_[static_cast<std::size_t>(y)] = BackgroundColor(
@@ -230,13 +249,26 @@ class Renderer::SampleShader {
  public:
   SampleShader(const Rasterizer& raster, std::span<const SceneMesh> meshes,
                const RenderSettings& settings, const Renderer& renderer)
-      : raster_(raster), meshes_(meshes), settings_(settings), r_(renderer) {
-    const ShadingContext& ctx = r_.context_;
-    ground_light_ = ctx.ambient + ctx.key_radiance * std::max(ctx.key_dir.y, 0.0f) +
-                    ctx.fill_radiance * std::max(ctx.fill_dir.y, 0.0f);
-  }
+      : raster_(raster), meshes_(meshes), settings_(settings), r_(renderer) {}
+
+  // What ShadeSample did with a sample.
+  enum class Kind {
+    kColor,     // `color` holds the sample's colour
+    kGround,    // a ground sample: nothing written (GroundShader shades it)
+    kDeferred,  // Blinn-Phong: ShadeSurface's inputs went to lane i % 4 of deferred[i / 4]
+  };
 
   [[gnu::always_inline]] glm::vec3 Shade(std::uint32_t id, int sx, int sy) {
+    glm::vec3 color;
+    if (ShadeSample(id, sx, sy, color, nullptr, 0) == Kind::kGround)
+      return r_.ground_shader_.Shade(sx, sy);
+    return color;
+  }
+
+  // The colour of sample (sx, sy) of triangle `id`; with `deferred` set,
+  // Blinn-Phong surfaces are left to ShadeSurface4 (four samples at a time).
+  [[gnu::always_inline]] Kind ShadeSample(std::uint32_t id, int sx, int sy, glm::vec3& color,
+                                          SurfacePoints4* deferred, int i) {
     Entry& t = cache_[id & (kCacheSize - 1)];
     if (t.id != id) Load(id, t);
     // Perspective-correct weights up to a common scale: edge function times
@@ -247,15 +279,12 @@ class Renderer::SampleShader {
     const float w2 = t.wc[2] + t.wa[2] * fx + t.wb[2] * fy;
     const ShadingContext& ctx = r_.context_;
     const LightingModel model = ctx.model;
-    if (t.ground) {
-      const float inv = 1.0f / (w0 + w1 + w2);
-      const glm::vec3 p = (w0 * inv) * t.p[0] + (w1 * inv) * t.p[1] + (w2 * inv) * t.p[2];
-      const glm::vec3 albedo = GroundAlbedo(settings_.ground_style, r_.grid_spacing_, p, ctx.eye);
-      const float shadow = ContactShadowFactor(r_.shadows_, p);
-      if (model == LightingModel::kUnlit) return albedo * shadow;
-      return albedo * ground_light_ * shadow;
+    if (t.ground) return Kind::kGround;
+    color = glm::vec3(0.0f);
+    if (t.lambert_plane) {
+      color = LambertPlane(t, fx, fy);
+      return Kind::kColor;
     }
-    if (t.lambert_plane) return LambertPlane(t, fx, fy);
     glm::vec3 albedo = t.albedo;
     const bool need_weights = t.interpolate_color || model == LightingModel::kBlinnPhong;
     float l0 = w0, l1 = w1, l2 = w2;
@@ -266,7 +295,10 @@ class Renderer::SampleShader {
       l2 = w2 * inv;
     }
     if (t.interpolate_color) albedo = l0 * t.col[0] + l1 * t.col[1] + l2 * t.col[2];
-    if (model == LightingModel::kUnlit) return albedo;
+    if (model == LightingModel::kUnlit) {
+      color = albedo;
+      return Kind::kColor;
+    }
     glm::vec3 n = t.face_normal;
     // Unnormalized weights suffice: the interpolated normal is renormalized.
     if (t.smooth) n = w0 * t.n[0] + w1 * t.n[1] + w2 * t.n[2];
@@ -275,11 +307,23 @@ class Renderer::SampleShader {
       // N.L / |N|, with the square root only for lit samples.
       const float d = glm::dot(n, ctx.key_dir);
       const float n_dot_l = d > 0.0f && len2 > 0.0f ? d / std::sqrt(len2) : 0.0f;
-      return albedo * (ctx.ambient + ctx.key_radiance * n_dot_l);
+      color = albedo * (ctx.ambient + ctx.key_radiance * n_dot_l);
+      return Kind::kColor;
     }
     n = len2 > 0.0f ? n * (1.0f / std::sqrt(len2)) : t.face_normal;
     const glm::vec3 p = l0 * t.p[0] + l1 * t.p[1] + l2 * t.p[2];
-    return ShadeSurface(ctx, albedo, n, p);
+    if (deferred != nullptr) {
+      SurfacePoints4& d = deferred[i >> 2];
+      const int lane = i & 3;
+      for (int c = 0; c < 3; ++c) {
+        d.albedo[c][lane] = albedo[c];
+        d.normal[c][lane] = n[c];
+        d.position[c][lane] = p[c];
+      }
+      return Kind::kDeferred;
+    }
+    color = ShadeSurface(ctx, albedo, n, p);
+    return Kind::kColor;
   }
 
   // Shade() as RGBA (alpha 1) for the single-sample path, which stores it as is.
@@ -297,10 +341,12 @@ class Renderer::SampleShader {
   // The terms of a sample's colour, base + key * max(D, 0) / |N|: for a
   // plane-lit triangle its (N, D) and the entry's lit_base / lit_key; for any
   // other the shaded colour (alpha 1) in `base`, zero `key` and zero (N, D).
-  [[gnu::always_inline]] void ShadeTerms(std::uint32_t id, int sx, int sy, float* nd, float* base,
-                                         float* key) {
+  // kGround and kDeferred as ShadeSample (nothing written to nd, base, key).
+  [[gnu::always_inline]] Kind ShadeTerms(std::uint32_t id, int sx, int sy, float* nd, float* base,
+                                         float* key, SurfacePoints4* deferred, int i) {
     Entry& t = cache_[id & (kCacheSize - 1)];
     if (t.id != id) Load(id, t);
+    if (t.ground) return Kind::kGround;
     if (t.lambert_plane) {
       const float fx = static_cast<float>(sx - t.ref_x), fy = static_cast<float>(sy - t.ref_y);
       _mm_store_ps(nd, _mm_add_ps(_mm_add_ps(_mm_load_ps(t.plane_c),
@@ -308,12 +354,15 @@ class Renderer::SampleShader {
                                   _mm_mul_ps(_mm_load_ps(t.plane_b), _mm_set1_ps(fy))));
       _mm_store_ps(base, _mm_load_ps(t.lit_base));
       _mm_store_ps(key, _mm_load_ps(t.lit_key));
-      return;
+      return Kind::kColor;
     }
-    const glm::vec3 c = Shade(id, sx, sy);
+    glm::vec3 c;
+    const Kind kind = ShadeSample(id, sx, sy, c, deferred, i);
+    if (kind != Kind::kColor) return kind;
     _mm_store_ps(base, _mm_set_ps(1.0f, c.z, c.y, c.x));
     _mm_store_ps(key, _mm_setzero_ps());
     _mm_store_ps(nd, _mm_setzero_ps());
+    return Kind::kColor;
   }
 #endif
 
@@ -388,13 +437,8 @@ class Renderer::SampleShader {
       }
     };
     t.ground = tri.mesh == static_cast<std::uint32_t>(meshes_.size());
+    if (t.ground) return;  // shaded by GroundShader from the sample position alone
     glm::vec3 corner[3];
-    if (t.ground) {
-      const glm::uvec3 v = r_.ground_triangles_[tri.triangle];
-      for (int k = 0; k < 3; ++k) corner[k] = r_.ground_positions_[v[k]];
-      to_vertices(corner, t.p);
-      return;
-    }
     const SceneMesh& mesh = meshes_[tri.mesh];
     const glm::uvec3 v = mesh.triangles[tri.triangle];
     t.smooth = settings_.shading == ShadingMode::kSmooth && !mesh.normals.empty();
@@ -460,9 +504,40 @@ class Renderer::SampleShader {
   std::span<const SceneMesh> meshes_;
   const RenderSettings& settings_;
   const Renderer& r_;
-  glm::vec3 ground_light_{0.0f};  // ambient + key and fill diffuse on the (up-facing) ground
   Entry cache_[kCacheSize];
 };
+
+template <class Store>
+void Renderer::ShadeGroundRow(int x0, int sy, int n, const bool* ground, Store&& store) const {
+  for (int i = 0; i < n; i += 4) {
+    if (!(ground[i] || ground[i + 1] || ground[i + 2] || ground[i + 3])) continue;
+    float r[4], g[4], b[4];
+    ground_shader_.Shade4(x0 + i, sy, r, g, b);
+    for (int k = 0; k < 4 && i + k < n; ++k)
+      if (ground[i + k]) store(i + k, glm::vec3(r[k], g[k], b[k]));
+  }
+}
+
+template <class Store>
+void Renderer::ShadeSurfaceRow(int n, const bool* surface, SurfacePoints4* deferred,
+                               Store&& store) const {
+  for (int i = 0; i < n; i += 4) {
+    if (!(surface[i] || surface[i + 1] || surface[i + 2] || surface[i + 3])) continue;
+    SurfacePoints4& group = deferred[i >> 2];
+    for (int k = 0; k < 4; ++k) {
+      if (surface[i + k]) continue;  // an unused lane: give it harmless finite inputs
+      for (int c = 0; c < 3; ++c) {
+        group.albedo[c][k] = 0.0f;
+        group.normal[c][k] = c == 1 ? 1.0f : 0.0f;
+        group.position[c][k] = context_.eye[c] + (c == 1 ? 1.0f : 0.0f);
+      }
+    }
+    float out[3][4];
+    ShadeSurface4(context_, group, out);
+    for (int k = 0; k < 4 && i + k < n; ++k)
+      if (surface[i + k]) store(i + k, glm::vec3(out[0][k], out[1][k], out[2][k]));
+  }
+}
 
 void Renderer::ShadeTile(int tile, const RenderSettings& settings,
                          std::span<const SceneMesh> meshes, TileScratch& s, Image& image) {
@@ -491,6 +566,10 @@ void Renderer::ShadeTile(int tile, const RenderSettings& settings,
       // colour = base + key * max(D, 0) / |N| as in LambertPlane, same order
       // of operations, so the bytes equal the one-sample path's.
       alignas(16) float nd[kTileSize][4], base[kTileSize][4], key[kTileSize][4];
+      bool ground[kTileSize + 3] = {};  // + 3: the last group of four may pass n
+      bool surface[kTileSize + 3] = {};  // Blinn-Phong samples left to ShadeSurface4
+      SurfacePoints4 deferred[kTileSize / 4];
+      bool any_ground = false, any_surface = false;
       const int n = x1 - x0;
       for (int i = 0; i < n; ++i) {
         const std::uint32_t id = s.ids[row + static_cast<std::size_t>(i)];
@@ -499,9 +578,20 @@ void Renderer::ShadeTile(int tile, const RenderSettings& settings,
           _mm_store_ps(key[i], _mm_setzero_ps());
           _mm_store_ps(nd[i], _mm_setzero_ps());
         } else {
-          shader.ShadeTerms(id, x0 + i, sy, nd[i], base[i], key[i]);
+          const SampleShader::Kind kind =
+              shader.ShadeTerms(id, x0 + i, sy, nd[i], base[i], key[i], deferred, i);
+          if (kind == SampleShader::Kind::kColor) continue;
+          (kind == SampleShader::Kind::kGround ? ground : surface)[i] = true;
+          (kind == SampleShader::Kind::kGround ? any_ground : any_surface) = true;
+          _mm_store_ps(key[i], _mm_setzero_ps());
+          _mm_store_ps(nd[i], _mm_setzero_ps());
         }
       }
+      auto store_base = [&](int i, const glm::vec3& c) {
+        _mm_store_ps(base[i], _mm_set_ps(1.0f, c.z, c.y, c.x));
+      };
+      if (any_ground) ShadeGroundRow(x0, sy, n, ground, store_base);
+      if (any_surface) ShadeSurfaceRow(n, surface, deferred, store_base);
       for (int i = n; i < ((n + 3) & ~3); ++i) _mm_store_ps(nd[i], _mm_setzero_ps());
       for (int i = 0; i < n; i += 4) {
         __m128 x = _mm_load_ps(nd[i]), y = _mm_load_ps(nd[i + 1]), z = _mm_load_ps(nd[i + 2]),
@@ -548,6 +638,23 @@ void Renderer::ShadeTile(int tile, const RenderSettings& settings,
     const glm::vec3 bg = background_rows_[static_cast<std::size_t>(sy)];
     const std::size_t row = static_cast<std::size_t>(sy - y0) * kTileSize;
     const std::size_t out_row = static_cast<std::size_t>((sy - y0) / ss) * static_cast<std::size_t>(out_stride);
+    // The row's colours first, so the ground's samples are shaded four at a time.
+    glm::vec3 color[kTileSize];
+    bool ground[kTileSize + 3] = {}, surface[kTileSize + 3] = {};
+    SurfacePoints4 deferred[kTileSize / 4];
+    bool any_ground = false, any_surface = false;
+    for (int sx = x0; sx < x1; ++sx) {
+      const std::uint32_t id = s.ids[row + static_cast<std::size_t>(sx - x0)];
+      const int i = sx - x0;
+      if (id == kNoTriangle) continue;
+      const SampleShader::Kind kind =
+          shader.ShadeSample(id, sx, sy, color[static_cast<std::size_t>(i)], deferred, i);
+      if (kind == SampleShader::Kind::kGround) ground[i] = any_ground = true;
+      if (kind == SampleShader::Kind::kDeferred) surface[i] = any_surface = true;
+    }
+    auto store_color = [&](int i, const glm::vec3& c) { color[static_cast<std::size_t>(i)] = c; };
+    if (any_ground) ShadeGroundRow(x0, sy, x1 - x0, ground, store_color);
+    if (any_surface) ShadeSurfaceRow(x1 - x0, surface, deferred, store_color);
     for (int sx = x0; sx < x1; ++sx) {
       const std::size_t at = row + static_cast<std::size_t>(sx - x0);
       const std::uint32_t id = s.ids[at];
@@ -556,7 +663,7 @@ void Renderer::ShadeTile(int tile, const RenderSettings& settings,
       if (id == kNoTriangle) {
         if (!transparent) sample = glm::vec4(bg, 0.0f);
       } else {
-        sample = glm::vec4(shader.Shade(id, sx, sy), 1.0f);
+        sample = glm::vec4(color[static_cast<std::size_t>(sx - x0)], 1.0f);
         float& nearest = s.nearest[out_row + static_cast<std::size_t>((sx - x0) / ss)];
         nearest = std::min(nearest, 1.0f / s.depth[at]);
       }

@@ -21,10 +21,12 @@
 
 #include "mocap/error.h"
 #include "render/camera.h"
+#include "render/ground_shader.h"
 #include "render/image.h"
 #include "render/overlay.h"
 #include "render/rasterizer.h"
 #include "render/shading.h"
+#include "render/shading4.h"
 
 namespace render {
 
@@ -96,6 +98,16 @@ class Renderer {
   };
   class SampleShader;
   void FillBackgroundTile(int tile, const RenderSettings& settings, Image& image);
+  // Calls store(i, colour) for every i in [0, n) with ground[i] set (`ground`
+  // holds n rounded up to 4 entries), the colour of ground sample (x0 + i, sy).
+  template <class Store>
+  void ShadeGroundRow(int x0, int sy, int n, const bool* ground, Store&& store) const;
+  // Calls store(i, colour) for every i in [0, n) with surface[i] set: the
+  // Blinn-Phong colour from the ShadeSurface inputs in lane i % 4 of
+  // deferred[i / 4], four at a time (ShadeSurface4). Fills unused lanes.
+  template <class Store>
+  void ShadeSurfaceRow(int n, const bool* surface, SurfacePoints4* deferred,
+                       Store&& store) const;
   void ShadeTile(int tile, const RenderSettings& settings, std::span<const SceneMesh> meshes,
                  TileScratch& scratch, Image& image);
   // Tent resolve of output rows [row0, row1) from samples_ into `image`.
@@ -113,6 +125,7 @@ class Renderer {
   // and coverage (1 covered, 0 empty). Empty otherwise.
   std::vector<glm::vec4> samples_;
   ShadingContext context_;
+  GroundShader ground_shader_;                          // this frame's ground (when drawn)
   float grid_spacing_ = 1.0f;
 };
 

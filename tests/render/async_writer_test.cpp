@@ -5,6 +5,8 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <chrono>
+#include <thread>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -100,6 +102,25 @@ TEST(AsyncImageWriter, LaterSubmitReturnsTheErrorAndStops) {
   EXPECT_FALSE(writer.Finish().ok());
   EXPECT_FALSE(fs::exists(dir / "b.png")) << "nothing is queued after an error";
   EXPECT_EQ(writer.frames_written(), 0);
+}
+
+TEST(AsyncImageWriter, HandsBackAWrittenFramesBuffersForReuse) {
+  const fs::path dir = FreshDir("spare");
+  AsyncImageWriter writer({.num_workers = 1, .max_in_flight = 2});
+  EXPECT_TRUE(writer.TakeSpareImage().rgba.empty()) << "nothing written yet";
+  ASSERT_TRUE(writer.Submit(Frame(0), (dir / "a.png").string()));
+  // Wait (bounded) for the worker to finish the frame.
+  for (int i = 0; i < 2000 && writer.frames_written() < 1; ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  ASSERT_EQ(writer.frames_written(), 1);
+  const Image spare = writer.TakeSpareImage();
+  EXPECT_GE(spare.rgba.capacity(), std::size_t{48 * 32}) << "the frame's buffer came back";
+  EXPECT_TRUE(writer.TakeSpareImage().rgba.empty()) << "each buffer is handed out once";
+  ASSERT_TRUE(writer.Finish());
+  // The spare did not change what was written.
+  const fs::path sync = dir / "sync.png";
+  ASSERT_TRUE(WriteImage(Frame(0), sync.string()));
+  EXPECT_EQ(Bytes(dir / "a.png"), Bytes(sync));
 }
 
 }  // namespace

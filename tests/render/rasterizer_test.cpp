@@ -402,6 +402,83 @@ TEST(RasterizerTest, FarPlaneClipsOnlyWhenAsked) {
   }
 }
 
+// RasterizeTile's fast paths (four samples per step: int32 lanes for small
+// triangles, exact double lanes for large ones) against the plain per-sample
+// definition: edge values from EdgeValue with the top-left bias, z = sum of
+// float(E_i) * inv_w_i / area, nearest wins, ties keep the earlier triangle.
+TEST(RasterizerTest, TileFastPathsEqualThePerSampleDefinition) {
+  const int w = 230, h = 170;  // partial tiles at the right and bottom
+  std::vector<glm::vec4> clip;
+  std::vector<glm::uvec3> tris;
+  std::uint32_t seed = 12345u;
+  auto next = [&seed] {  // deterministic LCG in [0, 1)
+    seed = seed * 1664525u + 1013904223u;
+    return static_cast<float>(seed >> 8) / 16777216.0f;
+  };
+  for (int t = 0; t < 120; ++t) {
+    const float size = t % 3 == 0 ? 1.6f : 0.12f;  // large (> 48 samples) and small
+    const glm::vec2 c(next() * 2.0f - 1.0f, next() * 2.0f - 1.0f);
+    for (int k = 0; k < 3; ++k) {
+      const float wv = 0.5f + 2.0f * next();  // perspective: w differs per vertex
+      const glm::vec2 q = c + size * glm::vec2(next() - 0.5f, next() - 0.5f);
+      clip.emplace_back(q.x * wv, q.y * wv, 0.0f, wv);
+    }
+    const auto b = static_cast<unsigned>(3 * t);
+    tris.push_back({b, b + 1, b + 2});
+  }
+  const ClipMesh mesh{.clip_positions = clip, .triangles = tris};
+  Rasterizer raster;
+  ASSERT_TRUE(raster.Setup({&mesh, 1}, {.width = w, .height = h, .threads = 1}));
+  // Reference over the whole raster, in setup order (with one thread, id = index).
+  std::vector<float> ref_depth(static_cast<std::size_t>(w * h), 0.0f);
+  std::vector<std::uint32_t> ref_ids(static_cast<std::size_t>(w * h), render::kNoTriangle);
+  std::uint32_t id = 0;
+  int large = 0;
+  raster.ForEachTriangle([&](const render::RasterTriangle& tri) {
+    const std::int64_t area2 = std::int64_t{tri.x[1] - tri.x[0]} * (tri.y[2] - tri.y[0]) -
+                               std::int64_t{tri.y[1] - tri.y[0]} * (tri.x[2] - tri.x[0]);
+    const float inv_area = 1.0f / static_cast<float>(area2);
+    large += tri.max_x - tri.min_x > 48 ? 1 : 0;
+    Rasterizer::ForEachSample(tri, 0, 0, w, h, [&](int x, int y) {
+      float z = 0.0f;
+      for (int i = 0; i < 3; ++i) {
+        const int a = (i + 1) % 3, b = (i + 2) % 3;
+        const std::int32_t dx = tri.x[b] - tri.x[a], dy = tri.y[b] - tri.y[a];
+        const bool top_left = dy < 0 || (dy == 0 && dx > 0);
+        const std::int64_t e =
+            render::EdgeValue(tri.x[a], tri.y[a], tri.x[b], tri.y[b], x, y) - (top_left ? 0 : 1);
+        z = i == 0 ? static_cast<float>(e) * (tri.inv_w[0] * inv_area)
+                   : z + static_cast<float>(e) * (tri.inv_w[i] * inv_area);
+      }
+      const auto at = static_cast<std::size_t>(y * w + x);
+      if (z > ref_depth[at]) {
+        ref_depth[at] = z;
+        ref_ids[at] = id;
+      }
+    });
+    ++id;
+  });
+  ASSERT_GT(large, 10);
+  std::vector<float> depth(render::kTileBufferSize);
+  std::vector<std::uint32_t> ids(render::kTileBufferSize);
+  int covered = 0;
+  for (int tile = 0; tile < raster.num_tiles(); ++tile) {
+    raster.RasterizeTile(tile, depth, ids);
+    const int x0 = (tile % raster.tiles_x()) * render::kTileSize;
+    const int y0 = (tile / raster.tiles_x()) * render::kTileSize;
+    for (int y = y0; y < std::min(y0 + render::kTileSize, h); ++y) {
+      for (int x = x0; x < std::min(x0 + render::kTileSize, w); ++x) {
+        const auto local = static_cast<std::size_t>((y - y0) * render::kTileSize + (x - x0));
+        const auto at = static_cast<std::size_t>(y * w + x);
+        ASSERT_EQ(ids[local], ref_ids[at]) << x << "," << y;
+        ASSERT_EQ(depth[local], ref_depth[at]) << x << "," << y;
+        covered += ids[local] != render::kNoTriangle ? 1 : 0;
+      }
+    }
+  }
+  EXPECT_GT(covered, w * h / 2);
+}
+
 TEST(RasterizerTest, OutputIsIdenticalFor1And2And8Threads) {
   const int w = 200, h = 150;
   const rendertest::TriMesh a = rendertest::MakeSphere(glm::vec3(0.0f, 1.0f, 0.0f), 1.0f, 30, 50);

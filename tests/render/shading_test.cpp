@@ -6,9 +6,11 @@
 #include <cmath>
 #include <vector>
 
+#include <glm/gtc/matrix_transform.hpp>
 #include <gtest/gtest.h>
 
 #include "render/renderer.h"
+#include "render/shading4.h"
 #include "support/tolerances.h"
 #include "tests/render/render_fixtures.h"
 
@@ -192,6 +194,50 @@ TEST(ShadingTest, EmptyTilesMatchBackgroundOfShadedTiles) {
       }
     }
     EXPECT_GT(covered, 5);
+  }
+}
+
+// ShadeSurface4 (four lanes) gives ShadeSurface's bits in every lane: whole and
+// fractional exponents, no specular, lights behind the surface.
+TEST(ShadingTest, ShadeSurface4IsShadeSurfaceBitForBit) {
+  std::uint32_t seed = 99u;
+  auto next = [&seed] {  // deterministic LCG in [-1, 1)
+    seed = seed * 1664525u + 1013904223u;
+    return static_cast<float>(seed >> 8) / 8388608.0f - 1.0f;
+  };
+  const glm::mat4 view = glm::lookAt(glm::vec3(0.5f, 1.2f, 3.0f), glm::vec3(0.0f, 0.8f, 0.0f),
+                                     glm::vec3(0.0f, 1.0f, 0.0f));
+  for (const float shininess : {32.0f, 7.0f, 12.5f}) {
+    for (const float specular : {0.25f, 0.0f}) {
+      render::LightRig rig;
+      rig.shininess = shininess;
+      rig.specular = specular;
+      const render::ShadingContext ctx =
+          render::MakeShadingContext(rig, render::LightingModel::kBlinnPhong, view);
+      int lit = 0;
+      for (int trial = 0; trial < 500; ++trial) {
+        render::SurfacePoints4 in;
+        glm::vec3 albedo[4], normal[4], position[4];
+        for (int k = 0; k < 4; ++k) {
+          albedo[k] = glm::abs(glm::vec3(next(), next(), next()));
+          normal[k] = glm::normalize(glm::vec3(next(), next(), next()) + glm::vec3(0.0f, 0.0f, 0.3f));
+          position[k] = glm::vec3(next(), next() + 1.0f, next());
+          for (int c = 0; c < 3; ++c) {
+            in.albedo[c][k] = albedo[k][c];
+            in.normal[c][k] = normal[k][c];
+            in.position[c][k] = position[k][c];
+          }
+        }
+        float out[3][4];
+        render::ShadeSurface4(ctx, in, out);
+        for (int k = 0; k < 4; ++k) {
+          const glm::vec3 expected = render::ShadeSurface(ctx, albedo[k], normal[k], position[k]);
+          ASSERT_EQ(glm::vec3(out[0][k], out[1][k], out[2][k]), expected) << trial << " lane " << k;
+          lit += expected != albedo[k] * ctx.ambient ? 1 : 0;
+        }
+      }
+      EXPECT_GT(lit, 1000);  // most samples got some light, so the lit terms were compared
+    }
   }
 }
 

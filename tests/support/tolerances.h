@@ -98,6 +98,12 @@ inline constexpr float kClipDepthRelTol = 1e-5f;
 // Shading of a tessellated sphere against the analytic sphere's N.L (the
 // interpolated normal of a 64x128 UV sphere is off by well under 1 degree).
 inline constexpr float kTessellatedShadingTol = 5e-3f;
+// GroundShader (float ray through the sample, hoisted reciprocals, polynomial
+// exp) against GroundAlbedo * ContactShadowFactor at a double-precision ray
+// hit: on a grid line's soft edge (0.04 spacings wide) a 1e-6 relative
+// position error moves the weight by ~1e-3 of the line contrast (0.2); a
+// quarter of one 8-bit step.
+inline constexpr float kGroundShaderTol = 1e-3f;
 // A smoothly varying shaded value read at the pixel containing a projected
 // point rather than at the point itself.
 inline constexpr float kPixelFootprintTol = 2e-2f;
