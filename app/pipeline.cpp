@@ -294,7 +294,7 @@ mocap::JobStatus FramePipeline::AddExampleShapes(Impl& m, std::size_t p) {
       {.model_from_bind = m.palette,
        .dq_palette = dqs ? std::span<const deform::DualQuat>(m.dq_palette)
                          : std::span<const deform::DualQuat>()},
-      rotations);
+      rotations, ds);
   if (!s) return s;
   return deform::PoseSpaceApplyJob{
       .global = m.carried[p], .rotations = rotations, .displacement = ds, .control = m.carried[p]}

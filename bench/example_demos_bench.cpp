@@ -93,6 +93,23 @@ void Update(benchmark::State& state, bool rebuild) {
   (void)deform::CarryControlPointsJob{.patch = &p, .model_from_bind = s.palette, .control = carried}
       .Run();
   const deform::ExamplePose pose{.model_from_bind = s.palette};
+  // How many control points need A at this pose (dS != 0), and how many of
+  // those blend three or more bones (Newton's polar iteration).
+  (void)deform::ComputePoseFeatures(s.character.skeleton, space.features, s.locals, features);
+  (void)deform::PoseSpaceJob{.model = &space.model, .features = features, .displacement = ds}.Run();
+  int moving = 0, three_plus = 0;
+  for (std::size_t c = 0; c < nc; ++c) {
+    if (ds[c] == glm::vec3(0.0f)) continue;
+    ++moving;
+    int bones = 0;
+    for (int i = 0; i < p.control_weights.influences; ++i) {
+      bones += p.control_weights.weights[c * static_cast<std::size_t>(p.control_weights.influences) +
+                                         static_cast<std::size_t>(i)] != 0.0f;
+    }
+    three_plus += bones >= 3;
+  }
+  state.counters["moving"] = moving;
+  state.counters["moving_3plus_bones"] = three_plus;
   for (auto _ : state) {
     if (rebuild) {
       (void)deform::CarryControlPointsJob{.patch = &p, .model_from_bind = s.palette,
@@ -102,7 +119,7 @@ void Update(benchmark::State& state, bool rebuild) {
     (void)deform::ComputePoseFeatures(s.character.skeleton, space.features, s.locals, features);
     (void)deform::PoseSpaceJob{.model = &space.model, .features = features, .displacement = ds}
         .Run();
-    (void)deform::PatchControlRotations(p, pose, rotations);
+    (void)deform::PatchControlRotations(p, pose, rotations, ds);
     (void)deform::PoseSpaceApplyJob{.global = carried, .rotations = rotations, .displacement = ds,
                                     .control = carried}
         .Run();

@@ -302,6 +302,8 @@ glm::dmat3 PolarRotation(const glm::dmat3& m) {
   return PolarBySvd(m);
 }
 
+glm::dmat3 PolarRotationSvd(const glm::dmat3& m) { return PolarBySvd(m); }
+
 JobStatus SsdControlRotations(std::span<const glm::mat4> model_from_bind, int influences,
                               std::span<const std::uint16_t> joint_indices,
                               std::span<const float> joint_weights,

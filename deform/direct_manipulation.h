@@ -132,6 +132,9 @@ mocap::Result<ManipulationResult> MoveBoundVertices(const BSplineSurface& surfac
 // norm, U V^T of its SVD with the sign of the last singular vector flipped if
 // needed so the determinant is +1).
 glm::dmat3 PolarRotation(const glm::dmat3& m);
+// The same factor always by the SVD (OpenCV), the reference the faster
+// iterations (PolarRotation's Newton, PolarRotationNewton) are tested against.
+glm::dmat3 PolarRotationSvd(const glm::dmat3& m);
 
 // 4.3, SSD: A_c = PolarRotation(sum_b W_c,b R_b), R_b the 3x3 part of the
 // palette matrix model_from_bind[b]. `joint_indices` / `joint_weights` are

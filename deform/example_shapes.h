@@ -84,14 +84,26 @@ mocap::Result<SculptedExample> SculptExample(const PatchSetup& patch, const Skin
 // The rotations A_c (#C unit quaternions) the control points of `patch` move
 // with under the global layer: DqsControlRotations when pose.dq_palette is
 // set; otherwise the SSD polar rotation of sum_b W_c,b R_b (4.3), the same
-// rotation SsdControlRotations gives (to round-off) but in closed form for a
-// control point with one or two bones: with R1^T R2 = Rot(a, theta),
-// polar(w1 R1 + w2 R2) = R1 Rot(a, atan2(w2 sin theta, w1 + w2 cos theta)).
-// Control points with more bones, or a palette that is not rigid, take the
-// SVD. Never allocates.
+// rotation SsdControlRotations gives (to round-off, ~1e-12 before the cast to
+// float) but faster: in closed form for a control point with one or two
+// bones (with R1^T R2 = Rot(a, theta),
+// polar(w1 R1 + w2 R2) = R1 Rot(a, atan2(w2 sin theta, w1 + w2 cos theta))),
+// by Newton's polar iteration (PolarRotationNewton) for three or more.
+// Blends with det <= kPolarNewtonMinDet (reflecting or nearly singular), and
+// a palette that is not rigid, take PolarRotation / SsdControlRotations.
+//
+// `displacement` (optional, #C or empty): the dS(theta) these rotations will
+// turn (PoseSpaceJob's output). Where it is exactly (0,0,0), A is not
+// computed and the identity is written: Q = G + A dS is then G for any
+// rotation A, so PoseSpaceApplyJob's result is the same, and the bones only
+// such control points use are not even converted. Control points that no
+// example moves (by default the boundary ring, which direct manipulation
+// keeps fixed) have dS exactly 0 at every pose.
+// kSizeMismatch on a `displacement` of another size. Never allocates.
 [[nodiscard]] mocap::JobStatus PatchControlRotations(const PatchSetup& patch,
                                                      const ExamplePose& pose,
-                                                     std::span<glm::quat> rotations);
+                                                     std::span<glm::quat> rotations,
+                                                     std::span<const glm::vec3> displacement = {});
 
 // What one patch needs per frame for dS: which joints make theta and the
 // fitted interpolant. A default-constructed value (no model) means the patch

@@ -429,3 +429,57 @@ TEST(RigExamples, ControlRotationsMatchThePolarDecomposition) {
 }
 
 }  // namespace
+
+namespace {
+
+// The shoulder demo's patch (samples/data/shoulder.json, 9x6): 36 of its 54
+// control points blend three bones, so PatchControlRotations takes Newton's
+// polar iteration there. Against the SVD of each control point's blend, at
+// every 5th frame of shoulder.bvh (arm raised and lowered).
+TEST(RigExamples, ShoulderThreeBoneRotationsMatchTheSvd) {
+  auto rig = app::LoadRig((kSamples / "shoulder.json").string());
+  ASSERT_TRUE(rig.ok()) << rig.error().ToString();
+  auto source = app::LoadMotionSource(rig->motion, {.y_up = true});
+  ASSERT_TRUE(source.ok()) << source.error().ToString();
+  auto character = app::MakeCharacter(std::move(*source));
+  ASSERT_TRUE(character.ok()) << character.error().ToString();
+  auto patches = app::BuildRigPatches(*rig, *character);
+  ASSERT_TRUE(patches.ok()) << patches.error().ToString();
+  const app::Character& ch = *character;
+  const deform::PatchSetup& p = (*patches)[0];
+  const deform::SkinWeights& w = p.control_weights;
+  const auto k = static_cast<std::size_t>(w.influences);
+  int three_bone = 0;
+  for (std::size_t c = 0; c < p.rest_control.size(); ++c) {
+    int bones = 0;
+    for (std::size_t i = 0; i < k; ++i) bones += w.weights[c * k + i] != 0.0f;
+    three_bone += bones >= 3;
+  }
+  EXPECT_GE(three_bone, 30);
+  const auto nj = static_cast<std::size_t>(ch.skeleton.num_joints());
+  std::vector<mocap::JointTransform> locals(nj);
+  std::vector<glm::mat4> model(nj), palette(ch.mesh.skin_joints.size());
+  std::vector<glm::quat> fast(p.rest_control.size());
+  double worst = 0.0;
+  for (int frame = 0; frame < ch.motion.num_frames; frame += 5) {
+    ASSERT_TRUE((mocap::LocalPoseJob{&ch.skeleton, ch.motion.frame(frame), locals}.Run()));
+    ASSERT_TRUE((mocap::LocalToModelJob{.parents = ch.skeleton.parents, .locals = locals,
+                                        .model_from_joint = model}.Run()));
+    ASSERT_TRUE(deform::BuildSkinningPalette(model, ch.mesh, palette));
+    ASSERT_TRUE(deform::PatchControlRotations(p, {.model_from_bind = palette}, fast));
+    for (std::size_t c = 0; c < fast.size(); ++c) {
+      glm::dmat3 blend(0.0);
+      for (std::size_t i = 0; i < k; ++i) {
+        blend += static_cast<double>(w.weights[c * k + i]) *
+                 glm::dmat3(glm::mat3(palette[w.joints[c * k + i]]));
+      }
+      const glm::quat svd(glm::quat_cast(deform::PolarRotationSvd(blend)));
+      const glm::quat sign = glm::dot(fast[c], svd) < 0.0f ? -svd : svd;
+      const glm::quat diff = fast[c] - sign;
+      worst = std::max(worst, 2.0 * static_cast<double>(glm::length(glm::vec4(diff.x, diff.y, diff.z, diff.w))));
+    }
+  }
+  EXPECT_LT(worst, testsupport::kRotationTolRad);
+}
+
+}  // namespace

@@ -241,3 +241,11 @@ inline constexpr float kElasticVisiblePeakCm = 1.0f;
 inline constexpr float kElasticSettledFraction = 0.05f;
 
 }  // namespace testsupport
+
+namespace testsupport {
+
+// The polar factor of a blend of rotations by Newton's iteration against the
+// SVD's, in double, per matrix entry (the stopping rule leaves ~1e-13).
+inline constexpr double kPolarFactorTol = 1e-10;
+
+}  // namespace testsupport
