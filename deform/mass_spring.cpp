@@ -4,9 +4,11 @@
 #include <cmath>
 #include <cstdio>
 #include <numbers>
+#include <optional>
 #include <string>
 #include <utility>
 
+#include "deform/internal/driving_sampler.h"
 #include "deform/internal/mass_spring_modal.h"
 
 namespace deform {
@@ -52,20 +54,17 @@ class Integrator {
     gravity_ = glm::vec3(glm::dvec3(glm::normalize(p_.down)) * g);
     gravity_bind_ = glm::conjugate(net_.bind_rotation) * gravity_;
     max_accel_ = p_.max_acceleration_mps2 * p_.units_per_metre;
+    // Below this |a|^2 the length is certainly <= max_accel_ (float rounding of
+    // the square is far inside 1%), so most samples skip the square root.
+    surely_below_accel2_ = 0.99f * max_accel_ * max_accel_;
+    if (!job.kinematics.empty()) {
+      sampler_.emplace(job.kinematics, job.num_joints, job.joint, job.frame_time_s);
+    }
   }
 
   Forcing Sample(double t) {
-    DrivingFrame d;
-    if (!job_.kinematics.empty()) {
-      mocap::JointKinematics k;
-      if (mocap::SampleJointKinematics(job_.kinematics, job_.num_joints, job_.joint,
-                                       job_.frame_time_s, t, &k)) {
-        d = {k.rotation, k.local_linear_acceleration, k.local_angular_velocity,
-             k.local_angular_acceleration};
-      }
-    } else {
-      d = (*job_.driving)(t);
-    }
+    // Kinematics: SampleJointKinematics' values (internal/driving_sampler.h).
+    DrivingFrame d = sampler_ ? sampler_->Sample(t) : (*job_.driving)(t);
     MassSpringCounters& c = st_.counters;
     const glm::vec4 q(d.rotation.x, d.rotation.y, d.rotation.z, d.rotation.w);
     if (!Finite(d.linear_acceleration) || !Finite(d.angular_velocity) ||
@@ -74,10 +73,12 @@ class Integrator {
       ++c.non_finite_inputs;  // a glitch: the frame is taken as at rest in the bind pose
       d = DrivingFrame{net_.bind_rotation};
     }
-    const float a_len = glm::length(d.linear_acceleration);
-    if (a_len > max_accel_) {
-      ++c.acceleration_clamps;
-      d.linear_acceleration *= max_accel_ / a_len;
+    if (glm::dot(d.linear_acceleration, d.linear_acceleration) > surely_below_accel2_) {
+      const float a_len = glm::length(d.linear_acceleration);
+      if (a_len > max_accel_) {
+        ++c.acceleration_clamps;
+        d.linear_acceleration *= max_accel_ / a_len;
+      }
     }
     Forcing f;
     f.gain = p_.gain;
@@ -202,18 +203,8 @@ class Integrator {
         ev[c * stride + a] = va[static_cast<int>(c)];
       }
     }
-    for (std::size_t c = 0; c < 3; ++c) {
-      for (std::size_t k = 0; k < n; ++k) {
-        float mx = 0.0f, mv = 0.0f;
-        for (std::size_t a = 0; a < n; ++a) {
-          const float u = net_.modes[a * n + k];
-          mx += u * e[c * stride + a];
-          mv += u * ev[c * stride + a];
-        }
-        x[c * stride + k] = mx;
-        v[c * stride + k] = mv;
-      }
-    }
+    internal::PointsToModal(net_, e, x, job_.allow_avx);
+    internal::PointsToModal(net_, ev, v, job_.allow_avx);
   }
 
   // Accelerations of every free point from point-space springs.
@@ -325,7 +316,8 @@ class Integrator {
   MassSpringState& st_;
   const MassSpringParams& p_;
   glm::vec3 gravity_{0.0f}, gravity_bind_{0.0f};
-  float max_accel_ = 0.0f;
+  float max_accel_ = 0.0f, surely_below_accel2_ = 0.0f;
+  std::optional<internal::KinematicsDrivingSampler> sampler_;
 };
 
 bool UsesModes(const MassSpringNetwork& net) {

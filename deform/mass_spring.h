@@ -138,6 +138,7 @@ struct MassSpringNetwork {
   std::vector<float> mode_lanes;           // 7 x mode_stride, rows: mode_omega2, mode_damping,
                                            // mode_sum, mode_rest x, y, z, mode_max_abs
   std::vector<float> modes_by_mode;        // #free x mode_stride: U[a, k] at [k * stride + a]
+  std::vector<float> modes_by_point;       // #free x mode_stride: U[a, k] at [a * stride + k]
   std::vector<std::string> messages;       // step-rule notes ("time step halved to ...")
 };
 

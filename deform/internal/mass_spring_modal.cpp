@@ -183,31 +183,31 @@ template <typename V>
   return {SumLanes(sum_x16) + SumLanes(sum_x8), SumLanes(sum_v16) + SumLanes(sum_v8)};
 }
 
+// out_c[i] = sum_j m[j * stride + i] in_c[j], j ascending from 0 (the scalar
+// code's order), for lanes i of a group.
 template <typename V>
-[[gnu::always_inline]] inline void ToPointsGroups(const MassSpringNetwork& net, const float* modal,
-                                                  float* points, std::size_t first,
-                                                  std::size_t last) {
-  const std::size_t n = static_cast<std::size_t>(net.num_free);
-  const std::size_t stride = static_cast<std::size_t>(net.mode_stride);
-  const float* u = net.modes_by_mode.data();
-  for (std::size_t a = first; a < last; a += kWidth<V>) {
+[[gnu::always_inline]] inline void MatrixGroups(const float* m, std::size_t n, std::size_t stride,
+                                                const float* in, float* out, std::size_t first,
+                                                std::size_t last) {
+  for (std::size_t i = first; i < last; i += kWidth<V>) {
     V sum[3] = {Splat<V>(0.0f), Splat<V>(0.0f), Splat<V>(0.0f)};
-    for (std::size_t k = 0; k < n; ++k) {
-      const V column = Load<V>(u + k * stride + a);  // U[a .., k]
+    for (std::size_t j = 0; j < n; ++j) {
+      const V column = Load<V>(m + j * stride + i);
 #pragma GCC unroll 3
-      for (std::size_t c = 0; c < 3; ++c) sum[c] = sum[c] + column * Splat<V>(modal[c * stride + k]);
+      for (std::size_t c = 0; c < 3; ++c) sum[c] = sum[c] + column * Splat<V>(in[c * stride + j]);
     }
 #pragma GCC unroll 3
-    for (std::size_t c = 0; c < 3; ++c) Store(points + c * stride + a, sum[c]);
+    for (std::size_t c = 0; c < 3; ++c) Store(out + c * stride + i, sum[c]);
   }
 }
 
-[[gnu::always_inline]] inline void ToPointsBody(const MassSpringNetwork& net, const float* modal,
-                                                float* points) {
+[[gnu::always_inline]] inline void MatrixBody(const MassSpringNetwork& net, const float* m,
+                                              const float* in, float* out) {
+  const std::size_t n = static_cast<std::size_t>(net.num_free);
   const std::size_t n8 = static_cast<std::size_t>(net.mode_stride);
   const std::size_t n16 = n8 / 16 * 16;
-  ToPointsGroups<V16>(net, modal, points, 0, n16);
-  ToPointsGroups<V8>(net, modal, points, n16, n8);
+  MatrixGroups<V16>(m, n, n8, in, out, 0, n16);
+  MatrixGroups<V8>(m, n, n8, in, out, n16, n8);
 }
 
 ModalStepSums StepSse(const MassSpringNetwork& net, const StageCoefficients& s0,
@@ -224,13 +224,13 @@ ModalStepSums StepSse(const MassSpringNetwork& net, const StageCoefficients& s0,
   return StepBody(net, s0, sm, s1, h, x, v, x_out, v_out);
 }
 
-void ToPointsSse(const MassSpringNetwork& net, const float* modal, float* points) {
-  ToPointsBody(net, modal, points);
+void MatrixSse(const MassSpringNetwork& net, const float* m, const float* in, float* out) {
+  MatrixBody(net, m, in, out);
 }
 
-[[gnu::target("avx")]] void ToPointsAvx(const MassSpringNetwork& net, const float* modal,
-                                        float* points) {
-  ToPointsBody(net, modal, points);
+[[gnu::target("avx")]] void MatrixAvx(const MassSpringNetwork& net, const float* m,
+                                      const float* in, float* out) {
+  MatrixBody(net, m, in, out);
 }
 
 bool CpuHasAvx() {
@@ -246,11 +246,14 @@ ModalStepFn SelectModalStep(bool allow_avx) {
 
 void ModalToPoints(const MassSpringNetwork& network, const float* modal, float* points,
                    bool allow_avx) {
-  if (allow_avx && CpuHasAvx()) {
-    ToPointsAvx(network, modal, points);
-  } else {
-    ToPointsSse(network, modal, points);
-  }
+  const float* m = network.modes_by_mode.data();
+  (allow_avx && CpuHasAvx() ? MatrixAvx : MatrixSse)(network, m, modal, points);
+}
+
+void PointsToModal(const MassSpringNetwork& network, const float* points, float* modal,
+                   bool allow_avx) {
+  const float* m = network.modes_by_point.data();
+  (allow_avx && CpuHasAvx() ? MatrixAvx : MatrixSse)(network, m, points, modal);
 }
 
 }  // namespace deform::internal

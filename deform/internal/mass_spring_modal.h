@@ -65,4 +65,8 @@ ModalStepFn SelectModalStep(bool allow_avx);
 void ModalToPoints(const MassSpringNetwork& network, const float* modal, float* points,
                    bool allow_avx);
 
+// The inverse, eta_k = sum_a U[a, k] e_a (a ascending from 0, as the scalar code).
+void PointsToModal(const MassSpringNetwork& network, const float* points, float* modal,
+                   bool allow_avx);
+
 }  // namespace deform::internal
