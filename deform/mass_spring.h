@@ -216,8 +216,8 @@ struct MassSpringStepJob {
   glm::vec3 user_acceleration{0.0f};  // a push (model units/s^2, driving frame) during this run
   std::span<glm::vec3> displacements = {};  // output, M*N: e at time_s in the driving frame
                                       // (boundary entries 0); may be empty
-  bool allow_avx = true;  // modal solver: the AVX step when the CPU has it, else SSE2;
-                          // both give the same bits (false: SSE2, for tests)
+  bool allow_avx = true;  // modal solver: the AVX2+FMA (else AVX) step if the CPU has it;
+                          // false: SSE2, the scalar order's bits (internal/mass_spring_modal.h)
 
   // kMissingInput: no network, state or driving source; kSizeMismatch: state not
   // sized for the network, displacements not M*N; kOutOfRange: kinematics

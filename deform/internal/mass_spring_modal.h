@@ -1,11 +1,15 @@
 #pragma once
 // The modal RK4 step of the elastic layer (deform/mass_spring.h) on padded
-// structure-of-arrays mode data, in 8-float lanes: one template compiled twice,
-// as pairs of SSE2 registers (baseline x86-64) and as AVX registers (chosen at
-// run time). Both perform the same IEEE operations in the same order as the
-// scalar formulation the header documents (no FMA: the build uses
-// -ffp-contract=off and no "fma" target), so a trajectory has the same bits on
-// either path, on any x86-64 machine.
+// structure-of-arrays mode data, in 8-float lanes: one template compiled three
+// times, chosen at run time:
+//  - SSE2 (baseline x86-64, pairs of registers) and AVX: the same IEEE
+//    operations in the same order as the scalar formulation the header documents
+//    (the build uses -ffp-contract=off), so a trajectory has the same bits on
+//    either, on any x86-64 machine ("exact");
+//  - AVX2 + FMA: a * b + c contracted, one rounding instead of two; about twice
+//    as fast, and equal to the exact paths up to float round-off (a damped linear
+//    system: differences stay at round-off level, mass_spring_simd_test).
+// Each is deterministic: same inputs, same bits, whatever the thread count.
 //
 // Layout: a modal vector field (displacement eta or velocity eta') is 3 rows of
 // MassSpringNetwork::mode_stride floats, x row, y row, z row: component c of
@@ -57,7 +61,13 @@ using ModalStepFn = ModalStepSums (*)(const MassSpringNetwork& network,
                                       const StageCoefficients& s1, float h, const float* x,
                                       const float* v, float* x_out, float* v_out);
 
-// The AVX step when `allow_avx` and the CPU has AVX, else the SSE2 step.
+enum class ModalKernel {
+  kFastest,   // AVX2 + FMA when the CPU has both, else AVX, else SSE2
+  kExactAvx,  // AVX when the CPU has it, else SSE2 (same bits either way)
+  kPortable,  // SSE2
+};
+ModalStepFn SelectModalStep(ModalKernel kernel);
+// MassSpringStepJob::allow_avx: true -> kFastest, false -> kPortable.
 ModalStepFn SelectModalStep(bool allow_avx);
 
 // Point-space field e_a = sum_k U[a, k] eta_k of a modal field (both 3 x stride;
