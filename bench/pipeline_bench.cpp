@@ -5,19 +5,31 @@
 // BM_EvaluateBelly: the sample rig samples/data/belly_jump.json (SSD, one 6x6
 // belly patch on the mannequin, the jump) with and without its elastic layer,
 // frame after frame, so the difference is the elastic layer's cost per frame.
+// BM_BellyFrameShare: that cost as a share of a whole rendered frame.
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
+#include <span>
+#include <string>
 #include <utility>
+#include <vector>
 
 #include <benchmark/benchmark.h>
 
 #include "app/demo_data.h"
 #include "app/motion_source.h"
 #include "app/elastic_layer.h"
+#include "app/frame_render.h"
 #include "app/pipeline.h"
 #include "app/rig_file.h"
 #include "app/rig_patches.h"
+#include "mocap/kinematics.h"
+#include "render/camera.h"
+#include "render/image.h"
+#include "render/renderer.h"
 
 namespace {
 
@@ -93,6 +105,90 @@ void BM_EvaluateBelly(benchmark::State& state, bool elastic) {
 
 BENCHMARK_CAPTURE(BM_EvaluateBelly, patch_only, false)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(BM_EvaluateBelly, patch_elastic, true)->Unit(benchmark::kMicrosecond);
+
+double ThreadCpuSeconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
+// The elastic layer's cost per output frame as a share of the whole frame: the
+// belly_jump rig at 30 fps, each iteration one frame of (a) the layered
+// pipeline with the elastic patch (Evaluate) and (b) its render at 1280 x 720,
+// supersample 2, one thread (DrawCharacterFrame, as `patchskin render` draws;
+// PNG encoding not included), while a separate ElasticLayer advances a copy of
+// the same network to the same time (c). Counters (thread CPU time per frame):
+// elastic_us = (c), frame_us = (a) + (b), elastic_share = (c) / ((a) + (b)).
+void BM_BellyFrameShare(benchmark::State& state) {
+  auto rig = app::LoadRig(std::string(PATCHSKIN_SAMPLES_DIR) + "/belly_jump.json");
+  if (!rig.ok()) {
+    state.SkipWithError(rig.error().ToString().c_str());
+    return;
+  }
+  auto src = app::LoadMotionSource(rig->motion, {.y_up = true});
+  if (!src.ok()) std::abort();
+  auto c = app::MakeCharacter(std::move(*src));
+  if (!c.ok()) std::abort();
+  auto patches = app::BuildRigPatches(*rig, *c);
+  auto specs = app::ResolveRigElastic(*rig, *c, *patches);
+  auto pipeline = app::FramePipeline::Create(*c, app::GlobalMethod::kSsd, 1);
+  if (!patches.ok() || !specs.ok() || !pipeline.ok()) std::abort();
+  auto layer = app::ElasticLayer::Create(*c, *patches, *specs);
+  if (!layer.ok()) std::abort();
+  if (!pipeline->SetPatches(std::move(*patches)).ok()) std::abort();
+  if (!pipeline->SetElastic(std::move(*specs)).ok()) std::abort();
+  // Joint matrices of every frame for the separate layer's driving rotation.
+  const mocap::Skeleton& skel = c->skeleton;
+  const std::size_t nj = static_cast<std::size_t>(skel.num_joints());
+  std::vector<mocap::JointTransform> locals(nj);
+  std::vector<glm::mat4> model(static_cast<std::size_t>(c->motion.num_frames) * nj);
+  if (!mocap::ModelMatricesJob{.skeleton = &skel, .motion = &c->motion, .locals = locals,
+                               .model_from_joint = model}
+           .Run()) {
+    std::abort();
+  }
+  app::DeformedFrame frame;
+  if (!pipeline->Evaluate(0.0, frame).ok()) std::abort();
+  render::RenderSettings settings;  // 1280 x 720
+  settings.supersample = 2;
+  settings.threads = 1;
+  const render::Camera camera =
+      render::FrameBounds(frame.bounds, 35.0f, 1280.0f / 720.0f, glm::vec3(0.0f, 0.0f, -1.0f));
+  render::Renderer renderer, unused;
+  render::Image image, scratch;
+  std::vector<std::vector<glm::vec3>> displacements(static_cast<std::size_t>(rig->patches.size()));
+  const double dt = 1.0 / 30.0;
+  const int frames = static_cast<int>(c->motion.duration_s() / dt);
+  const double clip_dt = c->motion.frame_time_s;
+  double elastic_s = 0.0, frame_s = 0.0;
+  int f = 0;
+  for (auto _ : state) {
+    const double t = f * dt;
+    const double t0 = ThreadCpuSeconds();
+    if (!pipeline->Evaluate(t, frame).ok()) std::abort();
+    const app::FrameDrawOptions options{.frame_number = f};
+    if (!app::DrawCharacterFrame(*c, frame, nullptr, camera, settings, options, renderer, unused,
+                                 scratch, image)
+             .ok()) {
+      std::abort();
+    }
+    const double t1 = ThreadCpuSeconds();
+    const std::size_t clip_frame = static_cast<std::size_t>(std::lround(t / clip_dt));
+    const std::span<const glm::mat4> joints(&model[std::min(clip_frame, model.size() / nj - 1) * nj], nj);
+    if (!(*layer)->Advance(t, joints, displacements).ok()) std::abort();
+    const double t2 = ThreadCpuSeconds();
+    frame_s += t1 - t0;
+    elastic_s += t2 - t1;
+    benchmark::DoNotOptimize(image);
+    f = f + 1 < frames ? f + 1 : 0;  // a restart re-simulates from t = 0
+  }
+  const double n = static_cast<double>(state.iterations());
+  state.counters["elastic_us"] = 1e6 * elastic_s / n;
+  state.counters["frame_us"] = 1e6 * frame_s / n;
+  state.counters["elastic_share"] = elastic_s / frame_s;
+}
+
+BENCHMARK(BM_BellyFrameShare)->Unit(benchmark::kMillisecond)->MinTime(3.0);
 
 }  // namespace
 

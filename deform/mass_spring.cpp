@@ -4,8 +4,12 @@
 #include <cmath>
 #include <cstdio>
 #include <numbers>
+#include <optional>
 #include <string>
+#include <utility>
 
+#include "deform/internal/driving_sampler.h"
+#include "deform/internal/mass_spring_modal.h"
 
 namespace deform {
 namespace {
@@ -50,20 +54,17 @@ class Integrator {
     gravity_ = glm::vec3(glm::dvec3(glm::normalize(p_.down)) * g);
     gravity_bind_ = glm::conjugate(net_.bind_rotation) * gravity_;
     max_accel_ = p_.max_acceleration_mps2 * p_.units_per_metre;
+    // Below this |a|^2 the length is certainly <= max_accel_ (float rounding of
+    // the square is far inside 1%), so most samples skip the square root.
+    surely_below_accel2_ = 0.99f * max_accel_ * max_accel_;
+    if (!job.kinematics.empty()) {
+      sampler_.emplace(job.kinematics, job.num_joints, job.joint, job.frame_time_s);
+    }
   }
 
   Forcing Sample(double t) {
-    DrivingFrame d;
-    if (!job_.kinematics.empty()) {
-      mocap::JointKinematics k;
-      if (mocap::SampleJointKinematics(job_.kinematics, job_.num_joints, job_.joint,
-                                       job_.frame_time_s, t, &k)) {
-        d = {k.rotation, k.local_linear_acceleration, k.local_angular_velocity,
-             k.local_angular_acceleration};
-      }
-    } else {
-      d = (*job_.driving)(t);
-    }
+    // Kinematics: SampleJointKinematics' values (internal/driving_sampler.h).
+    DrivingFrame d = sampler_ ? sampler_->Sample(t) : (*job_.driving)(t);
     MassSpringCounters& c = st_.counters;
     const glm::vec4 q(d.rotation.x, d.rotation.y, d.rotation.z, d.rotation.w);
     if (!Finite(d.linear_acceleration) || !Finite(d.angular_velocity) ||
@@ -72,10 +73,12 @@ class Integrator {
       ++c.non_finite_inputs;  // a glitch: the frame is taken as at rest in the bind pose
       d = DrivingFrame{net_.bind_rotation};
     }
-    const float a_len = glm::length(d.linear_acceleration);
-    if (a_len > max_accel_) {
-      ++c.acceleration_clamps;
-      d.linear_acceleration *= max_accel_ / a_len;
+    if (glm::dot(d.linear_acceleration, d.linear_acceleration) > surely_below_accel2_) {
+      const float a_len = glm::length(d.linear_acceleration);
+      if (a_len > max_accel_) {
+        ++c.acceleration_clamps;
+        d.linear_acceleration *= max_accel_ / a_len;
+      }
     }
     Forcing f;
     f.gain = p_.gain;
@@ -88,102 +91,120 @@ class Integrator {
     return f;
   }
 
-  // One RK4 step of every mode, each an independent 3-D oscillator. The modes
-  // are processed in structure-of-arrays form so the loops over k vectorize.
-  void ModalStep(double h_d, const Forcing& f0, const Forcing& fm, const Forcing& f1) {
-    const float h = static_cast<float>(h_d), hh = 0.5f * h;
-    const int n = net_.num_free;
-    const std::size_t ns = static_cast<std::size_t>(n);
-    float x[3][kMaxFree], v[3][kMaxFree], xs[3][kMaxFree], vs[3][kMaxFree];
-    float sx[3][kMaxFree], sv[3][kMaxFree], acc[3][kMaxFree];
-    for (std::size_t k = 0; k < ns; ++k) {
+  // The moving-frame terms as matrices: -gam ([al]x + [w]x^2) acts on positions
+  // (the rigid Euler + centrifugal term on k, and the same on e), -2 gam [w]x on
+  // velocities (Coriolis). Row-major.
+  static internal::StageCoefficients Coefficients(const Forcing& f) {
+    internal::StageCoefficients m;
+    const glm::vec3 w = f.w, al = f.al;
+    const float ww = glm::dot(w, w);
+    const float skew_al[3][3] = {{0, -al.z, al.y}, {al.z, 0, -al.x}, {-al.y, al.x, 0}};
+    const float skew_w[3][3] = {{0, -w.z, w.y}, {w.z, 0, -w.x}, {-w.y, w.x, 0}};
+    for (int r = 0; r < 3; ++r) {
       for (int c = 0; c < 3; ++c) {
-        x[c][k] = st_.position[k][c];
-        v[c][k] = st_.velocity[k][c];
+        const float w2 = w[r] * w[c] - (r == c ? ww : 0.0f);  // [w]x^2 = w w^T - |w|^2 I
+        m.mx[r][c] = -f.gain * (skew_al[r][c] + w2);
+        m.mv[r][c] = -2.0f * f.gain * skew_w[r][c];
+      }
+      m.common[r] = f.common[r];
+    }
+    return m;
+  }
+
+  // Whole RK4 steps of every mode until the step time reaches `until_s`. The
+  // modes live in padded structure-of-arrays buffers for the run (two pairs:
+  // the newest step and the one before, swapped after each step); the state's
+  // vec3 arrays are read once before and written once after.
+  void ModalSteps(double until_s) {
+    const std::size_t n = static_cast<std::size_t>(net_.num_free);
+    const std::size_t stride = static_cast<std::size_t>(net_.mode_stride);
+    alignas(32) float buffers[4][3 * internal::kMaxModeStride];
+    float* x = buffers[0];
+    float* v = buffers[1];
+    float* prev_x = buffers[2];
+    float* prev_v = buffers[3];
+    std::fill(x, x + 3 * stride, 0.0f);
+    std::fill(v, v + 3 * stride, 0.0f);
+    for (std::size_t k = 0; k < n; ++k) {
+      for (std::size_t c = 0; c < 3; ++c) {
+        x[c * stride + k] = st_.position[k][static_cast<int>(c)];
+        v[c * stride + k] = st_.velocity[k][static_cast<int>(c)];
       }
     }
-    const StageMatrices m0(f0), mm(fm), m1(f1);
-    Accelerations(m0, x, v, acc);
-    for (int c = 0; c < 3; ++c) {
-      for (int k = 0; k < n; ++k) {
-        sx[c][k] = v[c][k];
-        sv[c][k] = acc[c][k];
-        xs[c][k] = x[c][k] + hh * v[c][k];
-        vs[c][k] = v[c][k] + hh * acc[c][k];
-      }
+    const internal::ModalStepFn step = internal::SelectModalStep(job_.allow_avx);
+    const double h = net_.time_step_s;
+    internal::StageCoefficients c0 = Coefficients(Sample(st_.step_time_s));
+    while (st_.step_time_s < until_s) {
+      const double t = st_.step_time_s;
+      const internal::StageCoefficients cm = Coefficients(Sample(t + 0.5 * h));
+      const internal::StageCoefficients c1 = Coefficients(Sample(t + h));
+      const internal::ModalStepSums sums =
+          step(net_, c0, cm, c1, static_cast<float>(h), x, v, prev_x, prev_v);
+      std::swap(x, prev_x);
+      std::swap(v, prev_v);
+      ModalLimits(sums, x, v, prev_x, prev_v);
+      st_.step_time_s = t + h;
+      ++st_.counters.steps;
+      c0 = c1;
     }
-    Accelerations(mm, xs, vs, acc);
-    for (int c = 0; c < 3; ++c) {
-      for (int k = 0; k < n; ++k) {
-        sx[c][k] += 2.0f * vs[c][k];
-        sv[c][k] += 2.0f * acc[c][k];
-        xs[c][k] = x[c][k] + hh * vs[c][k];
-        vs[c][k] = v[c][k] + hh * acc[c][k];
-      }
-    }
-    Accelerations(mm, xs, vs, acc);
-    for (int c = 0; c < 3; ++c) {
-      for (int k = 0; k < n; ++k) {
-        sx[c][k] += 2.0f * vs[c][k];
-        sv[c][k] += 2.0f * acc[c][k];
-        xs[c][k] = x[c][k] + h * vs[c][k];
-        vs[c][k] = v[c][k] + h * acc[c][k];
-      }
-    }
-    Accelerations(m1, xs, vs, acc);
-    for (std::size_t k = 0; k < ns; ++k) {
-      st_.prev_position[k] = st_.position[k];
-      st_.prev_velocity[k] = st_.velocity[k];
-      for (int c = 0; c < 3; ++c) {
-        st_.position[k][c] = x[c][k] + (h / 6.0f) * (sx[c][k] + vs[c][k]);
-        st_.velocity[k][c] = v[c][k] + (h / 6.0f) * (sv[c][k] + acc[c][k]);
+    for (std::size_t k = 0; k < n; ++k) {
+      for (std::size_t c = 0; c < 3; ++c) {
+        const int ci = static_cast<int>(c);
+        st_.position[k][ci] = x[c * stride + k];
+        st_.velocity[k][ci] = v[c * stride + k];
+        st_.prev_position[k][ci] = prev_x[c * stride + k];
+        st_.prev_velocity[k][ci] = prev_v[c * stride + k];
       }
     }
   }
 
-  // The moving-frame terms as matrices: -gam ([al]x + [w]x^2) acts on positions
-  // (the rigid Euler + centrifugal term on k, and the same on e), -2 gam [w]x on
-  // velocities (Coriolis). Row-major.
-  struct StageMatrices {
-    float mx[3][3], mv[3][3], common[3];
-    explicit StageMatrices(const Forcing& f) {
-      const glm::vec3 w = f.w, al = f.al;
-      const float ww = glm::dot(w, w);
-      const float skew_al[3][3] = {{0, -al.z, al.y}, {al.z, 0, -al.x}, {-al.y, al.x, 0}};
-      const float skew_w[3][3] = {{0, -w.z, w.y}, {w.z, 0, -w.x}, {-w.y, w.x, 0}};
-      for (int r = 0; r < 3; ++r) {
-        for (int c = 0; c < 3; ++c) {
-          const float w2 = w[r] * w[c] - (r == c ? ww : 0.0f);  // [w]x^2 = w w^T - |w|^2 I
-          mx[r][c] = -f.gain * (skew_al[r][c] + w2);
-          mv[r][c] = -2.0f * f.gain * skew_w[r][c];
-        }
-        common[r] = f.common[r];
+  // ApplyLimits on the modal buffers (3 x stride each) of the newest step.
+  void ModalLimits(const internal::ModalStepSums& sums, float* x, float* v, float* prev_x,
+                   float* prev_v) {
+    const std::size_t n = static_cast<std::size_t>(net_.num_free);
+    const std::size_t stride = static_cast<std::size_t>(net_.mode_stride);
+    if (!std::isfinite(sums.sum_x) || !std::isfinite(sums.sum_v)) {
+      ++st_.counters.non_finite_resets;
+      for (float* a : {x, v, prev_x, prev_v}) std::fill(a, a + 3 * stride, 0.0f);
+      return;
+    }
+    // U is orthonormal, so |e_a|^2 <= sum_k |eta_k|^2; also |e_a| <= sum_k u_k |eta_k|
+    // with u_k = max_a |U[a, k]|. Below e_max by either bound nothing can exceed.
+    const float e_max = p_.max_displacement;
+    if (sums.sum_x <= e_max * e_max) return;
+    const float* u_max = net_.mode_lanes.data() + internal::kLaneMaxAbs * stride;
+    float bound = 0.0f;
+    for (std::size_t k = 0; k < n; ++k) {
+      bound += u_max[k] * glm::length(glm::vec3(x[k], x[stride + k], x[2 * stride + k]));
+    }
+    if (bound <= e_max) return;
+    alignas(32) float e[3 * internal::kMaxModeStride];
+    internal::ModalToPoints(net_, x, e, job_.allow_avx);
+    const auto point = [stride](const float* f, std::size_t a) {
+      return glm::vec3(f[a], f[stride + a], f[2 * stride + a]);
+    };
+    bool any = false;
+    for (std::size_t a = 0; a < n && !any; ++a) any = glm::length(point(e, a)) > e_max;
+    if (!any) return;
+    // The clamp itself (rare): point space, then back to modes.
+    alignas(32) float ev[3 * internal::kMaxModeStride];
+    internal::ModalToPoints(net_, v, ev, job_.allow_avx);
+    for (std::size_t a = 0; a < n; ++a) {
+      glm::vec3 ea = point(e, a), va = point(ev, a);
+      const float len = glm::length(ea);
+      if (len <= e_max) continue;
+      const glm::vec3 dir = ea / len;
+      ea = dir * e_max;
+      const float outward = glm::dot(va, dir);
+      if (outward > 0.0f) va -= outward * dir;
+      ++st_.counters.displacement_clamps;
+      for (std::size_t c = 0; c < 3; ++c) {
+        e[c * stride + a] = ea[static_cast<int>(c)];
+        ev[c * stride + a] = va[static_cast<int>(c)];
       }
     }
-  };
-
-  void Accelerations(const StageMatrices& m, const float (*x)[kMaxFree],
-                     const float (*v)[kMaxFree], float (*acc)[kMaxFree]) const {
-    const int n = net_.num_free;
-    const float* w2 = net_.mode_omega2.data();
-    const float* cd = net_.mode_damping.data();
-    const float* sk = net_.mode_sum.data();
-    const float* px = net_.mode_rest_soa.data();
-    const float* py = px + n;
-    const float* pz = py + n;
-    for (int c = 0; c < 3; ++c) {
-      const float* r = m.mx[c];
-      const float* q = m.mv[c];
-      const float cc = m.common[c];
-      float* out = acc[c];
-      const float* xc = x[c];
-      const float* vc = v[c];
-      for (int k = 0; k < n; ++k) {
-        out[k] = sk[k] * cc + r[0] * (px[k] + x[0][k]) + r[1] * (py[k] + x[1][k]) +
-                 r[2] * (pz[k] + x[2][k]) + q[0] * v[0][k] + q[1] * v[1][k] + q[2] * v[2][k] -
-                 w2[k] * xc[k] - cd[k] * vc[k];
-      }
-    }
+    internal::PointsToModal(net_, e, x, job_.allow_avx);
+    internal::PointsToModal(net_, ev, v, job_.allow_avx);
   }
 
   // Accelerations of every free point from point-space springs.
@@ -258,8 +279,9 @@ class Integrator {
     }
   }
 
-  // |e_a| <= e_max with the outward velocity removed; non-finite state resets.
-  void ApplyLimits(bool modal) {
+  // |e_a| <= e_max with the outward velocity removed; non-finite state resets
+  // (point-space state; ModalLimits does the same for the modes).
+  void ApplyLimits() {
     const std::size_t n = static_cast<std::size_t>(net_.num_free);
     const float e_max = p_.max_displacement;
     float sum_x = 0.0f, sum_v = 0.0f;
@@ -275,24 +297,8 @@ class Integrator {
       std::fill(st_.prev_velocity.begin(), st_.prev_velocity.end(), glm::vec3(0.0f));
       return;
     }
-    // U is orthonormal, so |e_a|^2 <= sum_k |eta_k|^2; also |e_a| <= sum_k u_k |eta_k|
-    // with u_k = max_a |U[a, k]|. Below e_max by either bound nothing can exceed.
     if (sum_x <= e_max * e_max) return;
-    if (modal) {
-      float bound = 0.0f;
-      for (std::size_t k = 0; k < n; ++k) {
-        bound += net_.mode_max_abs[k] * glm::length(st_.position[k]);
-      }
-      if (bound <= e_max) return;
-    }
     std::span<glm::vec3> e(st_.position), v(st_.velocity);
-    if (modal) {
-      e = std::span<glm::vec3>(st_.work).subspan(0, n);
-      v = std::span<glm::vec3>(st_.work).subspan(n, n);
-      ToPoints(st_.position, e);
-      ToPoints(st_.velocity, v);
-    }
-    bool changed = false;
     for (std::size_t a = 0; a < n; ++a) {
       const float len = glm::length(e[a]);
       if (len <= e_max) continue;
@@ -301,29 +307,6 @@ class Integrator {
       const float outward = glm::dot(v[a], dir);
       if (outward > 0.0f) v[a] -= outward * dir;
       ++st_.counters.displacement_clamps;
-      changed = true;
-    }
-    if (modal && changed) {
-      ToModes(e, st_.position);
-      ToModes(v, st_.velocity);
-    }
-  }
-
-  void ToPoints(std::span<const glm::vec3> modal, std::span<glm::vec3> points) const {
-    const std::size_t n = static_cast<std::size_t>(net_.num_free);
-    for (std::size_t a = 0; a < n; ++a) {
-      glm::vec3 sum(0.0f);
-      const float* row = &net_.modes[a * n];
-      for (std::size_t k = 0; k < n; ++k) sum += row[k] * modal[k];
-      points[a] = sum;
-    }
-  }
-  void ToModes(std::span<const glm::vec3> points, std::span<glm::vec3> modal) const {
-    const std::size_t n = static_cast<std::size_t>(net_.num_free);
-    std::fill(modal.begin(), modal.end(), glm::vec3(0.0f));
-    for (std::size_t a = 0; a < n; ++a) {
-      const float* row = &net_.modes[a * n];
-      for (std::size_t k = 0; k < n; ++k) modal[k] += row[k] * points[a];
     }
   }
 
@@ -333,7 +316,8 @@ class Integrator {
   MassSpringState& st_;
   const MassSpringParams& p_;
   glm::vec3 gravity_{0.0f}, gravity_bind_{0.0f};
-  float max_accel_ = 0.0f;
+  float max_accel_ = 0.0f, surely_below_accel2_ = 0.0f;
+  std::optional<internal::KinematicsDrivingSampler> sampler_;
 };
 
 bool UsesModes(const MassSpringNetwork& net) {
@@ -406,18 +390,16 @@ JobStatus MassSpringStepJob::Run() const {
   }
   const bool modal = UsesModes(net);
   Integrator integrator(*this);
-  if (st.step_time_s < time_s - eps) {
+  if (modal && st.step_time_s < time_s - eps) {
+    integrator.ModalSteps(time_s - eps);
+  } else if (st.step_time_s < time_s - eps) {
     Forcing f0 = integrator.Sample(st.step_time_s);
     while (st.step_time_s < time_s - eps) {
       const double t = st.step_time_s;
       const Forcing fm = integrator.Sample(t + 0.5 * h);
       const Forcing f1 = integrator.Sample(t + h);
-      if (modal) {
-        integrator.ModalStep(h, f0, fm, f1);
-      } else {
-        integrator.PointStep(h, f0, fm, f1);
-      }
-      integrator.ApplyLimits(modal);
+      integrator.PointStep(h, f0, fm, f1);
+      integrator.ApplyLimits();
       st.step_time_s = t + h;
       ++st.counters.steps;
       f0 = f1;
@@ -434,20 +416,24 @@ JobStatus MassSpringStepJob::Run() const {
   for (std::size_t a = 0; a < n; ++a) {
     blended[a] = st.prev_position[a] + alpha * (st.position[a] - st.prev_position[a]);
   }
-  std::span<glm::vec3> points = std::span<glm::vec3>(st.work).subspan(3 * n, n);
-  if (modal) {
-    for (std::size_t a = 0; a < n; ++a) {
-      glm::vec3 sum(0.0f);
-      const float* row = &net.modes[a * n];
-      for (std::size_t k = 0; k < n; ++k) sum += row[k] * blended[k];
-      points[a] = sum;
-    }
-  } else {
-    std::copy(blended.begin(), blended.end(), points.begin());
-  }
   std::fill(displacements.begin(), displacements.end(), glm::vec3(0.0f));
+  if (modal) {  // e = U eta with the modes in lanes (internal/mass_spring_modal.h)
+    const std::size_t stride = static_cast<std::size_t>(net.mode_stride);
+    alignas(32) float eta[3 * internal::kMaxModeStride];
+    alignas(32) float e[3 * internal::kMaxModeStride];
+    std::fill(eta, eta + 3 * stride, 0.0f);  // the padding lanes
+    for (std::size_t k = 0; k < n; ++k) {
+      for (std::size_t c = 0; c < 3; ++c) eta[c * stride + k] = blended[k][static_cast<int>(c)];
+    }
+    internal::ModalToPoints(net, eta, e, allow_avx);
+    for (std::size_t a = 0; a < n; ++a) {
+      displacements[static_cast<std::size_t>(net.point_of_free[a])] =
+          glm::vec3(e[a], e[stride + a], e[2 * stride + a]);
+    }
+    return mocap::kJobOk;
+  }
   for (std::size_t a = 0; a < n; ++a) {
-    displacements[static_cast<std::size_t>(net.point_of_free[a])] = points[a];
+    displacements[static_cast<std::size_t>(net.point_of_free[a])] = blended[a];
   }
   return mocap::kJobOk;
 }

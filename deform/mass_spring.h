@@ -132,6 +132,13 @@ struct MassSpringNetwork {
   std::vector<glm::vec3> mode_rest;        // #free: sum_a U[a, k] k_a
   std::vector<float> mode_max_abs;         // #free: max_a |U[a, k]| (cheap limit check)
   std::vector<float> mode_rest_soa;        // 3 x #free: mode_rest as x..., y..., z... (SoA)
+  // The same per-mode data padded for the SIMD step (internal/mass_spring_modal.h):
+  // #free rounded up to a whole number of 8-float lanes; padding lanes hold 0.
+  int mode_stride = 0;                     // #free rounded up to a multiple of 8
+  std::vector<float> mode_lanes;           // 7 x mode_stride, rows: mode_omega2, mode_damping,
+                                           // mode_sum, mode_rest x, y, z, mode_max_abs
+  std::vector<float> modes_by_mode;        // #free x mode_stride: U[a, k] at [k * stride + a]
+  std::vector<float> modes_by_point;       // #free x mode_stride: U[a, k] at [a * stride + k]
   std::vector<std::string> messages;       // step-rule notes ("time step halved to ...")
 };
 
@@ -209,6 +216,8 @@ struct MassSpringStepJob {
   glm::vec3 user_acceleration{0.0f};  // a push (model units/s^2, driving frame) during this run
   std::span<glm::vec3> displacements = {};  // output, M*N: e at time_s in the driving frame
                                       // (boundary entries 0); may be empty
+  bool allow_avx = true;  // modal solver: the AVX2+FMA (else AVX) step if the CPU has it;
+                          // false: SSE2, the scalar order's bits (internal/mass_spring_modal.h)
 
   // kMissingInput: no network, state or driving source; kSizeMismatch: state not
   // sized for the network, displacements not M*N; kOutOfRange: kinematics

@@ -1,0 +1,144 @@
+#include "deform/internal/mass_spring_modal.h"
+
+#include <cmath>
+
+// The 8-lane helpers pass vectors by value, but all of them are internal and
+// always inlined into their callers, so no call crosses the ABI GCC warns about.
+#pragma GCC diagnostic ignored "-Wpsabi"
+
+namespace deform::internal {
+namespace {
+
+// Eight floats as one GCC vector: an AVX register in the target("avx"...)
+// functions below (GCC lowers it through memory where AVX is off).
+namespace native {
+inline constexpr bool kPairGroups = true;  // 16-lane groups (two registers per value)
+typedef float V8 __attribute__((vector_size(32)));
+typedef float V8Unaligned __attribute__((vector_size(32), aligned(4)));
+[[gnu::always_inline]] inline V8 SplatV8(float x) { return x - V8{}; }  // x - (+0) is x, even -0
+[[gnu::always_inline]] inline V8 LoadV8(const float* p) { return *reinterpret_cast<const V8Unaligned*>(p); }
+[[gnu::always_inline]] inline void StoreV8(float* p, const V8& v) { *reinterpret_cast<V8Unaligned*>(p) = v; }
+[[gnu::always_inline]] inline float SumV8(const V8& v) {
+  float s = v[0];
+  for (int l = 1; l < 8; ++l) s += v[l];
+  return s;
+}
+}  // namespace native
+
+// Eight floats as two SSE2 registers, for the baseline path.
+namespace sse2 {
+inline constexpr bool kPairGroups = false;  // 8-lane groups: already two registers per value
+typedef float V4 __attribute__((vector_size(16)));
+typedef float V4Unaligned __attribute__((vector_size(16), aligned(4)));
+struct V8 {
+  V4 lo, hi;
+};
+[[gnu::always_inline]] inline V8 operator+(const V8& a, const V8& b) { return {a.lo + b.lo, a.hi + b.hi}; }
+[[gnu::always_inline]] inline V8 operator-(const V8& a, const V8& b) { return {a.lo - b.lo, a.hi - b.hi}; }
+[[gnu::always_inline]] inline V8 operator*(const V8& a, const V8& b) { return {a.lo * b.lo, a.hi * b.hi}; }
+[[gnu::always_inline]] inline V8 SplatV8(float x) {
+  const V4 b = x - V4{};
+  return {b, b};
+}
+[[gnu::always_inline]] inline V8 LoadV8(const float* p) {
+  return {*reinterpret_cast<const V4Unaligned*>(p), *reinterpret_cast<const V4Unaligned*>(p + 4)};
+}
+[[gnu::always_inline]] inline void StoreV8(float* p, const V8& v) {
+  *reinterpret_cast<V4Unaligned*>(p) = v.lo;
+  *reinterpret_cast<V4Unaligned*>(p + 4) = v.hi;
+}
+[[gnu::always_inline]] inline float SumV8(const V8& v) {  // lanes 0..7 in order, as native
+  float s = v.lo[0];
+  for (int l = 1; l < 4; ++l) s += v.lo[l];
+  for (int l = 0; l < 4; ++l) s += v.hi[l];
+  return s;
+}
+}  // namespace sse2
+
+// As written: the same IEEE operations as the scalar formulation (the build
+// has -ffp-contract=off).
+namespace exact_sse2 {
+using namespace sse2;
+#include "deform/internal/mass_spring_modal_kernel.inc"
+}  // namespace exact_sse2
+
+namespace exact_avx {
+using namespace native;
+#include "deform/internal/mass_spring_modal_kernel.inc"
+}  // namespace exact_avx
+
+// AVX2 with a * b + c contracted into FMA: fewer instructions and shorter
+// dependency chains, with one rounding where the scalar code has two.
+#pragma GCC push_options
+#pragma GCC target("avx2,fma")
+#pragma GCC optimize("fp-contract=fast")
+namespace fused {
+using namespace native;
+#include "deform/internal/mass_spring_modal_kernel.inc"
+}  // namespace fused
+
+ModalStepSums StepFma(const MassSpringNetwork& net, const StageCoefficients& s0,
+                      const StageCoefficients& sm, const StageCoefficients& s1, float h,
+                      const float* x, const float* v, float* x_out, float* v_out) {
+  return fused::StepBody(net, s0, sm, s1, h, x, v, x_out, v_out);
+}
+#pragma GCC pop_options
+
+ModalStepSums StepSse(const MassSpringNetwork& net, const StageCoefficients& s0,
+                      const StageCoefficients& sm, const StageCoefficients& s1, float h,
+                      const float* x, const float* v, float* x_out, float* v_out) {
+  return exact_sse2::StepBody(net, s0, sm, s1, h, x, v, x_out, v_out);
+}
+
+[[gnu::target("avx")]] ModalStepSums StepAvx(const MassSpringNetwork& net,
+                                             const StageCoefficients& s0,
+                                             const StageCoefficients& sm,
+                                             const StageCoefficients& s1, float h, const float* x,
+                                             const float* v, float* x_out, float* v_out) {
+  return exact_avx::StepBody(net, s0, sm, s1, h, x, v, x_out, v_out);
+}
+
+void MatrixSse(const MassSpringNetwork& net, const float* m, const float* in, float* out) {
+  exact_sse2::MatrixBody(net, m, in, out);
+}
+
+[[gnu::target("avx")]] void MatrixAvx(const MassSpringNetwork& net, const float* m,
+                                      const float* in, float* out) {
+  exact_avx::MatrixBody(net, m, in, out);
+}
+
+bool CpuHasAvx() {
+  static const bool has = __builtin_cpu_supports("avx");
+  return has;
+}
+
+bool CpuHasAvx2Fma() {
+  static const bool has = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+  return has;
+}
+
+}  // namespace
+
+ModalStepFn SelectModalStep(ModalKernel kernel) {
+  if (kernel == ModalKernel::kFastest && CpuHasAvx2Fma()) return &StepFma;
+  if (kernel != ModalKernel::kPortable && CpuHasAvx()) return &StepAvx;
+  return &StepSse;
+}
+
+ModalStepFn SelectModalStep(bool allow_avx) {
+  return SelectModalStep(allow_avx ? ModalKernel::kFastest : ModalKernel::kPortable);
+}
+
+void ModalToPoints(const MassSpringNetwork& network, const float* modal, float* points,
+                   bool allow_avx) {
+  const float* m = network.modes_by_mode.data();
+  (allow_avx && CpuHasAvx() ? MatrixAvx : MatrixSse)(network, m, modal, points);
+}
+
+void PointsToModal(const MassSpringNetwork& network, const float* points, float* modal,
+                   bool allow_avx) {
+  const float* m = network.modes_by_point.data();
+  (allow_avx && CpuHasAvx() ? MatrixAvx : MatrixSse)(network, m, points, modal);
+}
+
+}  // namespace deform::internal

@@ -1,0 +1,82 @@
+#pragma once
+// The modal RK4 step of the elastic layer (deform/mass_spring.h) on padded
+// structure-of-arrays mode data, in 8-float lanes: one template compiled three
+// times, chosen at run time:
+//  - SSE2 (baseline x86-64, pairs of registers) and AVX: the same IEEE
+//    operations in the same order as the scalar formulation the header documents
+//    (the build uses -ffp-contract=off), so a trajectory has the same bits on
+//    either, on any x86-64 machine ("exact");
+//  - AVX2 + FMA: a * b + c contracted, one rounding instead of two; about twice
+//    as fast, and equal to the exact paths up to float round-off (a damped linear
+//    system: differences stay at round-off level, mass_spring_simd_test).
+// Each is deterministic: same inputs, same bits, whatever the thread count.
+//
+// Layout: a modal vector field (displacement eta or velocity eta') is 3 rows of
+// MassSpringNetwork::mode_stride floats, x row, y row, z row: component c of
+// mode k at [c * stride + k]. Padding lanes (k >= #free) hold 0 and stay 0.
+
+#include <cstddef>
+
+#include "deform/mass_spring.h"
+
+namespace deform::internal {
+
+// Floats per SIMD lane group; MassSpringNetwork::mode_stride is a multiple of it.
+inline constexpr int kModeLanes = 8;
+// Largest mode_stride: (16 - 2)^2 = 196 free points, rounded up to 200.
+inline constexpr int kMaxModeStride = 200;
+
+// Rows of MassSpringNetwork::mode_lanes.
+enum ModeLaneField : int {
+  kLaneOmega2 = 0,   // (2 pi f_k)^2
+  kLaneDamping = 1,  // c_k / m
+  kLaneSum = 2,      // sum_a U[a, k]
+  kLaneRestX = 3,    // sum_a U[a, k] k_a, x
+  kLaneRestY = 4,
+  kLaneRestZ = 5,
+  kLaneMaxAbs = 6,   // max_a |U[a, k]|
+};
+
+// The moving-frame terms of one RK4 stage time, per unit mass, as matrices
+// acting on all modes alike (row-major):
+//   eta_k'' = sum_k common + mx (rest_k + eta_k) + mv eta_k' - omega2_k eta_k - damping_k eta_k'
+// with mx = -gam ([al]x + [w]x^2), mv = -2 gam [w]x and common = -gam a + gravity + push.
+struct StageCoefficients {
+  float mx[3][3] = {};
+  float mv[3][3] = {};
+  float common[3] = {};
+};
+
+// Sums of the new state the limit check needs (ALGORITHMS.md 6 limits):
+struct ModalStepSums {
+  float sum_x = 0.0f;  // sum_k |eta_k|^2 (>= |e_a|^2 for every point: U orthonormal)
+  float sum_v = 0.0f;  // sum_k |eta'_k|^2
+};
+
+// One RK4 step of every mode, from (x, v) at t to (x_out, v_out) at t + h, with
+// the coefficients at t, t + h/2 and t + h. Arrays: 3 x mode_stride each (see the
+// layout above); outputs must not alias inputs.
+using ModalStepFn = ModalStepSums (*)(const MassSpringNetwork& network,
+                                      const StageCoefficients& s0, const StageCoefficients& sm,
+                                      const StageCoefficients& s1, float h, const float* x,
+                                      const float* v, float* x_out, float* v_out);
+
+enum class ModalKernel {
+  kFastest,   // AVX2 + FMA when the CPU has both, else AVX, else SSE2
+  kExactAvx,  // AVX when the CPU has it, else SSE2 (same bits either way)
+  kPortable,  // SSE2
+};
+ModalStepFn SelectModalStep(ModalKernel kernel);
+// MassSpringStepJob::allow_avx: true -> kFastest, false -> kPortable.
+ModalStepFn SelectModalStep(bool allow_avx);
+
+// Point-space field e_a = sum_k U[a, k] eta_k of a modal field (both 3 x stride;
+// k summed in ascending order from 0, as the scalar code does).
+void ModalToPoints(const MassSpringNetwork& network, const float* modal, float* points,
+                   bool allow_avx);
+
+// The inverse, eta_k = sum_a U[a, k] e_a (a ascending from 0, as the scalar code).
+void PointsToModal(const MassSpringNetwork& network, const float* points, float* modal,
+                   bool allow_avx);
+
+}  // namespace deform::internal

@@ -1,0 +1,245 @@
+// The modal solver's SIMD step (deform/internal/mass_spring_modal.h): the exact
+// AVX and SSE2 kernels give the same bits, the portable one the bits of the
+// scalar formulation the header documents (same operations in the same order),
+// and the fastest (AVX2 + FMA) follows them within float round-off, for mode
+// counts that use every lane grouping (16-lane groups, an 8-lane tail).
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdint>
+#include <cstring>
+#include <functional>
+#include <tuple>
+#include <utility>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "deform/mass_spring.h"
+#include "deform/internal/mass_spring_modal.h"
+#include "support/tolerances.h"
+
+namespace {
+
+using deform::DrivingFrame;
+using deform::MassSpringNetwork;
+using deform::MassSpringParams;
+using deform::MassSpringState;
+using deform::MassSpringStepJob;
+using DriveFn = std::function<DrivingFrame(double)>;
+using namespace testsupport;
+
+MassSpringNetwork Build(int rows, int cols, const MassSpringParams& params) {
+  std::vector<glm::vec3> points;
+  for (int i = 0; i < rows; ++i)
+    for (int j = 0; j < cols; ++j)
+      points.emplace_back(2.0f * static_cast<float>(j), 0.3f * static_cast<float>(i * j),
+                          2.0f * static_cast<float>(i));
+  auto net = deform::BuildMassSpringNetwork(
+      {.rows = rows, .cols = cols, .rest_points = points, .max_angular_speed_rad_s = 3.0f},
+      params);
+  EXPECT_TRUE(net.ok()) << net.error().ToString();
+  return std::move(net).value();
+}
+
+bool SameBits(const std::vector<glm::vec3>& a, const std::vector<glm::vec3>& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(glm::vec3)) == 0;
+}
+
+// Grid sizes, their mode counts and lane groups: 4x4: 4 (one 8-lane group),
+// 5x5: 9 (one 16-lane group), 6x9: 28 (two 16-lane groups), 8x8: 36 (two 16-lane
+// groups and an 8-lane one), 16x16: 196 (twelve and one).
+constexpr std::pair<int, int> kGrids[] = {{4, 4}, {5, 5}, {6, 9}, {8, 8}, {16, 16}};
+
+// The exact kernels (SSE2 and AVX) step by step from the same states and
+// coefficients: the same bits, sums included.
+TEST(MassSpringSimd, ExactAvxAndSse2KernelsGiveTheSameBits) {
+  if (!__builtin_cpu_supports("avx")) GTEST_SKIP() << "this CPU has no AVX: only the SSE2 path runs";
+  using deform::internal::ModalKernel;
+  const auto avx = deform::internal::SelectModalStep(ModalKernel::kExactAvx);
+  const auto sse = deform::internal::SelectModalStep(ModalKernel::kPortable);
+  ASSERT_NE(avx, sse);
+  for (const auto& [rows, cols] : kGrids) {
+    SCOPED_TRACE(testing::Message() << rows << "x" << cols);
+    const MassSpringNetwork net = Build(rows, cols, {});
+    const std::size_t size = 3 * static_cast<std::size_t>(net.mode_stride);
+    std::vector<float> x(size, 0.0f), v(size, 0.0f);
+    for (std::size_t c = 0; c < 3; ++c) {
+      for (int k = 0; k < net.num_free; ++k) {  // padding lanes stay 0
+        x[c * size / 3 + static_cast<std::size_t>(k)] = std::sin(0.7f * static_cast<float>(k) + static_cast<float>(c));
+        v[c * size / 3 + static_cast<std::size_t>(k)] = 3.0f * std::cos(1.3f * static_cast<float>(k * (c + 1)));
+      }
+    }
+    std::vector<float> xa(size), va(size), xb(size), vb(size);
+    deform::internal::StageCoefficients s[3];
+    for (int step = 0; step < 200; ++step) {
+      for (int i = 0; i < 3; ++i) {
+        const float t = 0.01f * static_cast<float>(step * 3 + i);
+        for (int r = 0; r < 3; ++r) {
+          for (int c = 0; c < 3; ++c) {
+            s[i].mx[r][c] = 2.0f * std::sin(t + static_cast<float>(r * 3 + c));
+            s[i].mv[r][c] = r == c ? 0.0f : std::cos(2.0f * t + static_cast<float>(r - c));
+          }
+          s[i].common[r] = 400.0f * std::sin(3.0f * t + static_cast<float>(r));
+        }
+      }
+      const float h = static_cast<float>(net.time_step_s);
+      const auto sa = avx(net, s[0], s[1], s[2], h, x.data(), v.data(), xa.data(), va.data());
+      const auto sb = sse(net, s[0], s[1], s[2], h, x.data(), v.data(), xb.data(), vb.data());
+      ASSERT_EQ(std::memcmp(xa.data(), xb.data(), size * sizeof(float)), 0) << "step " << step;
+      ASSERT_EQ(std::memcmp(va.data(), vb.data(), size * sizeof(float)), 0) << "step " << step;
+      ASSERT_EQ(std::memcmp(&sa, &sb, sizeof sa), 0) << "step " << step;
+      x = xa;
+      v = va;
+    }
+    EXPECT_GT(std::abs(x[0]), 0.0f);
+  }
+}
+
+// The job with the fastest kernel (AVX2 + FMA where the CPU has it) against the
+// portable one over 100 s of a gentle drive (no limit reached): FMA rounds once
+// where the exact kernels round twice, and the damped linear system keeps the
+// difference at round-off level.
+TEST(MassSpringSimd, FastestKernelFollowsThePortableOne) {
+  const DriveFn drive = [](double t) {
+    const float s = static_cast<float>(std::sin(4.0 * t)), c = static_cast<float>(std::cos(2.5 * t));
+    return DrivingFrame{glm::angleAxis(0.4f * s, glm::vec3(0, 1, 0)),
+                        glm::vec3(150.0f * s, 60.0f * c, -40.0f * s * c), glm::vec3(0.2f, 0.8f * c, 0.1f),
+                        glm::vec3(0.5f, -2.0f * s, 0.3f * c)};
+  };
+  for (const auto& [rows, cols] : kGrids) {
+    SCOPED_TRACE(testing::Message() << rows << "x" << cols);
+    const MassSpringNetwork net = Build(rows, cols, {});
+    MassSpringState fast, portable;
+    fast.Resize(net);
+    portable.Resize(net);
+    const std::size_t points = static_cast<std::size_t>(rows * cols);
+    std::vector<glm::vec3> out_fast(points), out_portable(points);
+    float peak = 0.0f, worst = 0.0f;
+    const int frames = rows == 16 ? 300 : 3000;
+    for (int f = 0; f < frames; ++f) {
+      for (auto [state, out, allow] :
+           {std::tuple{&fast, &out_fast, true}, {&portable, &out_portable, false}}) {
+        const MassSpringStepJob job{.network = &net, .state = state, .time_s = f / 30.0,
+                                    .driving = &drive, .displacements = *out, .allow_avx = allow};
+        ASSERT_TRUE(job.Run());
+      }
+      for (std::size_t a = 0; a < points; ++a) {
+        peak = std::max(peak, glm::length(out_portable[a]));
+        worst = std::max(worst, glm::length(out_fast[a] - out_portable[a]));
+      }
+    }
+    ASSERT_EQ(fast.counters.any_limit(), 0);
+    EXPECT_GT(peak, 0.1f);
+    EXPECT_LE(worst, kFusedKernelRelTol * peak);
+    std::printf("%dx%d: peak %.4f, largest fastest - portable difference %.3g\n", rows, cols,
+                double(peak), double(worst));
+  }
+}
+
+// The scalar formulation of deform/mass_spring.h, one mode and one component at
+// a time, in the order the header's equations are written: with no limit
+// reached, the SIMD paths must reproduce it bit for bit.
+struct ScalarModes {
+  std::vector<glm::vec3> x, v;
+};
+
+void ScalarStage(const MassSpringNetwork& net, const DrivingFrame& d, const ScalarModes& in,
+                 ScalarModes& acc) {
+  const float gain = net.params.gain;
+  const glm::vec3 common = -gain * d.linear_acceleration + glm::vec3(0.0f);
+  const glm::vec3 w = d.angular_velocity, al = d.angular_acceleration;
+  const float ww = glm::dot(w, w);
+  const float skew_al[3][3] = {{0, -al.z, al.y}, {al.z, 0, -al.x}, {-al.y, al.x, 0}};
+  const float skew_w[3][3] = {{0, -w.z, w.y}, {w.z, 0, -w.x}, {-w.y, w.x, 0}};
+  float mx[3][3], mv[3][3];
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) {
+      mx[r][c] = -gain * (skew_al[r][c] + (w[r] * w[c] - (r == c ? ww : 0.0f)));
+      mv[r][c] = -2.0f * gain * skew_w[r][c];
+    }
+  }
+  for (std::size_t k = 0; k < in.x.size(); ++k) {
+    const glm::vec3 e = net.mode_rest[k] + in.x[k];
+    for (int c = 0; c < 3; ++c) {
+      acc.x[k][c] = net.mode_sum[k] * common[c] + mx[c][0] * e.x + mx[c][1] * e.y +
+                    mx[c][2] * e.z + mv[c][0] * in.v[k].x + mv[c][1] * in.v[k].y +
+                    mv[c][2] * in.v[k].z - net.mode_omega2[k] * in.x[k][c] -
+                    net.mode_damping[k] * in.v[k][c];
+    }
+  }
+}
+
+void ScalarStep(const MassSpringNetwork& net, const DriveFn& drive, double t, ScalarModes& z) {
+  const float h = static_cast<float>(net.time_step_s), hh = 0.5f * h;
+  const double hd = net.time_step_s;
+  const std::size_t n = z.x.size();
+  ScalarModes acc{std::vector<glm::vec3>(n), {}}, s{z.v, {}}, zs{z.x, z.v};
+  s.v.resize(n);
+  const DrivingFrame f0 = drive(t), fm = drive(t + 0.5 * hd), f1 = drive(t + hd);
+  ScalarStage(net, f0, z, acc);
+  for (std::size_t k = 0; k < n; ++k) {
+    s.v[k] = acc.x[k];
+    zs.x[k] = z.x[k] + hh * z.v[k];
+    zs.v[k] = z.v[k] + hh * acc.x[k];
+  }
+  for (const float step : {hh, h}) {
+    ScalarStage(net, fm, zs, acc);
+    for (std::size_t k = 0; k < n; ++k) {
+      s.x[k] = s.x[k] + 2.0f * zs.v[k];
+      s.v[k] = s.v[k] + 2.0f * acc.x[k];
+      zs.x[k] = z.x[k] + step * zs.v[k];
+      zs.v[k] = z.v[k] + step * acc.x[k];
+    }
+  }
+  ScalarStage(net, f1, zs, acc);
+  for (std::size_t k = 0; k < n; ++k) {
+    z.x[k] = z.x[k] + (h / 6.0f) * (s.x[k] + zs.v[k]);
+    z.v[k] = z.v[k] + (h / 6.0f) * (s.v[k] + acc.x[k]);
+  }
+}
+
+TEST(MassSpringSimd, BothPathsMatchTheScalarFormulation) {
+  const DriveFn drive = [](double t) {  // gentle: no limit is reached
+    const float s = static_cast<float>(std::sin(6.0 * t));
+    return DrivingFrame{glm::quat(1, 0, 0, 0), glm::vec3(80.0f * s, 30.0f, -20.0f * s),
+                        glm::vec3(0.3f, 1.2f * s, 0.1f), glm::vec3(0.5f, -7.0f * s, 0.2f)};
+  };
+  for (const auto& [rows, cols] : {std::pair{5, 5}, {7, 7}, {8, 8}}) {
+    SCOPED_TRACE(testing::Message() << rows << "x" << cols);
+    MassSpringParams p;
+    p.gravity = false;
+    const MassSpringNetwork net = Build(rows, cols, p);
+    const std::size_t n = static_cast<std::size_t>(net.num_free);
+    for (const bool allow_avx : {true, false}) {
+      MassSpringState state;
+      state.Resize(net);
+      const int frames = 90;
+      for (int f = 0; f < frames; ++f) {
+        const MassSpringStepJob job{.network = &net, .state = &state, .time_s = f / 30.0,
+                                    .driving = &drive, .allow_avx = allow_avx};
+        ASSERT_TRUE(job.Run());
+      }
+      ASSERT_EQ(state.counters.any_limit(), 0);
+      ScalarModes z{std::vector<glm::vec3>(n), std::vector<glm::vec3>(n)};
+      double t = 0.0;
+      for (std::int64_t step = 0; step < state.counters.steps; ++step) {
+        ScalarStep(net, drive, t, z);
+        t += net.time_step_s;
+      }
+      if (!allow_avx) {  // the portable (exact) kernel: bit for bit
+        EXPECT_TRUE(SameBits(z.x, state.position));
+        EXPECT_TRUE(SameBits(z.v, state.velocity));
+      } else {  // the fastest: FMA where the CPU has it
+        for (std::size_t k = 0; k < n; ++k) {
+          EXPECT_LE(glm::length(z.x[k] - state.position[k]),
+                    kFusedKernelRelTol * glm::length(z.x[k]) + kFusedKernelAbsTol);
+        }
+      }
+      EXPECT_GT(glm::length(state.position[0]), 0.01f);  // the drive moved it
+    }
+  }
+}
+
+}  // namespace
