@@ -55,7 +55,8 @@ void BM_MassSpringCallback(benchmark::State& bench, int size, deform::MassSpring
 
 // Driving frame sampled from the jump's per-frame kinematics (hips, 120 fps) by
 // mocap::SampleJointKinematics at every RK4 stage time; loops over the clip.
-void BM_MassSpringSampled(benchmark::State& bench, int size) {
+// fma: MassSpringStepJob::allow_fma (the AVX2+FMA step; rounded differently, off by default).
+void BM_MassSpringSampled(benchmark::State& bench, int size, bool fma) {
   const deform::MassSpringNetwork net = MakeNetwork(size, deform::MassSpringSolver::kModal);
   deform::MassSpringState state;
   state.Resize(net);
@@ -71,7 +72,7 @@ void BM_MassSpringSampled(benchmark::State& bench, int size) {
     const deform::MassSpringStepJob job{
         .network = &net, .state = &state, .time_s = (frame++ % frames30) / 30.0,
         .kinematics = kin, .num_joints = skel.num_joints(), .joint = skel.FindJoint("Hips"),
-        .frame_time_s = options.frame_time_s, .displacements = disp};
+        .frame_time_s = options.frame_time_s, .displacements = disp, .allow_fma = fma};
     benchmark::DoNotOptimize(job.Run());
     benchmark::DoNotOptimize(disp.data());
   }
@@ -85,7 +86,9 @@ BENCHMARK_CAPTURE(BM_MassSpringCallback, modal_5x5, 5, deform::MassSpringSolver:
 BENCHMARK_CAPTURE(BM_MassSpringCallback, modal_7x7, 7, deform::MassSpringSolver::kModal);
 BENCHMARK_CAPTURE(BM_MassSpringCallback, point_5x5, 5, deform::MassSpringSolver::kPointSpace);
 BENCHMARK_CAPTURE(BM_MassSpringCallback, point_7x7, 7, deform::MassSpringSolver::kPointSpace);
-BENCHMARK_CAPTURE(BM_MassSpringSampled, modal_5x5, 5);
-BENCHMARK_CAPTURE(BM_MassSpringSampled, modal_7x7, 7);
+BENCHMARK_CAPTURE(BM_MassSpringSampled, modal_5x5, 5, false);
+BENCHMARK_CAPTURE(BM_MassSpringSampled, modal_7x7, 7, false);
+BENCHMARK_CAPTURE(BM_MassSpringSampled, modal_5x5_fma, 5, true);
+BENCHMARK_CAPTURE(BM_MassSpringSampled, modal_7x7_fma, 7, true);
 
 BENCHMARK_MAIN();

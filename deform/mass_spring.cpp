@@ -131,7 +131,7 @@ class Integrator {
         v[c * stride + k] = st_.velocity[k][static_cast<int>(c)];
       }
     }
-    const internal::ModalStepFn step = internal::SelectModalStep(job_.allow_avx);
+    const internal::ModalStepFn step = internal::SelectModalStep(job_.allow_avx, job_.allow_fma);
     const double h = net_.time_step_s;
     internal::StageCoefficients c0 = Coefficients(Sample(st_.step_time_s));
     while (st_.step_time_s < until_s) {

@@ -216,8 +216,12 @@ struct MassSpringStepJob {
   glm::vec3 user_acceleration{0.0f};  // a push (model units/s^2, driving frame) during this run
   std::span<glm::vec3> displacements = {};  // output, M*N: e at time_s in the driving frame
                                       // (boundary entries 0); may be empty
-  bool allow_avx = true;  // modal solver: the AVX2+FMA (else AVX) step if the CPU has it;
-                          // false: SSE2, the scalar order's bits (internal/mass_spring_modal.h)
+  bool allow_avx = true;   // modal solver: the AVX step if the CPU has it, else SSE2; both
+                           // give the scalar order's bits (internal/mass_spring_modal.h)
+  bool allow_fma = false;  // with allow_avx: the AVX2+FMA step where the CPU has it, about
+                           // twice as fast but rounded differently, so frames would then
+                           // differ between CPUs with and without FMA (a render farm's chunks
+                           // must match); off by default
 
   // kMissingInput: no network, state or driving source; kSizeMismatch: state not
   // sized for the network, displacements not M*N; kOutOfRange: kinematics

@@ -125,8 +125,9 @@ ModalStepFn SelectModalStep(ModalKernel kernel) {
   return &StepSse;
 }
 
-ModalStepFn SelectModalStep(bool allow_avx) {
-  return SelectModalStep(allow_avx ? ModalKernel::kFastest : ModalKernel::kPortable);
+ModalStepFn SelectModalStep(bool allow_avx, bool allow_fma) {
+  if (!allow_avx) return SelectModalStep(ModalKernel::kPortable);
+  return SelectModalStep(allow_fma ? ModalKernel::kFastest : ModalKernel::kExactAvx);
 }
 
 void ModalToPoints(const MassSpringNetwork& network, const float* modal, float* points,

@@ -67,8 +67,10 @@ enum class ModalKernel {
   kPortable,  // SSE2
 };
 ModalStepFn SelectModalStep(ModalKernel kernel);
-// MassSpringStepJob::allow_avx: true -> kFastest, false -> kPortable.
-ModalStepFn SelectModalStep(bool allow_avx);
+// MassSpringStepJob's switches: allow_avx and allow_fma -> kFastest, allow_avx
+// alone -> kExactAvx (the default: the same bits on every x86-64 CPU), neither ->
+// kPortable.
+ModalStepFn SelectModalStep(bool allow_avx, bool allow_fma);
 
 // Point-space field e_a = sum_k U[a, k] eta_k of a modal field (both 3 x stride;
 // k summed in ascending order from 0, as the scalar code does).

@@ -122,7 +122,8 @@ TEST(MassSpringSimd, FastestKernelFollowsThePortableOne) {
       for (auto [state, out, allow] :
            {std::tuple{&fast, &out_fast, true}, {&portable, &out_portable, false}}) {
         const MassSpringStepJob job{.network = &net, .state = state, .time_s = f / 30.0,
-                                    .driving = &drive, .displacements = *out, .allow_avx = allow};
+                                    .driving = &drive, .displacements = *out, .allow_avx = allow,
+                                    .allow_fma = allow};
         ASSERT_TRUE(job.Run());
       }
       for (std::size_t a = 0; a < points; ++a) {
@@ -212,13 +213,15 @@ TEST(MassSpringSimd, BothPathsMatchTheScalarFormulation) {
     p.gravity = false;
     const MassSpringNetwork net = Build(rows, cols, p);
     const std::size_t n = static_cast<std::size_t>(net.num_free);
-    for (const bool allow_avx : {true, false}) {
+    // (AVX, FMA): the default (exact AVX), the fastest (FMA where the CPU has it), SSE2.
+    for (const auto& [allow_avx, allow_fma] : {std::pair{true, false}, {true, true}, {false, false}}) {
       MassSpringState state;
       state.Resize(net);
       const int frames = 90;
       for (int f = 0; f < frames; ++f) {
         const MassSpringStepJob job{.network = &net, .state = &state, .time_s = f / 30.0,
-                                    .driving = &drive, .allow_avx = allow_avx};
+                                    .driving = &drive, .allow_avx = allow_avx,
+                                    .allow_fma = allow_fma};
         ASSERT_TRUE(job.Run());
       }
       ASSERT_EQ(state.counters.any_limit(), 0);
@@ -228,7 +231,7 @@ TEST(MassSpringSimd, BothPathsMatchTheScalarFormulation) {
         ScalarStep(net, drive, t, z);
         t += net.time_step_s;
       }
-      if (!allow_avx) {  // the portable (exact) kernel: bit for bit
+      if (!allow_fma) {  // the exact kernels (SSE2, AVX): bit for bit
         EXPECT_TRUE(SameBits(z.x, state.position));
         EXPECT_TRUE(SameBits(z.v, state.velocity));
       } else {  // the fastest: FMA where the CPU has it
