@@ -83,6 +83,74 @@ mocap::Result<std::vector<mocap::JointKinematics>> DrivingKinematics(
   return kin;
 }
 
+mocap::Result<std::vector<mocap::JointKinematics>> DrivingKinematicsOf(
+    const mocap::Skeleton& skeleton, const mocap::Motion& motion, std::span<const int> joints,
+    double cutoff_hz, const glm::mat4& model_from_root) {
+  const auto fail = [&](const std::string& what) {
+    return mocap::MakeError(mocap::ErrorCode::kInvalidArgument,
+                            {skeleton.info.source_file, 0, 0, {}}, "joint kinematics: " + what);
+  };
+  const std::size_t nj = static_cast<std::size_t>(skeleton.num_joints());
+  const std::size_t nd = joints.size();
+  if (nd == 0) return fail("no driving joints");
+  for (std::size_t d = 0; d < nd; ++d) {
+    if (joints[d] < 0 || static_cast<std::size_t>(joints[d]) >= nj) {
+      return fail("driving joint " + std::to_string(joints[d]) + " out of range");
+    }
+    if (std::find(joints.begin(), joints.begin() + static_cast<std::ptrdiff_t>(d), joints[d]) !=
+        joints.begin() + static_cast<std::ptrdiff_t>(d)) {
+      return fail("driving joint " + std::to_string(joints[d]) + " listed twice");
+    }
+  }
+  if (motion.num_frames < 1) return fail("motion has no frames");
+  const std::size_t nf = static_cast<std::size_t>(motion.num_frames);
+  // Model matrices of every joint, a chunk of frames at a time; keep the
+  // driving columns. Each frame's matrices depend on that frame alone.
+  constexpr std::size_t kChunkFrames = 256;
+  std::vector<mocap::JointTransform> locals(nj);
+  std::vector<glm::mat4> chunk(nj * std::min(kChunkFrames, nf));
+  std::vector<glm::mat4> raw(nd * nf);
+  for (std::size_t first = 0; first < nf; first += kChunkFrames) {
+    const std::size_t count = std::min(kChunkFrames, nf - first);
+    const std::span<glm::mat4> out = std::span(chunk).first(count * nj);
+    const mocap::JobStatus s = mocap::ModelMatricesJob{.skeleton = &skeleton,
+                                                       .motion = &motion,
+                                                       .first_frame = static_cast<int>(first),
+                                                       .model_from_root = model_from_root,
+                                                       .locals = locals,
+                                                       .model_from_joint = out}
+                                   .Run();
+    if (!s) return fail(s.what);
+    for (std::size_t k = 0; k < count; ++k) {
+      for (std::size_t d = 0; d < nd; ++d) {
+        raw[(first + k) * nd + d] = out[k * nj + static_cast<std::size_t>(joints[d])];
+      }
+    }
+  }
+  chunk = {};
+  locals = {};
+  const int num_columns = static_cast<int>(nd);
+  if (cutoff_hz > 0.0) {
+    std::vector<glm::mat4> smooth(nd * nf);
+    const mocap::JobStatus s = mocap::SmoothTrajectoriesJob{.model_from_joint = raw,
+                                                            .num_joints = num_columns,
+                                                            .frame_time_s = motion.frame_time_s,
+                                                            .cutoff_hz = cutoff_hz,
+                                                            .output = smooth}
+                                   .Run();
+    if (!s) return fail(s.what);
+    raw = std::move(smooth);  // frees the unsmoothed columns before kin is allocated
+  }
+  std::vector<mocap::JointKinematics> kin(nd * nf);
+  const mocap::JobStatus s = mocap::KinematicsJob{.model_from_joint = raw,
+                                                  .num_joints = num_columns,
+                                                  .frame_time_s = motion.frame_time_s,
+                                                  .output = kin}
+                                 .Run();
+  if (!s) return fail(s.what);
+  return kin;
+}
+
 mocap::Result<std::vector<ElasticPatchSpec>> ResolveRigElastic(
     const Rig& rig, const Character& character, std::span<const deform::PatchSetup> patches) {
   std::vector<ElasticPatchSpec> specs;
@@ -129,31 +197,46 @@ mocap::Result<std::unique_ptr<ElasticLayer>> ElasticLayer::Create(
   mocap::Result<std::vector<glm::mat4>> bind = BindModelFromJoint(c);
   if (!bind.ok()) return std::move(bind).error();
   const std::size_t nj = static_cast<std::size_t>(c.skeleton.num_joints());
-  for (ElasticPatchSpec& spec : specs) {
+  // One compact kinematics table per distinct cutoff, with a column per
+  // distinct driving joint of the patches using that cutoff.
+  for (const ElasticPatchSpec& spec : specs) {
     if (spec.patch < 0 || static_cast<std::size_t>(spec.patch) >= patches.size()) {
       return ElasticError(c, spec.patch, "", "patch index out of range");
     }
     if (spec.joint < 0 || static_cast<std::size_t>(spec.joint) >= nj) {
       return ElasticError(c, spec.patch, ".joint", "driving joint out of range");
     }
+    auto group = std::find_if(layer->kinematics_.begin(), layer->kinematics_.end(),
+                              [&](const Kinematics& k) { return k.cutoff_hz == spec.cutoff_hz; });
+    if (group == layer->kinematics_.end()) {
+      layer->kinematics_.push_back({spec.cutoff_hz, {}, {}});
+      group = layer->kinematics_.end() - 1;
+    }
+    if (std::find(group->joints.begin(), group->joints.end(), spec.joint) == group->joints.end()) {
+      group->joints.push_back(spec.joint);
+    }
+  }
+  for (Kinematics& k : layer->kinematics_) {
+    auto kin = DrivingKinematicsOf(c.skeleton, c.motion, k.joints, k.cutoff_hz, c.world_from_model);
+    if (!kin.ok()) return std::move(kin).error();
+    k.frames = std::move(*kin);
+  }
+  for (ElasticPatchSpec& spec : specs) {
     const deform::PatchSetup& ps = patches[static_cast<std::size_t>(spec.patch)];
     Patch p;
     p.spec = spec;
-    p.kinematics = -1;
     for (std::size_t k = 0; k < layer->kinematics_.size(); ++k) {
       if (layer->kinematics_[k].cutoff_hz == spec.cutoff_hz) p.kinematics = static_cast<int>(k);
     }
-    if (p.kinematics < 0) {
-      auto kin = DrivingKinematics(c.skeleton, c.motion, spec.cutoff_hz, c.world_from_model);
-      if (!kin.ok()) return std::move(kin).error();
-      layer->kinematics_.push_back({spec.cutoff_hz, std::move(*kin)});
-      p.kinematics = static_cast<int>(layer->kinematics_.size() - 1);
-    }
-    const std::vector<mocap::JointKinematics>& kin =
-        layer->kinematics_[static_cast<std::size_t>(p.kinematics)].frames;
+    const Kinematics& table = layer->kinematics_[static_cast<std::size_t>(p.kinematics)];
+    p.slot = static_cast<int>(std::find(table.joints.begin(), table.joints.end(), spec.joint) -
+                              table.joints.begin());
+    const std::size_t nd = table.joints.size();
+    // Step rule: the driving joint's largest angular speed over the whole
+    // motion, from its column of the compact table.
     float max_w = 0.0f;
     for (std::size_t f = 0; f < static_cast<std::size_t>(c.motion.num_frames); ++f) {
-      max_w = std::max(max_w, glm::length(kin[f * nj + static_cast<std::size_t>(spec.joint)]
+      max_w = std::max(max_w, glm::length(table.frames[f * nd + static_cast<std::size_t>(p.slot)]
                                               .local_angular_velocity));
     }
     // Rest control points in the driving joint's (rigid) bind frame.
@@ -186,13 +269,14 @@ mocap::Result<std::unique_ptr<ElasticLayer>> ElasticLayer::Create(
 mocap::Status ElasticLayer::RunAll(double time_s) {
   const Character& c = *character_;
   for (Patch& p : patches_) {
+    const Kinematics& table = kinematics_[static_cast<std::size_t>(p.kinematics)];
     const mocap::JobStatus s =
         deform::MassSpringStepJob{.network = &p.network,
                                   .state = &p.state,
                                   .time_s = time_s,
-                                  .kinematics = kinematics_[static_cast<std::size_t>(p.kinematics)].frames,
-                                  .num_joints = c.skeleton.num_joints(),
-                                  .joint = p.spec.joint,
+                                  .kinematics = table.frames,
+                                  .num_joints = static_cast<int>(table.joints.size()),
+                                  .joint = p.slot,
                                   .frame_time_s = c.motion.frame_time_s,
                                   .displacements = p.local}
             .Run();

@@ -88,11 +88,14 @@ class ElasticLayer {
     deform::MassSpringCounters baseline;  // counters at the last restart
     std::vector<glm::vec3> local;         // #M x #N displacement in the joint frame
     int kinematics = 0;                   // index into kinematics_
+    int slot = 0;                         // column of spec.joint in that table
     float displacement = 0.0f;
   };
+  // The driving joints sharing one cutoff, and their kinematics only.
   struct Kinematics {
     double cutoff_hz = 0.0;
-    std::vector<mocap::JointKinematics> frames;  // #F x #J
+    std::vector<int> joints;                     // #D distinct skeleton joints
+    std::vector<mocap::JointKinematics> frames;  // #F x #D, column d = joints[d]
   };
   mocap::Status RunAll(double time_s);
 
@@ -112,5 +115,18 @@ class ElasticLayer {
 mocap::Result<std::vector<mocap::JointKinematics>> DrivingKinematics(
     const mocap::Skeleton& skeleton, const mocap::Motion& motion, double cutoff_hz,
     const glm::mat4& model_from_root = glm::mat4(1.0f));
+
+// The same kinematics for the listed joints only: a compact #F x #D table,
+// frame-major, column d holding joints[d] (any order, no repeats, each in
+// [0, #J)). Bit-identical to the matching entries of DrivingKinematics: the
+// smoothing and the differences work per joint column. Memory: the model
+// matrices are evaluated CHUNK frames at a time (#J x 64 B x chunk) and only
+// the listed columns kept, so the peak is #F x #D x (64 + 124) B plus a
+// constant, instead of #F x #J x 252 B. Errors (kInvalidArgument) as
+// DrivingKinematics, and for a joint list that is empty, repeats a joint or
+// holds one out of range.
+mocap::Result<std::vector<mocap::JointKinematics>> DrivingKinematicsOf(
+    const mocap::Skeleton& skeleton, const mocap::Motion& motion, std::span<const int> joints,
+    double cutoff_hz, const glm::mat4& model_from_root = glm::mat4(1.0f));
 
 }  // namespace app

@@ -198,8 +198,9 @@ struct MassSpringState {
 
 // Advances a state to `time_s` and writes the displacement there.
 // Driving kinematics, one of:
-//  - `kinematics` (per-frame buffer of ComputeKinematics / KinematicsJob, all #F x #J)
-//    with `num_joints`, `joint` and `frame_time_s`: sampled by
+//  - `kinematics` (per-frame buffer of ComputeKinematics / KinematicsJob, all #F x #J,
+//    or a compact #F x #D table of some joints only, num_joints = #D and `joint`
+//    the column) with `num_joints`, `joint` and `frame_time_s`: sampled by
 //    mocap::SampleJointKinematics at every RK4 stage time;
 //  - `driving`: a callback giving the frame at any time (tests, procedural input).
 // Resets (zero state, then preroll_s of simulation) on the first run, when time
