@@ -40,13 +40,17 @@ glm::dvec4 Evaluate(const GltfChannel& channel, double t) {
   };
   const std::vector<float>& times = channel.times_s;
   const std::size_t n = times.size();
-  if (n == 1 || t <= times.front()) return read(0, value_offset);
-  if (t >= times.back()) return read(n - 1, value_offset);
-  // First key strictly after t: segment [k, k+1] with times[k] <= t < times[k+1].
+  // Key times are floats, and a time is placed among them as a float: a time computed
+  // in double as "key k" must land on key k even where the double lies a hair below
+  // the float key. Every test below uses that same float, so k1 stays inside the keys
+  // (comparing the ends in double once let a time just below the last key run the
+  // search past the end: found by AddressSanitizer). !(tf > front) takes NaN to key 0.
+  const float tf = static_cast<float>(t);
+  if (n == 1 || !(tf > times.front())) return read(0, value_offset);
+  if (tf >= times.back()) return read(n - 1, value_offset);
+  // First key strictly after tf: segment [k, k+1] with times[k] <= tf < times[k+1].
   const std::size_t k1 =
-      static_cast<std::size_t>(std::upper_bound(times.begin(), times.end(), static_cast<float>(t),
-                                                [](float a, float b) { return a < b; }) -
-                               times.begin());
+      static_cast<std::size_t>(std::upper_bound(times.begin(), times.end(), tf) - times.begin());
   const std::size_t k = k1 - 1;
   const double t0 = times[k];
   const double dt = static_cast<double>(times[k1]) - t0;

@@ -22,7 +22,7 @@ void EvaluateWeights(const GltfWeightsChannel& channel, float t, std::span<float
   auto copy_key = [&](std::size_t k) { std::copy_n(key(k, value_offset), w, out.begin()); };
   const std::vector<float>& times = channel.times_s;
   const std::size_t n = times.size();
-  if (n == 1 || t <= times.front()) return copy_key(0);
+  if (n == 1 || !(t > times.front())) return copy_key(0);  // a NaN time too
   if (t >= times.back()) return copy_key(n - 1);
   const auto k1 = static_cast<std::size_t>(std::upper_bound(times.begin(), times.end(), t) - times.begin());
   const std::size_t k = k1 - 1;  // times[k] <= t < times[k1]

@@ -14,6 +14,7 @@
 
 #include <gtest/gtest.h>
 
+#include "support/sanitizer.h"
 #include "support/data_paths.h"
 #include "support/long_capture.h"
 #include "support/run_process.h"
@@ -70,6 +71,7 @@ Measured RenderElastic(const fs::path& dir, int frames) {
 }
 
 TEST(ElasticLongCapture, PeakMemoryGrowsOnlyWithTheMotionDataAndTheDrivingJointsTable) {
+  PATCHSKIN_SKIP_MEMORY_BOUND_UNDER_ASAN();
   const fs::path dir = testsupport::TestOutputPath("elastic_long_capture/x").parent_path();
   fs::remove_all(dir);
   fs::create_directories(dir);

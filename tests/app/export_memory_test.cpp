@@ -14,6 +14,7 @@
 
 #include <gtest/gtest.h>
 
+#include "support/sanitizer.h"
 #include "support/data_paths.h"
 #include "support/gltf_writer.h"
 #include "support/run_process.h"
@@ -104,6 +105,7 @@ fs::path Dir() {
 }
 
 TEST(ExportMemory, ObjSequenceDoesNotGrowWithTheFrameCount) {
+  PATCHSKIN_SKIP_MEMORY_BOUND_UNDER_ASAN();
   const fs::path dir = Dir();
   const int side = 24;  // 576 vertices: 50 KB of OBJ per frame
   const fs::path grid = WriteGrid(dir, side);
@@ -115,6 +117,7 @@ TEST(ExportMemory, ObjSequenceDoesNotGrowWithTheFrameCount) {
 }
 
 TEST(ExportMemory, GlbDoesNotHoldTheFrames) {
+  PATCHSKIN_SKIP_MEMORY_BOUND_UNDER_ASAN();
   const fs::path dir = Dir();
   const int side = 64;  // 4096 vertices: 98 KB of data per frame (~10 KB of bookkeeping)
   const fs::path grid = WriteGrid(dir, side);

@@ -98,6 +98,24 @@ TEST(GltfAnimation, StepHoldsTheEarlierKey) {
   ExpectVec3(SampleJoint(model, model.skeleton.FindJoint("root"), 1.5).translation, {0, 0, 0}, kFloatTol);
 }
 
+// A time a hair below the last key in double that rounds to it as a float used to
+// run the key search past the end (AddressSanitizer: heap-buffer-overflow); it must
+// give the last key's value, as must every later time. A NaN time gives the first key.
+TEST(GltfAnimation, TimeJustBelowTheLastKeyStaysInsideTheKeys) {
+  GltfWriter w = TwoJointTriangle();
+  const float last = 0.1f;  // not a double: its double value lies off every float-sized step
+  AddChannel(w, 1, "translation", "LINEAR", {0.0f, last}, {0, 0, 0, 2, 4, 6});
+  const GltfModel model = Load(w, "edge_time.gltf");
+  ASSERT_EQ(model.animations.size(), 1u);
+  const int tip = model.skeleton.FindJoint("tip");
+  const double below = std::nextafter(static_cast<double>(last), 0.0);
+  ASSERT_LT(below, static_cast<double>(last));
+  ASSERT_EQ(static_cast<float>(below), last);  // the case: equal once rounded to float
+  ExpectVec3(SampleJoint(model, tip, below).translation, {2, 4, 6}, kFloatTol);
+  ExpectVec3(SampleJoint(model, tip, static_cast<double>(last)).translation, {2, 4, 6}, kFloatTol);
+  ExpectVec3(SampleJoint(model, tip, std::nan("")).translation, {0, 0, 0}, kFloatTol);
+}
+
 // Hermite basis written out independently of the importer.
 glm::vec3 Hermite(const glm::vec3& v0, const glm::vec3& out0, const glm::vec3& in1, const glm::vec3& v1,
                   float dt, float s) {
