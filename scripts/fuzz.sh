@@ -9,6 +9,11 @@
 # run, leaves the input in build/fuzz/artifacts/<target>/ and fails this
 # script; fix the bug and copy the input to fuzz/corpus/<target>/ so the
 # ctest replay keeps it fixed.
+#
+# FUZZ_RUNS (optional, with FUZZ_SEED, default 1) also caps the number of inputs
+# per target: with a fixed seed and a count the run is the same sequence of
+# inputs on every machine, so CI tries exactly what was tried before landing
+# (scripts/ci_extended.sh sets it); without it the run is time-bounded and random.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds="${1:-60}"
@@ -40,7 +45,11 @@ for t in "${targets[@]}"; do
   mkdir -p "$work" "$artifacts"
   echo "fuzz: $t for ${seconds}s (seeds: $seeds)"
   # shellcheck disable=SC2086
-  if ! "$build/fuzz/fuzz_$t" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
+  runs=()
+  if [ -n "${FUZZ_RUNS:-}" ]; then
+    runs=(-runs="$FUZZ_RUNS" -seed="${FUZZ_SEED:-1}")
+  fi
+  if ! "$build/fuzz/fuzz_$t" "${runs[@]}" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
       -malloc_limit_mb=1024 -max_len=1048576 -print_final_stats=1 \
       -artifact_prefix="$artifacts" "$work" $seeds > "$build/fuzz_$t.log" 2>&1; then
     echo "fuzz: $t FAILED; input in $artifacts, log $build/fuzz_$t.log" >&2

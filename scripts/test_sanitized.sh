@@ -3,8 +3,9 @@
 # the `asan` preset (build/asan: -O1 -g1, every library and test instrumented,
 # no benchmarks), then ctest. -O1 instead of the dev preset's -O0 keeps the
 # heavy tests (golden renders, the 90-frame interrupted render) affordable on
-# a 2-core CI machine; tests labelled `no_sanitizer` are left out (each label
-# carries its reason in tests/CMakeLists.txt).
+# a 2-core CI machine. Peak-memory tests skip themselves under ASan
+# (tests/support/sanitizer.h); a test that cannot run here would carry the
+# label `no_sanitizer` with its reason in tests/CMakeLists.txt (none does).
 #
 # Any report fails the run: ASan aborts on the first error, UBSan halts
 # (-fno-sanitize-recover), and a child `patchskin` the app tests start inherits
