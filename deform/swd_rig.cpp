@@ -50,8 +50,9 @@ int FindRoot(std::vector<int>& parent, int i) {
   return i;
 }
 
-// Number of connected parts (by shared triangle vertices) of the mesh.
-int CountParts(const Mesh& mesh) {
+// Union-find parents joining the vertices of every triangle: FindRoot(parent, v)
+// names the connected part (by shared triangle vertices) of vertex v.
+std::vector<int> PartParents(const Mesh& mesh) {
   const std::size_t nv = mesh.positions.size();
   std::vector<int> parent(nv);
   for (std::size_t v = 0; v < nv; ++v) parent[v] = static_cast<int>(v);
@@ -61,6 +62,13 @@ int CountParts(const Mesh& mesh) {
     parent[static_cast<std::size_t>(FindRoot(parent, static_cast<int>(t.y)))] = a;
     parent[static_cast<std::size_t>(FindRoot(parent, static_cast<int>(t.z)))] = a;
   }
+  return parent;
+}
+
+// Number of connected parts (by shared triangle vertices) of the mesh.
+int CountParts(const Mesh& mesh) {
+  const std::size_t nv = mesh.positions.size();
+  std::vector<int> parent = PartParents(mesh);
   int parts = 0;
   for (std::size_t v = 0; v < nv; ++v) parts += FindRoot(parent, static_cast<int>(v)) == static_cast<int>(v) ? 1 : 0;
   return parts;
@@ -89,14 +97,7 @@ mocap::Result<std::vector<SweepVertexBinding>> BindByComponent(
   constexpr float kFamilyShare = 0.75f;
   const std::size_t nv = mesh.positions.size();
   const auto nc = static_cast<int>(chains.size());
-  std::vector<int> parent(nv);
-  for (std::size_t v = 0; v < nv; ++v) parent[v] = static_cast<int>(v);
-  for (const glm::uvec3& t : mesh.triangles) {
-    if (t.x >= nv || t.y >= nv || t.z >= nv) continue;
-    const int a = FindRoot(parent, static_cast<int>(t.x));
-    parent[static_cast<std::size_t>(FindRoot(parent, static_cast<int>(t.y)))] = a;
-    parent[static_cast<std::size_t>(FindRoot(parent, static_cast<int>(t.z)))] = a;
-  }
+  std::vector<int> parent = PartParents(mesh);
   // Nearest sweep of every vertex, counted per part.
   std::vector<int> trunk_of(chains.size(), -1);
   for (const SweepJunction& j : junctions) trunk_of[static_cast<std::size_t>(j.branch)] = j.trunk;

@@ -11,24 +11,15 @@
 
 #include "mocap/bvh_reader.h"
 #include "mocap/bvh_writer.h"
-#include "mocap/synthetic.h"
+#include "support/long_capture.h"
 
 namespace {
 
-// A 120 fps walk of `frames` frames as BVH text (about 500 bytes a frame).
+// A 120 fps walk of `frames` frames as BVH text (testsupport::LongCaptureText).
 std::string WalkText(int frames) {
-  const mocap::Skeleton skeleton = mocap::MakeHumanoidSkeleton();
-  mocap::WalkOptions walk;
-  walk.frame_time_s = 1.0 / 120.0;
-  walk.num_cycles = frames / 120 + 1;
-  mocap::Result<mocap::Motion> motion = mocap::MakeWalkMotion(skeleton, walk);
-  EXPECT_TRUE(motion.ok());
-  motion->num_frames = frames;
-  motion->values.resize(static_cast<std::size_t>(frames) *
-                        static_cast<std::size_t>(motion->num_channels));
-  mocap::Result<std::string> text = mocap::FormatBvh(skeleton, *motion);
-  EXPECT_TRUE(text.ok());
-  return *text;
+  std::string text = testsupport::LongCaptureText(frames);
+  EXPECT_FALSE(text.empty());
+  return text;
 }
 
 mocap::BvhReadOptions Halves() {
