@@ -3,12 +3,14 @@
 // The paper (Lee, Kim, Yoon 2009) reports 1122 updates/s for a 5x5 network and
 // 400 for a 7x7 one; the goal is 1000x that per core: 1.122 M and 400 k frames/s.
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <vector>
 
 #include <benchmark/benchmark.h>
 
+#include "deform/internal/mass_spring_modal.h"
 #include "deform/mass_spring.h"
 #include "mocap/kinematics.h"
 #include "mocap/synthetic.h"
@@ -53,6 +55,41 @@ void BM_MassSpringCallback(benchmark::State& bench, int size, deform::MassSpring
   bench.counters["paper_updates_per_s"] = size == 5 ? 1122.0 : 400.0;
 }
 
+// The Callback row's motion read from a table made before timing (every h/2 over
+// 10 s, the clip looped): the same job with the bench's own sin/cos and most of
+// its callback cost taken out, to show the elastic layer's share alone. Labelled
+// as such; the Callback row stays the reference.
+void BM_MassSpringTable(benchmark::State& bench, int size) {
+  const deform::MassSpringNetwork net = MakeNetwork(size, deform::MassSpringSolver::kModal);
+  deform::MassSpringState state;
+  state.Resize(net);
+  const double half_step = 0.5 * net.time_step_s;
+  const int frames30 = 300;  // 10 s at 30 fps
+  std::vector<deform::DrivingFrame> table(static_cast<std::size_t>(10.0 / half_step) + 2);
+  for (std::size_t i = 0; i < table.size(); ++i) {
+    const double t = static_cast<double>(i) * half_step;
+    const float s = static_cast<float>(std::sin(7.0 * t)), c = static_cast<float>(std::cos(7.0 * t));
+    table[i] = deform::DrivingFrame{glm::angleAxis(0.2f * s, glm::vec3(0, 1, 0)),
+                                    glm::vec3(300.0f * s, 100.0f * c, 0), glm::vec3(0, 1.4f * c, 0),
+                                    glm::vec3(0, -9.8f * s, 0)};
+  }
+  const std::function<deform::DrivingFrame(double)> drive = [&table, half_step](double t) {
+    const long i = std::lround(t / half_step);
+    return table[static_cast<std::size_t>(std::clamp(i, 0L, static_cast<long>(table.size()) - 1))];
+  };
+  std::vector<glm::vec3> disp(static_cast<std::size_t>(size * size));
+  int frame = 0;
+  for (auto _ : bench) {
+    const deform::MassSpringStepJob job{.network = &net, .state = &state,
+                                        .time_s = (frame++ % frames30) / 30.0, .driving = &drive,
+                                        .displacements = disp};
+    benchmark::DoNotOptimize(job.Run());
+    benchmark::DoNotOptimize(disp.data());
+  }
+  bench.SetItemsProcessed(bench.iterations());
+  bench.counters["paper_updates_per_s"] = size == 5 ? 1122.0 : 400.0;
+}
+
 // Driving frame sampled from the jump's per-frame kinematics (hips, 120 fps) by
 // mocap::SampleJointKinematics at every RK4 stage time; loops over the clip.
 // fma: MassSpringStepJob::allow_fma (the AVX2+FMA step; rounded differently, off by default).
@@ -78,14 +115,74 @@ void BM_MassSpringSampled(benchmark::State& bench, int size, bool fma) {
   }
   bench.SetItemsProcessed(bench.iterations());
   bench.counters["paper_updates_per_s"] = size == 5 ? 1122.0 : 400.0;
+  bench.counters["clamps_per_frame"] = static_cast<double>(state.counters.displacement_clamps) /
+                                       static_cast<double>(bench.iterations());
+}
+
+// The modal RK4 kernel alone (no sampling, limits or conversions): 8 steps per
+// iteration, i.e. one 30 fps frame's worth, with fixed stage coefficients.
+void BM_MassSpringKernel(benchmark::State& bench, int size, deform::internal::ModalKernel kernel) {
+  const deform::MassSpringNetwork net = MakeNetwork(size, deform::MassSpringSolver::kModal);
+  const auto step = deform::internal::SelectModalStep(kernel);
+  const std::size_t n = 3 * static_cast<std::size_t>(net.mode_stride);
+  alignas(32) float buffers[4][3 * deform::internal::kMaxModeStride] = {};
+  float *x = buffers[0], *v = buffers[1], *x1 = buffers[2], *v1 = buffers[3];
+  for (std::size_t i = 0; i < n; ++i) x[i] = (i % static_cast<std::size_t>(net.mode_stride)) <
+                                                      static_cast<std::size_t>(net.num_free)
+                                                  ? 0.01f * static_cast<float>(i % 7)
+                                                  : 0.0f;
+  deform::internal::StageCoefficients c;
+  for (int r = 0; r < 3; ++r) {
+    for (int k = 0; k < 3; ++k) {
+      c.mx[r][k] = 0.1f * static_cast<float>(r - k);
+      c.mv[r][k] = r == k ? 0.0f : 0.2f * static_cast<float>(k - r);
+    }
+    c.common[r] = 10.0f * static_cast<float>(r);
+  }
+  const float h = static_cast<float>(net.time_step_s);
+  for (auto _ : bench) {
+    for (int i = 0; i < 8; ++i) {
+      benchmark::DoNotOptimize(step(net, c, c, c, h, x, v, x1, v1));
+      std::swap(x, x1);
+      std::swap(v, v1);
+    }
+    benchmark::ClobberMemory();
+  }
+  bench.SetItemsProcessed(bench.iterations());
+}
+
+// The same 8 steps, each from the same input (no step waits for the one before):
+// the kernel's throughput rather than its latency.
+void BM_MassSpringKernelIndependent(benchmark::State& bench, int size,
+                                    deform::internal::ModalKernel kernel) {
+  const deform::MassSpringNetwork net = MakeNetwork(size, deform::MassSpringSolver::kModal);
+  const auto step = deform::internal::SelectModalStep(kernel);
+  alignas(32) float buffers[4][3 * deform::internal::kMaxModeStride] = {};
+  deform::internal::StageCoefficients c;
+  for (int r = 0; r < 3; ++r) c.common[r] = 10.0f * static_cast<float>(r);
+  const float h = static_cast<float>(net.time_step_s);
+  for (auto _ : bench) {
+    for (int i = 0; i < 8; ++i) {
+      benchmark::DoNotOptimize(step(net, c, c, c, h, buffers[0], buffers[1], buffers[2 + (i & 1)],
+                                    buffers[3 - (i & 1)]));
+    }
+    benchmark::ClobberMemory();
+  }
+  bench.SetItemsProcessed(bench.iterations());
 }
 
 }  // namespace
 
+BENCHMARK_CAPTURE(BM_MassSpringKernel, exact_5x5, 5, deform::internal::ModalKernel::kExactAvx);
+BENCHMARK_CAPTURE(BM_MassSpringKernel, exact_7x7, 7, deform::internal::ModalKernel::kExactAvx);
+BENCHMARK_CAPTURE(BM_MassSpringKernelIndependent, exact_5x5, 5, deform::internal::ModalKernel::kExactAvx);
+BENCHMARK_CAPTURE(BM_MassSpringKernelIndependent, exact_7x7, 7, deform::internal::ModalKernel::kExactAvx);
 BENCHMARK_CAPTURE(BM_MassSpringCallback, modal_5x5, 5, deform::MassSpringSolver::kModal);
 BENCHMARK_CAPTURE(BM_MassSpringCallback, modal_7x7, 7, deform::MassSpringSolver::kModal);
 BENCHMARK_CAPTURE(BM_MassSpringCallback, point_5x5, 5, deform::MassSpringSolver::kPointSpace);
 BENCHMARK_CAPTURE(BM_MassSpringCallback, point_7x7, 7, deform::MassSpringSolver::kPointSpace);
+BENCHMARK_CAPTURE(BM_MassSpringTable, modal_5x5, 5);
+BENCHMARK_CAPTURE(BM_MassSpringTable, modal_7x7, 7);
 BENCHMARK_CAPTURE(BM_MassSpringSampled, modal_5x5, 5, false);
 BENCHMARK_CAPTURE(BM_MassSpringSampled, modal_7x7, 7, false);
 BENCHMARK_CAPTURE(BM_MassSpringSampled, modal_5x5_fma, 5, true);

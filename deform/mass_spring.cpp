@@ -10,6 +10,7 @@
 
 #include "deform/internal/driving_sampler.h"
 #include "deform/internal/mass_spring_modal.h"
+#include "deform/internal/stage_forcing.h"
 
 namespace deform {
 namespace {
@@ -21,6 +22,9 @@ using mocap::MakeError;
 constexpr double kStandardGravityMps2 = 9.81;
 constexpr int kMaxGridSize = 16;
 constexpr int kMaxFree = (kMaxGridSize - 2) * (kMaxGridSize - 2);
+// Modal steps whose stage coefficients are computed together (one 30 fps frame
+// at h = 1/240 s).
+constexpr std::size_t kBatchSteps = 8;
 
 bool Finite(const glm::vec3& v) {
   return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
@@ -60,9 +64,13 @@ class Integrator {
     if (!job.kinematics.empty()) {
       sampler_.emplace(job.kinematics, job.num_joints, job.joint, job.frame_time_s);
     }
+    forcing_ = {.gain = p_.gain, .user_acceleration = job.user_acceleration,
+                .gravity = p_.gravity, .gravity_model = gravity_, .gravity_bind = gravity_bind_};
   }
 
-  Forcing Sample(double t) {
+  // The driving frame at t, checked: a non-finite frame becomes the bind frame,
+  // |a| is clamped (both counted).
+  DrivingFrame CheckedFrame(double t) {
     // Kinematics: SampleJointKinematics' values (internal/driving_sampler.h).
     DrivingFrame d = sampler_ ? sampler_->Sample(t) : (*job_.driving)(t);
     MassSpringCounters& c = st_.counters;
@@ -80,6 +88,11 @@ class Integrator {
         d.linear_acceleration *= max_accel_ / a_len;
       }
     }
+    return d;
+  }
+
+  Forcing Sample(double t) {
+    const DrivingFrame d = CheckedFrame(t);
     Forcing f;
     f.gain = p_.gain;
     f.w = d.angular_velocity;
@@ -89,26 +102,6 @@ class Integrator {
       f.common += glm::conjugate(glm::normalize(d.rotation)) * gravity_ - gravity_bind_;
     }
     return f;
-  }
-
-  // The moving-frame terms as matrices: -gam ([al]x + [w]x^2) acts on positions
-  // (the rigid Euler + centrifugal term on k, and the same on e), -2 gam [w]x on
-  // velocities (Coriolis). Row-major.
-  static internal::StageCoefficients Coefficients(const Forcing& f) {
-    internal::StageCoefficients m;
-    const glm::vec3 w = f.w, al = f.al;
-    const float ww = glm::dot(w, w);
-    const float skew_al[3][3] = {{0, -al.z, al.y}, {al.z, 0, -al.x}, {-al.y, al.x, 0}};
-    const float skew_w[3][3] = {{0, -w.z, w.y}, {w.z, 0, -w.x}, {-w.y, w.x, 0}};
-    for (int r = 0; r < 3; ++r) {
-      for (int c = 0; c < 3; ++c) {
-        const float w2 = w[r] * w[c] - (r == c ? ww : 0.0f);  // [w]x^2 = w w^T - |w|^2 I
-        m.mx[r][c] = -f.gain * (skew_al[r][c] + w2);
-        m.mv[r][c] = -2.0f * f.gain * skew_w[r][c];
-      }
-      m.common[r] = f.common[r];
-    }
-    return m;
   }
 
   // Whole RK4 steps of every mode until the step time reaches `until_s`. The
@@ -133,19 +126,37 @@ class Integrator {
     }
     const internal::ModalStepFn step = internal::SelectModalStep(job_.allow_avx, job_.allow_fma);
     const double h = net_.time_step_s;
-    internal::StageCoefficients c0 = Coefficients(Sample(st_.step_time_s));
+    // Steps go in batches of up to kBatchSteps: the frames at the batch's stage
+    // times first (t + h/2, t + h, t + 3h/2, ...: the times and the order of the
+    // step-by-step loop), their coefficients four at a time
+    // (internal/stage_forcing.h: the same bits), then the steps. coeffs[2 i],
+    // [2 i + 1], [2 i + 2]: step i's start, middle and end.
+    DrivingFrame frames[2 * kBatchSteps];
+    internal::StageCoefficients coeffs[2 * kBatchSteps + 1];
+    frames[0] = CheckedFrame(st_.step_time_s);
+    internal::StageCoefficientsOfEach({frames, 1}, forcing_, {coeffs, 1});
     while (st_.step_time_s < until_s) {
-      const double t = st_.step_time_s;
-      const internal::StageCoefficients cm = Coefficients(Sample(t + 0.5 * h));
-      const internal::StageCoefficients c1 = Coefficients(Sample(t + h));
-      const internal::ModalStepSums sums =
-          step(net_, c0, cm, c1, static_cast<float>(h), x, v, prev_x, prev_v);
-      std::swap(x, prev_x);
-      std::swap(v, prev_v);
-      ModalLimits(sums, x, v, prev_x, prev_v);
-      st_.step_time_s = t + h;
-      ++st_.counters.steps;
-      c0 = c1;
+      double starts[kBatchSteps];
+      std::size_t count = 0;
+      for (double t = st_.step_time_s; count < kBatchSteps && t < until_s; t = t + h) {
+        starts[count++] = t;
+      }
+      for (std::size_t i = 0; i < count; ++i) {
+        frames[2 * i] = CheckedFrame(starts[i] + 0.5 * h);
+        frames[2 * i + 1] = CheckedFrame(starts[i] + h);
+      }
+      internal::StageCoefficientsOfEach({frames, 2 * count}, forcing_, {coeffs + 1, 2 * count});
+      for (std::size_t i = 0; i < count; ++i) {
+        const internal::ModalStepSums sums =
+            step(net_, coeffs[2 * i], coeffs[2 * i + 1], coeffs[2 * i + 2],
+                 static_cast<float>(h), x, v, prev_x, prev_v);
+        std::swap(x, prev_x);
+        std::swap(v, prev_v);
+        ModalLimits(sums, x, v, prev_x, prev_v);
+        st_.step_time_s = starts[i] + h;
+        ++st_.counters.steps;
+      }
+      coeffs[0] = coeffs[2 * count];
     }
     for (std::size_t k = 0; k < n; ++k) {
       for (std::size_t c = 0; c < 3; ++c) {
@@ -318,6 +329,7 @@ class Integrator {
   glm::vec3 gravity_{0.0f}, gravity_bind_{0.0f};
   float max_accel_ = 0.0f, surely_below_accel2_ = 0.0f;
   std::optional<internal::KinematicsDrivingSampler> sampler_;
+  internal::ForcingConstants forcing_;
 };
 
 bool UsesModes(const MassSpringNetwork& net) {

@@ -1,0 +1,42 @@
+#pragma once
+// The elastic layer's per-stage-time forcing (deform/mass_spring.h) as the
+// modal step's coefficient matrices (internal/mass_spring_modal.h), for one
+// driving frame at a time (the scalar reference) or for four at a time, one per
+// SSE2 lane, with the same IEEE operations in the same order per lane: the same
+// bits (the build has -ffp-contract=off; tests/deform/stage_forcing_test.cpp).
+// A run of 8 RK4 steps needs 17 of them; in lanes they cost about a quarter of
+// the scalar instructions.
+//
+// The frames given here are already checked: MassSpringStepJob replaces a
+// non-finite frame by the bind frame and clamps |a| before this point.
+
+#include <span>
+
+#include <glm/glm.hpp>
+
+#include "deform/internal/mass_spring_modal.h"
+#include "deform/mass_spring.h"
+
+namespace deform::internal {
+
+// What the forcing adds besides the frame, fixed for a run.
+struct ForcingConstants {
+  float gain = 1.0f;                    // gam (MassSpringParams::gain)
+  glm::vec3 user_acceleration{0.0f};    // u, model units/s^2 in the driving frame
+  bool gravity = true;                  // add R^T g - R_bind^T g
+  glm::vec3 gravity_model{0.0f};        // g in model space, model units/s^2
+  glm::vec3 gravity_bind{0.0f};         // R_bind^T g
+};
+
+// The scalar formulation, written as glm evaluates it:
+//   common = -gam a + u (+ conj(normalize(R)) g - R_bind^T g with gravity),
+//   mx = -gam ([al]x + [w]x^2) with [w]x^2 = w w^T - |w|^2 I, mv = -2 gam [w]x.
+StageCoefficients StageCoefficientsOf(const DrivingFrame& frame, const ForcingConstants& k);
+
+// The same for frames.size() frames (any count), four at a time in SSE2 lanes:
+// out[i] has the bits of StageCoefficientsOf(frames[i], k). out.size() ==
+// frames.size().
+void StageCoefficientsOfEach(std::span<const DrivingFrame> frames, const ForcingConstants& k,
+                             std::span<StageCoefficients> out);
+
+}  // namespace deform::internal
