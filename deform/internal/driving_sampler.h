@@ -15,8 +15,14 @@
 
 #include "deform/mass_spring.h"
 #include "mocap/kinematics.h"
+#include "mocap/sampling.h"
 
 namespace deform::internal {
+
+// mocap::FindFrameBlend, bit for bit, without its library calls to floor and
+// round (SSE2 has no rounding instruction): the sampler calls it at every stage
+// time.
+mocap::FrameBlend FrameBlendAt(int num_frames, double frame_time_s, double time_s);
 
 class KinematicsDrivingSampler {
  public:
