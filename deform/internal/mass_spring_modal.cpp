@@ -16,6 +16,15 @@ inline constexpr bool kPairGroups = true;  // 16-lane groups (two registers per 
 typedef float V8 __attribute__((vector_size(32)));
 typedef float V8Unaligned __attribute__((vector_size(32), aligned(4)));
 [[gnu::always_inline]] inline V8 SplatV8(float x) { return x - V8{}; }  // x - (+0) is x, even -0
+// A float in memory to all lanes: vbroadcastss. (AVX has no register-to-register
+// broadcast, and from SplatV8 of a value it has loaded GCC makes a scalar load,
+// four inserts and a lane copy: in the matrix products, six shuffles per
+// multiply-add pair where one load does.) Only ever inlined into AVX functions.
+[[gnu::always_inline]] inline V8 BroadcastV8(const float* p) {
+  V8 r;
+  asm("vbroadcastss %1, %0" : "=x"(r) : "m"(*p));
+  return r;
+}
 [[gnu::always_inline]] inline V8 LoadV8(const float* p) { return *reinterpret_cast<const V8Unaligned*>(p); }
 [[gnu::always_inline]] inline void StoreV8(float* p, const V8& v) { *reinterpret_cast<V8Unaligned*>(p) = v; }
 [[gnu::always_inline]] inline float SumV8(const V8& v) {
@@ -43,6 +52,7 @@ struct V8 {
 [[gnu::always_inline]] inline V8 LoadV8(const float* p) {
   return {*reinterpret_cast<const V4Unaligned*>(p), *reinterpret_cast<const V4Unaligned*>(p + 4)};
 }
+[[gnu::always_inline]] inline V8 BroadcastV8(const float* p) { return SplatV8(*p); }
 [[gnu::always_inline]] inline void StoreV8(float* p, const V8& v) {
   *reinterpret_cast<V4Unaligned*>(p) = v.lo;
   *reinterpret_cast<V4Unaligned*>(p + 4) = v.hi;
