@@ -8,6 +8,7 @@
 #include <glm/gtc/quaternion.hpp>
 
 #include "deform/polar_rotation.h"
+#include "deform/polar_rotation_lanes.h"
 
 namespace deform {
 namespace {
@@ -22,6 +23,9 @@ mocap::Error EditError(const ExampleEdit& e, const std::string& message) {
 constexpr std::size_t kMaxFastBones = 256;
 // Largest |R^T R - I| entry for a palette matrix to count as a rotation.
 constexpr double kRigidTol = 1e-4;
+// Blends PatchControlRotations hands to the lane Newton at once (a multiple
+// of kPolarLanes; stack arrays of this size).
+constexpr std::size_t kPolarBatch = 32;
 
 bool Finite(const glm::dvec3& v) {
   return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
@@ -92,6 +96,27 @@ mocap::JobStatus PatchControlRotations(const PatchSetup& patch, const ExamplePos
       have[b] = 1;
     }
   }
+  // Blends of three or more bones wait in a batch for Newton's polar
+  // iteration in SIMD lanes (polar_rotation_lanes.h, bit for bit the scalar
+  // iteration, so the grouping does not change any result); a blend it
+  // refuses (det <= kPolarNewtonMinDet: nearly singular or reflecting) takes
+  // PolarRotation, whose SVD fixes the sign as SsdControlRotations always did.
+  std::array<glm::dmat3, kPolarBatch> blends;
+  std::array<glm::quat, kPolarBatch> quats;
+  std::array<std::uint8_t, kPolarBatch> converged;
+  std::array<std::size_t, kPolarBatch> batch_control;
+  std::size_t batched = 0;
+  const auto flush = [&] {
+    (void)PolarRotationsNewton(std::span(blends.data(), batched), {},
+                               std::span(converged.data(), batched), PolarLanesPath::kAuto,
+                               std::span(quats.data(), batched));
+    for (std::size_t i = 0; i < batched; ++i) {
+      rotations[batch_control[i]] =
+          converged[i] ? quats[i]
+                       : glm::normalize(glm::quat(glm::quat_cast(PolarRotation(blends[i]))));
+    }
+    batched = 0;
+  };
   for (std::size_t c = 0; c < rotations.size(); ++c) {
     if (skip(c)) {
       rotations[c] = glm::quat(1.0f, 0.0f, 0.0f, 0.0f);
@@ -136,19 +161,17 @@ mocap::JobStatus PatchControlRotations(const PatchSetup& patch, const ExamplePos
       }
       // Two opposite rotations at (nearly) equal weight: the general path.
     }
-    // Three or more bones: the polar factor of sum_b w_b R_b by Newton's
-    // iteration (polar_rotation.h); a blend with det <= kPolarNewtonMinDet
-    // (nearly singular, or reflecting) takes PolarRotation, whose SVD fixes
-    // the sign as SsdControlRotations always did.
+    // Three or more bones: the polar factor of sum_b w_b R_b, in the batch.
     glm::dmat3 blend(0.0);
     for (int i = 0; i < n; ++i) {
       const std::size_t slot = slots[static_cast<std::size_t>(i)];
       blend += static_cast<double>(w.weights[slot]) * bone_matrix[w.joints[slot]];
     }
-    glm::dmat3 polar;
-    if (!PolarRotationNewton(blend, polar)) polar = PolarRotation(blend);
-    rotations[c] = glm::normalize(glm::quat(glm::quat_cast(polar)));
+    blends[batched] = blend;
+    batch_control[batched++] = c;
+    if (batched == kPolarBatch) flush();
   }
+  flush();
   return mocap::kJobOk;
 }
 

@@ -1,0 +1,187 @@
+#include "deform/polar_rotation_lanes.h"
+
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+
+#include <immintrin.h>
+
+#include <glm/gtc/quaternion.hpp>
+
+#include "deform/polar_rotation.h"
+
+// The lane helpers pass vectors by value, but all are internal and always
+// inlined into their callers, so no call crosses the ABI GCC warns about.
+#pragma GCC diagnostic ignored "-Wpsabi"
+
+namespace deform {
+namespace {
+
+static_assert(sizeof(glm::dmat3) == 9 * sizeof(double), "dmat3 must be 9 packed doubles");
+
+// Lane types built from GCC vectors: a base vector (2 or 4 doubles) or a Pair
+// of them, which gives the core two independent dependency chains.
+template <typename T>
+struct Pair {
+  T a, b;
+};
+template <typename T>
+[[gnu::always_inline]] inline Pair<T> operator+(const Pair<T>& x, const Pair<T>& y) { return {x.a + y.a, x.b + y.b}; }
+template <typename T>
+[[gnu::always_inline]] inline Pair<T> operator-(const Pair<T>& x, const Pair<T>& y) { return {x.a - y.a, x.b - y.b}; }
+template <typename T>
+[[gnu::always_inline]] inline Pair<T> operator*(const Pair<T>& x, const Pair<T>& y) { return {x.a * y.a, x.b * y.b}; }
+template <typename T>
+[[gnu::always_inline]] inline Pair<T> operator/(const Pair<T>& x, const Pair<T>& y) { return {x.a / y.a, x.b / y.b}; }
+template <typename T>
+[[gnu::always_inline]] inline auto operator<(const Pair<T>& x, const Pair<T>& y) {
+  return Pair<decltype(x.a < y.a)>{x.a < y.a, x.b < y.b};
+}
+template <typename T>
+[[gnu::always_inline]] inline auto operator>(const Pair<T>& x, const Pair<T>& y) {
+  return Pair<decltype(x.a > y.a)>{x.a > y.a, x.b > y.b};
+}
+template <typename T>
+[[gnu::always_inline]] inline Pair<T> operator|(const Pair<T>& x, const Pair<T>& y) { return {x.a | y.a, x.b | y.b}; }
+
+template <typename T>
+inline constexpr int kWidth = static_cast<int>(sizeof(T) / 8);  // 8-byte lanes
+
+template <typename V>
+[[gnu::always_inline]] inline V Splat(double x) {
+  if constexpr (requires(V v) { v.a; }) {
+    using T = decltype(V{}.a);
+    return {Splat<T>(x), Splat<T>(x)};
+  } else {
+    return x + V{};  // x + (+0) is x for every x but -0, which never occurs here
+  }
+}
+template <typename V, typename E>
+[[gnu::always_inline]] inline V Load(const E* p) {
+  if constexpr (requires(V v) { v.a; }) {
+    using T = decltype(V{}.a);
+    return {Load<T>(p), Load<T>(p + kWidth<T>)};
+  } else {
+    V v;
+    for (int l = 0; l < kWidth<V>; ++l) v[l] = p[l];
+    return v;
+  }
+}
+template <typename V>
+[[gnu::always_inline]] inline double Lane(const V& v, int l) {
+  if constexpr (requires { v.a; }) {
+    constexpr int h = kWidth<decltype(v.a)>;
+    return l < h ? Lane(v.a, l) : Lane(v.b, l - h);
+  } else {
+    return v[l];
+  }
+}
+template <typename M>
+[[gnu::always_inline]] inline int Bits(const M& m) {
+  if constexpr (requires { m.a; }) {
+    return Bits(m.a) | (Bits(m.b) << kWidth<decltype(m.a)>);
+  } else {
+    int bits = 0;
+    for (int l = 0; l < kWidth<M>; ++l) bits |= m[l] != 0 ? 1 << l : 0;
+    return bits;
+  }
+}
+template <typename M>
+[[gnu::always_inline]] inline M MaskOf(int bits) {
+  if constexpr (requires(M m) { m.a; }) {
+    using T = decltype(M{}.a);
+    return {MaskOf<T>(bits), MaskOf<T>(bits >> kWidth<T>)};
+  } else {
+    M m;
+    for (int l = 0; l < kWidth<M>; ++l) m[l] = ((bits >> l) & 1) ? -1 : 0;
+    return m;
+  }
+}
+template <typename M, typename V>
+[[gnu::always_inline]] inline V Select(const M& m, const V& x, const V& y) {
+  if constexpr (requires { m.a; }) {
+    return {Select(m.a, x.a, y.a), Select(m.b, x.b, y.b)};
+  } else {
+    return m ? x : y;
+  }
+}
+
+// SSE2 (the x86-64 baseline): 4 lanes as two 2-double registers.
+namespace sse2 {
+typedef double V2 __attribute__((vector_size(16)));
+[[gnu::always_inline]] inline V2 Sqrt(const V2& v) { return V2(_mm_sqrt_pd(__m128d(v))); }
+[[gnu::always_inline]] inline Pair<V2> Sqrt(const Pair<V2>& v) { return {Sqrt(v.a), Sqrt(v.b)}; }
+using V = Pair<V2>;
+using M = decltype(V{} < V{});
+#include "deform/internal/polar_lanes_kernel.inc"
+}  // namespace sse2
+
+void NewtonSse2(const double* in, double* out, glm::quat* quats, std::uint8_t* ok,
+                std::size_t count) {
+  sse2::NewtonAll(in, out, quats, ok, count);
+}
+
+// AVX: 8 lanes as two 4-double registers (two groups' iterations interleave).
+#pragma GCC push_options
+#pragma GCC target("avx")
+namespace avx {
+typedef double V4 __attribute__((vector_size(32)));
+[[gnu::always_inline]] inline V4 Sqrt(const V4& v) { return V4(_mm256_sqrt_pd(__m256d(v))); }
+[[gnu::always_inline]] inline Pair<V4> Sqrt(const Pair<V4>& v) { return {Sqrt(v.a), Sqrt(v.b)}; }
+using V = Pair<V4>;
+using M = decltype(V{} < V{});
+#include "deform/internal/polar_lanes_kernel.inc"
+}  // namespace avx
+
+void NewtonAvx(const double* in, double* out, glm::quat* quats, std::uint8_t* ok,
+               std::size_t count) {
+  avx::NewtonAll(in, out, quats, ok, count);
+}
+#pragma GCC pop_options
+
+}  // namespace
+
+bool PolarLanesAvxAvailable() {
+  static const bool has = __builtin_cpu_supports("avx");
+  return has;
+}
+
+mocap::JobStatus PolarRotationsNewton(std::span<const glm::dmat3> blends,
+                                      std::span<glm::dmat3> rotations,
+                                      std::span<std::uint8_t> converged, PolarLanesPath path,
+                                      std::span<glm::quat> quats) {
+  const std::size_t n = blends.size();
+  if ((!rotations.empty() && rotations.size() != n) || converged.size() != n ||
+      (!quats.empty() && quats.size() != n)) {
+    return {mocap::JobStatus::kSizeMismatch,
+            "converged must be #N like blends, rotations and quats #N or empty"};
+  }
+  if (path == PolarLanesPath::kAuto) {
+    path = PolarLanesAvxAvailable() ? PolarLanesPath::kAvx : PolarLanesPath::kSse2;
+  }
+  if (path == PolarLanesPath::kAvx && !PolarLanesAvxAvailable()) {
+    return {mocap::JobStatus::kOutOfRange, "this CPU has no AVX"};
+  }
+  if (n == 0) return mocap::kJobOk;
+  if (path == PolarLanesPath::kScalar) {
+    for (std::size_t i = 0; i < n; ++i) {
+      glm::dmat3 r;
+      converged[i] = PolarRotationNewton(blends[i], r) ? 1 : 0;
+      if (!converged[i]) continue;
+      if (!rotations.empty()) rotations[i] = r;
+      if (!quats.empty()) quats[i] = glm::normalize(glm::quat(glm::quat_cast(r)));
+    }
+    return mocap::kJobOk;
+  }
+  const double* in = &blends[0][0][0];
+  double* out = rotations.empty() ? nullptr : &rotations[0][0][0];
+  glm::quat* q = quats.empty() ? nullptr : quats.data();
+  if (path == PolarLanesPath::kAvx) {
+    NewtonAvx(in, out, q, converged.data(), n);
+  } else {
+    NewtonSse2(in, out, q, converged.data(), n);
+  }
+  return mocap::kJobOk;
+}
+
+}  // namespace deform

@@ -1,0 +1,59 @@
+#pragma once
+// PolarRotationNewton (polar_rotation.h) on many blends at once, in groups of
+// SIMD lanes: the per-frame rotations A of the example shapes (ALGORITHMS.md
+// 4.3) for the control points that blend three or more bones. With AVX a
+// group is 8 blends in two 4-double registers (two independent dependency
+// chains, so one group's divisions overlap the other's); with SSE2 (the
+// x86-64 baseline) 4 blends in two 2-double registers.
+//
+// Each lane does exactly the scalar iteration's IEEE operations in the same
+// order (the build has -ffp-contract=off and no FMA is used), and a lane's
+// result is its iterate at the step where *it* converged; lanes that
+// converged earlier keep being computed with the group but are no longer
+// read. So every result, its success flag included, is bit for bit
+// PolarRotationNewton's, whatever the grouping, the path (AVX, SSE2, scalar)
+// or the number of blends (the last group is padded with the identity, which
+// converges in one step). A group costs the iterations of its slowest lane.
+// The optional quaternion output is glm::quat_cast done in the lanes (the
+// same candidates, comparisons and arithmetic), then glm::normalize of its
+// float cast: again bit for bit the scalar expression.
+// Higham's scaling (det X outside [1/8, 8]) takes two scalar square roots in
+// the lanes that need it; it is rare for blends of rotations.
+
+#include <cstdint>
+#include <span>
+
+#include <glm/glm.hpp>
+#include <glm/gtc/quaternion.hpp>
+
+#include "mocap/error.h"
+
+namespace deform {
+
+enum class PolarLanesPath : std::uint8_t {
+  kAuto,    // kAvx when the CPU has AVX, else kSse2
+  kScalar,  // PolarRotationNewton once per blend
+  kSse2,    // groups of 4 lanes in two 2-double registers (x86-64 baseline)
+  kAvx,     // groups of 8 lanes in two 4-double AVX registers (CPUs with AVX only)
+};
+
+// Whether this CPU (and OS) can run the kAvx path.
+bool PolarLanesAvxAvailable();
+
+// For every i of the #N `blends` (any N, 0 included): where
+// PolarRotationNewton(blends[i], R) returns true, converged[i] = 1,
+// rotations[i] = R and quats[i] = glm::normalize(glm::quat(glm::quat_cast(R)))
+// (a unit float quaternion, its largest double component positive), all bit
+// for bit; otherwise (det <= kPolarNewtonMinDet, not finite, or no
+// convergence in kPolarNewtonMaxIterations) converged[i] = 0 and rotations[i],
+// quats[i] are left as they were: the caller falls back to PolarRotation (SVD).
+// `converged` #N; `rotations` and `quats` #N or empty (not wanted).
+// kSizeMismatch on other sizes; kOutOfRange for kAvx on a CPU without AVX.
+// Never allocates; thread-safe.
+[[nodiscard]] mocap::JobStatus PolarRotationsNewton(std::span<const glm::dmat3> blends,
+                                                    std::span<glm::dmat3> rotations,
+                                                    std::span<std::uint8_t> converged,
+                                                    PolarLanesPath path = PolarLanesPath::kAuto,
+                                                    std::span<glm::quat> quats = {});
+
+}  // namespace deform
