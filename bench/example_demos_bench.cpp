@@ -14,6 +14,8 @@
 
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
@@ -97,19 +99,26 @@ void Update(benchmark::State& state, bool rebuild) {
   // those blend three or more bones (Newton's polar iteration).
   (void)deform::ComputePoseFeatures(s.character.skeleton, space.features, s.locals, features);
   (void)deform::PoseSpaceJob{.model = &space.model, .features = features, .displacement = ds}.Run();
+  // And how many distinct bones those control points blend (each is
+  // converted once per update).
   int moving = 0, three_plus = 0;
+  std::vector<std::uint8_t> bone_used(s.palette.size(), 0);
   for (std::size_t c = 0; c < nc; ++c) {
     if (ds[c] == glm::vec3(0.0f)) continue;
     ++moving;
     int bones = 0;
     for (int i = 0; i < p.control_weights.influences; ++i) {
-      bones += p.control_weights.weights[c * static_cast<std::size_t>(p.control_weights.influences) +
-                                         static_cast<std::size_t>(i)] != 0.0f;
+      const std::size_t slot = c * static_cast<std::size_t>(p.control_weights.influences) +
+                               static_cast<std::size_t>(i);
+      if (p.control_weights.weights[slot] == 0.0f) continue;
+      ++bones;
+      bone_used[p.control_weights.joints[slot]] = 1;
     }
     three_plus += bones >= 3;
   }
   state.counters["moving"] = moving;
   state.counters["moving_3plus_bones"] = three_plus;
+  state.counters["bones"] = static_cast<double>(std::count(bone_used.begin(), bone_used.end(), 1));
   for (auto _ : state) {
     if (rebuild) {
       (void)deform::CarryControlPointsJob{.patch = &p, .model_from_bind = s.palette,

@@ -140,23 +140,27 @@ mocap::JobStatus PatchControlRotations(const PatchSetup& patch, const ExamplePos
       const glm::dquat q1 = bone[w.joints[slots[0]]];
       glm::dquat rel = glm::conjugate(q1) * bone[w.joints[slots[1]]];  // R1^T R2 = Rot(a, theta)
       if (rel.w < 0.0) rel = -rel;
-      const double s = glm::length(glm::dvec3(rel.x, rel.y, rel.z));
+      const glm::dvec3 v(rel.x, rel.y, rel.z);                 // sin(theta/2) a
+      const double s2 = glm::dot(v, v);
       const double w1 = w.weights[slots[0]], w2 = w.weights[slots[1]];
-      // theta from rel = (cos(theta/2), sin(theta/2) a): sin theta = 2 s c,
-      // cos theta = 2 c^2 - 1 (no trigonometric calls).
-      const double y = 2.0 * w2 * s * rel.w, x = w1 + w2 * (2.0 * rel.w * rel.w - 1.0);
-      const double rho = std::sqrt(x * x + y * y);
-      if (s < 1e-12 && rho >= 1e-6) {
+      // theta from rel = (c, s a), c = cos(theta/2), s = sin(theta/2):
+      // sin theta = 2 s c, cos theta = 2 c^2 - 1 (no trigonometric calls).
+      const double yc = 2.0 * w2 * rel.w;                      // y = yc s
+      const double x = w1 + w2 * (2.0 * rel.w * rel.w - 1.0), y2 = yc * yc * s2;
+      const double rho = std::sqrt(x * x + y2);
+      if (s2 < 1e-24 && rho >= 1e-6) {
         rotations[c] = glm::quat(q1);
         continue;
       }
       if (rho >= 1e-6 && rho + x >= 1e-9) {
         // w1 I + w2 Rot(a, theta) is normal with eigenvalues 1 and w1 + w2 e^(+-i theta)
         // = rho e^(+-i phi), so its orthogonal polar factor is Rot(a, phi); as a
-        // quaternion (cos(phi/2), sin(phi/2) a) ~ (rho + x, y a), normalized.
-        const glm::dvec3 axis = glm::dvec3(rel.x, rel.y, rel.z) / s;
-        const glm::dquat turn = glm::normalize(glm::dquat(rho + x, y * axis));
-        rotations[c] = glm::quat(glm::normalize(q1 * turn));
+        // quaternion (cos(phi/2), sin(phi/2) a) ~ (rho + x, y a) = (rho + x, yc v),
+        // of length sqrt((rho + x)^2 + y^2). q1 is a unit quaternion, so one
+        // normalization of the product suffices.
+        const glm::dquat turn(rho + x, yc * v);
+        const double inv_len = 1.0 / std::sqrt((rho + x) * (rho + x) + y2);
+        rotations[c] = glm::quat((q1 * turn) * inv_len);
         continue;
       }
       // Two opposite rotations at (nearly) equal weight: the general path.

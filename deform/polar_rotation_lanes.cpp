@@ -20,7 +20,7 @@ namespace {
 static_assert(sizeof(glm::dmat3) == 9 * sizeof(double), "dmat3 must be 9 packed doubles");
 
 // Lane types built from GCC vectors: a base vector (2 or 4 doubles) or a Pair
-// of them, which gives the core two independent dependency chains.
+// of them.
 template <typename T>
 struct Pair {
   T a, b;
@@ -42,7 +42,23 @@ template <typename T>
   return Pair<decltype(x.a > y.a)>{x.a > y.a, x.b > y.b};
 }
 template <typename T>
+[[gnu::always_inline]] inline auto operator==(const Pair<T>& x, const Pair<T>& y) {
+  return Pair<decltype(x.a == y.a)>{x.a == y.a, x.b == y.b};
+}
+template <typename T>
+[[gnu::always_inline]] inline auto operator!=(const Pair<T>& x, const Pair<T>& y) {
+  return Pair<decltype(x.a != y.a)>{x.a != y.a, x.b != y.b};
+}
+template <typename T>
 [[gnu::always_inline]] inline Pair<T> operator|(const Pair<T>& x, const Pair<T>& y) { return {x.a | y.a, x.b | y.b}; }
+template <typename T>
+[[gnu::always_inline]] inline Pair<T> operator&(const Pair<T>& x, const Pair<T>& y) { return {x.a & y.a, x.b & y.b}; }
+template <typename T>
+[[gnu::always_inline]] inline T AndNot(const T& x, const T& y) { return x & ~y; }
+template <typename T>
+[[gnu::always_inline]] inline Pair<T> AndNot(const Pair<T>& x, const Pair<T>& y) {
+  return {AndNot(x.a, y.a), AndNot(x.b, y.b)};
+}
 
 template <typename T>
 inline constexpr int kWidth = static_cast<int>(sizeof(T) / 8);  // 8-byte lanes
@@ -76,27 +92,6 @@ template <typename V>
     return v[l];
   }
 }
-template <typename M>
-[[gnu::always_inline]] inline int Bits(const M& m) {
-  if constexpr (requires { m.a; }) {
-    return Bits(m.a) | (Bits(m.b) << kWidth<decltype(m.a)>);
-  } else {
-    int bits = 0;
-    for (int l = 0; l < kWidth<M>; ++l) bits |= m[l] != 0 ? 1 << l : 0;
-    return bits;
-  }
-}
-template <typename M>
-[[gnu::always_inline]] inline M MaskOf(int bits) {
-  if constexpr (requires(M m) { m.a; }) {
-    using T = decltype(M{}.a);
-    return {MaskOf<T>(bits), MaskOf<T>(bits >> kWidth<T>)};
-  } else {
-    M m;
-    for (int l = 0; l < kWidth<M>; ++l) m[l] = ((bits >> l) & 1) ? -1 : 0;
-    return m;
-  }
-}
 template <typename M, typename V>
 [[gnu::always_inline]] inline V Select(const M& m, const V& x, const V& y) {
   if constexpr (requires { m.a; }) {
@@ -113,6 +108,9 @@ typedef double V2 __attribute__((vector_size(16)));
 [[gnu::always_inline]] inline Pair<V2> Sqrt(const Pair<V2>& v) { return {Sqrt(v.a), Sqrt(v.b)}; }
 using V = Pair<V2>;
 using M = decltype(V{} < V{});
+[[gnu::always_inline]] inline int Bits(const M& m) {
+  return _mm_movemask_pd(__m128d(m.a)) | (_mm_movemask_pd(__m128d(m.b)) << 2);
+}
 #include "deform/internal/polar_lanes_kernel.inc"
 }  // namespace sse2
 
@@ -121,15 +119,15 @@ void NewtonSse2(const double* in, double* out, glm::quat* quats, std::uint8_t* o
   sse2::NewtonAll(in, out, quats, ok, count);
 }
 
-// AVX: 8 lanes as two 4-double registers (two groups' iterations interleave).
+// AVX: 4 lanes in one 4-double register.
 #pragma GCC push_options
 #pragma GCC target("avx")
 namespace avx {
 typedef double V4 __attribute__((vector_size(32)));
 [[gnu::always_inline]] inline V4 Sqrt(const V4& v) { return V4(_mm256_sqrt_pd(__m256d(v))); }
-[[gnu::always_inline]] inline Pair<V4> Sqrt(const Pair<V4>& v) { return {Sqrt(v.a), Sqrt(v.b)}; }
-using V = Pair<V4>;
+using V = V4;
 using M = decltype(V{} < V{});
+[[gnu::always_inline]] inline int Bits(const M& m) { return _mm256_movemask_pd(__m256d(m)); }
 #include "deform/internal/polar_lanes_kernel.inc"
 }  // namespace avx
 

@@ -1,10 +1,10 @@
 #pragma once
 // PolarRotationNewton (polar_rotation.h) on many blends at once, in groups of
 // SIMD lanes: the per-frame rotations A of the example shapes (ALGORITHMS.md
-// 4.3) for the control points that blend three or more bones. With AVX a
-// group is 8 blends in two 4-double registers (two independent dependency
-// chains, so one group's divisions overlap the other's); with SSE2 (the
-// x86-64 baseline) 4 blends in two 2-double registers.
+// 4.3) for the control points that blend three or more bones: groups of 4
+// blends, in one 4-double AVX register or two 2-double SSE2 registers (the
+// x86-64 baseline). Groups of 8 (two AVX registers) were measured slower on
+// the shoulder patch: more spills, and a group waits for its slowest lane.
 //
 // Each lane does exactly the scalar iteration's IEEE operations in the same
 // order (the build has -ffp-contract=off and no FMA is used), and a lane's
@@ -33,8 +33,8 @@ namespace deform {
 enum class PolarLanesPath : std::uint8_t {
   kAuto,    // kAvx when the CPU has AVX, else kSse2
   kScalar,  // PolarRotationNewton once per blend
-  kSse2,    // groups of 4 lanes in two 2-double registers (x86-64 baseline)
-  kAvx,     // groups of 8 lanes in two 4-double AVX registers (CPUs with AVX only)
+  kSse2,    // 4 lanes in two 2-double registers (x86-64 baseline)
+  kAvx,     // 4 lanes in one 4-double AVX register (CPUs with AVX only)
 };
 
 // Whether this CPU (and OS) can run the kAvx path.
