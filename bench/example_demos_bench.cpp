@@ -6,6 +6,9 @@
 //   BM_DemoPoseUpdate        theta (features from the local pose) -> dS(theta)
 //                            -> A (control-point rotations) -> Q = G + A dS:
 //                            the paper's "RBF" column (3195 and 5348 per second)
+//   BM_DemoRotations, BM_DemoDisplacementAndApply
+//                            the update's two parts alone: A (given dS), and
+//                            features -> dS -> Q = G + A dS (given A)
 //   BM_DemoUpdateAndRebuild  carry G by SSD + the update above + rebuild of the
 //                            bound vertices: one patch's whole per-frame work,
 //                            beside the paper's "Total (FPS)" (581 and 532)
@@ -149,9 +152,51 @@ void Update(benchmark::State& state, bool rebuild) {
                  std::to_string(rebuilt.size()) + " bound vertices");
 }
 
+// The update's parts on their own, for where the time goes: the rotations A
+// (PatchControlRotations, given dS) and the rest (features, dS, Q = G + A dS
+// with given A).
+void Part(benchmark::State& state, bool rotations_only) {
+  const DemoScene& s = Scene(static_cast<int>(state.range(0)));
+  if (!s.error.empty()) {
+    state.SkipWithError(s.error.c_str());
+    return;
+  }
+  const deform::PatchSetup& p = s.patches[0];
+  const deform::PatchPoseSpace& space = s.spaces.patches[0];
+  const auto nc = static_cast<std::size_t>(p.num_control());
+  std::vector<glm::vec3> carried(nc), ds(nc), control(nc);
+  std::vector<glm::quat> rotations(nc);
+  std::vector<float> features(static_cast<std::size_t>(space.model.dimension));
+  (void)deform::CarryControlPointsJob{.patch = &p, .model_from_bind = s.palette, .control = carried}
+      .Run();
+  const deform::ExamplePose pose{.model_from_bind = s.palette};
+  (void)deform::ComputePoseFeatures(s.character.skeleton, space.features, s.locals, features);
+  (void)deform::PoseSpaceJob{.model = &space.model, .features = features, .displacement = ds}.Run();
+  (void)deform::PatchControlRotations(p, pose, rotations, ds);
+  for (auto _ : state) {
+    if (rotations_only) {
+      (void)deform::PatchControlRotations(p, pose, rotations, ds);
+      benchmark::DoNotOptimize(rotations.data());
+    } else {
+      (void)deform::ComputePoseFeatures(s.character.skeleton, space.features, s.locals, features);
+      (void)deform::PoseSpaceJob{.model = &space.model, .features = features, .displacement = ds}
+          .Run();
+      (void)deform::PoseSpaceApplyJob{.global = carried, .rotations = rotations,
+                                      .displacement = ds, .control = control}
+          .Run();
+      benchmark::DoNotOptimize(control.data());
+    }
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+
 void BM_DemoPoseUpdate(benchmark::State& state) { Update(state, false); }
+void BM_DemoRotations(benchmark::State& state) { Part(state, true); }
+void BM_DemoDisplacementAndApply(benchmark::State& state) { Part(state, false); }
 void BM_DemoUpdateAndRebuild(benchmark::State& state) { Update(state, true); }
 BENCHMARK(BM_DemoPoseUpdate)->Arg(0)->Arg(1);
+BENCHMARK(BM_DemoRotations)->Arg(0)->Arg(1);
+BENCHMARK(BM_DemoDisplacementAndApply)->Arg(0)->Arg(1);
 BENCHMARK(BM_DemoUpdateAndRebuild)->Arg(0)->Arg(1);
 
 }  // namespace
