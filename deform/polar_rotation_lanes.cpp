@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 
 #include <immintrin.h>
 
@@ -61,15 +62,15 @@ template <typename T>
 }
 
 template <typename T>
-inline constexpr int kWidth = static_cast<int>(sizeof(T) / 8);  // 8-byte lanes
+inline constexpr int kWidth = static_cast<int>(sizeof(T) / sizeof(T{}[0]));  // lanes of a GCC vector
 
-template <typename V>
-[[gnu::always_inline]] inline V Splat(double x) {
+template <typename V, typename E>
+[[gnu::always_inline]] inline V Splat(E x) {
   if constexpr (requires(V v) { v.a; }) {
     using T = decltype(V{}.a);
     return {Splat<T>(x), Splat<T>(x)};
   } else {
-    return x + V{};  // x + (+0) is x for every x but -0, which never occurs here
+    return x + V{};  // x + (+0) is x for every x but -0, which is never splat
   }
 }
 template <typename V, typename E>
@@ -84,7 +85,7 @@ template <typename V, typename E>
   }
 }
 template <typename V>
-[[gnu::always_inline]] inline double Lane(const V& v, int l) {
+[[gnu::always_inline]] inline auto Lane(const V& v, int l) {
   if constexpr (requires { v.a; }) {
     constexpr int h = kWidth<decltype(v.a)>;
     return l < h ? Lane(v.a, l) : Lane(v.b, l - h);
@@ -101,11 +102,17 @@ template <typename M, typename V>
   }
 }
 
-// SSE2 (the x86-64 baseline): 4 lanes as two 2-double registers.
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// SSE2 (the x86-64 baseline): 4 doubles as two 2-double registers.
 namespace sse2 {
+using E = double;
+constexpr double kMinDet = kPolarNewtonMinDet, kMaxDet = kInf;
+constexpr double kStop2 = kPolarNewtonStop * kPolarNewtonStop;
 typedef double V2 __attribute__((vector_size(16)));
-[[gnu::always_inline]] inline V2 Sqrt(const V2& v) { return V2(_mm_sqrt_pd(__m128d(v))); }
-[[gnu::always_inline]] inline Pair<V2> Sqrt(const Pair<V2>& v) { return {Sqrt(v.a), Sqrt(v.b)}; }
+[[gnu::always_inline]] inline Pair<V2> Sqrt(const Pair<V2>& v) {
+  return {V2(_mm_sqrt_pd(__m128d(v.a))), V2(_mm_sqrt_pd(__m128d(v.b)))};
+}
 using V = Pair<V2>;
 using M = decltype(V{} < V{});
 [[gnu::always_inline]] inline int Bits(const M& m) {
@@ -114,26 +121,57 @@ using M = decltype(V{} < V{});
 #include "deform/internal/polar_lanes_kernel.inc"
 }  // namespace sse2
 
+// SSE: 4 floats in one register.
+namespace sse2_float {
+using E = float;
+constexpr double kMinDet = kPolarFloatMinDet, kMaxDet = kPolarFloatMaxDet;
+constexpr double kStop2 = kPolarFloatStop * kPolarFloatStop;
+typedef float V __attribute__((vector_size(16)));
+[[gnu::always_inline]] inline V Sqrt(const V& v) { return V(_mm_sqrt_ps(__m128(v))); }
+using M = decltype(V{} < V{});
+[[gnu::always_inline]] inline int Bits(const M& m) { return _mm_movemask_ps(__m128(m)); }
+#include "deform/internal/polar_lanes_kernel.inc"
+}  // namespace sse2_float
+
 void NewtonSse2(const double* in, double* out, glm::quat* quats, std::uint8_t* ok,
                 std::size_t count) {
   sse2::NewtonAll(in, out, quats, ok, count);
 }
+void NewtonSse2Float(const double* in, glm::quat* quats, std::uint8_t* ok, std::size_t count) {
+  sse2_float::NewtonAll(in, nullptr, quats, ok, count);
+}
 
-// AVX: 4 lanes in one 4-double register.
+// AVX: 4 doubles, or 8 floats, in one register.
 #pragma GCC push_options
 #pragma GCC target("avx")
 namespace avx {
-typedef double V4 __attribute__((vector_size(32)));
-[[gnu::always_inline]] inline V4 Sqrt(const V4& v) { return V4(_mm256_sqrt_pd(__m256d(v))); }
-using V = V4;
+using E = double;
+constexpr double kMinDet = kPolarNewtonMinDet, kMaxDet = kInf;
+constexpr double kStop2 = kPolarNewtonStop * kPolarNewtonStop;
+typedef double V __attribute__((vector_size(32)));
+[[gnu::always_inline]] inline V Sqrt(const V& v) { return V(_mm256_sqrt_pd(__m256d(v))); }
 using M = decltype(V{} < V{});
 [[gnu::always_inline]] inline int Bits(const M& m) { return _mm256_movemask_pd(__m256d(m)); }
 #include "deform/internal/polar_lanes_kernel.inc"
 }  // namespace avx
 
+namespace avx_float {
+using E = float;
+constexpr double kMinDet = kPolarFloatMinDet, kMaxDet = kPolarFloatMaxDet;
+constexpr double kStop2 = kPolarFloatStop * kPolarFloatStop;
+typedef float V __attribute__((vector_size(32)));
+[[gnu::always_inline]] inline V Sqrt(const V& v) { return V(_mm256_sqrt_ps(__m256(v))); }
+using M = decltype(V{} < V{});
+[[gnu::always_inline]] inline int Bits(const M& m) { return _mm256_movemask_ps(__m256(m)); }
+#include "deform/internal/polar_lanes_kernel.inc"
+}  // namespace avx_float
+
 void NewtonAvx(const double* in, double* out, glm::quat* quats, std::uint8_t* ok,
                std::size_t count) {
   avx::NewtonAll(in, out, quats, ok, count);
+}
+void NewtonAvxFloat(const double* in, glm::quat* quats, std::uint8_t* ok, std::size_t count) {
+  avx_float::NewtonAll(in, nullptr, quats, ok, count);
 }
 #pragma GCC pop_options
 
@@ -178,6 +216,35 @@ mocap::JobStatus PolarRotationsNewton(std::span<const glm::dmat3> blends,
     NewtonAvx(in, out, q, converged.data(), n);
   } else {
     NewtonSse2(in, out, q, converged.data(), n);
+  }
+  return mocap::kJobOk;
+}
+
+}  // namespace deform
+
+namespace deform {
+
+mocap::JobStatus PolarRotationsNewtonFloat(std::span<const glm::dmat3> blends,
+                                           std::span<glm::quat> quats,
+                                           std::span<std::uint8_t> converged, PolarLanesPath path) {
+  const std::size_t n = blends.size();
+  if (quats.size() != n || converged.size() != n) {
+    return {mocap::JobStatus::kSizeMismatch, "quats and converged must be #N like blends"};
+  }
+  if (path == PolarLanesPath::kAuto) {
+    path = PolarLanesAvxAvailable() ? PolarLanesPath::kAvx : PolarLanesPath::kSse2;
+  }
+  if (path == PolarLanesPath::kAvx && !PolarLanesAvxAvailable()) {
+    return {mocap::JobStatus::kOutOfRange, "this CPU has no AVX"};
+  }
+  if (path == PolarLanesPath::kScalar) {
+    return {mocap::JobStatus::kOutOfRange, "the float iteration has no scalar path"};
+  }
+  if (n == 0) return mocap::kJobOk;
+  if (path == PolarLanesPath::kAvx) {
+    NewtonAvxFloat(&blends[0][0][0], quats.data(), converged.data(), n);
+  } else {
+    NewtonSse2Float(&blends[0][0][0], quats.data(), converged.data(), n);
   }
   return mocap::kJobOk;
 }

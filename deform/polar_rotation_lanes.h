@@ -56,4 +56,26 @@ bool PolarLanesAvxAvailable();
                                                     PolarLanesPath path = PolarLanesPath::kAuto,
                                                     std::span<glm::quat> quats = {});
 
+// The same iteration in float lanes (8 with AVX, 4 with SSE), for
+// well-conditioned blends only, as a faster first try: every lane whose
+// det X leaves (kPolarFloatMinDet, kPolarFloatMaxDet] at any step is refused
+// (converged[i] = 0, quats[i] left alone) and goes to PolarRotationsNewton,
+// so the float iteration never needs Higham's scaling. A lane stops after
+// the step shorter than kPolarFloatStop: near U the error after a step is
+// about half its squared length (5e-9), below float round-off. The result
+// differs from the double iteration's by float round-off magnified by the
+// blend's conditioning, 1 / (sigma_i + sigma_j) <= 4 here: measured below
+// kPolarFloatTol (tests/support/tolerances.h) on random blends, against
+// kRotationTolRad = 1e-5 for the rotations' users. Each lane's result
+// depends on that lane's blend only (any grouping, count or path gives the
+// same bits). `blends`, `quats`, `converged` all #N; kSizeMismatch
+// otherwise; kOutOfRange for kScalar, or kAvx without AVX.
+inline constexpr double kPolarFloatMinDet = 0.125;
+inline constexpr double kPolarFloatMaxDet = 8.0;
+inline constexpr double kPolarFloatStop = 1e-4;
+[[nodiscard]] mocap::JobStatus PolarRotationsNewtonFloat(std::span<const glm::dmat3> blends,
+                                                         std::span<glm::quat> quats,
+                                                         std::span<std::uint8_t> converged,
+                                                         PolarLanesPath path = PolarLanesPath::kAuto);
+
 }  // namespace deform

@@ -4,6 +4,8 @@
 // stays within the SVD's polar factor.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cstdio>
 #include <cstring>
 #include <limits>
 #include <numbers>
@@ -191,6 +193,103 @@ TEST(PolarRotationsNewton, RejectsMismatchedSpansAndAnUnavailablePath) {
   if (!avx.ok()) {
     EXPECT_EQ(avx.code, mocap::JobStatus::kOutOfRange);
   }
+}
+
+}  // namespace
+
+namespace {
+
+float QuatDistance(const glm::quat& a, const glm::quat& b) {
+  const glm::quat s = glm::dot(a, b) < 0.0f ? -b : b;
+  return glm::length(glm::vec4(a.x - s.x, a.y - s.y, a.z - s.z, a.w - s.w));
+}
+
+TEST(PolarRotationsNewtonFloat, TakesWellConditionedBlendsWithinTheFloatTolerance) {
+  std::mt19937 rng(31);
+  const std::vector<glm::dmat3> blends = MixedBlends(rng, 3001);
+  const std::size_t n = blends.size();
+  std::vector<glm::quat> reference(n);
+  std::vector<std::uint8_t> reference_ok(n);
+  ASSERT_TRUE(deform::PolarRotationsNewton(blends, {}, reference_ok, PolarLanesPath::kScalar, reference));
+  std::vector<glm::quat> first;
+  std::vector<std::uint8_t> first_ok;
+  for (PolarLanesPath path : Paths()) {
+    if (path == PolarLanesPath::kScalar) {
+      std::vector<glm::quat> q(n);
+      std::vector<std::uint8_t> ok(n);
+      EXPECT_EQ(deform::PolarRotationsNewtonFloat(blends, q, ok, path).code,
+                mocap::JobStatus::kOutOfRange);
+      continue;
+    }
+    std::vector<glm::quat> q(n, glm::quat(3.0f, 3.0f, 3.0f, 3.0f));
+    std::vector<std::uint8_t> ok(n, 9);
+    ASSERT_TRUE(deform::PolarRotationsNewtonFloat(blends, q, ok, path));
+    int taken = 0;
+    float worst = 0.0f;
+    for (std::size_t i = 0; i < n; ++i) {
+      const double det = glm::determinant(blends[i]);
+      if (!ok[i]) {
+        EXPECT_EQ(ok[i], 0);
+        EXPECT_TRUE(SameBits(q[i], glm::quat(3.0f, 3.0f, 3.0f, 3.0f))) << i;
+        // Refused: outside the float range at the start (or, rarely, later).
+        continue;
+      }
+      ++taken;
+      // Taken only where the double iteration converges too, det in range.
+      ASSERT_EQ(reference_ok[i], 1) << i;
+      EXPECT_GT(det, deform::kPolarFloatMinDet * (1.0 - 1e-6)) << i;
+      EXPECT_LE(det, deform::kPolarFloatMaxDet) << i;
+      const float d = QuatDistance(q[i], reference[i]);
+      worst = std::max(worst, d);
+      EXPECT_LT(d, testsupport::kPolarFloatTol) << i << " det " << det;
+      EXPECT_NEAR(glm::length(glm::vec4(q[i].x, q[i].y, q[i].z, q[i].w)), 1.0f, 1e-6f);
+    }
+    // Every well-conditioned random blend is taken (4 of 7 kinds, minus the
+    // wide 3- and 4-bone blends with det <= 1/8).
+    EXPECT_GT(taken, static_cast<int>(n) * 4 / 7 - static_cast<int>(n) / 10) << int(path);
+    std::printf("float lanes, path %d: %d of %zu taken, worst %.3g\n", int(path), taken, n,
+                static_cast<double>(worst));
+    // The same bits whatever the path (AVX 8 lanes, SSE 4 lanes).
+    if (first.empty()) {
+      first = q, first_ok = ok;
+    } else {
+      for (std::size_t i = 0; i < n; ++i) {
+        ASSERT_EQ(ok[i], first_ok[i]) << i;
+        if (ok[i]) {
+          EXPECT_TRUE(SameBits(q[i], first[i])) << i;
+        }
+      }
+    }
+  }
+}
+
+TEST(PolarRotationsNewtonFloat, AnyCountGivesTheSameResults) {
+  std::mt19937 rng(37);
+  const std::vector<glm::dmat3> blends = MixedBlends(rng, 40);
+  std::vector<glm::quat> whole(blends.size());
+  std::vector<std::uint8_t> whole_ok(blends.size());
+  ASSERT_TRUE(deform::PolarRotationsNewtonFloat(blends, whole, whole_ok));
+  for (std::size_t first = 0; first < 3; ++first) {
+    for (std::size_t count = 0; count <= 17; ++count) {
+      std::vector<glm::quat> q(count + 1, glm::quat(5.0f, 5.0f, 5.0f, 5.0f));
+      std::vector<std::uint8_t> ok(count + 1, 9);
+      ASSERT_TRUE(deform::PolarRotationsNewtonFloat(std::span(blends).subspan(first, count),
+                                                    std::span(q).first(count),
+                                                    std::span(ok).first(count)));
+      for (std::size_t i = 0; i < count; ++i) {
+        ASSERT_EQ(ok[i], whole_ok[first + i]) << first << " " << count << " " << i;
+        if (ok[i]) {
+          EXPECT_TRUE(SameBits(q[i], whole[first + i])) << first << " " << count << " " << i;
+        }
+      }
+      EXPECT_EQ(ok[count], 9);
+      EXPECT_TRUE(SameBits(q[count], glm::quat(5.0f, 5.0f, 5.0f, 5.0f)));
+    }
+  }
+  std::vector<glm::quat> q(3);
+  std::vector<std::uint8_t> ok(4);
+  EXPECT_EQ(deform::PolarRotationsNewtonFloat(std::span(blends).first(4), q, ok).code,
+            mocap::JobStatus::kSizeMismatch);
 }
 
 }  // namespace
