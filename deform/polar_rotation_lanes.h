@@ -19,6 +19,10 @@
 // float cast: again bit for bit the scalar expression.
 // Higham's scaling (det X outside [1/8, 8]) takes two scalar square roots in
 // the lanes that need it; it is rare for blends of rotations.
+//
+// PolarRotationsNewtonFloat (below) runs the same kernel in float, 8 lanes
+// per AVX register, on well-conditioned blends only: a first try that
+// PatchControlRotations makes before these double lanes (and the SVD).
 
 #include <cstdint>
 #include <span>
