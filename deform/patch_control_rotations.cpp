@@ -8,9 +8,9 @@
 // Newton's polar iteration in float SIMD lanes (polar_rotation_lanes.h;
 // within 1e-6 of the double iteration for the blends it takes, det in
 // (1/8, 8]), then in double lanes (the scalar iteration's bits) for the
-// rest, then the SVD. (Sorting the control points into
-// per-kind index lists first, to avoid data-dependent branches, was measured
-// slower: more instructions, and the branches predict well.)
+// rest, then the SVD. (Sorting all control points into per-kind index lists
+// first, to avoid data-dependent branches, was measured slower: more
+// instructions for no gain; only the moving ones are listed.)
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -102,8 +102,7 @@ mocap::JobStatus PatchControlRotations(const PatchSetup& patch, const ExamplePos
   std::array<std::size_t, kMaxInfluences> slots{};
   for (std::size_t c0 = 0; c0 < rotations.size(); c0 += kChunk) {
     const std::size_t count = std::min(kChunk, rotations.size() - c0);
-    // The control points that move, listed without a branch per point (which
-    // of them move follows the patch's layout, and mispredicted often); the
+    // The control points that move, listed without a branch per point; the
     // others keep the identity.
     std::size_t num_moving = 0;
     for (std::size_t c = c0; c < c0 + count; ++c) {
@@ -111,8 +110,7 @@ mocap::JobStatus PatchControlRotations(const PatchSetup& patch, const ExamplePos
       moving[num_moving] = static_cast<std::uint32_t>(c);
       num_moving += moves(c) ? 1 : 0;
     }
-    // The bones these control points use, marked without a branch per slot
-    // (zero weights are scattered through the slots and mispredicted).
+    // The bones these control points use, marked without a branch per slot.
     std::array<bool, kMaxFastBones> needed{};
     bool beyond = false;
     for (std::size_t j = 0; j < num_moving; ++j) {
