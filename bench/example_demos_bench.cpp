@@ -6,6 +6,9 @@
 //   BM_DemoPoseUpdate        theta (features from the local pose) -> dS(theta)
 //                            -> A (control-point rotations) -> Q = G + A dS:
 //                            the paper's "RBF" column (3195 and 5348 per second)
+//   BM_DemoRotations, BM_DemoDisplacementAndApply
+//                            the update's two parts alone: A (given dS), and
+//                            features -> dS -> Q = G + A dS (given A)
 //   BM_DemoUpdateAndRebuild  carry G by SSD + the update above + rebuild of the
 //                            bound vertices: one patch's whole per-frame work,
 //                            beside the paper's "Total (FPS)" (581 and 532)
@@ -14,6 +17,8 @@
 
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
@@ -97,19 +102,26 @@ void Update(benchmark::State& state, bool rebuild) {
   // those blend three or more bones (Newton's polar iteration).
   (void)deform::ComputePoseFeatures(s.character.skeleton, space.features, s.locals, features);
   (void)deform::PoseSpaceJob{.model = &space.model, .features = features, .displacement = ds}.Run();
+  // And how many distinct bones those control points blend (each is
+  // converted once per update).
   int moving = 0, three_plus = 0;
+  std::vector<std::uint8_t> bone_used(s.palette.size(), 0);
   for (std::size_t c = 0; c < nc; ++c) {
     if (ds[c] == glm::vec3(0.0f)) continue;
     ++moving;
     int bones = 0;
     for (int i = 0; i < p.control_weights.influences; ++i) {
-      bones += p.control_weights.weights[c * static_cast<std::size_t>(p.control_weights.influences) +
-                                         static_cast<std::size_t>(i)] != 0.0f;
+      const std::size_t slot = c * static_cast<std::size_t>(p.control_weights.influences) +
+                               static_cast<std::size_t>(i);
+      if (p.control_weights.weights[slot] == 0.0f) continue;
+      ++bones;
+      bone_used[p.control_weights.joints[slot]] = 1;
     }
     three_plus += bones >= 3;
   }
   state.counters["moving"] = moving;
   state.counters["moving_3plus_bones"] = three_plus;
+  state.counters["bones"] = static_cast<double>(std::count(bone_used.begin(), bone_used.end(), 1));
   for (auto _ : state) {
     if (rebuild) {
       (void)deform::CarryControlPointsJob{.patch = &p, .model_from_bind = s.palette,
@@ -140,9 +152,51 @@ void Update(benchmark::State& state, bool rebuild) {
                  std::to_string(rebuilt.size()) + " bound vertices");
 }
 
+// The update's parts on their own, for where the time goes: the rotations A
+// (PatchControlRotations, given dS) and the rest (features, dS, Q = G + A dS
+// with given A).
+void Part(benchmark::State& state, bool rotations_only) {
+  const DemoScene& s = Scene(static_cast<int>(state.range(0)));
+  if (!s.error.empty()) {
+    state.SkipWithError(s.error.c_str());
+    return;
+  }
+  const deform::PatchSetup& p = s.patches[0];
+  const deform::PatchPoseSpace& space = s.spaces.patches[0];
+  const auto nc = static_cast<std::size_t>(p.num_control());
+  std::vector<glm::vec3> carried(nc), ds(nc), control(nc);
+  std::vector<glm::quat> rotations(nc);
+  std::vector<float> features(static_cast<std::size_t>(space.model.dimension));
+  (void)deform::CarryControlPointsJob{.patch = &p, .model_from_bind = s.palette, .control = carried}
+      .Run();
+  const deform::ExamplePose pose{.model_from_bind = s.palette};
+  (void)deform::ComputePoseFeatures(s.character.skeleton, space.features, s.locals, features);
+  (void)deform::PoseSpaceJob{.model = &space.model, .features = features, .displacement = ds}.Run();
+  (void)deform::PatchControlRotations(p, pose, rotations, ds);
+  for (auto _ : state) {
+    if (rotations_only) {
+      (void)deform::PatchControlRotations(p, pose, rotations, ds);
+      benchmark::DoNotOptimize(rotations.data());
+    } else {
+      (void)deform::ComputePoseFeatures(s.character.skeleton, space.features, s.locals, features);
+      (void)deform::PoseSpaceJob{.model = &space.model, .features = features, .displacement = ds}
+          .Run();
+      (void)deform::PoseSpaceApplyJob{.global = carried, .rotations = rotations,
+                                      .displacement = ds, .control = control}
+          .Run();
+      benchmark::DoNotOptimize(control.data());
+    }
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+
 void BM_DemoPoseUpdate(benchmark::State& state) { Update(state, false); }
+void BM_DemoRotations(benchmark::State& state) { Part(state, true); }
+void BM_DemoDisplacementAndApply(benchmark::State& state) { Part(state, false); }
 void BM_DemoUpdateAndRebuild(benchmark::State& state) { Update(state, true); }
 BENCHMARK(BM_DemoPoseUpdate)->Arg(0)->Arg(1);
+BENCHMARK(BM_DemoRotations)->Arg(0)->Arg(1);
+BENCHMARK(BM_DemoDisplacementAndApply)->Arg(0)->Arg(1);
 BENCHMARK(BM_DemoUpdateAndRebuild)->Arg(0)->Arg(1);
 
 }  // namespace

@@ -384,8 +384,12 @@ JobStatus PoseSpaceApplyJob::Validate() const {
 JobStatus PoseSpaceApplyJob::Run() const {
   const JobStatus status = Validate();
   if (!status.ok()) return status;
-  for (size_t c = 0; c < global.size(); ++c)
-    control[c] = global[c] + rotations[c] * displacement[c];
+  // Where dS is exactly zero (control points no example moves) A dS is zero:
+  // Q = G, without the rotation.
+  for (size_t c = 0; c < global.size(); ++c) {
+    control[c] = displacement[c] == glm::vec3(0.0f) ? global[c]
+                                                     : global[c] + rotations[c] * displacement[c];
+  }
   return mocap::kJobOk;
 }
 

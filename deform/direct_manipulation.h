@@ -164,7 +164,9 @@ glm::dmat3 PolarRotationSvd(const glm::dmat3& m);
                                                         std::span<glm::vec3> example);
 
 // Per frame: Q_c = G_c + A_c dS_c(theta) (ALGORITHMS.md 0, step 2 without the
-// elastic term). Never allocates; any split of the #C arrays gives the same bits.
+// elastic term); where dS_c is exactly (0,0,0), Q_c = G_c without reading A_c
+// (PatchControlRotations writes the identity there). Never
+// allocates; any split of the #C arrays gives the same bits.
 struct PoseSpaceApplyJob {
   // Inputs.
   std::span<const glm::vec3> global{};        // #C control points G after the global layer (model)

@@ -18,10 +18,6 @@ mocap::Error EditError(const ExampleEdit& e, const std::string& message) {
   return mocap::MakeError(ErrorCode::kInvalidArgument, e.loc, message);
 }
 
-// Most skin joints the fast SSD rotation path keeps on the stack.
-constexpr std::size_t kMaxFastBones = 256;
-// Largest |R^T R - I| entry for a palette matrix to count as a rotation.
-constexpr double kRigidTol = 1e-4;
 
 bool Finite(const glm::dvec3& v) {
   return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
@@ -31,126 +27,6 @@ bool Finite(const glm::dvec3& v) {
 glm::dmat3 Rotation3(const glm::mat4& m) { return glm::dmat3(glm::mat3(m)); }
 
 }  // namespace
-
-mocap::JobStatus PatchControlRotations(const PatchSetup& patch, const ExamplePose& pose,
-                                       std::span<glm::quat> rotations,
-                                       std::span<const glm::vec3> displacement) {
-  if (!displacement.empty() && displacement.size() != rotations.size()) {
-    return {mocap::JobStatus::kSizeMismatch, "displacement must be empty or #C"};
-  }
-  // Q = G + A dS is G whatever A is where dS is exactly zero (A 0 = 0): the
-  // identity stands in for A there.
-  const auto skip = [&](std::size_t c) {
-    return !displacement.empty() && displacement[c] == glm::vec3(0.0f);
-  };
-  const auto identity_where_skipped = [&](mocap::JobStatus st) {
-    if (!st) return st;
-    for (std::size_t c = 0; c < rotations.size(); ++c) {
-      if (skip(c)) rotations[c] = glm::quat(1.0f, 0.0f, 0.0f, 0.0f);
-    }
-    return st;
-  };
-  const SkinWeights& w = patch.control_weights;
-  if (!pose.dq_palette.empty()) {
-    return identity_where_skipped(
-        DqsControlRotations(pose.dq_palette, w.influences, w.joints, w.weights, rotations));
-  }
-  const std::size_t num_skin = pose.model_from_bind.size();
-  const int k = w.influences;
-  if (k < 1 || k > kMaxInfluences || num_skin > kMaxFastBones ||
-      w.joints.size() != rotations.size() * static_cast<std::size_t>(k) ||
-      w.weights.size() != w.joints.size()) {
-    return identity_where_skipped(
-        SsdControlRotations(pose.model_from_bind, k, w.joints, w.weights, rotations));
-  }
-  // Bone rotations as matrices and quaternions, converted once per call and
-  // only for the bones this patch's moving control points use; a palette
-  // matrix that is not a rotation (scale, shear) sends the whole patch to the
-  // general polar decomposition.
-  std::array<glm::dmat3, kMaxFastBones> bone_matrix;
-  std::array<glm::dquat, kMaxFastBones> bone;
-  std::array<std::uint8_t, kMaxFastBones> have{};
-  const auto kk = static_cast<std::size_t>(k);
-  for (std::size_t c = 0; c < rotations.size(); ++c) {
-    if (skip(c)) continue;  // no slot of this control point is needed
-    for (std::size_t slot = c * kk; slot < (c + 1) * kk; ++slot) {
-      const std::uint16_t b = w.joints[slot];
-      if (w.weights[slot] == 0.0f || have[b]) continue;
-      if (b >= num_skin) return {mocap::JobStatus::kOutOfRange, "joint index beyond the palette"};
-      const glm::dmat3 r(glm::mat3(pose.model_from_bind[b]));
-      const glm::dmat3 rtr = glm::transpose(r) * r;
-      double off = 0.0;
-      for (int i = 0; i < 3; ++i) {
-        for (int j = 0; j < 3; ++j) off = std::max(off, std::abs(rtr[i][j] - (i == j ? 1.0 : 0.0)));
-      }
-      if (off > kRigidTol || glm::determinant(r) <= 0.0) {
-        return identity_where_skipped(
-            SsdControlRotations(pose.model_from_bind, k, w.joints, w.weights, rotations));
-      }
-      bone_matrix[b] = r;
-      bone[b] = glm::normalize(glm::quat_cast(r));
-      have[b] = 1;
-    }
-  }
-  for (std::size_t c = 0; c < rotations.size(); ++c) {
-    if (skip(c)) {
-      rotations[c] = glm::quat(1.0f, 0.0f, 0.0f, 0.0f);
-      continue;
-    }
-    // The influences with nonzero weight, in slot order.
-    int n = 0;
-    std::array<std::size_t, kMaxInfluences> slots{};
-    for (std::size_t slot = c * kk; slot < (c + 1) * kk; ++slot) {
-      if (w.weights[slot] != 0.0f) slots[static_cast<std::size_t>(n++)] = slot;
-    }
-    if (n == 0) {  // no weight at all (CheckSkinWeights rejects it): no turn
-      rotations[c] = glm::quat(1.0f, 0.0f, 0.0f, 0.0f);
-      continue;
-    }
-    if (n == 1) {
-      rotations[c] = glm::quat(bone[w.joints[slots[0]]]);
-      continue;
-    }
-    if (n == 2) {
-      const glm::dquat q1 = bone[w.joints[slots[0]]];
-      glm::dquat rel = glm::conjugate(q1) * bone[w.joints[slots[1]]];  // R1^T R2 = Rot(a, theta)
-      if (rel.w < 0.0) rel = -rel;
-      const double s = glm::length(glm::dvec3(rel.x, rel.y, rel.z));
-      const double w1 = w.weights[slots[0]], w2 = w.weights[slots[1]];
-      // theta from rel = (cos(theta/2), sin(theta/2) a): sin theta = 2 s c,
-      // cos theta = 2 c^2 - 1 (no trigonometric calls).
-      const double y = 2.0 * w2 * s * rel.w, x = w1 + w2 * (2.0 * rel.w * rel.w - 1.0);
-      const double rho = std::sqrt(x * x + y * y);
-      if (s < 1e-12 && rho >= 1e-6) {
-        rotations[c] = glm::quat(q1);
-        continue;
-      }
-      if (rho >= 1e-6 && rho + x >= 1e-9) {
-        // w1 I + w2 Rot(a, theta) is normal with eigenvalues 1 and w1 + w2 e^(+-i theta)
-        // = rho e^(+-i phi), so its orthogonal polar factor is Rot(a, phi); as a
-        // quaternion (cos(phi/2), sin(phi/2) a) ~ (rho + x, y a), normalized.
-        const glm::dvec3 axis = glm::dvec3(rel.x, rel.y, rel.z) / s;
-        const glm::dquat turn = glm::normalize(glm::dquat(rho + x, y * axis));
-        rotations[c] = glm::quat(glm::normalize(q1 * turn));
-        continue;
-      }
-      // Two opposite rotations at (nearly) equal weight: the general path.
-    }
-    // Three or more bones: the polar factor of sum_b w_b R_b by Newton's
-    // iteration (polar_rotation.h); a blend with det <= kPolarNewtonMinDet
-    // (nearly singular, or reflecting) takes PolarRotation, whose SVD fixes
-    // the sign as SsdControlRotations always did.
-    glm::dmat3 blend(0.0);
-    for (int i = 0; i < n; ++i) {
-      const std::size_t slot = slots[static_cast<std::size_t>(i)];
-      blend += static_cast<double>(w.weights[slot]) * bone_matrix[w.joints[slot]];
-    }
-    glm::dmat3 polar;
-    if (!PolarRotationNewton(blend, polar)) polar = PolarRotation(blend);
-    rotations[c] = glm::normalize(glm::quat(glm::quat_cast(polar)));
-  }
-  return mocap::kJobOk;
-}
 
 mocap::Result<SculptedExample> SculptExample(const PatchSetup& patch, const SkinnedMesh& mesh,
                                              const ExamplePose& pose,

@@ -88,9 +88,13 @@ mocap::Result<SculptedExample> SculptExample(const PatchSetup& patch, const Skin
 // float) but faster: in closed form for a control point with one or two
 // bones (with R1^T R2 = Rot(a, theta),
 // polar(w1 R1 + w2 R2) = R1 Rot(a, atan2(w2 sin theta, w1 + w2 cos theta))),
-// by Newton's polar iteration (PolarRotationNewton) for three or more.
+// by Newton's polar iteration for three or more: in float SIMD lanes for
+// blends with det in (1/8, 8] (PolarRotationsNewtonFloat, within 1e-6 of the
+// double iteration, which kRotationTolRad = 1e-5 leaves far apart), else in
+// double lanes (PolarRotationsNewton, PolarRotationNewton's bits).
 // Blends with det <= kPolarNewtonMinDet (reflecting or nearly singular), and
 // a palette that is not rigid, take PolarRotation / SsdControlRotations.
+// Defined in patch_control_rotations.cpp.
 //
 // `displacement` (optional, #C or empty): the dS(theta) these rotations will
 // turn (PoseSpaceJob's output). Where it is exactly (0,0,0), A is not
@@ -99,7 +103,9 @@ mocap::Result<SculptedExample> SculptExample(const PatchSetup& patch, const Skin
 // such control points use are not even converted. Control points that no
 // example moves (by default the boundary ring, which direct manipulation
 // keeps fixed) have dS exactly 0 at every pose.
-// kSizeMismatch on a `displacement` of another size. Never allocates.
+// kSizeMismatch on a `displacement` of another size; kOutOfRange on a
+// weighted joint index beyond the palette (rotations then unspecified).
+// Never allocates.
 [[nodiscard]] mocap::JobStatus PatchControlRotations(const PatchSetup& patch,
                                                      const ExamplePose& pose,
                                                      std::span<glm::quat> rotations,

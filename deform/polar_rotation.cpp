@@ -5,11 +5,6 @@
 namespace deform {
 namespace {
 
-// Scaling pays only while the iterate is far from orthogonal (it costs two
-// square roots and a division on the critical path of an iteration): a
-// blend of rotations with det in [1/8, 8] converges as fast without it.
-constexpr double kScaleBelowDet = 0.125, kScaleAboveDet = 8.0;
-
 double Norm2(const glm::dmat3& m) {
   return glm::dot(m[0], m[0]) + glm::dot(m[1], m[1]) + glm::dot(m[2], m[2]);
 }
@@ -29,7 +24,11 @@ bool PolarRotationNewton(const glm::dmat3& m, glm::dmat3& rotation, int* iterati
     if (!(det > kPolarNewtonMinDet)) return false;
     const double inv_det = 1.0 / det;
     double g = 1.0;
-    if (det < kScaleBelowDet || det > kScaleAboveDet) {
+    // Scaling pays only while the iterate is far from orthogonal (it costs two
+    // square roots and a division on the critical path of an iteration): a
+    // blend of rotations with det in [1/8, 8] converges as fast without it.
+    // polar_rotation_lanes.cpp repeats these operations lane by lane.
+    if (det < kPolarNewtonScaleBelowDet || det > kPolarNewtonScaleAboveDet) {
       // |X^-1|_F = |cof|_F / det; g = sqrt(|X^-1|_F / |X|_F).
       g = std::sqrt(std::sqrt(Norm2(cof) / Norm2(x)) * inv_det);
     }

@@ -36,6 +36,10 @@ inline constexpr double kPolarNewtonStop = 1e-6;
 // Smallest det M the iteration accepts (for |M|_2 <= 1, as for convex blends
 // of rotations, this bounds the smallest singular value below by this value).
 inline constexpr double kPolarNewtonMinDet = 1e-6;
+// Higham's scaling is applied while det X_k is below the first or above the
+// second of these (far from orthogonal); elsewhere g = 1.
+inline constexpr double kPolarNewtonScaleBelowDet = 0.125;
+inline constexpr double kPolarNewtonScaleAboveDet = 8.0;
 // Most iterations before giving up (never reached for det M >
 // kPolarNewtonMinDet in tests; a safety net against NaN input).
 inline constexpr int kPolarNewtonMaxIterations = 20;
