@@ -19,6 +19,13 @@ void StreamRow(glm::vec4* dst, int n, const glm::vec4& v) {
 #if defined(__SSE2__)
   if ((reinterpret_cast<std::uintptr_t>(dst) & 15u) == 0) {
     const __m128 x = _mm_set_ps(v.w, v.z, v.y, v.x);
+    for (; i + 4 <= n; i += 4) {  // a cache line per step
+      float* p = reinterpret_cast<float*>(dst + i);
+      _mm_stream_ps(p, x);
+      _mm_stream_ps(p + 4, x);
+      _mm_stream_ps(p + 8, x);
+      _mm_stream_ps(p + 12, x);
+    }
     for (; i < n; ++i) _mm_stream_ps(reinterpret_cast<float*>(dst + i), x);
   }
 #endif
@@ -30,6 +37,12 @@ void StreamRow(float* dst, int n, float v) {
 #if defined(__SSE2__)
   for (; i < n && (reinterpret_cast<std::uintptr_t>(dst + i) & 15u) != 0; ++i) dst[i] = v;
   const __m128 x = _mm_set1_ps(v);
+  for (; i + 16 <= n; i += 16) {  // a cache line per step
+    _mm_stream_ps(dst + i, x);
+    _mm_stream_ps(dst + i + 4, x);
+    _mm_stream_ps(dst + i + 8, x);
+    _mm_stream_ps(dst + i + 12, x);
+  }
   for (; i + 4 <= n; i += 4) _mm_stream_ps(dst + i, x);
 #endif
   for (; i < n; ++i) dst[i] = v;
