@@ -6,7 +6,6 @@
 #include <cstdint>
 #include <cstring>
 #include <limits>
-#include <type_traits>
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -386,62 +385,6 @@ class Renderer::SampleShader {
     _mm_store_ps(nd, _mm_setzero_ps());
     return Kind::kColor;
   }
-
-  // Four adjacent samples sx + [0, 4) of row sy that all show triangle `id`:
-  // when it is plane-lit, shades them in one go (the planes evaluated with
-  // the four samples in the lanes; per lane the operations and their order
-  // are those of ShadeTerms and the row's second pass, so the bytes are the
-  // same) and stores them to out[0, 4); returns false, storing nothing,
-  // for any other kind of triangle.
-  [[gnu::always_inline]] bool ShadePlaneGroup(std::uint32_t id, int sx, int sy, glm::vec4* out,
-                                              bool aligned) {
-    Entry& t = cache_[id & (kCacheSize - 1)];
-    if (t.id != id) Load(id, t);
-    if (!t.lambert_plane) return false;
-    const __m128 fx = _mm_cvtepi32_ps(_mm_add_epi32(_mm_set1_epi32(sx - t.ref_x),
-                                                     _mm_setr_epi32(0, 1, 2, 3)));
-    const __m128 fy = _mm_set1_ps(static_cast<float>(sy - t.ref_y));
-    const __m128 a = _mm_load_ps(t.plane_a), b = _mm_load_ps(t.plane_b), c = _mm_load_ps(t.plane_c);
-    // Component k of (N, D) in the four lanes: (c + a * fx) + b * fy.
-    const auto plane = [&](auto k) {
-      constexpr int imm = decltype(k)::value * 0x55;
-      return _mm_add_ps(_mm_add_ps(_mm_shuffle_ps(c, c, imm), _mm_mul_ps(_mm_shuffle_ps(a, a, imm), fx)),
-                        _mm_mul_ps(_mm_shuffle_ps(b, b, imm), fy));
-    };
-    const __m128 nx = plane(std::integral_constant<int, 0>{});
-    const __m128 ny = plane(std::integral_constant<int, 1>{});
-    const __m128 nz = plane(std::integral_constant<int, 2>{});
-    const __m128 d = plane(std::integral_constant<int, 3>{});
-    const __m128 zero = _mm_setzero_ps();
-    const __m128 len2 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(nx, nx), _mm_mul_ps(ny, ny)), _mm_mul_ps(nz, nz));
-    const __m128 lit = _mm_and_ps(_mm_cmpgt_ps(d, zero), _mm_cmpgt_ps(len2, zero));
-    const __m128 n_dot_l = _mm_and_ps(lit, _mm_div_ps(d, _mm_sqrt_ps(len2)));
-    const __m128 base = _mm_load_ps(t.lit_base), key = _mm_load_ps(t.lit_key);
-    // Channel k of the four colours: base + key * n_dot_l.
-    const auto channel = [&](auto k) {
-      constexpr int imm = decltype(k)::value * 0x55;
-      return _mm_add_ps(_mm_shuffle_ps(base, base, imm),
-                        _mm_mul_ps(_mm_shuffle_ps(key, key, imm), n_dot_l));
-    };
-    __m128 r = channel(std::integral_constant<int, 0>{});
-    __m128 g = channel(std::integral_constant<int, 1>{});
-    __m128 bl = channel(std::integral_constant<int, 2>{});
-    __m128 al = channel(std::integral_constant<int, 3>{});
-    _MM_TRANSPOSE4_PS(r, g, bl, al);
-    float* dst = reinterpret_cast<float*>(out);
-    if (aligned) {
-      _mm_stream_ps(dst, r);
-      _mm_stream_ps(dst + 4, g);
-      _mm_stream_ps(dst + 8, bl);
-      _mm_stream_ps(dst + 12, al);
-    } else {
-      _mm_storeu_ps(dst, r);
-      _mm_storeu_ps(dst + 4, g);
-      _mm_storeu_ps(dst + 8, bl);
-      _mm_storeu_ps(dst + 12, al);
-    }
-    return true;
-  }
 #endif
 
  private:
@@ -649,39 +592,7 @@ void Renderer::ShadeTile(int tile, const RenderSettings& settings,
       SurfacePoints4 deferred[kTileSize / 4];
       bool any_ground = false, any_surface = false;
       const int n = x1 - x0;
-      const bool aligned = (reinterpret_cast<std::uintptr_t>(rgba) & 15u) == 0;
-      // Most groups of four show the background only or one triangle only
-      // (over half of them on BM_RenderBody): those are stored at once, the
-      // background as bg + 0 * 0 like an empty sample of the second pass, a
-      // plane-lit triangle by ShadePlaneGroup. The others take both passes.
-      bool group_done[kTileSize / 4] = {};
-      {
-        const __m128 empty_color =
-            _mm_add_ps(_mm_set_ps(bg.w, bg.z, bg.y, bg.x), _mm_mul_ps(_mm_setzero_ps(), _mm_setzero_ps()));
-        const std::uint32_t* q = s.ids.data() + row;
-        for (int i = 0; i + 4 <= n; i += 4) {
-          const std::uint32_t id = q[i];
-          if (q[i + 1] != id || q[i + 2] != id || q[i + 3] != id) continue;
-          if (id == kNoTriangle) {
-            float* dst = reinterpret_cast<float*>(rgba + i);
-            for (int k = 0; k < 4; ++k) {
-              if (aligned) {
-                _mm_stream_ps(dst + 4 * k, empty_color);
-              } else {
-                _mm_storeu_ps(dst + 4 * k, empty_color);
-              }
-            }
-            group_done[i >> 2] = true;
-          } else {
-            group_done[i >> 2] = shader.ShadePlaneGroup(id, x0 + i, sy, rgba + i, aligned);
-          }
-        }
-      }
       for (int i = 0; i < n; ++i) {
-        if (group_done[i >> 2]) {
-          i += 3;
-          continue;
-        }
         const std::uint32_t id = s.ids[row + static_cast<std::size_t>(i)];
         if (id == kNoTriangle) {
           _mm_store_ps(base[i], _mm_set_ps(bg.w, bg.z, bg.y, bg.x));
@@ -704,7 +615,6 @@ void Renderer::ShadeTile(int tile, const RenderSettings& settings,
       if (any_surface) ShadeSurfaceRow(n, surface, deferred, store_base);
       for (int i = n; i < ((n + 3) & ~3); ++i) _mm_store_ps(nd[i], _mm_setzero_ps());
       for (int i = 0; i < n; i += 4) {
-        if (group_done[i >> 2]) continue;
         __m128 x = _mm_load_ps(nd[i]), y = _mm_load_ps(nd[i + 1]), z = _mm_load_ps(nd[i + 2]),
                d = _mm_load_ps(nd[i + 3]);
         _MM_TRANSPOSE4_PS(x, y, z, d);
@@ -717,7 +627,7 @@ void Renderer::ShadeTile(int tile, const RenderSettings& settings,
         for (int j = 0; j < 4 && i + j < n; ++j) {
           const __m128 c = _mm_add_ps(_mm_load_ps(base[i + j]),
                                       _mm_mul_ps(_mm_load_ps(key[i + j]), _mm_set1_ps(n_dot_l[j])));
-          if (aligned) {
+          if ((reinterpret_cast<std::uintptr_t>(rgba + i + j) & 15u) == 0) {
             _mm_stream_ps(reinterpret_cast<float*>(rgba + i + j), c);
           } else {
             _mm_storeu_ps(reinterpret_cast<float*>(rgba + i + j), c);
