@@ -48,26 +48,28 @@ inline void StreamFence() {
 }
 
 // View depth (1 / stored 1/w, +inf where empty) of `n` samples of one tile row.
-// Ordinary stores, not streaming ones: a tile row of depth is only 256 bytes
-// (four cache lines) and such short non-temporal chunks at a large stride
-// drain slowly; through the cache the BM_RenderBody frame was 3-7 % faster
-// (loaded 2-core VM, alternating runs).
 void WriteDepthRow(const float* inv_w, const std::uint32_t* ids, int n, float* out) {
   int i = 0;
 #if defined(__SSE2__)
   const __m128 one = _mm_set1_ps(1.0f);
   const __m128 inf = _mm_set1_ps(std::numeric_limits<float>::infinity());
   const __m128i empty = _mm_set1_epi32(static_cast<int>(kNoTriangle));
+  const bool aligned = (reinterpret_cast<std::uintptr_t>(out) & 15u) == 0;
   for (; i + 4 <= n; i += 4) {
     const __m128 miss = _mm_castsi128_ps(_mm_cmpeq_epi32(
         _mm_loadu_si128(reinterpret_cast<const __m128i*>(ids + i)), empty));  // all ones = empty
     // Empty samples hold 1/w = 0: divide 1 by 1 there instead, then select inf.
     const __m128 d = _mm_div_ps(one, _mm_or_ps(_mm_andnot_ps(miss, _mm_loadu_ps(inv_w + i)),
                                                _mm_and_ps(miss, one)));
-    _mm_storeu_ps(out + i, _mm_or_ps(_mm_and_ps(miss, inf), _mm_andnot_ps(miss, d)));
+    const __m128 v = _mm_or_ps(_mm_and_ps(miss, inf), _mm_andnot_ps(miss, d));
+    if (aligned) {
+      _mm_stream_ps(out + i, v);
+    } else {
+      _mm_storeu_ps(out + i, v);
+    }
   }
 #endif
-  for (; i < n; ++i) out[i] = ids[i] != kNoTriangle ? 1.0f / inv_w[i] : kInf;
+  for (; i < n; ++i) StreamStore(out + i, ids[i] != kNoTriangle ? 1.0f / inv_w[i] : kInf);
 }
 
 mocap::JobStatus Fail(mocap::JobStatus::Code code, const char* what) { return {code, what}; }
