@@ -373,9 +373,12 @@ void Rasterizer::RasterizeTile(int tile, std::span<float> depth,
         for (; i < full; i += 4) {
           const __m128i inside =
               _mm_cmpgt_epi32(_mm_or_si128(_mm_or_si128(e0, e1), e2), minus_one);
-          // About half of a small triangle's bounding box is outside it: skip
-          // the depth test and the stores of groups with no sample inside.
-          if (_mm_movemask_epi8(inside) != 0) group(i, inside);
+          // No test for an empty group: about half of a small triangle's
+          // bounding box lies outside it, in no predictable pattern, and the
+          // mispredicted branch cost more than the masked depth test and
+          // stores it saved (RasterizeTile ~12 % faster without it, against
+          // SampleShader::Load in alternating perf profiles).
+          group(i, inside);
           e0 = _mm_add_epi32(e0, step0);
           e1 = _mm_add_epi32(e1, step1);
           e2 = _mm_add_epi32(e2, step2);
