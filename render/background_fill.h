@@ -15,7 +15,9 @@
 //   BackgroundFill fill;
 //   std::atomic<std::size_t> cursor{0};
 //   fill.Plan(raster, ss, sample_rows, transparent, image.width, image.height, cursor);
-//   // on every thread of the frame, after its other work:
+//   // on the frame's threads, a share after each shaded tile (the stores
+//   // then drain while the next tile computes), and after their other work:
+//   fill.Drain(share, image);
 //   fill.Drain(fill.units(), image);
 //
 // Every unit is claimed exactly once through the shared cursor and writes
