@@ -1,6 +1,7 @@
 #include "render/renderer.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -210,15 +211,43 @@ mocap::JobStatus Renderer::Render(const Camera& camera, std::span<const SceneMes
     s.accum.resize(kTileSize * kTileSize);
     s.nearest.resize(kTileSize * kTileSize);
   }
-  internal::ParallelForDynamic(rasterizer_.num_tiles(), threads, [&](int tile, int thread) {
-    TileScratch& s = scratch_[static_cast<std::size_t>(thread)];
-    if (rasterizer_.tile_triangle_count(tile) == 0) {
-      FillBackgroundTile(tile, settings, image);
-      return;
-    }
-    rasterizer_.RasterizeTile(tile, s.depth, s.ids);
-    ShadeTile(tile, settings, meshes, s, image);
-  });
+  if (tent) {
+    internal::ParallelForDynamic(rasterizer_.num_tiles(), threads, [&](int tile, int thread) {
+      TileScratch& s = scratch_[static_cast<std::size_t>(thread)];
+      if (rasterizer_.tile_triangle_count(tile) == 0) {
+        FillBackgroundTile(tile, settings, image);
+        return;
+      }
+      rasterizer_.RasterizeTile(tile, s.depth, s.ids);
+      ShadeTile(tile, settings, meshes, s, image);
+    });
+  } else {
+    // Background tiles are written in long row runs (see background_fill.h),
+    // their share after each shaded tile so that their stores drain while the
+    // next tile computes; whatever is left at the end.
+    shaded_tiles_.clear();
+    for (int tile = 0; tile < rasterizer_.num_tiles(); ++tile)
+      if (rasterizer_.tile_triangle_count(tile) != 0) shaded_tiles_.push_back(tile);
+    std::atomic<std::size_t> fill_cursor{0};
+    fill_.Plan(rasterizer_, ss, background_rows_, settings.background.transparent, settings.width,
+               settings.height, fill_cursor);
+    const int count = static_cast<int>(shaded_tiles_.size());
+    std::atomic<int> next{0};
+    internal::RunOnThreads(std::min(threads, std::max(count, 1)), [&](int thread) {
+      TileScratch& s = scratch_[static_cast<std::size_t>(thread)];
+      std::size_t credit = 0;  // background units owed, times count
+      for (int i = next.fetch_add(1); i < count; i = next.fetch_add(1)) {
+        const int tile = shaded_tiles_[static_cast<std::size_t>(i)];
+        rasterizer_.RasterizeTile(tile, s.depth, s.ids);
+        ShadeTile(tile, settings, meshes, s, image);
+        credit += fill_.units();
+        const std::size_t due = credit / static_cast<std::size_t>(count);
+        credit -= due * static_cast<std::size_t>(count);
+        fill_.Drain(due, image);
+      }
+      fill_.Drain(fill_.units(), image);
+    });
+  }
   if (tent) {
     // Every sample is shaded before any pixel reads its neighbours' samples.
     internal::RunOnThreads(threads, [&](int t) {

@@ -20,6 +20,7 @@
 #include <glm/glm.hpp>
 
 #include "mocap/error.h"
+#include "render/background_fill.h"
 #include "render/camera.h"
 #include "render/ground_shader.h"
 #include "render/image.h"
@@ -97,6 +98,8 @@ class Renderer {
     std::vector<float> nearest;             // output pixels of one tile: min view depth
   };
   class SampleShader;
+  // Tent resolve only (it also fills samples_); the box resolve writes
+  // background tiles through fill_.
   void FillBackgroundTile(int tile, const RenderSettings& settings, Image& image);
   // Calls store(i, colour) for every i in [0, n) with ground[i] set (`ground`
   // holds n rounded up to 4 entries), the colour of ground sample (x0 + i, sy).
@@ -120,6 +123,9 @@ class Renderer {
   std::vector<ContactShadow> shadows_;
   std::vector<glm::vec3> background_rows_;              // per sample row
   std::vector<TileScratch> scratch_;                    // per thread
+  // Box resolve: the background tiles, written in row runs (see background_fill.h).
+  BackgroundFill fill_;
+  std::vector<int> shaded_tiles_;                       // tiles with triangles, ascending
   // Tent resolve only: every shaded sample of the frame, row-major over the
   // sample raster: rgb (the background where empty; 0 there when transparent)
   // and coverage (1 covered, 0 empty). Empty otherwise.
