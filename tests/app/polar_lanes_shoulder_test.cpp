@@ -9,26 +9,20 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstring>
-#include <filesystem>
+#include <memory>
 #include <vector>
 
 #include <glm/gtc/quaternion.hpp>
 
-#include "app/motion_source.h"
-#include "app/pipeline.h"
-#include "app/rig_file.h"
-#include "app/rig_patches.h"
 #include "deform/direct_manipulation.h"
 #include "deform/polar_rotation.h"
 #include "deform/polar_rotation_lanes.h"
 #include "deform/skinning_job.h"
 #include "mocap/pose.h"
+#include "support/example_demos.h"
 #include "support/tolerances.h"
 
 namespace {
-
-namespace fs = std::filesystem;
-const fs::path kSamples = fs::path(GOLDEN_DIR) / ".." / ".." / "samples" / "data";
 
 float QuatDistance(const glm::quat& a, const glm::quat& b) {
   const glm::quat s = glm::dot(a, b) < 0.0f ? -b : b;
@@ -36,16 +30,10 @@ float QuatDistance(const glm::quat& a, const glm::quat& b) {
 }
 
 TEST(PolarLanesShoulder, LanesMatchTheScalarIterationAndTheSvdOnTheDemoBlends) {
-  auto rig = app::LoadRig((kSamples / "shoulder.json").string());
-  ASSERT_TRUE(rig.ok()) << rig.error().ToString();
-  auto source = app::LoadMotionSource(rig->motion, {.y_up = true});
-  ASSERT_TRUE(source.ok()) << source.error().ToString();
-  auto character = app::MakeCharacter(std::move(*source));
-  ASSERT_TRUE(character.ok()) << character.error().ToString();
-  auto patches = app::BuildRigPatches(*rig, *character);
-  ASSERT_TRUE(patches.ok()) << patches.error().ToString();
-  const app::Character& ch = *character;
-  const deform::SkinWeights& w = (*patches)[0].control_weights;
+  const std::unique_ptr<testsupport::Demo> demo = testsupport::LoadDemo("shoulder");
+  ASSERT_TRUE(demo->error.empty()) << demo->error;
+  const app::Character& ch = demo->character;
+  const deform::SkinWeights& w = demo->patches[0].control_weights;
   const auto k = static_cast<std::size_t>(w.influences);
   const std::size_t nc = w.joints.size() / k;
   const auto nj = static_cast<std::size_t>(ch.skeleton.num_joints());
