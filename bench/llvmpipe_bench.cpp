@@ -16,8 +16,13 @@
 // thread does vertex work and binning and N threads rasterize.) The row name
 // and the "threads" counter give the count in use; the label is GL_RENDERER.
 //
+// per_vertex:1 rows use fixed-function GL lighting instead (one directional
+// light, the same Lambert terms evaluated per vertex and interpolated:
+// Gouraud, cheaper per pixel than what our renderer does).
+//
 // Optional (bench only): built when pkg-config finds osmesa (Debian's
-// libosmesa6-dev). Args: width, height, threads (from LP_NUM_THREADS).
+// libosmesa6-dev). Args: width, height, threads (from LP_NUM_THREADS),
+// per_vertex (0 GLSL per fragment, 1 fixed-function per vertex).
 
 #include <algorithm>
 #include <cstdint>
@@ -110,6 +115,7 @@ void BM_LlvmpipeBody(benchmark::State& state) {
   static const bench::BodyMesh body = bench::MakeBody();
   const int width = static_cast<int>(state.range(0));
   const int height = static_cast<int>(state.range(1));
+  const bool per_vertex = state.range(3) != 0;
   const auto pixel_count = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
 
   // The colour buffer OSMesa renders into, and the buffer the pixels are read back into.
@@ -138,6 +144,28 @@ void BM_LlvmpipeBody(benchmark::State& state) {
   const render::ShadingContext lights = render::MakeShadingContext(
       render::LightRig{}, render::LightingModel::kLambert, camera.ViewFromWorld());
   const glm::vec3 albedo = render::SceneMesh{}.base_color;
+  if (per_vertex) {
+    // Fixed-function lighting (Gouraud): the same Lambert terms per vertex.
+    // GL's light 0 is given in eye space, like the rig's view-space key light.
+    const render::LightRig rig;
+    const glm::vec4 key_dir_view(glm::normalize(rig.key.direction_view), 0.0f);
+    const glm::vec4 key_radiance(lights.key_radiance, 1.0f), ambient(lights.ambient, 1.0f);
+    const glm::vec4 material(albedo, 1.0f), black(0.0f, 0.0f, 0.0f, 1.0f);
+    glMatrixMode(GL_PROJECTION);
+    glLoadMatrixf(glm::value_ptr(camera.ClipFromView()));
+    glMatrixMode(GL_MODELVIEW);
+    glLoadIdentity();
+    glLightfv(GL_LIGHT0, GL_POSITION, glm::value_ptr(key_dir_view));
+    glLightfv(GL_LIGHT0, GL_DIFFUSE, glm::value_ptr(key_radiance));
+    glLightfv(GL_LIGHT0, GL_AMBIENT, glm::value_ptr(black));
+    glLightfv(GL_LIGHT0, GL_SPECULAR, glm::value_ptr(black));
+    glLightModelfv(GL_LIGHT_MODEL_AMBIENT, glm::value_ptr(ambient));
+    glMaterialfv(GL_FRONT_AND_BACK, GL_AMBIENT_AND_DIFFUSE, glm::value_ptr(material));
+    glMaterialfv(GL_FRONT_AND_BACK, GL_SPECULAR, glm::value_ptr(black));
+    glEnable(GL_LIGHTING);
+    glEnable(GL_LIGHT0);
+    glLoadMatrixf(glm::value_ptr(camera.ViewFromWorld()));
+  }
   glUseProgram(program);
   glUniformMatrix4fv(glGetUniformLocation(program, "u_clip_from_world"), 1, GL_FALSE,
                      glm::value_ptr(clip_from_world));
@@ -146,18 +174,29 @@ void BM_LlvmpipeBody(benchmark::State& state) {
                glm::value_ptr(lights.key_radiance));
   glUniform3fv(glGetUniformLocation(program, "u_ambient"), 1, glm::value_ptr(lights.ambient));
   glUniform3fv(glGetUniformLocation(program, "u_albedo"), 1, glm::value_ptr(albedo));
+  if (per_vertex) glUseProgram(0);
 
   const auto vertex_bytes = static_cast<GLsizeiptr>(body.positions.size() * sizeof(glm::vec3));
   GLuint buffers[3] = {};
   glGenBuffers(3, buffers);
   glBindBuffer(GL_ARRAY_BUFFER, buffers[0]);
   glBufferData(GL_ARRAY_BUFFER, vertex_bytes, nullptr, GL_STREAM_DRAW);
-  glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 0, nullptr);
-  glEnableVertexAttribArray(0);
+  if (per_vertex) {
+    glVertexPointer(3, GL_FLOAT, 0, nullptr);
+    glEnableClientState(GL_VERTEX_ARRAY);
+  } else {
+    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 0, nullptr);
+    glEnableVertexAttribArray(0);
+  }
   glBindBuffer(GL_ARRAY_BUFFER, buffers[1]);
   glBufferData(GL_ARRAY_BUFFER, vertex_bytes, nullptr, GL_STREAM_DRAW);
-  glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, 0, nullptr);
-  glEnableVertexAttribArray(1);
+  if (per_vertex) {
+    glNormalPointer(GL_FLOAT, 0, nullptr);
+    glEnableClientState(GL_NORMAL_ARRAY);
+  } else {
+    glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, 0, nullptr);
+    glEnableVertexAttribArray(1);
+  }
   glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, buffers[2]);
   glBufferData(GL_ELEMENT_ARRAY_BUFFER,
                static_cast<GLsizeiptr>(body.triangles.size() * sizeof(glm::uvec3)),
@@ -203,8 +242,9 @@ void BM_LlvmpipeBody(benchmark::State& state) {
   const auto covered = std::count_if(depth.begin(), depth.end(), [](float d) { return d < 1.0f; });
   const char* renderer_name = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
   state.SetLabel(renderer_name != nullptr ? renderer_name : "?");
-  if (const std::string path = bench::SnapshotPath("llvmpipe_" + std::to_string(width) + "x" +
-                                                   std::to_string(height));
+  if (const std::string path = bench::SnapshotPath(
+          "llvmpipe_" + std::to_string(width) + "x" + std::to_string(height) +
+          (per_vertex ? "_per_vertex" : ""));
       !path.empty()) {
     std::vector<std::uint8_t> rgb;
     rgb.reserve(pixel_count * 3);
@@ -235,9 +275,9 @@ int main(int argc, char** argv) {
   if (std::getenv("LP_NUM_THREADS") == nullptr) setenv("LP_NUM_THREADS", "1", 1);
   const int threads = LlvmpipeThreads();
   benchmark::RegisterBenchmark("BM_LlvmpipeBody", BM_LlvmpipeBody)
-      ->ArgNames({"w", "h", "threads"})
-      ->Args({1280, 720, threads})
-      ->Args({1920, 1080, threads})
+      ->ArgNames({"w", "h", "threads", "per_vertex"})
+      ->ArgsProduct({{1280}, {720}, {threads}, {0, 1}})
+      ->ArgsProduct({{1920}, {1080}, {threads}, {0, 1}})
       ->Unit(benchmark::kMillisecond)
       ->UseRealTime();
   benchmark::Initialize(&argc, argv);
