@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>
+#include <optional>
 #include <span>
 #include <string>
 #include <utility>
@@ -73,22 +74,40 @@ BENCHMARK_CAPTURE(BM_Evaluate, ssd, app::GlobalMethod::kSsd)->Arg(1)->Arg(2)->Un
 BENCHMARK_CAPTURE(BM_Evaluate, dqs, app::GlobalMethod::kDqs)->Arg(1)->Arg(2)->Unit(benchmark::kMicrosecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_Evaluate, swd, app::GlobalMethod::kSwd)->Arg(1)->Arg(2)->Unit(benchmark::kMicrosecond)->UseRealTime();
 
-void BM_EvaluateBelly(benchmark::State& state, bool elastic) {
+// The belly_jump sample rig on the mannequin: its character, patches and
+// resolved elastic specs. Skips the benchmark if the rig is missing.
+struct BellyScene {
+  app::Rig rig;
+  app::Character character;
+  std::vector<deform::PatchSetup> patches;
+  std::vector<app::ElasticPatchSpec> specs;
+};
+
+std::optional<BellyScene> LoadBelly(benchmark::State& state) {
   auto rig = app::LoadRig(std::string(PATCHSKIN_SAMPLES_DIR) + "/belly_jump.json");
   if (!rig.ok()) {
     state.SkipWithError(rig.error().ToString().c_str());
-    return;
+    return std::nullopt;
   }
   auto src = app::LoadMotionSource(rig->motion, {.y_up = true});
   if (!src.ok()) std::abort();
   auto c = app::MakeCharacter(std::move(*src));
   if (!c.ok()) std::abort();
   auto patches = app::BuildRigPatches(*rig, *c);
+  if (!patches.ok()) std::abort();
   auto specs = app::ResolveRigElastic(*rig, *c, *patches);
+  if (!specs.ok()) std::abort();
+  return BellyScene{std::move(*rig), std::move(*c), std::move(*patches), std::move(*specs)};
+}
+
+void BM_EvaluateBelly(benchmark::State& state, bool elastic) {
+  std::optional<BellyScene> scene = LoadBelly(state);
+  if (!scene) return;
+  const app::Character* c = &scene->character;
   auto pipeline = app::FramePipeline::Create(*c, app::GlobalMethod::kSsd, 1);
-  if (!patches.ok() || !specs.ok() || !pipeline.ok()) std::abort();
-  if (!pipeline->SetPatches(std::move(*patches)).ok()) std::abort();
-  if (elastic && !pipeline->SetElastic(std::move(*specs)).ok()) std::abort();
+  if (!pipeline.ok()) std::abort();
+  if (!pipeline->SetPatches(std::move(scene->patches)).ok()) std::abort();
+  if (elastic && !pipeline->SetElastic(std::move(scene->specs)).ok()) std::abort();
   app::DeformedFrame frame;
   const double dt = c->motion.frame_time_s;
   int f = 0;
@@ -120,23 +139,16 @@ double ThreadCpuSeconds() {
 // the same network to the same time (c). Counters (thread CPU time per frame):
 // elastic_us = (c), frame_us = (a) + (b), elastic_share = (c) / ((a) + (b)).
 void BM_BellyFrameShare(benchmark::State& state) {
-  auto rig = app::LoadRig(std::string(PATCHSKIN_SAMPLES_DIR) + "/belly_jump.json");
-  if (!rig.ok()) {
-    state.SkipWithError(rig.error().ToString().c_str());
-    return;
-  }
-  auto src = app::LoadMotionSource(rig->motion, {.y_up = true});
-  if (!src.ok()) std::abort();
-  auto c = app::MakeCharacter(std::move(*src));
-  if (!c.ok()) std::abort();
-  auto patches = app::BuildRigPatches(*rig, *c);
-  auto specs = app::ResolveRigElastic(*rig, *c, *patches);
+  std::optional<BellyScene> scene = LoadBelly(state);
+  if (!scene) return;
+  const app::Rig* rig = &scene->rig;
+  const app::Character* c = &scene->character;
   auto pipeline = app::FramePipeline::Create(*c, app::GlobalMethod::kSsd, 1);
-  if (!patches.ok() || !specs.ok() || !pipeline.ok()) std::abort();
-  auto layer = app::ElasticLayer::Create(*c, *patches, *specs);
+  if (!pipeline.ok()) std::abort();
+  auto layer = app::ElasticLayer::Create(*c, scene->patches, scene->specs);
   if (!layer.ok()) std::abort();
-  if (!pipeline->SetPatches(std::move(*patches)).ok()) std::abort();
-  if (!pipeline->SetElastic(std::move(*specs)).ok()) std::abort();
+  if (!pipeline->SetPatches(std::move(scene->patches)).ok()) std::abort();
+  if (!pipeline->SetElastic(std::move(scene->specs)).ok()) std::abort();
   // Joint matrices of every frame for the separate layer's driving rotation.
   const mocap::Skeleton& skel = c->skeleton;
   const std::size_t nj = static_cast<std::size_t>(skel.num_joints());
