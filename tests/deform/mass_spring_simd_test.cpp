@@ -18,6 +18,7 @@
 
 #include "deform/mass_spring.h"
 #include "deform/internal/mass_spring_modal.h"
+#include "support/mass_spring_networks.h"
 #include "support/tolerances.h"
 
 namespace {
@@ -29,19 +30,6 @@ using deform::MassSpringState;
 using deform::MassSpringStepJob;
 using DriveFn = std::function<DrivingFrame(double)>;
 using namespace testsupport;
-
-MassSpringNetwork Build(int rows, int cols, const MassSpringParams& params) {
-  std::vector<glm::vec3> points;
-  for (int i = 0; i < rows; ++i)
-    for (int j = 0; j < cols; ++j)
-      points.emplace_back(2.0f * static_cast<float>(j), 0.3f * static_cast<float>(i * j),
-                          2.0f * static_cast<float>(i));
-  auto net = deform::BuildMassSpringNetwork(
-      {.rows = rows, .cols = cols, .rest_points = points, .max_angular_speed_rad_s = 3.0f},
-      params);
-  EXPECT_TRUE(net.ok()) << net.error().ToString();
-  return std::move(net).value();
-}
 
 bool SameBits(const std::vector<glm::vec3>& a, const std::vector<glm::vec3>& b) {
   return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(glm::vec3)) == 0;
@@ -62,7 +50,7 @@ TEST(MassSpringSimd, ExactAvxAndSse2KernelsGiveTheSameBits) {
   ASSERT_NE(avx, sse);
   for (const auto& [rows, cols] : kGrids) {
     SCOPED_TRACE(testing::Message() << rows << "x" << cols);
-    const MassSpringNetwork net = Build(rows, cols, {});
+    const MassSpringNetwork net = CurvedGridNetwork(rows, cols);
     const std::size_t size = 3 * static_cast<std::size_t>(net.mode_stride);
     std::vector<float> x(size, 0.0f), v(size, 0.0f);
     for (std::size_t c = 0; c < 3; ++c) {
@@ -110,7 +98,7 @@ TEST(MassSpringSimd, FastestKernelFollowsThePortableOne) {
   };
   for (const auto& [rows, cols] : kGrids) {
     SCOPED_TRACE(testing::Message() << rows << "x" << cols);
-    const MassSpringNetwork net = Build(rows, cols, {});
+    const MassSpringNetwork net = CurvedGridNetwork(rows, cols);
     MassSpringState fast, portable;
     fast.Resize(net);
     portable.Resize(net);
@@ -211,7 +199,7 @@ TEST(MassSpringSimd, BothPathsMatchTheScalarFormulation) {
     SCOPED_TRACE(testing::Message() << rows << "x" << cols);
     MassSpringParams p;
     p.gravity = false;
-    const MassSpringNetwork net = Build(rows, cols, p);
+    const MassSpringNetwork net = CurvedGridNetwork(rows, cols, p);
     const std::size_t n = static_cast<std::size_t>(net.num_free);
     // (AVX, FMA): the default (exact AVX), the fastest (FMA where the CPU has it), SSE2.
     for (const auto& [allow_avx, allow_fma] : {std::pair{true, false}, {true, true}, {false, false}}) {

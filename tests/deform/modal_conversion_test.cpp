@@ -11,27 +11,16 @@
 
 #include "deform/internal/mass_spring_modal.h"
 #include "deform/mass_spring.h"
+#include "support/mass_spring_networks.h"
 
 namespace {
-
-deform::MassSpringNetwork Build(int rows, int cols) {
-  std::vector<glm::vec3> points;
-  for (int i = 0; i < rows; ++i)
-    for (int j = 0; j < cols; ++j)
-      points.emplace_back(2.0f * static_cast<float>(j), 0.3f * static_cast<float>(i * j),
-                          2.0f * static_cast<float>(i));
-  auto net = deform::BuildMassSpringNetwork(
-      {.rows = rows, .cols = cols, .rest_points = points, .max_angular_speed_rad_s = 3.0f});
-  EXPECT_TRUE(net.ok()) << net.error().ToString();
-  return std::move(net).value();
-}
 
 TEST(ModalConversion, BothPathsGiveTheScalarSums) {
   // 4x4: 4 modes (one 8-lane group), 5x5: 9 (one 16-lane group), 8x8: 36 (two
   // 16-lane groups and an 8-lane one), 16x16: 196.
   for (const auto& [rows, cols] : {std::pair{4, 4}, {5, 5}, {8, 8}, {16, 16}}) {
     SCOPED_TRACE(testing::Message() << rows << "x" << cols);
-    const deform::MassSpringNetwork net = Build(rows, cols);
+    const deform::MassSpringNetwork net = testsupport::CurvedGridNetwork(rows, cols);
     const std::size_t n = static_cast<std::size_t>(net.num_free);
     const std::size_t stride = static_cast<std::size_t>(net.mode_stride);
     std::vector<float> in(3 * stride, 0.0f);  // padding lanes 0
