@@ -13,6 +13,7 @@
 
 #include <immintrin.h>
 
+#include "deform/internal/cpu_features.h"
 #include "deform/patch_binding.h"
 
 // The 8-lane helpers pass vectors by value, but all of them are internal and
@@ -224,7 +225,7 @@ mocap::JobStatus PatchRebuildJob::Validate() const {
 mocap::JobStatus PatchRebuildJob::Run() const {
   if (const mocap::JobStatus st = Validate(); !st) return st;
   const size_t n = bindings.size();
-  const bool simd = allow_simd && __builtin_cpu_supports("avx");
+  const bool simd = allow_simd && internal::CpuHasAvx();
   const std::uint16_t* first = bindings.first.data();
   size_t i = 0;
   while (i < n) {

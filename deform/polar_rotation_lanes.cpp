@@ -9,6 +9,7 @@
 
 #include <glm/gtc/quaternion.hpp>
 
+#include "deform/internal/cpu_features.h"
 #include "deform/polar_rotation.h"
 
 // The lane helpers pass vectors by value, but all are internal and always
@@ -177,10 +178,7 @@ void NewtonAvxFloat(const double* in, glm::quat* quats, std::uint8_t* ok, std::s
 
 }  // namespace
 
-bool PolarLanesAvxAvailable() {
-  static const bool has = __builtin_cpu_supports("avx");
-  return has;
-}
+bool PolarLanesAvxAvailable() { return internal::CpuHasAvx(); }
 
 mocap::JobStatus PolarRotationsNewton(std::span<const glm::dmat3> blends,
                                       std::span<glm::dmat3> rotations,

@@ -12,6 +12,8 @@
 #define PATCHSKIN_SKINNING_SSE2 1
 #if defined(__GNUC__) && defined(__x86_64__) && !defined(PATCHSKIN_NO_AVX_SKINNING)
 #include <immintrin.h>
+
+#include "deform/internal/cpu_features.h"
 #define PATCHSKIN_SKINNING_AVX 1
 #endif
 #endif
@@ -133,10 +135,6 @@ __attribute__((target("avx"))) void SkinSpanAvx(const SkinningJob& job) {
   }
 }
 
-bool CpuHasAvx() {
-  static const bool has = __builtin_cpu_supports("avx");
-  return has;
-}
 #endif
 
 #else  // portable scalar loop, same order of operations as the SSE2 one
@@ -178,7 +176,7 @@ void SkinSpan(const SkinningJob& job) {
 template <int kN>
 void SkinDispatchNormals(const SkinningJob& job, [[maybe_unused]] bool allow_avx) {
 #if defined(PATCHSKIN_SKINNING_AVX)
-  if (allow_avx && CpuHasAvx()) {
+  if (allow_avx && internal::CpuHasAvx()) {
     if (job.rest_normals.empty()) {
       SkinSpanAvx<kN, false>(job);
     } else {
@@ -198,7 +196,7 @@ void SkinDispatchNormals(const SkinningJob& job, [[maybe_unused]] bool allow_avx
 
 const char* SkinningSimdPath() {
 #if defined(PATCHSKIN_SKINNING_AVX)
-  if (CpuHasAvx()) return "avx";
+  if (internal::CpuHasAvx()) return "avx";
 #endif
 #if defined(PATCHSKIN_SKINNING_SSE2)
   return "sse2";

@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "deform/internal/cpu_features.h"
+
 // The 8-lane helpers pass vectors by value, but all of them are internal and
 // always inlined into their callers, so no call crosses the ABI GCC warns about.
 #pragma GCC diagnostic ignored "-Wpsabi"
@@ -115,16 +117,6 @@ void MatrixSse(const MassSpringNetwork& net, const float* m, const float* in, fl
 [[gnu::target("avx")]] void MatrixAvx(const MassSpringNetwork& net, const float* m,
                                       const float* in, float* out) {
   exact_avx::MatrixBody(net, m, in, out);
-}
-
-bool CpuHasAvx() {
-  static const bool has = __builtin_cpu_supports("avx");
-  return has;
-}
-
-bool CpuHasAvx2Fma() {
-  static const bool has = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
-  return has;
 }
 
 }  // namespace
