@@ -37,14 +37,19 @@ FrameBlend FindFrameBlend(int num_frames, double frame_time_s, double time_s) {
   const double last = num_frames - 1;
   const double f = time_s / frame_time_s;
   if (f >= last) return {num_frames - 1, num_frames - 1, 0.0f};
-  const double nearest = std::round(f);
+  // 0 < f < #F - 1 < 2^31: truncation is floor, f - base is exact (base = 0, or
+  // f < 2 base), and round (half away from zero) is base or base + 1; no
+  // library calls to floor and round (SSE2 has no rounding instruction), which
+  // matters to the elastic layer's sampler (every RK4 stage time).
+  const double base = static_cast<double>(static_cast<int>(f));
+  const double fraction = f - base;
+  const double nearest = fraction >= 0.5 ? base + 1.0 : base;
   if (std::abs(f - nearest) <= 1e-9 * std::max(1.0, nearest)) {  // on a frame: exact
     const int k = static_cast<int>(nearest);
     return {k, k, 0.0f};
   }
-  const double base = std::floor(f);
   const int k = static_cast<int>(base);
-  return {k, k + 1, static_cast<float>(f - base)};
+  return {k, k + 1, static_cast<float>(fraction)};
 }
 
 JobStatus SampleLocalsJob::Validate() const {

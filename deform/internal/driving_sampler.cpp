@@ -41,28 +41,8 @@ void KinematicsDrivingSampler::Prepare(int frame0) {
   }
 }
 
-mocap::FrameBlend FrameBlendAt(int num_frames, double frame_time_s, double time_s) {
-  if (num_frames <= 1 || !(frame_time_s > 0.0) || !std::isfinite(time_s) || time_s <= 0.0) {
-    return {};
-  }
-  const double last = num_frames - 1;
-  const double f = time_s / frame_time_s;
-  if (f >= last) return {num_frames - 1, num_frames - 1, 0.0f};
-  // 0 < f < #F - 1 < 2^31: truncation is floor, f - base is exact (base = 0, or
-  // f < 2 base), and std::round (half away from zero) is base or base + 1.
-  const double base = static_cast<double>(static_cast<int>(f));
-  const double fraction = f - base;
-  const double nearest = fraction >= 0.5 ? base + 1.0 : base;
-  if (std::abs(f - nearest) <= 1e-9 * std::max(1.0, nearest)) {  // on a frame: exact
-    const int k = static_cast<int>(nearest);
-    return {k, k, 0.0f};
-  }
-  const int k = static_cast<int>(base);
-  return {k, k + 1, static_cast<float>(fraction)};
-}
-
 DrivingFrame KinematicsDrivingSampler::Sample(double time_s) {
-  const mocap::FrameBlend blend = FrameBlendAt(num_frames_, frame_time_s_, time_s);
+  const mocap::FrameBlend blend = mocap::FindFrameBlend(num_frames_, frame_time_s_, time_s);
   const mocap::JointKinematics& k0 =
       kinematics_[static_cast<std::size_t>(blend.frame0) * num_joints_ + joint_];
   if (blend.frame1 == blend.frame0) {

@@ -19,11 +19,6 @@
 
 namespace deform::internal {
 
-// mocap::FindFrameBlend, bit for bit, without its library calls to floor and
-// round (SSE2 has no rounding instruction): the sampler calls it at every stage
-// time.
-mocap::FrameBlend FrameBlendAt(int num_frames, double frame_time_s, double time_s);
-
 class KinematicsDrivingSampler {
  public:
   // `kinematics` (#F x #J, frame-major, not empty) must outlive the sampler;

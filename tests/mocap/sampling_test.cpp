@@ -1,6 +1,10 @@
 #include "mocap/sampling.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <limits>
+#include <random>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -239,6 +243,61 @@ TEST(Resample, RejectsBadInput) {
   mocap::Skeleton other = s;
   other.num_channels = 12;
   EXPECT_EQ(mocap::Resample(other, m, 0.05).error().code, mocap::ErrorCode::kInvalidArgument);
+}
+
+// FindFrameBlend (truncation instead of floor and round) against its definition
+// with std::floor and std::round: frames, weights and the on-a-frame snapping
+// (within 1e-9 frames) the same at stage times, near frame times on either side
+// of the snapping threshold, at half frames (round's ties), at and past both
+// ends, and for degenerate inputs.
+mocap::FrameBlend FloorRoundFrameBlend(int num_frames, double frame_time_s, double time_s) {
+  if (num_frames <= 1 || !(frame_time_s > 0.0) || !std::isfinite(time_s) || time_s <= 0.0) {
+    return {};
+  }
+  const double f = time_s / frame_time_s;
+  if (f >= num_frames - 1) return {num_frames - 1, num_frames - 1, 0.0f};
+  const double nearest = std::round(f);
+  if (std::abs(f - nearest) <= 1e-9 * std::max(1.0, nearest)) {
+    const int k = static_cast<int>(nearest);
+    return {k, k, 0.0f};
+  }
+  const double base = std::floor(f);
+  const int k = static_cast<int>(base);
+  return {k, k + 1, static_cast<float>(f - base)};
+}
+
+TEST(FindFrameBlend, MatchesTheFloorAndRoundDefinitionBitForBit) {
+  std::vector<double> times = {0.0, -0.0, -1.0, 1e-300, std::numeric_limits<double>::quiet_NaN(),
+                               std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()};
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> u(-0.5, 80.0);
+  for (int i = 0; i < 20000; ++i) times.push_back(u(rng));
+  int snapped = 0, blended = 0;
+  for (const int num_frames : {0, 1, 2, 3, 121, 9000}) {
+    for (const double h : {1.0 / 120, 1.0 / 30, 0.01, 1.0 / 7, 0.0, -1.0}) {
+      std::vector<double> all = times;
+      for (int k = 0; k <= 200 && k < num_frames + 2; ++k) {
+        const double at = k * h;
+        for (const double d : {0.0, 1e-12, -1e-12, 0.99e-9, -0.99e-9, 1.01e-9, -1.01e-9, 1e-7}) {
+          all.push_back(at + d * h * std::max(1, k));
+        }
+        all.push_back((k + 0.5) * h);                    // a tie for round
+        all.push_back(std::nextafter((k + 0.5) * h, 0.0));
+        for (int s = 0; s < 4; ++s) all.push_back(k * h + s * h / 4.0);  // stage times
+      }
+      for (const double t : all) {
+        const mocap::FrameBlend a = FloorRoundFrameBlend(num_frames, h, t);
+        const mocap::FrameBlend b = mocap::FindFrameBlend(num_frames, h, t);
+        ASSERT_EQ(a.frame0, b.frame0) << num_frames << " frames, h " << h << ", t " << t;
+        ASSERT_EQ(a.frame1, b.frame1) << num_frames << " frames, h " << h << ", t " << t;
+        ASSERT_EQ(std::memcmp(&a.weight, &b.weight, sizeof a.weight), 0) << "t " << t;
+        snapped += a.frame0 == a.frame1 && a.frame0 > 0 && a.frame0 < num_frames - 1;
+        blended += a.frame0 != a.frame1;
+      }
+    }
+  }
+  EXPECT_GT(snapped, 1000);  // the on-a-frame branch ran inside the clip
+  EXPECT_GT(blended, 10000);
 }
 
 }  // namespace
