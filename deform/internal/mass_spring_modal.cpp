@@ -1,6 +1,7 @@
 #include "deform/internal/mass_spring_modal.h"
 
 #include <cmath>
+#include <cstring>
 
 #include "deform/internal/cpu_features.h"
 
@@ -16,6 +17,7 @@ namespace {
 namespace native {
 inline constexpr bool kPairGroups = true;  // 16-lane groups (two registers per value)
 typedef float V8 __attribute__((vector_size(32)));
+typedef float V4 __attribute__((vector_size(16)));
 typedef float V8Unaligned __attribute__((vector_size(32), aligned(4)));
 [[gnu::always_inline]] inline V8 SplatV8(float x) { return x - V8{}; }  // x - (+0) is x, even -0
 // A float in memory to all lanes: vbroadcastss. (AVX has no register-to-register
@@ -30,9 +32,7 @@ typedef float V8Unaligned __attribute__((vector_size(32), aligned(4)));
 [[gnu::always_inline]] inline V8 LoadV8(const float* p) { return *reinterpret_cast<const V8Unaligned*>(p); }
 [[gnu::always_inline]] inline void StoreV8(float* p, const V8& v) { *reinterpret_cast<V8Unaligned*>(p) = v; }
 [[gnu::always_inline]] inline float SumV8(const V8& v) {
-  float s = v[0];
-  for (int l = 1; l < 8; ++l) s += v[l];
-  return s;
+  return ((v[0] + v[4]) + (v[2] + v[6])) + ((v[1] + v[5]) + (v[3] + v[7]));
 }
 }  // namespace native
 
@@ -59,11 +59,8 @@ struct V8 {
   *reinterpret_cast<V4Unaligned*>(p) = v.lo;
   *reinterpret_cast<V4Unaligned*>(p + 4) = v.hi;
 }
-[[gnu::always_inline]] inline float SumV8(const V8& v) {  // lanes 0..7 in order, as native
-  float s = v.lo[0];
-  for (int l = 1; l < 4; ++l) s += v.lo[l];
-  for (int l = 0; l < 4; ++l) s += v.hi[l];
-  return s;
+[[gnu::always_inline]] inline float SumV8(const V8& v) {  // as native
+  return ((v.lo[0] + v.hi[0]) + (v.lo[2] + v.hi[2])) + ((v.lo[1] + v.hi[1]) + (v.lo[3] + v.hi[3]));
 }
 }  // namespace sse2
 
