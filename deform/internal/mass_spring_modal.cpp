@@ -1,6 +1,7 @@
 #include "deform/internal/mass_spring_modal.h"
 
 #include <cmath>
+#include <cstddef>
 #include <cstring>
 
 #include "deform/internal/cpu_features.h"
