@@ -30,6 +30,12 @@ typedef float V8Unaligned __attribute__((vector_size(32), aligned(4)));
   asm("vbroadcastss %1, %0" : "=x"(r) : "m"(*p));
   return r;
 }
+// The same, not before `after` is computed.
+[[gnu::always_inline]] inline V8 BroadcastAfter(const float* p, const V8& after) {
+  V8 r;
+  asm("vbroadcastss %1, %0" : "=x"(r) : "m"(*p), "x"(after));
+  return r;
+}
 [[gnu::always_inline]] inline V8 LoadV8(const float* p) { return *reinterpret_cast<const V8Unaligned*>(p); }
 [[gnu::always_inline]] inline void StoreV8(float* p, const V8& v) { *reinterpret_cast<V8Unaligned*>(p) = v; }
 [[gnu::always_inline]] inline float SumV8(const V8& v) {
@@ -56,6 +62,7 @@ struct V8 {
   return {*reinterpret_cast<const V4Unaligned*>(p), *reinterpret_cast<const V4Unaligned*>(p + 4)};
 }
 [[gnu::always_inline]] inline V8 BroadcastV8(const float* p) { return SplatV8(*p); }
+[[gnu::always_inline]] inline V8 BroadcastAfter(const float* p, const V8&) { return SplatV8(*p); }
 [[gnu::always_inline]] inline void StoreV8(float* p, const V8& v) {
   *reinterpret_cast<V4Unaligned*>(p) = v.lo;
   *reinterpret_cast<V4Unaligned*>(p + 4) = v.hi;
