@@ -38,8 +38,9 @@ typedef float V8Unaligned __attribute__((vector_size(32), aligned(4)));
 }
 [[gnu::always_inline]] inline V8 LoadV8(const float* p) { return *reinterpret_cast<const V8Unaligned*>(p); }
 [[gnu::always_inline]] inline void StoreV8(float* p, const V8& v) { *reinterpret_cast<V8Unaligned*>(p) = v; }
-[[gnu::always_inline]] inline float SumV8(const V8& v) {
-  return ((v[0] + v[4]) + (v[2] + v[6])) + ((v[1] + v[5]) + (v[3] + v[7]));
+[[gnu::always_inline]] inline void HalvesV8(const V8& v, V4& lo, V4& hi) {
+  lo = __builtin_shufflevector(v, v, 0, 1, 2, 3);
+  hi = __builtin_shufflevector(v, v, 4, 5, 6, 7);
 }
 }  // namespace native
 
@@ -67,8 +68,9 @@ struct V8 {
   *reinterpret_cast<V4Unaligned*>(p) = v.lo;
   *reinterpret_cast<V4Unaligned*>(p + 4) = v.hi;
 }
-[[gnu::always_inline]] inline float SumV8(const V8& v) {  // as native
-  return ((v.lo[0] + v.hi[0]) + (v.lo[2] + v.hi[2])) + ((v.lo[1] + v.hi[1]) + (v.lo[3] + v.hi[3]));
+[[gnu::always_inline]] inline void HalvesV8(const V8& v, V4& lo, V4& hi) {
+  lo = v.lo;
+  hi = v.hi;
 }
 }  // namespace sse2
 
