@@ -16,7 +16,7 @@ namespace {
 // Eight floats as one GCC vector: an AVX register in the target("avx"...)
 // functions below (GCC lowers it through memory where AVX is off).
 namespace native {
-inline constexpr bool kPairGroups = true;  // 16-lane groups (two registers per value)
+inline constexpr bool kPairGroups = true;  // matrix products: 16-lane groups (two registers)
 typedef float V8 __attribute__((vector_size(32)));
 typedef float V4 __attribute__((vector_size(16)));
 typedef float V8Unaligned __attribute__((vector_size(32), aligned(4)));
@@ -46,7 +46,7 @@ typedef float V8Unaligned __attribute__((vector_size(32), aligned(4)));
 
 // Eight floats as two SSE2 registers, for the baseline path.
 namespace sse2 {
-inline constexpr bool kPairGroups = false;  // 8-lane groups: already two registers per value
+inline constexpr bool kPairGroups = false;  // matrix products: 8 lanes, already two registers
 typedef float V4 __attribute__((vector_size(16)));
 typedef float V4Unaligned __attribute__((vector_size(16), aligned(4)));
 struct V8 {
@@ -87,7 +87,7 @@ using namespace native;
 }  // namespace exact_avx
 
 // AVX2 with a * b + c contracted into FMA: fewer instructions and shorter
-// dependency chains, with one rounding where the scalar code has two.
+// dependency chains, with one rounding where the scalar formulation has two.
 #pragma GCC push_options
 #pragma GCC target("avx2,fma")
 #pragma GCC optimize("fp-contract=fast")
