@@ -1,6 +1,8 @@
 #include "deform/internal/mass_spring_modal.h"
 
 #include <cmath>
+#include <cstddef>
+#include <cstring>
 
 #include "deform/internal/cpu_features.h"
 
@@ -14,8 +16,9 @@ namespace {
 // Eight floats as one GCC vector: an AVX register in the target("avx"...)
 // functions below (GCC lowers it through memory where AVX is off).
 namespace native {
-inline constexpr bool kPairGroups = true;  // 16-lane groups (two registers per value)
+inline constexpr bool kPairGroups = true;  // matrix products: 16-lane groups (two registers)
 typedef float V8 __attribute__((vector_size(32)));
+typedef float V4 __attribute__((vector_size(16)));
 typedef float V8Unaligned __attribute__((vector_size(32), aligned(4)));
 [[gnu::always_inline]] inline V8 SplatV8(float x) { return x - V8{}; }  // x - (+0) is x, even -0
 // A float in memory to all lanes: vbroadcastss. (AVX has no register-to-register
@@ -27,18 +30,23 @@ typedef float V8Unaligned __attribute__((vector_size(32), aligned(4)));
   asm("vbroadcastss %1, %0" : "=x"(r) : "m"(*p));
   return r;
 }
+// The same, not before `after` is computed.
+[[gnu::always_inline]] inline V8 BroadcastAfter(const float* p, const V8& after) {
+  V8 r;
+  asm("vbroadcastss %1, %0" : "=x"(r) : "m"(*p), "x"(after));
+  return r;
+}
 [[gnu::always_inline]] inline V8 LoadV8(const float* p) { return *reinterpret_cast<const V8Unaligned*>(p); }
 [[gnu::always_inline]] inline void StoreV8(float* p, const V8& v) { *reinterpret_cast<V8Unaligned*>(p) = v; }
-[[gnu::always_inline]] inline float SumV8(const V8& v) {
-  float s = v[0];
-  for (int l = 1; l < 8; ++l) s += v[l];
-  return s;
+[[gnu::always_inline]] inline void HalvesV8(const V8& v, V4& lo, V4& hi) {
+  lo = __builtin_shufflevector(v, v, 0, 1, 2, 3);
+  hi = __builtin_shufflevector(v, v, 4, 5, 6, 7);
 }
 }  // namespace native
 
 // Eight floats as two SSE2 registers, for the baseline path.
 namespace sse2 {
-inline constexpr bool kPairGroups = false;  // 8-lane groups: already two registers per value
+inline constexpr bool kPairGroups = false;  // matrix products: 8 lanes, already two registers
 typedef float V4 __attribute__((vector_size(16)));
 typedef float V4Unaligned __attribute__((vector_size(16), aligned(4)));
 struct V8 {
@@ -55,15 +63,14 @@ struct V8 {
   return {*reinterpret_cast<const V4Unaligned*>(p), *reinterpret_cast<const V4Unaligned*>(p + 4)};
 }
 [[gnu::always_inline]] inline V8 BroadcastV8(const float* p) { return SplatV8(*p); }
+[[gnu::always_inline]] inline V8 BroadcastAfter(const float* p, const V8&) { return SplatV8(*p); }
 [[gnu::always_inline]] inline void StoreV8(float* p, const V8& v) {
   *reinterpret_cast<V4Unaligned*>(p) = v.lo;
   *reinterpret_cast<V4Unaligned*>(p + 4) = v.hi;
 }
-[[gnu::always_inline]] inline float SumV8(const V8& v) {  // lanes 0..7 in order, as native
-  float s = v.lo[0];
-  for (int l = 1; l < 4; ++l) s += v.lo[l];
-  for (int l = 0; l < 4; ++l) s += v.hi[l];
-  return s;
+[[gnu::always_inline]] inline void HalvesV8(const V8& v, V4& lo, V4& hi) {
+  lo = v.lo;
+  hi = v.hi;
 }
 }  // namespace sse2
 
@@ -80,7 +87,7 @@ using namespace native;
 }  // namespace exact_avx
 
 // AVX2 with a * b + c contracted into FMA: fewer instructions and shorter
-// dependency chains, with one rounding where the scalar code has two.
+// dependency chains, with one rounding where the scalar formulation has two.
 #pragma GCC push_options
 #pragma GCC target("avx2,fma")
 #pragma GCC optimize("fp-contract=fast")

@@ -1,15 +1,33 @@
 #pragma once
 // The modal RK4 step of the elastic layer (deform/mass_spring.h) on padded
-// structure-of-arrays mode data, in 8-float lanes: one template compiled three
-// times, chosen at run time:
+// structure-of-arrays mode data: modes in groups of 8 lanes, and a last mode
+// left over (a 5x5 or 7x7 grid has 8 k + 1 modes) as (x, y, z, unused) in one
+// 4-float register beside the last group. One template compiled three times,
+// chosen at run time:
 //  - SSE2 (baseline x86-64, pairs of registers) and AVX: the same IEEE
-//    operations in the same order as the scalar formulation the header documents
-//    (the build uses -ffp-contract=off), so a trajectory has the same bits on
-//    either, on any x86-64 machine ("exact");
-//  - AVX2 + FMA: a * b + c contracted, one rounding instead of two; about twice
-//    as fast, and equal to the exact paths up to float round-off (a damped linear
-//    system: differences stay at round-off level, mass_spring_simd_test).
+//    operations in the same order, the scalar formulation below (the build uses
+//    -ffp-contract=off), so a trajectory has the same bits on either, on any
+//    x86-64 machine ("exact");
+//  - AVX2 + FMA: a * b + c contracted, one rounding instead of two; faster, and
+//    equal to the exact paths up to float round-off (a damped linear system:
+//    differences stay at round-off level, mass_spring_simd_test).
 // Each is deterministic: same inputs, same bits, whatever the thread count.
+//
+// Scalar formulation: per mode k (omega2, damping, sum, rest: its mode_lanes
+// entries) and component c, with a(c) < b(c) the other two axes
+// ((1, 2), (0, 2), (0, 1)) and e = rest + x, the acceleration at one stage
+// time (StageCoefficients s) is, evaluated in exactly this order,
+//   acc_c(s, x, v) = ((sum s.common_c + s.mx_c0 e_x) + (s.mx_c1 e_y + s.mx_c2 e_z))
+//                  + ((s.mv_ca v_a + s.mv_cb v_b) - (omega2 x_c + damping v_c))
+// (mv = -2 gam [w]x is skew: its diagonal is zero and never read), and the RK4
+// step (ALGORITHMS.md 6, with x' = v) is
+//   k1 = acc(s0, x, v)
+//   v2 = v + h/2 k1,  k2 = acc(sm, x + h/2 v,  v2)
+//   v3 = v + h/2 k2,  k3 = acc(sm, x + h/2 v2, v3)
+//   v4 = v + h k3,    k4 = acc(s1, x + h v3,   v4)
+//   x+ = x + h/6 ((v + v4) + 2 (v2 + v3))
+//   v+ = v + h/6 ((k1 + 2 (k2 + k3)) + k4)
+// with h/2 and h/6 rounded to float once.
 //
 // Layout: a modal vector field (displacement eta or velocity eta') is 3 rows of
 // MassSpringNetwork::mode_stride floats, x row, y row, z row: component c of
@@ -40,14 +58,18 @@ enum ModeLaneField : int {
 // The moving-frame terms of one RK4 stage time, per unit mass, as matrices
 // acting on all modes alike (row-major):
 //   eta_k'' = sum_k common + mx (rest_k + eta_k) + mv eta_k' - omega2_k eta_k - damping_k eta_k'
-// with mx = -gam ([al]x + [w]x^2), mv = -2 gam [w]x and common = -gam a + gravity + push.
+// with mx = -gam ([al]x + [w]x^2), mv = -2 gam [w]x (skew: the step reads only
+// its off-diagonal entries) and common = -gam a + gravity + push; the order of
+// evaluation is the scalar formulation above.
 struct StageCoefficients {
   float mx[3][3] = {};
   float mv[3][3] = {};
   float common[3] = {};
 };
 
-// Sums of the new state the limit check needs (ALGORITHMS.md 6 limits):
+// Sums of the new state the limit check needs (ALGORITHMS.md 6 limits); the
+// exact paths add the terms in the same order (per mode (x^2 + y^2) + z^2, the
+// 8 lanes of the groups in a fixed tree, then the lone mode):
 struct ModalStepSums {
   float sum_x = 0.0f;  // sum_k |eta_k|^2 (>= |e_a|^2 for every point: U orthonormal)
   float sum_v = 0.0f;  // sum_k |eta'_k|^2
