@@ -1,0 +1,51 @@
+#pragma once
+// The elastic layer's driving source for one MassSpringStepJob run: the job's
+// kinematics (internal/driving_sampler.h) or its callback, with the input limits
+// of ALGORITHMS.md 6 applied to every sample: a frame with a NaN/Inf field or a
+// zero rotation becomes the bind frame at rest, |a| above the clamp is scaled
+// back to it. Each such sample adds to the state's counters. Also the run's
+// ForcingConstants (internal/stage_forcing.h). Shared by the modal and the
+// point-space solvers.
+
+#include <optional>
+
+#include <glm/glm.hpp>
+
+#include "deform/internal/driving_sampler.h"
+#include "deform/internal/stage_forcing.h"
+#include "deform/mass_spring.h"
+
+namespace deform::internal {
+
+// What the checks did to one sample.
+struct SampleChecks {
+  bool non_finite = false;  // replaced by the bind frame (counted in non_finite_inputs)
+  bool clamped = false;     // |a| scaled to the clamp (counted in acceleration_clamps)
+};
+
+class CheckedDriving {
+ public:
+  // `job` must have passed Validate(); it must outlive this object.
+  explicit CheckedDriving(const MassSpringStepJob& job);
+
+  // The checked driving frame at `time_s`; the checks are counted in
+  // job.state->counters and returned in `checks`.
+  DrivingFrame Sample(double time_s, SampleChecks& checks);
+  DrivingFrame Sample(double time_s) {
+    SampleChecks unused;
+    return Sample(time_s, unused);
+  }
+
+  // gain, push and gravity of the run.
+  const ForcingConstants& forcing() const { return forcing_; }
+
+ private:
+  const MassSpringStepJob& job_;
+  glm::quat bind_rotation_{1, 0, 0, 0};
+  float max_accel_ = 0.0f;            // the |a| clamp, model units/s^2
+  float surely_below_accel2_ = 0.0f;  // |a|^2 below this needs no square root
+  std::optional<KinematicsDrivingSampler> sampler_;
+  ForcingConstants forcing_;
+};
+
+}  // namespace deform::internal
