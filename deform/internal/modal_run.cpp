@@ -162,7 +162,8 @@ class ModalRunner {
         frames[2 * i] = driving.Sample(starts[i] + 0.5 * h);
         frames[2 * i + 1] = driving.Sample(starts[i] + h, last_checks);
       }
-      StageCoefficientsOfEach({frames, 2 * count}, driving.forcing(), {coeffs + 1, 2 * count});
+      StageCoefficientsOfEach({frames, 2 * count}, driving.forcing(), {coeffs + 1, 2 * count},
+                              job_.allow_avx);
       for (std::size_t i = 0; i < count; ++i) {
         const ModalStepSums sums = step(net_, coeffs[2 * i], coeffs[2 * i + 1], coeffs[2 * i + 2],
                                         static_cast<float>(h), x, v, prev_x, prev_v);
