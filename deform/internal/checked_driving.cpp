@@ -29,9 +29,9 @@ CheckedDriving::CheckedDriving(const MassSpringStepJob& job)
               .gravity_model = gravity, .gravity_bind = glm::conjugate(bind_rotation_) * gravity};
 }
 
-DrivingFrame CheckedDriving::Sample(double time_s, SampleChecks& checks) {
+void CheckedDriving::Sample(double time_s, DrivingFrame& d, SampleChecks& checks) {
   // Kinematics: SampleJointKinematics' values (internal/driving_sampler.h).
-  DrivingFrame d = sampler_ ? sampler_->Sample(time_s) : (*job_.driving)(time_s);
+  d = sampler_ ? sampler_->Sample(time_s) : (*job_.driving)(time_s);
   MassSpringCounters& c = job_.state->counters;
   checks = {};
   const glm::vec4 q(d.rotation.x, d.rotation.y, d.rotation.z, d.rotation.w);
@@ -50,7 +50,6 @@ DrivingFrame CheckedDriving::Sample(double time_s, SampleChecks& checks) {
       d.linear_acceleration *= max_accel_ / a_len;
     }
   }
-  return d;
 }
 
 }  // namespace deform::internal

@@ -28,12 +28,14 @@ class CheckedDriving {
   // `job` must have passed Validate(); it must outlive this object.
   explicit CheckedDriving(const MassSpringStepJob& job);
 
-  // The checked driving frame at `time_s`; the checks are counted in
-  // job.state->counters and returned in `checks`.
-  DrivingFrame Sample(double time_s, SampleChecks& checks);
+  // The checked driving frame at `time_s`, written to `frame`; the checks are
+  // counted in job.state->counters and returned in `checks`.
+  void Sample(double time_s, DrivingFrame& frame, SampleChecks& checks);
   DrivingFrame Sample(double time_s) {
+    DrivingFrame frame;
     SampleChecks unused;
-    return Sample(time_s, unused);
+    Sample(time_s, frame, unused);
+    return frame;
   }
 
   // gain, push and gravity of the run.

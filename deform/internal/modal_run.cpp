@@ -5,6 +5,8 @@
 #include <cstring>
 #include <utility>
 
+#include <emmintrin.h>
+
 #include "deform/internal/checked_driving.h"
 #include "deform/internal/mass_spring_modal.h"
 #include "deform/internal/stage_forcing.h"
@@ -18,6 +20,7 @@ constexpr std::size_t kBatchSteps = 8;
 
 static_assert(sizeof(StageCoefficients) == sizeof(MassSpringState::LastStage::coefficients),
               "MassSpringState::LastStage holds a StageCoefficients");
+static_assert(sizeof(glm::vec3) == 3 * sizeof(float), "vec3 arrays are packed floats");
 
 // A batch's frames and coefficients without the default member initializers'
 // zero fill (2.3 KB a run).
@@ -97,17 +100,59 @@ class ModalRunner {
   }
 
  private:
-  // State vec3 array (#free) -> 3 x stride rows; padding lanes 0.
+  // State vec3 array (#free) -> 3 x stride rows; padding lanes 0. Four points
+  // at a time are three SSE2 loads, [x0 y0 z0 x1] [y1 z1 x2 y2] [z2 x3 y3 z3],
+  // shuffled into x, y and z rows (moves only).
   void Load(const std::vector<glm::vec3>& from, float* to) const {
-    for (std::size_t c = 0; c < 3; ++c) {
-      float* row = to + c * stride_;
-      for (std::size_t k = 0; k < n_; ++k) row[k] = from[k][static_cast<int>(c)];
-      std::fill(row + n_, row + stride_, 0.0f);
+    const float* in = &from[0].x;
+    float* const xs = to;
+    float* const ys = to + stride_;
+    float* const zs = to + 2 * stride_;
+    std::size_t k = 0;
+    for (; k + 4 <= n_; k += 4, in += 12) {
+      const __m128 a = _mm_loadu_ps(in), b = _mm_loadu_ps(in + 4), c = _mm_loadu_ps(in + 8);
+      const __m128 x = _mm_shuffle_ps(a, _mm_shuffle_ps(b, c, _MM_SHUFFLE(1, 1, 2, 2)),
+                                      _MM_SHUFFLE(2, 0, 3, 0));
+      const __m128 y = _mm_shuffle_ps(_mm_shuffle_ps(a, b, _MM_SHUFFLE(0, 0, 1, 1)),
+                                      _mm_shuffle_ps(b, c, _MM_SHUFFLE(2, 2, 3, 3)),
+                                      _MM_SHUFFLE(2, 0, 2, 0));
+      const __m128 z = _mm_shuffle_ps(_mm_shuffle_ps(a, b, _MM_SHUFFLE(1, 1, 2, 2)),
+                                      _mm_shuffle_ps(c, c, _MM_SHUFFLE(3, 3, 0, 0)),
+                                      _MM_SHUFFLE(2, 0, 2, 0));
+      _mm_storeu_ps(xs + k, x);
+      _mm_storeu_ps(ys + k, y);
+      _mm_storeu_ps(zs + k, z);
     }
+    for (; k < n_; ++k, in += 3) {
+      xs[k] = in[0];
+      ys[k] = in[1];
+      zs[k] = in[2];
+    }
+    for (float* row : {xs, ys, zs}) std::fill(row + n_, row + stride_, 0.0f);
   }
+  // The inverse of Load (padding lanes dropped).
   void Store(const float* from, std::vector<glm::vec3>& to) const {
-    for (std::size_t k = 0; k < n_; ++k) {
-      to[k] = glm::vec3(from[k], from[stride_ + k], from[2 * stride_ + k]);
+    float* out = &to[0].x;
+    const float* const xs = from;
+    const float* const ys = from + stride_;
+    const float* const zs = from + 2 * stride_;
+    std::size_t k = 0;
+    for (; k + 4 <= n_; k += 4, out += 12) {
+      const __m128 x = _mm_loadu_ps(xs + k), y = _mm_loadu_ps(ys + k), z = _mm_loadu_ps(zs + k);
+      _mm_storeu_ps(out, _mm_shuffle_ps(_mm_shuffle_ps(x, y, _MM_SHUFFLE(0, 0, 0, 0)),
+                                        _mm_shuffle_ps(z, x, _MM_SHUFFLE(1, 1, 0, 0)),
+                                        _MM_SHUFFLE(2, 0, 2, 0)));
+      _mm_storeu_ps(out + 4, _mm_shuffle_ps(_mm_shuffle_ps(y, z, _MM_SHUFFLE(1, 1, 1, 1)),
+                                            _mm_shuffle_ps(x, y, _MM_SHUFFLE(2, 2, 2, 2)),
+                                            _MM_SHUFFLE(2, 0, 2, 0)));
+      _mm_storeu_ps(out + 8, _mm_shuffle_ps(_mm_shuffle_ps(z, x, _MM_SHUFFLE(3, 3, 2, 2)),
+                                            _mm_shuffle_ps(y, z, _MM_SHUFFLE(3, 3, 3, 3)),
+                                            _MM_SHUFFLE(2, 0, 2, 0)));
+    }
+    for (; k < n_; ++k, out += 3) {
+      out[0] = xs[k];
+      out[1] = ys[k];
+      out[2] = zs[k];
     }
   }
 
@@ -129,7 +174,8 @@ class ModalRunner {
       return c;
     }
     SampleChecks checks;
-    const DrivingFrame frame = driving.Sample(t, checks);
+    DrivingFrame frame;
+    driving.Sample(t, frame, checks);
     c = StageCoefficientsOf(frame, driving.forcing());
     Remember(last, job_, t, frame, checks, c);
     return c;
@@ -150,7 +196,7 @@ class ModalRunner {
     DrivingFrame* const frames = batch.frames.at;
     StageCoefficients* const coeffs = batch.coeffs.at;
     coeffs[0] = FirstStage(driving);
-    SampleChecks last_checks;
+    SampleChecks checks, last_checks;
     std::size_t count = 0;
     while (st_.step_time_s < until_s) {
       double starts[kBatchSteps];
@@ -159,8 +205,8 @@ class ModalRunner {
         starts[count++] = t;
       }
       for (std::size_t i = 0; i < count; ++i) {
-        frames[2 * i] = driving.Sample(starts[i] + 0.5 * h);
-        frames[2 * i + 1] = driving.Sample(starts[i] + h, last_checks);
+        driving.Sample(starts[i] + 0.5 * h, frames[2 * i], checks);
+        driving.Sample(starts[i] + h, frames[2 * i + 1], last_checks);
       }
       StageCoefficientsOfEach({frames, 2 * count}, driving.forcing(), {coeffs + 1, 2 * count},
                               job_.allow_avx);
