@@ -1,6 +1,7 @@
 #include "deform/internal/checked_driving.h"
 
 #include <cmath>
+#include <new>
 
 #include <emmintrin.h>
 
@@ -41,9 +42,23 @@ CheckedDriving::CheckedDriving(const MassSpringStepJob& job)
               .gravity_model = gravity, .gravity_bind = glm::conjugate(bind_rotation_) * gravity};
 }
 
-void CheckedDriving::Sample(double time_s, DrivingFrame& d, SampleChecks& checks) {
-  // Kinematics: SampleJointKinematics' values (internal/driving_sampler.h).
-  d = sampler_ ? sampler_->Sample(time_s) : (*job_.driving)(time_s);
+void CheckedDriving::SampleRaw(double time_s, DrivingFrame& d) {
+  // Constructed in place (no temporary to copy: the copy's wide loads of the
+  // callee's narrow stores would stall store forwarding).
+  if (sampler_) {
+    ::new (static_cast<void*>(&d)) DrivingFrame(sampler_->Sample(time_s));
+  } else {
+    ::new (static_cast<void*>(&d)) DrivingFrame((*job_.driving)(time_s));
+  }
+}
+
+bool CheckedDriving::MayNeedChecks(const DrivingFrame& d) const {
+  const glm::vec4 q(d.rotation.x, d.rotation.y, d.rotation.z, d.rotation.w);
+  return !AllFinite(d) || !std::isfinite(glm::dot(q, q)) || glm::dot(q, q) < 1e-12f ||
+         glm::dot(d.linear_acceleration, d.linear_acceleration) > surely_below_accel2_;
+}
+
+void CheckedDriving::Check(DrivingFrame& d, SampleChecks& checks) {
   MassSpringCounters& c = job_.state->counters;
   checks = {};
   const glm::vec4 q(d.rotation.x, d.rotation.y, d.rotation.z, d.rotation.w);
@@ -59,6 +74,22 @@ void CheckedDriving::Sample(double time_s, DrivingFrame& d, SampleChecks& checks
       checks.clamped = true;
       d.linear_acceleration *= max_accel_ / a_len;
     }
+  }
+}
+
+void CheckedDriving::Sample(double time_s, DrivingFrame& d, SampleChecks& checks) {
+  SampleRaw(time_s, d);
+  Check(d, checks);
+}
+
+void CheckedDriving::CheckAll(std::span<DrivingFrame> frames, SampleChecks& last_checks) {
+  last_checks = {};
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    // Most frames need nothing; those that may go through the exact checks.
+    if (!MayNeedChecks(frames[i])) continue;
+    SampleChecks checks;
+    Check(frames[i], checks);
+    if (i + 1 == frames.size()) last_checks = checks;
   }
 }
 

@@ -8,6 +8,7 @@
 // point-space solvers.
 
 #include <optional>
+#include <span>
 
 #include <glm/glm.hpp>
 
@@ -38,10 +39,23 @@ class CheckedDriving {
     return frame;
   }
 
+  // The batch form, for many stage times sampled before any is used: the raw
+  // frames first (SampleRaw), then CheckAll over them: the same frames and
+  // counts as Sample on each, with a quick test per frame first (wide loads:
+  // cheap once the frames' stores are done) and the exact checks only on
+  // frames that may need them. `last_checks`: what the checks did to the last
+  // frame.
+  void SampleRaw(double time_s, DrivingFrame& frame);
+  void CheckAll(std::span<DrivingFrame> frames, SampleChecks& last_checks);
+
   // gain, push and gravity of the run.
   const ForcingConstants& forcing() const { return forcing_; }
 
  private:
+  void Check(DrivingFrame& frame, SampleChecks& checks);
+  // False only if Check would leave the frame alone (no count).
+  bool MayNeedChecks(const DrivingFrame& frame) const;
+
   const MassSpringStepJob& job_;
   glm::quat bind_rotation_{1, 0, 0, 0};
   float max_accel_ = 0.0f;            // the |a| clamp, model units/s^2

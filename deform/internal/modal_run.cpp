@@ -196,7 +196,7 @@ class ModalRunner {
     DrivingFrame* const frames = batch.frames.at;
     StageCoefficients* const coeffs = batch.coeffs.at;
     coeffs[0] = FirstStage(driving);
-    SampleChecks checks, last_checks;
+    SampleChecks last_checks;
     std::size_t count = 0;
     while (st_.step_time_s < until_s) {
       double starts[kBatchSteps];
@@ -205,9 +205,10 @@ class ModalRunner {
         starts[count++] = t;
       }
       for (std::size_t i = 0; i < count; ++i) {
-        driving.Sample(starts[i] + 0.5 * h, frames[2 * i], checks);
-        driving.Sample(starts[i] + h, frames[2 * i + 1], last_checks);
+        driving.SampleRaw(starts[i] + 0.5 * h, frames[2 * i]);
+        driving.SampleRaw(starts[i] + h, frames[2 * i + 1]);
       }
+      driving.CheckAll({frames, 2 * count}, last_checks);
       StageCoefficientsOfEach({frames, 2 * count}, driving.forcing(), {coeffs + 1, 2 * count},
                               job_.allow_avx);
       for (std::size_t i = 0; i < count; ++i) {

@@ -104,4 +104,44 @@ TEST(CheckedDriving, LargeFiniteValuesPassAndOnlyTheAccelerationIsClamped) {
   EXPECT_EQ(f.state.counters.acceleration_clamps, 3);
 }
 
+// The batch form (SampleRaw on every time, then CheckAll) gives the frames,
+// counts and last-frame checks of Sample on each time, with glitches and large
+// accelerations scattered over the batch (the last frame included or not).
+TEST(CheckedDriving, CheckAllMatchesSamplingOneAtATime) {
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  for (const int last_kind : {0, 1, 2}) {  // the last frame: ordinary, NaN, clamped
+    SCOPED_TRACE(testing::Message() << "last frame kind " << last_kind);
+    const auto make = [nan, last_kind](double t) {
+      DrivingFrame d = Ordinary();
+      const int i = static_cast<int>(std::lround(t * 100.0));
+      d.angular_velocity.y += 0.01f * static_cast<float>(i);
+      if (i == 3 || (i == 15 && last_kind == 1)) d.angular_acceleration.z = nan;
+      if (i == 5 || (i == 15 && last_kind == 2)) d.linear_acceleration = glm::vec3(0.0f, 3e5f, 0.0f);
+      if (i == 9) d.rotation = glm::quat(0.0f, 0.0f, 0.0f, 0.0f);
+      if (i == 11) d.linear_acceleration = glm::vec3(19900.0f, 0.0f, 0.0f);  // just below the clamp
+      return d;
+    };
+    Fixture one, batch;
+    one.drive = make;
+    batch.drive = make;
+    CheckedDriving by_one(one.job), by_batch(batch.job);
+    DrivingFrame a[16], b[16];
+    SampleChecks checks_one, checks_batch;
+    for (int i = 0; i < 16; ++i) {
+      by_one.Sample(i / 100.0, a[i], checks_one);
+      by_batch.SampleRaw(i / 100.0, b[i]);
+    }
+    by_batch.CheckAll(b, checks_batch);
+    for (int i = 0; i < 16; ++i) EXPECT_TRUE(SameBits(a[i], b[i])) << "frame " << i;
+    EXPECT_EQ(one.state.counters.non_finite_inputs, batch.state.counters.non_finite_inputs);
+    EXPECT_EQ(one.state.counters.acceleration_clamps, batch.state.counters.acceleration_clamps);
+    EXPECT_EQ(batch.state.counters.non_finite_inputs, last_kind == 1 ? 3 : 2);
+    EXPECT_EQ(batch.state.counters.acceleration_clamps, last_kind == 2 ? 2 : 1);
+    EXPECT_EQ(checks_batch.non_finite, checks_one.non_finite);
+    EXPECT_EQ(checks_batch.clamped, checks_one.clamped);
+    EXPECT_EQ(checks_batch.non_finite, last_kind == 1);
+    EXPECT_EQ(checks_batch.clamped, last_kind == 2);
+  }
+}
+
 }  // namespace
