@@ -198,7 +198,9 @@ struct MassSpringState {
   // instead of asking the driving source again, when `valid` and it is the same
   // source, network, time (bit for bit) and push; the counts it adds are the ones
   // the sample added, so counters read as if it were sampled again. Reset() and
-  // Resize() clear it. Only the modal solver writes or reads it.
+  // Resize() clear it. Only the modal solver writes or reads it. The source is
+  // known by address only: a caller that changes what the same callback or
+  // kinematics buffer returns for a time already sampled sets `valid = false`.
   struct LastStage {
     bool valid = false;
     double time_s = 0.0;                   // the stage time (== step_time_s when written)
@@ -226,7 +228,10 @@ struct MassSpringState {
 //    mocap::SampleJointKinematics at every RK4 stage time;
 //  - `driving`: a callback giving the frame at any time (tests, procedural input).
 // Resets (zero state, then preroll_s of simulation) on the first run, when time
-// goes back, or when it jumps ahead by more than max_time_gap_s.
+// goes back, or when it jumps ahead by more than max_time_gap_s. The modal
+// solver samples each stage time once: a run starts from the previous run's last
+// stage (MassSpringState::last_stage) and takes its other stage times in batches
+// of up to 8 steps before stepping (internal/modal_run.h).
 struct MassSpringStepJob {
   const MassSpringNetwork* network = nullptr;     // required
   MassSpringState* state = nullptr;               // required, Resize()d for network
