@@ -4,13 +4,11 @@
 #include <cmath>
 #include <cstdio>
 #include <numbers>
-#include <optional>
 #include <string>
 #include <utility>
 
-#include "deform/internal/driving_sampler.h"
-#include "deform/internal/mass_spring_modal.h"
-#include "deform/internal/stage_forcing.h"
+#include "deform/internal/checked_driving.h"
+#include "deform/internal/modal_run.h"
 
 namespace deform {
 namespace {
@@ -18,17 +16,6 @@ namespace {
 using mocap::ErrorCode;
 using mocap::FileLoc;
 using mocap::MakeError;
-
-constexpr double kStandardGravityMps2 = 9.81;
-constexpr int kMaxGridSize = 16;
-constexpr int kMaxFree = (kMaxGridSize - 2) * (kMaxGridSize - 2);
-// Modal steps whose stage coefficients are computed together (one 30 fps frame
-// at h = 1/240 s).
-constexpr std::size_t kBatchSteps = 8;
-
-bool Finite(const glm::vec3& v) {
-  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
-}
 
 // Everything the forces need at one stage time, per unit mass.
 struct Forcing {
@@ -50,186 +37,24 @@ inline glm::vec3 MovingFrameTerm(const Forcing& f, const glm::vec3& e, const glm
                     glm::cross(f.w, glm::cross(f.w, e)));
 }
 
-// A batch's frames and coefficients without the default member initializers'
-// zero fill (2.3 KB a run).
-struct BatchStorage {
-  union Frames {
-    Frames() {}
-    DrivingFrame at[2 * kBatchSteps];
-  } frames;
-  union Coefficients {
-    Coefficients() {}
-    internal::StageCoefficients at[2 * kBatchSteps + 1];
-  } coeffs;
-};
-
+// The point-space solver (kPointSpace, and the length model).
 class Integrator {
  public:
   explicit Integrator(const MassSpringStepJob& job)
-      : job_(job), net_(*job.network), st_(*job.state), p_(job.network->params) {
-    const double g = kStandardGravityMps2 * p_.units_per_metre;
-    gravity_ = glm::vec3(glm::dvec3(glm::normalize(p_.down)) * g);
-    gravity_bind_ = glm::conjugate(net_.bind_rotation) * gravity_;
-    max_accel_ = p_.max_acceleration_mps2 * p_.units_per_metre;
-    // Below this |a|^2 the length is certainly <= max_accel_ (float rounding of
-    // the square is far inside 1%), so most samples skip the square root.
-    surely_below_accel2_ = 0.99f * max_accel_ * max_accel_;
-    if (!job.kinematics.empty()) {
-      sampler_.emplace(job.kinematics, job.num_joints, job.joint, job.frame_time_s);
-    }
-    forcing_ = {.gain = p_.gain, .user_acceleration = job.user_acceleration,
-                .gravity = p_.gravity, .gravity_model = gravity_, .gravity_bind = gravity_bind_};
-  }
-
-  // The driving frame at t, checked: a non-finite frame becomes the bind frame,
-  // |a| is clamped (both counted).
-  DrivingFrame CheckedFrame(double t) {
-    // Kinematics: SampleJointKinematics' values (internal/driving_sampler.h).
-    DrivingFrame d = sampler_ ? sampler_->Sample(t) : (*job_.driving)(t);
-    MassSpringCounters& c = st_.counters;
-    const glm::vec4 q(d.rotation.x, d.rotation.y, d.rotation.z, d.rotation.w);
-    if (!Finite(d.linear_acceleration) || !Finite(d.angular_velocity) ||
-        !Finite(d.angular_acceleration) || !std::isfinite(glm::dot(q, q)) ||
-        glm::dot(q, q) < 1e-12f) {
-      ++c.non_finite_inputs;  // a glitch: the frame is taken as at rest in the bind pose
-      d = DrivingFrame{net_.bind_rotation};
-    }
-    if (glm::dot(d.linear_acceleration, d.linear_acceleration) > surely_below_accel2_) {
-      const float a_len = glm::length(d.linear_acceleration);
-      if (a_len > max_accel_) {
-        ++c.acceleration_clamps;
-        d.linear_acceleration *= max_accel_ / a_len;
-      }
-    }
-    return d;
-  }
+      : net_(*job.network), st_(*job.state), p_(job.network->params), driving_(job) {}
 
   Forcing Sample(double t) {
-    const DrivingFrame d = CheckedFrame(t);
+    const DrivingFrame d = driving_.Sample(t);
+    const internal::ForcingConstants& k = driving_.forcing();
     Forcing f;
     f.gain = p_.gain;
     f.w = d.angular_velocity;
     f.al = d.angular_acceleration;
-    f.common = -p_.gain * d.linear_acceleration + job_.user_acceleration;
+    f.common = -p_.gain * d.linear_acceleration + k.user_acceleration;
     if (p_.gravity) {
-      f.common += glm::conjugate(glm::normalize(d.rotation)) * gravity_ - gravity_bind_;
+      f.common += glm::conjugate(glm::normalize(d.rotation)) * k.gravity_model - k.gravity_bind;
     }
     return f;
-  }
-
-  // Whole RK4 steps of every mode until the step time reaches `until_s`. The
-  // modes live in padded structure-of-arrays buffers for the run (two pairs:
-  // the newest step and the one before, swapped after each step); the state's
-  // vec3 arrays are read once before and written once after.
-  void ModalSteps(double until_s) {
-    const std::size_t n = static_cast<std::size_t>(net_.num_free);
-    const std::size_t stride = static_cast<std::size_t>(net_.mode_stride);
-    alignas(32) float buffers[4][3 * internal::kMaxModeStride];
-    float* x = buffers[0];
-    float* v = buffers[1];
-    float* prev_x = buffers[2];
-    float* prev_v = buffers[3];
-    std::fill(x, x + 3 * stride, 0.0f);
-    std::fill(v, v + 3 * stride, 0.0f);
-    for (std::size_t k = 0; k < n; ++k) {
-      for (std::size_t c = 0; c < 3; ++c) {
-        x[c * stride + k] = st_.position[k][static_cast<int>(c)];
-        v[c * stride + k] = st_.velocity[k][static_cast<int>(c)];
-      }
-    }
-    const internal::ModalStepFn step = internal::SelectModalStep(job_.allow_avx, job_.allow_fma);
-    const double h = net_.time_step_s;
-    // Steps go in batches of up to kBatchSteps: the frames at the batch's stage
-    // times first (t + h/2, t + h, t + 3h/2, ...: the times and the order of the
-    // step-by-step loop), their coefficients four at a time
-    // (internal/stage_forcing.h: the same bits), then the steps. coeffs[2 i],
-    // [2 i + 1], [2 i + 2]: step i's start, middle and end.
-    BatchStorage batch;  // left uninitialized: every entry is written before it is read
-    DrivingFrame* const frames = batch.frames.at;
-    internal::StageCoefficients* const coeffs = batch.coeffs.at;
-    frames[0] = CheckedFrame(st_.step_time_s);
-    internal::StageCoefficientsOfEach({frames, 1}, forcing_, {coeffs, 1});
-    while (st_.step_time_s < until_s) {
-      double starts[kBatchSteps];
-      std::size_t count = 0;
-      for (double t = st_.step_time_s; count < kBatchSteps && t < until_s; t = t + h) {
-        starts[count++] = t;
-      }
-      for (std::size_t i = 0; i < count; ++i) {
-        frames[2 * i] = CheckedFrame(starts[i] + 0.5 * h);
-        frames[2 * i + 1] = CheckedFrame(starts[i] + h);
-      }
-      internal::StageCoefficientsOfEach({frames, 2 * count}, forcing_, {coeffs + 1, 2 * count});
-      for (std::size_t i = 0; i < count; ++i) {
-        const internal::ModalStepSums sums =
-            step(net_, coeffs[2 * i], coeffs[2 * i + 1], coeffs[2 * i + 2],
-                 static_cast<float>(h), x, v, prev_x, prev_v);
-        std::swap(x, prev_x);
-        std::swap(v, prev_v);
-        ModalLimits(sums, x, v, prev_x, prev_v);
-        st_.step_time_s = starts[i] + h;
-        ++st_.counters.steps;
-      }
-      coeffs[0] = coeffs[2 * count];
-    }
-    for (std::size_t k = 0; k < n; ++k) {
-      for (std::size_t c = 0; c < 3; ++c) {
-        const int ci = static_cast<int>(c);
-        st_.position[k][ci] = x[c * stride + k];
-        st_.velocity[k][ci] = v[c * stride + k];
-        st_.prev_position[k][ci] = prev_x[c * stride + k];
-        st_.prev_velocity[k][ci] = prev_v[c * stride + k];
-      }
-    }
-  }
-
-  // ApplyLimits on the modal buffers (3 x stride each) of the newest step.
-  void ModalLimits(const internal::ModalStepSums& sums, float* x, float* v, float* prev_x,
-                   float* prev_v) {
-    const std::size_t n = static_cast<std::size_t>(net_.num_free);
-    const std::size_t stride = static_cast<std::size_t>(net_.mode_stride);
-    if (!std::isfinite(sums.sum_x) || !std::isfinite(sums.sum_v)) {
-      ++st_.counters.non_finite_resets;
-      for (float* a : {x, v, prev_x, prev_v}) std::fill(a, a + 3 * stride, 0.0f);
-      return;
-    }
-    // U is orthonormal, so |e_a|^2 <= sum_k |eta_k|^2; also |e_a| <= sum_k u_k |eta_k|
-    // with u_k = max_a |U[a, k]|. Below e_max by either bound nothing can exceed.
-    const float e_max = p_.max_displacement;
-    if (sums.sum_x <= e_max * e_max) return;
-    const float* u_max = net_.mode_lanes.data() + internal::kLaneMaxAbs * stride;
-    float bound = 0.0f;
-    for (std::size_t k = 0; k < n; ++k) {
-      bound += u_max[k] * glm::length(glm::vec3(x[k], x[stride + k], x[2 * stride + k]));
-    }
-    if (bound <= e_max) return;
-    alignas(32) float e[3 * internal::kMaxModeStride];
-    internal::ModalToPoints(net_, x, e, job_.allow_avx);
-    const auto point = [stride](const float* f, std::size_t a) {
-      return glm::vec3(f[a], f[stride + a], f[2 * stride + a]);
-    };
-    bool any = false;
-    for (std::size_t a = 0; a < n && !any; ++a) any = glm::length(point(e, a)) > e_max;
-    if (!any) return;
-    // The clamp itself (rare): point space, then back to modes.
-    alignas(32) float ev[3 * internal::kMaxModeStride];
-    internal::ModalToPoints(net_, v, ev, job_.allow_avx);
-    for (std::size_t a = 0; a < n; ++a) {
-      glm::vec3 ea = point(e, a), va = point(ev, a);
-      const float len = glm::length(ea);
-      if (len <= e_max) continue;
-      const glm::vec3 dir = ea / len;
-      ea = dir * e_max;
-      const float outward = glm::dot(va, dir);
-      if (outward > 0.0f) va -= outward * dir;
-      ++st_.counters.displacement_clamps;
-      for (std::size_t c = 0; c < 3; ++c) {
-        e[c * stride + a] = ea[static_cast<int>(c)];
-        ev[c * stride + a] = va[static_cast<int>(c)];
-      }
-    }
-    internal::PointsToModal(net_, e, x, job_.allow_avx);
-    internal::PointsToModal(net_, ev, v, job_.allow_avx);
   }
 
   // Accelerations of every free point from point-space springs.
@@ -336,14 +161,10 @@ class Integrator {
   }
 
  private:
-  const MassSpringStepJob& job_;
   const MassSpringNetwork& net_;
   MassSpringState& st_;
   const MassSpringParams& p_;
-  glm::vec3 gravity_{0.0f}, gravity_bind_{0.0f};
-  float max_accel_ = 0.0f, surely_below_accel2_ = 0.0f;
-  std::optional<internal::KinematicsDrivingSampler> sampler_;
-  internal::ForcingConstants forcing_;
+  internal::CheckedDriving driving_;
 };
 
 bool UsesModes(const MassSpringNetwork& net) {
@@ -365,6 +186,7 @@ void MassSpringState::Resize(const MassSpringNetwork& network) {
 
 void MassSpringState::Reset() {
   started = false;
+  last_stage.valid = false;
   step_time_s = output_time_s = 0.0;
   std::fill(position.begin(), position.end(), glm::vec3(0.0f));
   std::fill(velocity.begin(), velocity.end(), glm::vec3(0.0f));
@@ -414,11 +236,13 @@ JobStatus MassSpringStepJob::Run() const {
     ++st.counters.time_resets;
     st.step_time_s = time_s - p.preroll_s;
   }
-  const bool modal = UsesModes(net);
-  Integrator integrator(*this);
-  if (modal && st.step_time_s < time_s - eps) {
-    integrator.ModalSteps(time_s - eps);
-  } else if (st.step_time_s < time_s - eps) {
+  if (UsesModes(net)) {
+    internal::RunModal(*this, time_s - eps);
+    st.output_time_s = time_s;
+    return mocap::kJobOk;
+  }
+  if (st.step_time_s < time_s - eps) {
+    Integrator integrator(*this);
     Forcing f0 = integrator.Sample(st.step_time_s);
     while (st.step_time_s < time_s - eps) {
       const double t = st.step_time_s;
@@ -438,28 +262,10 @@ JobStatus MassSpringStepJob::Run() const {
   // since a reset: both are the same zero state).
   const std::size_t n = static_cast<std::size_t>(net.num_free);
   const float alpha = static_cast<float>(std::clamp((time_s - (st.step_time_s - h)) / h, 0.0, 1.0));
-  std::span<glm::vec3> blended = std::span<glm::vec3>(st.work).subspan(2 * n, n);
-  for (std::size_t a = 0; a < n; ++a) {
-    blended[a] = st.prev_position[a] + alpha * (st.position[a] - st.prev_position[a]);
-  }
   std::fill(displacements.begin(), displacements.end(), glm::vec3(0.0f));
-  if (modal) {  // e = U eta with the modes in lanes (internal/mass_spring_modal.h)
-    const std::size_t stride = static_cast<std::size_t>(net.mode_stride);
-    alignas(32) float eta[3 * internal::kMaxModeStride];
-    alignas(32) float e[3 * internal::kMaxModeStride];
-    std::fill(eta, eta + 3 * stride, 0.0f);  // the padding lanes
-    for (std::size_t k = 0; k < n; ++k) {
-      for (std::size_t c = 0; c < 3; ++c) eta[c * stride + k] = blended[k][static_cast<int>(c)];
-    }
-    internal::ModalToPoints(net, eta, e, allow_avx);
-    for (std::size_t a = 0; a < n; ++a) {
-      displacements[static_cast<std::size_t>(net.point_of_free[a])] =
-          glm::vec3(e[a], e[stride + a], e[2 * stride + a]);
-    }
-    return mocap::kJobOk;
-  }
   for (std::size_t a = 0; a < n; ++a) {
-    displacements[static_cast<std::size_t>(net.point_of_free[a])] = blended[a];
+    displacements[static_cast<std::size_t>(net.point_of_free[a])] =
+        st.prev_position[a] + alpha * (st.position[a] - st.prev_position[a]);
   }
   return mocap::kJobOk;
 }

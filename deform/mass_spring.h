@@ -41,6 +41,7 @@
 // time, and the displacement returned is interpolated linearly between the last
 // two steps, so 30, 60 and 120 fps outputs sample the same trajectory.
 
+#include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <span>
@@ -192,6 +193,29 @@ struct MassSpringState {
   std::vector<glm::vec3> work;
   MassSpringCounters counters;
 
+  // The newest step's end stage time, as the modal solver last sampled it. A run's
+  // last stage time is the next run's first, so the next run starts from this
+  // instead of asking the driving source again, when `valid` and it is the same
+  // source, network, time (bit for bit) and push; the counts it adds are the ones
+  // the sample added, so counters read as if it were sampled again. Reset() and
+  // Resize() clear it. Only the modal solver writes or reads it. The source is
+  // known by address only: a caller that changes what the same callback or
+  // kinematics buffer returns for a time already sampled sets `valid = false`.
+  struct LastStage {
+    bool valid = false;
+    double time_s = 0.0;                   // the stage time (== step_time_s when written)
+    const void* network = nullptr;         // identity of the network and the source:
+    const void* source = nullptr;          //   the callback or kinematics.data()
+    std::size_t source_size = 0;           //   kinematics.size() (0 for a callback)
+    int num_joints = 0, joint = 0;         //   kinematics arguments
+    double frame_time_s = 0.0;
+    DrivingFrame frame;                    // checked (non-finite replaced, |a| clamped)
+    bool non_finite = false;               // the sample was non-finite (counted)
+    bool clamped = false;                  // |a| was clamped (counted)
+    glm::vec3 user_acceleration{0.0f};     // the push `coefficients` include
+    float coefficients[21] = {};           // internal::StageCoefficients (mx, mv, common)
+  } last_stage;
+
   void Resize(const MassSpringNetwork& network);
   void Reset();  // zero state, started = false; keeps the counters
 };
@@ -204,7 +228,10 @@ struct MassSpringState {
 //    mocap::SampleJointKinematics at every RK4 stage time;
 //  - `driving`: a callback giving the frame at any time (tests, procedural input).
 // Resets (zero state, then preroll_s of simulation) on the first run, when time
-// goes back, or when it jumps ahead by more than max_time_gap_s.
+// goes back, or when it jumps ahead by more than max_time_gap_s. The modal
+// solver samples each stage time once: a run starts from the previous run's last
+// stage (MassSpringState::last_stage) and takes its other stage times in batches
+// of up to 8 steps before stepping (internal/modal_run.h).
 struct MassSpringStepJob {
   const MassSpringNetwork* network = nullptr;     // required
   MassSpringState* state = nullptr;               // required, Resize()d for network

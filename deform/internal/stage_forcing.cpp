@@ -3,7 +3,11 @@
 #include <algorithm>
 #include <cstddef>
 
+#include <immintrin.h>
+
 #include <glm/gtc/quaternion.hpp>
+
+#include "deform/internal/cpu_features.h"
 
 namespace deform::internal {
 namespace {
@@ -98,6 +102,114 @@ void Four(const DrivingFrame* frames, int count, const ForcingConstants& k,
   }
 }
 
+// Eight frames in AVX lanes: the same per-lane operations as Four (so the same
+// bits), with the frames and the results moved by 8 x 8 transposes instead of
+// one scalar insert or extract per value (which cost more than the arithmetic).
+// The floats of one frame and of one output, in memory order:
+static_assert(sizeof(DrivingFrame) == 13 * sizeof(float) &&
+                  offsetof(DrivingFrame, linear_acceleration) == 4 * sizeof(float) &&
+                  offsetof(DrivingFrame, angular_velocity) == 7 * sizeof(float) &&
+                  offsetof(DrivingFrame, angular_acceleration) == 10 * sizeof(float),
+              "DrivingFrame: quaternion x y z w, then three vec3");
+static_assert(sizeof(StageCoefficients) == 21 * sizeof(float) &&
+                  offsetof(StageCoefficients, mv) == 9 * sizeof(float) &&
+                  offsetof(StageCoefficients, common) == 18 * sizeof(float),
+              "StageCoefficients: mx, mv, common, packed");
+static_assert(offsetof(glm::quat, x) == 0 && offsetof(glm::quat, w) == 3 * sizeof(float),
+              "glm::quat stored x, y, z, w");
+
+// Rows r[0..7] -> columns: r[i][l] becomes r[l][i].
+[[gnu::target("avx"), gnu::always_inline]] inline void Transpose8(__m256 r[8]) {
+  const __m256 t0 = _mm256_unpacklo_ps(r[0], r[1]), t1 = _mm256_unpackhi_ps(r[0], r[1]);
+  const __m256 t2 = _mm256_unpacklo_ps(r[2], r[3]), t3 = _mm256_unpackhi_ps(r[2], r[3]);
+  const __m256 t4 = _mm256_unpacklo_ps(r[4], r[5]), t5 = _mm256_unpackhi_ps(r[4], r[5]);
+  const __m256 t6 = _mm256_unpacklo_ps(r[6], r[7]), t7 = _mm256_unpackhi_ps(r[6], r[7]);
+  const __m256 s0 = _mm256_shuffle_ps(t0, t2, 0x44), s1 = _mm256_shuffle_ps(t0, t2, 0xEE);
+  const __m256 s2 = _mm256_shuffle_ps(t1, t3, 0x44), s3 = _mm256_shuffle_ps(t1, t3, 0xEE);
+  const __m256 s4 = _mm256_shuffle_ps(t4, t6, 0x44), s5 = _mm256_shuffle_ps(t4, t6, 0xEE);
+  const __m256 s6 = _mm256_shuffle_ps(t5, t7, 0x44), s7 = _mm256_shuffle_ps(t5, t7, 0xEE);
+  r[0] = _mm256_permute2f128_ps(s0, s4, 0x20);
+  r[1] = _mm256_permute2f128_ps(s1, s5, 0x20);
+  r[2] = _mm256_permute2f128_ps(s2, s6, 0x20);
+  r[3] = _mm256_permute2f128_ps(s3, s7, 0x20);
+  r[4] = _mm256_permute2f128_ps(s0, s4, 0x31);
+  r[5] = _mm256_permute2f128_ps(s1, s5, 0x31);
+  r[6] = _mm256_permute2f128_ps(s2, s6, 0x31);
+  r[7] = _mm256_permute2f128_ps(s3, s7, 0x31);
+}
+
+typedef float F8 __attribute__((vector_size(32)));  // an AVX register in EightAvx
+
+[[gnu::target("avx"), gnu::always_inline]] inline F8 Splat8(float x) {
+  return F8{x, x, x, x, x, x, x, x};
+}
+
+[[gnu::target("avx")]] void EightAvx(const DrivingFrame* frames, const ForcingConstants& k,
+                                     StageCoefficients* out) {
+  // Floats 0..7 and 8..12 of each frame (a masked load: nothing past the frame).
+  const __m256i first5 = _mm256_setr_epi32(-1, -1, -1, -1, -1, 0, 0, 0);
+  __m256 lo[8], hi[8];
+  for (int l = 0; l < 8; ++l) {
+    const float* p = reinterpret_cast<const float*>(frames + l);
+    lo[l] = _mm256_loadu_ps(p);
+    hi[l] = _mm256_maskload_ps(p + 8, first5);
+  }
+  Transpose8(lo);  // qx qy qz qw ax ay az wx
+  Transpose8(hi);  // wy wz alx aly alz - - -
+  const F8 qx0 = lo[0], qy0 = lo[1], qz0 = lo[2], qw0 = lo[3];
+  const F8 a[3] = {lo[4], lo[5], lo[6]};
+  const F8 w[3] = {lo[7], hi[0], hi[1]};
+  const F8 al[3] = {hi[2], hi[3], hi[4]};
+  // From here on, Four's operations in Four's order.
+  const F8 neg_gain = Splat8(-k.gain);
+  F8 common[3];
+  for (int c = 0; c < 3; ++c) common[c] = neg_gain * a[c] + Splat8(k.user_acceleration[c]);
+  if (k.gravity) {
+    const F8 dot = (qw0 * qw0 + qx0 * qx0) + (qy0 * qy0 + qz0 * qz0);
+    const F8 len = _mm256_sqrt_ps(dot);
+    const F8 one_over = Splat8(1.0f) / len;
+    const __m256 degenerate = _mm256_cmp_ps(len, Splat8(0.0f), _CMP_LE_OQ);
+    const F8 nw = _mm256_blendv_ps(qw0 * one_over, Splat8(1.0f), degenerate);
+    const F8 nx = _mm256_blendv_ps(qx0 * one_over, Splat8(0.0f), degenerate);
+    const F8 ny = _mm256_blendv_ps(qy0 * one_over, Splat8(0.0f), degenerate);
+    const F8 nz = _mm256_blendv_ps(qz0 * one_over, Splat8(0.0f), degenerate);
+    const F8 qx = -nx, qy = -ny, qz = -nz, qw = nw;
+    const F8 vx = Splat8(k.gravity_model.x), vy = Splat8(k.gravity_model.y),
+             vz = Splat8(k.gravity_model.z);
+    const F8 uvx = qy * vz - vy * qz, uvy = qz * vx - vz * qx, uvz = qx * vy - vx * qy;
+    const F8 uuvx = qy * uvz - uvy * qz, uuvy = qz * uvx - uvz * qx, uuvz = qx * uvy - uvx * qy;
+    const F8 two = Splat8(2.0f);
+    const F8 rotated[3] = {vx + ((uvx * qw) + uuvx) * two, vy + ((uvy * qw) + uuvy) * two,
+                           vz + ((uvz * qw) + uuvz) * two};
+    for (int c = 0; c < 3; ++c) common[c] = common[c] + (rotated[c] - Splat8(k.gravity_bind[c]));
+  }
+  const F8 zero = Splat8(0.0f);
+  const F8 ww = (w[0] * w[0] + w[1] * w[1]) + w[2] * w[2];
+  const F8 skew_al[3][3] = {{zero, -al[2], al[1]}, {al[2], zero, -al[0]}, {-al[1], al[0], zero}};
+  const F8 skew_w[3][3] = {{zero, -w[2], w[1]}, {w[2], zero, -w[0]}, {-w[1], w[0], zero}};
+  const F8 mv_scale = Splat8(-2.0f * k.gain);
+  // The 21 outputs in StageCoefficients order (mx, mv, common), 3 rows of padding.
+  __m256 rows[24];
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) {
+      const F8 w2 = w[r] * w[c] - (r == c ? ww : zero);
+      rows[3 * r + c] = neg_gain * (skew_al[r][c] + w2);
+      rows[9 + 3 * r + c] = mv_scale * skew_w[r][c];
+    }
+    rows[18 + r] = common[r];
+  }
+  rows[21] = rows[22] = rows[23] = zero;
+  Transpose8(rows);
+  Transpose8(rows + 8);
+  Transpose8(rows + 16);
+  for (int l = 0; l < 8; ++l) {
+    float* o = reinterpret_cast<float*>(out + l);
+    _mm256_storeu_ps(o, rows[l]);
+    _mm256_storeu_ps(o + 8, rows[8 + l]);
+    _mm256_maskstore_ps(o + 16, first5, rows[16 + l]);
+  }
+}
+
 }  // namespace
 
 StageCoefficients StageCoefficientsOf(const DrivingFrame& d, const ForcingConstants& k) {
@@ -120,9 +232,13 @@ StageCoefficients StageCoefficientsOf(const DrivingFrame& d, const ForcingConsta
 }
 
 void StageCoefficientsOfEach(std::span<const DrivingFrame> frames, const ForcingConstants& k,
-                             std::span<StageCoefficients> out) {
+                             std::span<StageCoefficients> out, bool allow_avx) {
   const std::size_t n = std::min(frames.size(), out.size());
-  for (std::size_t i = 0; i < n; i += 4) {
+  std::size_t i = 0;
+  if (allow_avx && CpuHasAvx()) {
+    for (; i + 8 <= n; i += 8) EightAvx(frames.data() + i, k, out.data() + i);
+  }
+  for (; i < n; i += 4) {
     const int count = static_cast<int>(std::min<std::size_t>(4, n - i));
     if (count == 4) {
       Four(frames.data() + i, 4, k, out.data() + i);

@@ -1,10 +1,12 @@
 #pragma once
 // The elastic layer's per-stage-time forcing (deform/mass_spring.h) as the
 // modal step's coefficient matrices (internal/mass_spring_modal.h), for one
-// driving frame at a time (the scalar reference) or for four at a time, one per
-// SSE2 lane, with the same IEEE operations in the same order per lane: the same
-// bits (the build has -ffp-contract=off; tests/deform/stage_forcing_test.cpp).
-// A 30 fps output frame (8 RK4 steps) needs 17 of them.
+// driving frame at a time (the scalar reference) or for four or eight at a time,
+// one per SSE2 or AVX lane, with the same IEEE operations in the same order per
+// lane: the same bits (the build has -ffp-contract=off;
+// tests/deform/stage_forcing_test.cpp). A 30 fps output frame (8 RK4 steps) has
+// 17 stage times; the first is the previous frame's last (internal/modal_run.h),
+// so 16 are new: two groups of eight.
 //
 // The frames given here are already checked: MassSpringStepJob replaces a
 // non-finite frame by the bind frame and clamps |a| before this point.
@@ -32,10 +34,11 @@ struct ForcingConstants {
 //   mx = -gam ([al]x + [w]x^2) with [w]x^2 = w w^T - |w|^2 I, mv = -2 gam [w]x.
 StageCoefficients StageCoefficientsOf(const DrivingFrame& frame, const ForcingConstants& k);
 
-// The same for frames.size() frames (any count), four at a time in SSE2 lanes:
-// out[i] has the bits of StageCoefficientsOf(frames[i], k). out.size() ==
-// frames.size().
+// The same for frames.size() frames (any count): eight at a time in AVX lanes
+// when allowed and the CPU has AVX, the rest four at a time in SSE2 lanes; out[i]
+// has the bits of StageCoefficientsOf(frames[i], k) either way. out.size() ==
+// frames.size(); nothing outside frames[i] and out[i] is read or written.
 void StageCoefficientsOfEach(std::span<const DrivingFrame> frames, const ForcingConstants& k,
-                             std::span<StageCoefficients> out);
+                             std::span<StageCoefficients> out, bool allow_avx = true);
 
 }  // namespace deform::internal

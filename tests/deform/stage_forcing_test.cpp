@@ -61,34 +61,40 @@ ForcingConstants Constants(bool gravity, float gain) {
   return k;
 }
 
-TEST(StageForcing, FourAtATimeGivesTheScalarBits) {
+// allow_avx: groups of eight in AVX lanes (on a CPU with AVX), the rest in
+// groups of four; without it, all in groups of four.
+TEST(StageForcing, FourAndEightAtATimeGiveTheScalarBits) {
   const std::vector<DrivingFrame> frames = RandomFrames(203, 7);
   for (const bool gravity : {true, false}) {
     for (const float gain : {1.0f, 0.37f, 0.0f, 2.5f}) {
-      SCOPED_TRACE(testing::Message() << "gravity " << gravity << ", gain " << gain);
-      const ForcingConstants k = Constants(gravity, gain);
-      std::vector<StageCoefficients> batched(frames.size());
-      deform::internal::StageCoefficientsOfEach(frames, k, batched);
-      int compared = 0;
-      for (std::size_t i = 0; i < frames.size(); ++i) {
-        const StageCoefficients scalar = deform::internal::StageCoefficientsOf(frames[i], k);
-        ASSERT_TRUE(SameBits(scalar, batched[i])) << "frame " << i;
-        ++compared;
+      for (const bool avx : {true, false}) {
+        SCOPED_TRACE(testing::Message() << "gravity " << gravity << ", gain " << gain
+                                        << ", avx " << avx);
+        const ForcingConstants k = Constants(gravity, gain);
+        std::vector<StageCoefficients> batched(frames.size());
+        deform::internal::StageCoefficientsOfEach(frames, k, batched, avx);
+        int compared = 0;
+        for (std::size_t i = 0; i < frames.size(); ++i) {
+          const StageCoefficients scalar = deform::internal::StageCoefficientsOf(frames[i], k);
+          ASSERT_TRUE(SameBits(scalar, batched[i])) << "frame " << i;
+          ++compared;
+        }
+        EXPECT_EQ(compared, 203);
       }
-      EXPECT_EQ(compared, 203);
     }
   }
 }
 
-// Every count from 1 to 9 (whole groups of four and partial ones) fills exactly
-// its own entries and leaves the rest of the output alone.
+// Every count from 1 to 19 (whole groups of eight and four and partial ones)
+// fills exactly its own entries and leaves the rest of the output alone.
 TEST(StageForcing, PartialGroupsWriteOnlyTheirEntries) {
-  const std::vector<DrivingFrame> frames = RandomFrames(9, 11);
+  const std::vector<DrivingFrame> frames = RandomFrames(19, 11);
   const ForcingConstants k = Constants(true, 1.0f);
   StageCoefficients marker;
   marker.common[0] = 12345.0f;
-  for (std::size_t count = 1; count <= 9; ++count) {
-    std::vector<StageCoefficients> out(10, marker);
+  marker.mx[0][0] = -7.0f;
+  for (std::size_t count = 1; count <= 19; ++count) {
+    std::vector<StageCoefficients> out(20, marker);
     deform::internal::StageCoefficientsOfEach(std::span(frames).first(count), k,
                                               std::span(out).first(count));
     for (std::size_t i = 0; i < count; ++i) {

@@ -1,0 +1,96 @@
+#include "deform/internal/checked_driving.h"
+
+#include <cmath>
+#include <new>
+
+#include <emmintrin.h>
+
+namespace deform::internal {
+namespace {
+
+constexpr double kStandardGravityMps2 = 9.81;
+
+// No field of the frame is NaN or Inf: x - x is +0 for a finite x and NaN
+// otherwise, and a sum with a NaN term is NaN. Four SSE2 lanes for the 13
+// floats instead of 13 scalar tests. (The quaternion is included; a non-finite
+// one fails the |q|^2 test below anyway.)
+bool AllFinite(const DrivingFrame& d) {
+  static_assert(sizeof(DrivingFrame) == 13 * sizeof(float), "DrivingFrame is 13 floats");
+  const float* f = &d.rotation.x;
+  const __m128 a = _mm_loadu_ps(f), b = _mm_loadu_ps(f + 4), c = _mm_loadu_ps(f + 8);
+  const __m128 e = _mm_set_ss(f[12]);
+  const __m128 sum = _mm_add_ps(_mm_add_ps(_mm_sub_ps(a, a), _mm_sub_ps(b, b)),
+                                _mm_add_ps(_mm_sub_ps(c, c), _mm_sub_ps(e, e)));
+  return _mm_movemask_ps(_mm_cmpunord_ps(sum, sum)) == 0;
+}
+
+}  // namespace
+
+CheckedDriving::CheckedDriving(const MassSpringStepJob& job)
+    : job_(job), bind_rotation_(job.network->bind_rotation) {
+  const MassSpringParams& p = job.network->params;
+  const double g = kStandardGravityMps2 * p.units_per_metre;
+  const glm::vec3 gravity = glm::vec3(glm::dvec3(glm::normalize(p.down)) * g);
+  max_accel_ = p.max_acceleration_mps2 * p.units_per_metre;
+  // Below this |a|^2 the length is certainly <= max_accel_ (float rounding of
+  // the square is far inside 1%), so most samples skip the square root.
+  surely_below_accel2_ = 0.99f * max_accel_ * max_accel_;
+  if (!job.kinematics.empty()) {
+    sampler_.emplace(job.kinematics, job.num_joints, job.joint, job.frame_time_s);
+  }
+  forcing_ = {.gain = p.gain, .user_acceleration = job.user_acceleration, .gravity = p.gravity,
+              .gravity_model = gravity, .gravity_bind = glm::conjugate(bind_rotation_) * gravity};
+}
+
+void CheckedDriving::SampleRaw(double time_s, DrivingFrame& d) {
+  // Constructed in place (no temporary to copy: the copy's wide loads of the
+  // callee's narrow stores would stall store forwarding).
+  if (sampler_) {
+    ::new (static_cast<void*>(&d)) DrivingFrame(sampler_->Sample(time_s));
+  } else {
+    ::new (static_cast<void*>(&d)) DrivingFrame((*job_.driving)(time_s));
+  }
+}
+
+bool CheckedDriving::MayNeedChecks(const DrivingFrame& d) const {
+  const glm::vec4 q(d.rotation.x, d.rotation.y, d.rotation.z, d.rotation.w);
+  return !AllFinite(d) || !std::isfinite(glm::dot(q, q)) || glm::dot(q, q) < 1e-12f ||
+         glm::dot(d.linear_acceleration, d.linear_acceleration) > surely_below_accel2_;
+}
+
+void CheckedDriving::Check(DrivingFrame& d, SampleChecks& checks) {
+  MassSpringCounters& c = job_.state->counters;
+  checks = {};
+  const glm::vec4 q(d.rotation.x, d.rotation.y, d.rotation.z, d.rotation.w);
+  if (!AllFinite(d) || !std::isfinite(glm::dot(q, q)) || glm::dot(q, q) < 1e-12f) {
+    ++c.non_finite_inputs;  // a glitch: the frame is taken as at rest in the bind pose
+    checks.non_finite = true;
+    d = DrivingFrame{bind_rotation_};
+  }
+  if (glm::dot(d.linear_acceleration, d.linear_acceleration) > surely_below_accel2_) {
+    const float a_len = glm::length(d.linear_acceleration);
+    if (a_len > max_accel_) {
+      ++c.acceleration_clamps;
+      checks.clamped = true;
+      d.linear_acceleration *= max_accel_ / a_len;
+    }
+  }
+}
+
+void CheckedDriving::Sample(double time_s, DrivingFrame& d, SampleChecks& checks) {
+  SampleRaw(time_s, d);
+  Check(d, checks);
+}
+
+void CheckedDriving::CheckAll(std::span<DrivingFrame> frames, SampleChecks& last_checks) {
+  last_checks = {};
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    // Most frames need nothing; those that may go through the exact checks.
+    if (!MayNeedChecks(frames[i])) continue;
+    SampleChecks checks;
+    Check(frames[i], checks);
+    if (i + 1 == frames.size()) last_checks = checks;
+  }
+}
+
+}  // namespace deform::internal

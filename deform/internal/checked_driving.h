@@ -1,0 +1,67 @@
+#pragma once
+// The elastic layer's driving source for one MassSpringStepJob run: the job's
+// kinematics (internal/driving_sampler.h) or its callback, with the input limits
+// of ALGORITHMS.md 6 applied to every sample: a frame with a NaN/Inf field or a
+// zero rotation becomes the bind frame at rest, |a| above the clamp is scaled
+// back to it. Each such sample adds to the state's counters. Also the run's
+// ForcingConstants (internal/stage_forcing.h). Shared by the modal and the
+// point-space solvers.
+
+#include <optional>
+#include <span>
+
+#include <glm/glm.hpp>
+
+#include "deform/internal/driving_sampler.h"
+#include "deform/internal/stage_forcing.h"
+#include "deform/mass_spring.h"
+
+namespace deform::internal {
+
+// What the checks did to one sample.
+struct SampleChecks {
+  bool non_finite = false;  // replaced by the bind frame (counted in non_finite_inputs)
+  bool clamped = false;     // |a| scaled to the clamp (counted in acceleration_clamps)
+};
+
+class CheckedDriving {
+ public:
+  // `job` must have passed Validate(); it must outlive this object.
+  explicit CheckedDriving(const MassSpringStepJob& job);
+
+  // The checked driving frame at `time_s`, written to `frame`; the checks are
+  // counted in job.state->counters and returned in `checks`.
+  void Sample(double time_s, DrivingFrame& frame, SampleChecks& checks);
+  DrivingFrame Sample(double time_s) {
+    DrivingFrame frame;
+    SampleChecks unused;
+    Sample(time_s, frame, unused);
+    return frame;
+  }
+
+  // The batch form, for many stage times sampled before any is used: the raw
+  // frames first (SampleRaw), then CheckAll over them: the same frames and
+  // counts as Sample on each, with a quick test per frame first (wide loads:
+  // cheap once the frames' stores are done) and the exact checks only on
+  // frames that may need them. `last_checks`: what the checks did to the last
+  // frame.
+  void SampleRaw(double time_s, DrivingFrame& frame);
+  void CheckAll(std::span<DrivingFrame> frames, SampleChecks& last_checks);
+
+  // gain, push and gravity of the run.
+  const ForcingConstants& forcing() const { return forcing_; }
+
+ private:
+  void Check(DrivingFrame& frame, SampleChecks& checks);
+  // False only if Check would leave the frame alone (no count).
+  bool MayNeedChecks(const DrivingFrame& frame) const;
+
+  const MassSpringStepJob& job_;
+  glm::quat bind_rotation_{1, 0, 0, 0};
+  float max_accel_ = 0.0f;            // the |a| clamp, model units/s^2
+  float surely_below_accel2_ = 0.0f;  // |a|^2 below this needs no square root
+  std::optional<KinematicsDrivingSampler> sampler_;
+  ForcingConstants forcing_;
+};
+
+}  // namespace deform::internal

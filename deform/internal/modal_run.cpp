@@ -1,0 +1,305 @@
+#include "deform/internal/modal_run.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <utility>
+
+#include <emmintrin.h>
+
+#include "deform/internal/checked_driving.h"
+#include "deform/internal/mass_spring_modal.h"
+#include "deform/internal/stage_forcing.h"
+
+namespace deform::internal {
+namespace {
+
+// Modal steps whose stage coefficients are computed together (one 30 fps frame
+// at h = 1/240 s).
+constexpr std::size_t kBatchSteps = 8;
+
+static_assert(sizeof(StageCoefficients) == sizeof(MassSpringState::LastStage::coefficients),
+              "MassSpringState::LastStage holds a StageCoefficients");
+static_assert(sizeof(glm::vec3) == 3 * sizeof(float), "vec3 arrays are packed floats");
+
+// A batch's frames and coefficients without the default member initializers'
+// zero fill (2.3 KB a run).
+struct BatchStorage {
+  union Frames {
+    Frames() {}
+    DrivingFrame at[2 * kBatchSteps];
+  } frames;
+  union Coefficients {
+    Coefficients() {}
+    StageCoefficients at[2 * kBatchSteps + 1];
+  } coeffs;
+};
+
+// Whether `last` is the checked sample this run would take at `time_s`.
+bool SameStage(const MassSpringState::LastStage& last, const MassSpringStepJob& job,
+               double time_s) {
+  const bool callback = job.kinematics.empty();
+  return last.valid && last.time_s == time_s && last.network == job.network &&
+         last.source == (callback ? static_cast<const void*>(job.driving)
+                                  : static_cast<const void*>(job.kinematics.data())) &&
+         last.source_size == job.kinematics.size() &&
+         (callback || (last.num_joints == job.num_joints && last.joint == job.joint &&
+                       last.frame_time_s == job.frame_time_s));
+}
+
+void Remember(MassSpringState::LastStage& last, const MassSpringStepJob& job, double time_s,
+              const DrivingFrame& frame, const SampleChecks& checks,
+              const StageCoefficients& coefficients) {
+  const bool callback = job.kinematics.empty();
+  last.valid = true;
+  last.time_s = time_s;
+  last.network = job.network;
+  last.source = callback ? static_cast<const void*>(job.driving)
+                         : static_cast<const void*>(job.kinematics.data());
+  last.source_size = job.kinematics.size();
+  last.num_joints = job.num_joints;
+  last.joint = job.joint;
+  last.frame_time_s = job.frame_time_s;
+  last.frame = frame;
+  last.non_finite = checks.non_finite;
+  last.clamped = checks.clamped;
+  last.user_acceleration = job.user_acceleration;
+  std::memcpy(last.coefficients, &coefficients, sizeof(StageCoefficients));
+}
+
+class ModalRunner {
+ public:
+  explicit ModalRunner(const MassSpringStepJob& job)
+      : job_(job),
+        net_(*job.network),
+        st_(*job.state),
+        n_(static_cast<std::size_t>(job.network->num_free)),
+        stride_(static_cast<std::size_t>(job.network->mode_stride)) {}
+
+  void Run(double until_s) {
+    const bool stepping = st_.step_time_s < until_s;
+    if (!stepping && job_.displacements.empty()) return;
+    alignas(32) float buffers[4][3 * kMaxModeStride];
+    float* x = buffers[0];
+    float* v = buffers[1];
+    float* prev_x = buffers[2];
+    float* prev_v = buffers[3];
+    if (stepping) {
+      Load(st_.position, x);
+      Load(st_.velocity, v);
+      Steps(until_s, x, v, prev_x, prev_v);
+      Store(x, st_.position);
+      Store(v, st_.velocity);
+      Store(prev_x, st_.prev_position);
+      Store(prev_v, st_.prev_velocity);
+    } else {
+      Load(st_.position, x);
+      Load(st_.prev_position, prev_x);
+    }
+    if (!job_.displacements.empty()) Output(x, prev_x);
+  }
+
+ private:
+  // State vec3 array (#free) -> 3 x stride rows; padding lanes 0. Four points
+  // at a time are three SSE2 loads, [x0 y0 z0 x1] [y1 z1 x2 y2] [z2 x3 y3 z3],
+  // shuffled into x, y and z rows (moves only).
+  void Load(const std::vector<glm::vec3>& from, float* to) const {
+    const float* in = &from[0].x;
+    float* const xs = to;
+    float* const ys = to + stride_;
+    float* const zs = to + 2 * stride_;
+    std::size_t k = 0;
+    for (; k + 4 <= n_; k += 4, in += 12) {
+      const __m128 a = _mm_loadu_ps(in), b = _mm_loadu_ps(in + 4), c = _mm_loadu_ps(in + 8);
+      const __m128 x = _mm_shuffle_ps(a, _mm_shuffle_ps(b, c, _MM_SHUFFLE(1, 1, 2, 2)),
+                                      _MM_SHUFFLE(2, 0, 3, 0));
+      const __m128 y = _mm_shuffle_ps(_mm_shuffle_ps(a, b, _MM_SHUFFLE(0, 0, 1, 1)),
+                                      _mm_shuffle_ps(b, c, _MM_SHUFFLE(2, 2, 3, 3)),
+                                      _MM_SHUFFLE(2, 0, 2, 0));
+      const __m128 z = _mm_shuffle_ps(_mm_shuffle_ps(a, b, _MM_SHUFFLE(1, 1, 2, 2)),
+                                      _mm_shuffle_ps(c, c, _MM_SHUFFLE(3, 3, 0, 0)),
+                                      _MM_SHUFFLE(2, 0, 2, 0));
+      _mm_storeu_ps(xs + k, x);
+      _mm_storeu_ps(ys + k, y);
+      _mm_storeu_ps(zs + k, z);
+    }
+    for (; k < n_; ++k, in += 3) {
+      xs[k] = in[0];
+      ys[k] = in[1];
+      zs[k] = in[2];
+    }
+    for (float* row : {xs, ys, zs}) std::fill(row + n_, row + stride_, 0.0f);
+  }
+  // The inverse of Load (padding lanes dropped).
+  void Store(const float* from, std::vector<glm::vec3>& to) const {
+    float* out = &to[0].x;
+    const float* const xs = from;
+    const float* const ys = from + stride_;
+    const float* const zs = from + 2 * stride_;
+    std::size_t k = 0;
+    for (; k + 4 <= n_; k += 4, out += 12) {
+      const __m128 x = _mm_loadu_ps(xs + k), y = _mm_loadu_ps(ys + k), z = _mm_loadu_ps(zs + k);
+      _mm_storeu_ps(out, _mm_shuffle_ps(_mm_shuffle_ps(x, y, _MM_SHUFFLE(0, 0, 0, 0)),
+                                        _mm_shuffle_ps(z, x, _MM_SHUFFLE(1, 1, 0, 0)),
+                                        _MM_SHUFFLE(2, 0, 2, 0)));
+      _mm_storeu_ps(out + 4, _mm_shuffle_ps(_mm_shuffle_ps(y, z, _MM_SHUFFLE(1, 1, 1, 1)),
+                                            _mm_shuffle_ps(x, y, _MM_SHUFFLE(2, 2, 2, 2)),
+                                            _MM_SHUFFLE(2, 0, 2, 0)));
+      _mm_storeu_ps(out + 8, _mm_shuffle_ps(_mm_shuffle_ps(z, x, _MM_SHUFFLE(3, 3, 2, 2)),
+                                            _mm_shuffle_ps(y, z, _MM_SHUFFLE(3, 3, 3, 3)),
+                                            _MM_SHUFFLE(2, 0, 2, 0)));
+    }
+    for (; k < n_; ++k, out += 3) {
+      out[0] = xs[k];
+      out[1] = ys[k];
+      out[2] = zs[k];
+    }
+  }
+
+  // The coefficients at the run's first stage time (the state's step time):
+  // the previous run's last when it is the same stage, else sampled.
+  StageCoefficients FirstStage(CheckedDriving& driving) {
+    MassSpringState::LastStage& last = st_.last_stage;
+    const double t = st_.step_time_s;
+    StageCoefficients c;
+    if (SameStage(last, job_, t)) {
+      // Counted again, as sampling the same stage again would count it.
+      st_.counters.non_finite_inputs += last.non_finite ? 1 : 0;
+      st_.counters.acceleration_clamps += last.clamped ? 1 : 0;
+      if (last.user_acceleration == job_.user_acceleration) {
+        std::memcpy(&c, last.coefficients, sizeof(StageCoefficients));
+      } else {  // another push this run: the same frame, new coefficients
+        c = StageCoefficientsOf(last.frame, driving.forcing());
+      }
+      return c;
+    }
+    SampleChecks checks;
+    DrivingFrame frame;
+    driving.Sample(t, frame, checks);
+    c = StageCoefficientsOf(frame, driving.forcing());
+    Remember(last, job_, t, frame, checks, c);
+    return c;
+  }
+
+  // Whole RK4 steps of every mode until the step time reaches `until_s`; x, v
+  // hold the newest step on entry and on return, prev_x, prev_v the one before.
+  // Steps go in batches of up to kBatchSteps: the frames at the batch's stage
+  // times first (t + h/2, t + h, t + 3h/2, ...: the times and the order of the
+  // step-by-step loop), their coefficients together (internal/stage_forcing.h:
+  // the same bits as one at a time), then the steps. coeffs[2 i], [2 i + 1],
+  // [2 i + 2]: step i's start, middle and end.
+  void Steps(double until_s, float*& x, float*& v, float*& prev_x, float*& prev_v) {
+    CheckedDriving driving(job_);
+    const ModalStepFn step = SelectModalStep(job_.allow_avx, job_.allow_fma);
+    const double h = net_.time_step_s;
+    BatchStorage batch;  // left uninitialized: every entry is written before it is read
+    DrivingFrame* const frames = batch.frames.at;
+    StageCoefficients* const coeffs = batch.coeffs.at;
+    coeffs[0] = FirstStage(driving);
+    SampleChecks last_checks;
+    std::size_t count = 0;
+    while (st_.step_time_s < until_s) {
+      double starts[kBatchSteps];
+      count = 0;
+      for (double t = st_.step_time_s; count < kBatchSteps && t < until_s; t = t + h) {
+        starts[count++] = t;
+      }
+      for (std::size_t i = 0; i < count; ++i) {
+        driving.SampleRaw(starts[i] + 0.5 * h, frames[2 * i]);
+        driving.SampleRaw(starts[i] + h, frames[2 * i + 1]);
+      }
+      driving.CheckAll({frames, 2 * count}, last_checks);
+      StageCoefficientsOfEach({frames, 2 * count}, driving.forcing(), {coeffs + 1, 2 * count},
+                              job_.allow_avx);
+      for (std::size_t i = 0; i < count; ++i) {
+        const ModalStepSums sums = step(net_, coeffs[2 * i], coeffs[2 * i + 1], coeffs[2 * i + 2],
+                                        static_cast<float>(h), x, v, prev_x, prev_v);
+        std::swap(x, prev_x);
+        std::swap(v, prev_v);
+        Limits(sums, x, v, prev_x, prev_v);
+        st_.step_time_s = starts[i] + h;
+        ++st_.counters.steps;
+      }
+      coeffs[0] = coeffs[2 * count];
+    }
+    Remember(st_.last_stage, job_, st_.step_time_s, frames[2 * count - 1], last_checks, coeffs[0]);
+  }
+
+  // The displacement limit and the non-finite reset (ALGORITHMS.md 6) on the
+  // modes (3 x stride each) of the newest step.
+  void Limits(const ModalStepSums& sums, float* x, float* v, float* prev_x, float* prev_v) {
+    if (!std::isfinite(sums.sum_x) || !std::isfinite(sums.sum_v)) {
+      ++st_.counters.non_finite_resets;
+      for (float* a : {x, v, prev_x, prev_v}) std::fill(a, a + 3 * stride_, 0.0f);
+      return;
+    }
+    // U is orthonormal, so |e_a|^2 <= sum_k |eta_k|^2; also |e_a| <= sum_k u_k |eta_k|
+    // with u_k = max_a |U[a, k]|. Below e_max by either bound nothing can exceed.
+    const float e_max = net_.params.max_displacement;
+    if (sums.sum_x <= e_max * e_max) return;
+    const std::size_t stride = stride_;
+    const float* u_max = net_.mode_lanes.data() + kLaneMaxAbs * stride;
+    float bound = 0.0f;
+    for (std::size_t k = 0; k < n_; ++k) {
+      bound += u_max[k] * glm::length(glm::vec3(x[k], x[stride + k], x[2 * stride + k]));
+    }
+    if (bound <= e_max) return;
+    alignas(32) float e[3 * kMaxModeStride];
+    ModalToPoints(net_, x, e, job_.allow_avx);
+    const auto point = [stride](const float* f, std::size_t a) {
+      return glm::vec3(f[a], f[stride + a], f[2 * stride + a]);
+    };
+    bool any = false;
+    for (std::size_t a = 0; a < n_ && !any; ++a) any = glm::length(point(e, a)) > e_max;
+    if (!any) return;
+    // The clamp itself (rare): point space, then back to modes.
+    alignas(32) float ev[3 * kMaxModeStride];
+    ModalToPoints(net_, v, ev, job_.allow_avx);
+    for (std::size_t a = 0; a < n_; ++a) {
+      glm::vec3 ea = point(e, a), va = point(ev, a);
+      const float len = glm::length(ea);
+      if (len <= e_max) continue;
+      const glm::vec3 dir = ea / len;
+      ea = dir * e_max;
+      const float outward = glm::dot(va, dir);
+      if (outward > 0.0f) va -= outward * dir;
+      ++st_.counters.displacement_clamps;
+      for (std::size_t c = 0; c < 3; ++c) {
+        e[c * stride + a] = ea[static_cast<int>(c)];
+        ev[c * stride + a] = va[static_cast<int>(c)];
+      }
+    }
+    PointsToModal(net_, e, x, job_.allow_avx);
+    PointsToModal(net_, ev, v, job_.allow_avx);
+  }
+
+  // e(time_s) = U (prev + alpha (x - prev)): linear interpolation between the
+  // last two steps (exact when no step was taken since a reset: both are the
+  // same zero state), in point space. Padding lanes stay 0.
+  void Output(const float* x, const float* prev_x) const {
+    const double h = net_.time_step_s;
+    const float alpha =
+        static_cast<float>(std::clamp((job_.time_s - (st_.step_time_s - h)) / h, 0.0, 1.0));
+    alignas(32) float eta[3 * kMaxModeStride];
+    alignas(32) float e[3 * kMaxModeStride];
+    for (std::size_t i = 0; i < 3 * stride_; ++i) eta[i] = prev_x[i] + alpha * (x[i] - prev_x[i]);
+    ModalToPoints(net_, eta, e, job_.allow_avx);
+    std::span<glm::vec3> out = job_.displacements;
+    std::fill(out.begin(), out.end(), glm::vec3(0.0f));  // boundary points
+    for (std::size_t a = 0; a < n_; ++a) {
+      out[static_cast<std::size_t>(net_.point_of_free[a])] =
+          glm::vec3(e[a], e[stride_ + a], e[2 * stride_ + a]);
+    }
+  }
+
+  const MassSpringStepJob& job_;
+  const MassSpringNetwork& net_;
+  MassSpringState& st_;
+  const std::size_t n_, stride_;
+};
+
+}  // namespace
+
+void RunModal(const MassSpringStepJob& job, double until_s) { ModalRunner(job).Run(until_s); }
+
+}  // namespace deform::internal

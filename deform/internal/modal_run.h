@@ -1,0 +1,24 @@
+#pragma once
+// MassSpringStepJob::Run for the modal solver (deform/mass_spring.h): whole RK4
+// steps of every mode up to the output time, the displacement limit after each
+// step, and the output displacement interpolated between the last two steps.
+//
+// Per run, the modes are copied once from the state's vec3 arrays into padded
+// structure-of-arrays buffers (internal/mass_spring_modal.h layout) and once
+// back; the output is blended and taken to point space from those buffers. The
+// stage coefficients of up to 8 steps are computed together before the steps
+// (internal/stage_forcing.h), and the run's first stage time, the previous run's
+// last, comes from MassSpringState::last_stage when it matches. The results are
+// the bits of stepping one step at a time with every stage time sampled
+// (tests/deform/stage_forcing_test.cpp, modal_run_test.cpp).
+
+#include "deform/mass_spring.h"
+
+namespace deform::internal {
+
+// Steps the modal state (job.state, already reset if the run resets) while its
+// step time is below `until_s`, then writes job.displacements (if not empty) at
+// job.time_s. `job` has passed Validate() and uses the modal solver.
+void RunModal(const MassSpringStepJob& job, double until_s);
+
+}  // namespace deform::internal

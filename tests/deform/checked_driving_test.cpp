@@ -1,0 +1,147 @@
+// The elastic layer's input checks (deform/internal/checked_driving.h): a NaN or
+// Inf in any of a driving frame's 13 floats, or a zero or overflowing rotation,
+// gives the bind frame at rest and one count; finite values pass unchanged
+// (however large, but for the |a| clamp), and each check is counted once per sample.
+
+#include <cmath>
+#include <cstring>
+#include <functional>
+#include <limits>
+
+#include <gtest/gtest.h>
+
+#include "deform/internal/checked_driving.h"
+#include "deform/mass_spring.h"
+#include "support/mass_spring_networks.h"
+
+namespace {
+
+using deform::DrivingFrame;
+using deform::internal::CheckedDriving;
+using deform::internal::SampleChecks;
+
+DrivingFrame Ordinary() {
+  return DrivingFrame{glm::normalize(glm::quat(0.9f, 0.2f, -0.3f, 0.1f)), glm::vec3(50.0f, -20.0f, 5.0f),
+                      glm::vec3(0.5f, 1.0f, -0.25f), glm::vec3(3.0f, -2.0f, 1.0f)};
+}
+
+bool SameBits(const DrivingFrame& a, const DrivingFrame& b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+struct Fixture {
+  deform::MassSpringNetwork net;
+  deform::MassSpringState state;
+  DrivingFrame next;  // what the callback returns
+  std::function<DrivingFrame(double)> drive;
+  deform::MassSpringStepJob job;
+  Fixture() : net(testsupport::CurvedGridNetwork(4, 4)) {
+    net.bind_rotation = glm::normalize(glm::quat(0.8f, 0.0f, 0.6f, 0.0f));
+    state.Resize(net);
+    drive = [this](double) { return next; };
+    job = {.network = &net, .state = &state, .driving = &drive};
+  }
+};
+
+TEST(CheckedDriving, EveryNonFiniteFieldGivesTheBindFrame) {
+  const float values[] = {std::numeric_limits<float>::quiet_NaN(),
+                          std::numeric_limits<float>::infinity(),
+                          -std::numeric_limits<float>::infinity()};
+  Fixture f;
+  CheckedDriving driving(f.job);
+  int expected = 0;
+  for (int field = 0; field < 13; ++field) {
+    for (const float bad : values) {
+      SCOPED_TRACE(testing::Message() << "float " << field << " = " << bad);
+      f.next = Ordinary();
+      std::memcpy(reinterpret_cast<float*>(&f.next) + field, &bad, sizeof bad);
+      DrivingFrame out;
+      SampleChecks checks;
+      driving.Sample(0.1, out, checks);
+      ++expected;
+      EXPECT_TRUE(checks.non_finite);
+      EXPECT_FALSE(checks.clamped);
+      EXPECT_TRUE(SameBits(out, DrivingFrame{f.net.bind_rotation}));
+      EXPECT_EQ(f.state.counters.non_finite_inputs, expected);
+    }
+  }
+  EXPECT_EQ(f.state.counters.acceleration_clamps, 0);
+}
+
+TEST(CheckedDriving, LargeFiniteValuesPassAndOnlyTheAccelerationIsClamped) {
+  Fixture f;
+  CheckedDriving driving(f.job);
+  const float max_accel = f.net.params.max_acceleration_mps2 * f.net.params.units_per_metre;
+  for (int field = 4; field < 13; ++field) {  // the three vectors (the rotation: below)
+    SCOPED_TRACE(testing::Message() << "float " << field);
+    f.next = Ordinary();
+    const float big = 1e18f;  // |a|^2 stays finite (with FLT_MAX it is Inf and a becomes 0)
+    std::memcpy(reinterpret_cast<float*>(&f.next) + field, &big, sizeof big);
+    DrivingFrame out;
+    SampleChecks checks;
+    driving.Sample(0.1, out, checks);
+    EXPECT_FALSE(checks.non_finite);
+    const bool acceleration = field < 7;
+    EXPECT_EQ(checks.clamped, acceleration);
+    if (acceleration) {
+      EXPECT_NEAR(glm::length(out.linear_acceleration), max_accel, 1e-3f * max_accel);
+      EXPECT_TRUE(SameBits(DrivingFrame{out.rotation, f.next.linear_acceleration,
+                                        out.angular_velocity, out.angular_acceleration},
+                           f.next));
+    } else {
+      EXPECT_TRUE(SameBits(out, f.next));
+    }
+  }
+  // A rotation whose |q|^2 overflows, and a zero one: taken as non-finite.
+  for (const glm::quat q : {glm::quat(3e19f, 0.0f, 0.0f, 0.0f), glm::quat(0.0f, 0.0f, 0.0f, 0.0f)}) {
+    f.next = Ordinary();
+    f.next.rotation = q;
+    DrivingFrame out;
+    SampleChecks checks;
+    driving.Sample(0.1, out, checks);
+    EXPECT_TRUE(checks.non_finite);
+    EXPECT_TRUE(SameBits(out, DrivingFrame{f.net.bind_rotation}));
+  }
+  EXPECT_EQ(f.state.counters.non_finite_inputs, 2);
+  EXPECT_EQ(f.state.counters.acceleration_clamps, 3);
+}
+
+// The batch form (SampleRaw on every time, then CheckAll) gives the frames,
+// counts and last-frame checks of Sample on each time, with glitches and large
+// accelerations scattered over the batch (the last frame included or not).
+TEST(CheckedDriving, CheckAllMatchesSamplingOneAtATime) {
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  for (const int last_kind : {0, 1, 2}) {  // the last frame: ordinary, NaN, clamped
+    SCOPED_TRACE(testing::Message() << "last frame kind " << last_kind);
+    const auto make = [nan, last_kind](double t) {
+      DrivingFrame d = Ordinary();
+      const int i = static_cast<int>(std::lround(t * 100.0));
+      d.angular_velocity.y += 0.01f * static_cast<float>(i);
+      if (i == 3 || (i == 15 && last_kind == 1)) d.angular_acceleration.z = nan;
+      if (i == 5 || (i == 15 && last_kind == 2)) d.linear_acceleration = glm::vec3(0.0f, 3e5f, 0.0f);
+      if (i == 9) d.rotation = glm::quat(0.0f, 0.0f, 0.0f, 0.0f);
+      if (i == 11) d.linear_acceleration = glm::vec3(19900.0f, 0.0f, 0.0f);  // just below the clamp
+      return d;
+    };
+    Fixture one, batch;
+    one.drive = make;
+    batch.drive = make;
+    CheckedDriving by_one(one.job), by_batch(batch.job);
+    DrivingFrame a[16], b[16];
+    SampleChecks checks_one, checks_batch;
+    for (int i = 0; i < 16; ++i) {
+      by_one.Sample(i / 100.0, a[i], checks_one);
+      by_batch.SampleRaw(i / 100.0, b[i]);
+    }
+    by_batch.CheckAll(b, checks_batch);
+    for (int i = 0; i < 16; ++i) EXPECT_TRUE(SameBits(a[i], b[i])) << "frame " << i;
+    EXPECT_EQ(one.state.counters.non_finite_inputs, batch.state.counters.non_finite_inputs);
+    EXPECT_EQ(one.state.counters.acceleration_clamps, batch.state.counters.acceleration_clamps);
+    EXPECT_EQ(batch.state.counters.non_finite_inputs, last_kind == 1 ? 3 : 2);
+    EXPECT_EQ(batch.state.counters.acceleration_clamps, last_kind == 2 ? 2 : 1);
+    EXPECT_EQ(checks_batch.non_finite, checks_one.non_finite);
+    EXPECT_EQ(checks_batch.clamped, checks_one.clamped);
+    EXPECT_EQ(checks_batch.non_finite, last_kind == 1);
+    EXPECT_EQ(checks_batch.clamped, last_kind == 2);
+  }
+}
+
+}  // namespace
