@@ -7,12 +7,15 @@
 // its weighted slots as a bit mask (4 influences: one SSE compare) and its
 // kind, 1, 2 or 3+ bones, without a branch per point or slot. Bones are
 // converted on first use (once per call). One and two bones take closed
-// forms. The blends of three or more bones are summed from a table of the
-// bones in use (each blend's weight per table bone, two blends at a time in
-// SSE2 doubles) straight into the rows the float Newton lanes load
-// (PolarRotationsNewtonFloatRows; within kPolarFloatTol of the double
-// iteration, det in (1/8, 8]); what those refuse goes to the double lanes
-// (the scalar iteration's bits) on the slot-order double blend, then the SVD.
+// forms. The blends of three or more bones are summed in slot order in
+// double (two entries at a time in SSE2, the same operations as glm's
+// dmat3 sum) and written rounded to float straight into the rows the float
+// Newton lanes load (PolarRotationsNewtonFloatRows; within kPolarFloatTol
+// of the double iteration, det in (1/8, 8]); what those refuse goes to the
+// double lanes (the scalar iteration's bits), then the SVD. (A table of the
+// bones in use, summed per bone for two blends at a time, took fewer
+// instructions but made a blend's last bit depend on which other control
+// points move: dropped.)
 // Measured and dropped: sorting all control points into per-kind lists
 // (more instructions for no gain); marking the bones needed with a store per
 // slot (a chain of read-modify-writes of the same few bytes).
@@ -39,10 +42,6 @@ constexpr std::size_t kMaxFastBones = 256;
 constexpr double kRigidTol = 1e-4;
 // Control points handled at once (stack arrays of this size; even).
 constexpr std::size_t kChunk = 64;
-// Most distinct bones the moving control points of a patch may use for their
-// 3+-bone blends to be built in lanes from a dense weight table; past it each
-// blend is summed on its own (same values up to the order of the sum).
-constexpr std::size_t kMaxTableBones = 8;
 // Two doubles, the x86-64 baseline's SSE2 register.
 typedef double D2 __attribute__((vector_size(16)));
 
@@ -103,16 +102,11 @@ mocap::JobStatus PatchControlRotations(const PatchSetup& patch, const ExamplePos
   };
   const auto kk = static_cast<std::size_t>(k);
   // Bone rotations as matrices and quaternions, converted on first use, so
-  // once per call and only for the bones the moving control points use; the
-  // first kMaxTableBones of them also join the blends' table, their entries
-  // as pairs of equal doubles.
+  // once per call and only for the bones the moving control points use.
   std::array<glm::dmat3, kMaxFastBones> bone_matrix;
   std::array<glm::dquat, kMaxFastBones> bone;
   std::array<bool, kMaxFastBones> have;
   std::fill_n(have.begin(), num_skin, false);
-  std::array<std::array<D2, 9>, kMaxTableBones> table_matrix;
-  std::array<std::uint32_t, kMaxFastBones> table_index;  // valid where have[b] && < num_table
-  std::size_t num_table = 0;
   // Converts bone b (< num_skin); false if its palette matrix is not a
   // rotation (scale, shear), which sends the whole patch to the general
   // polar decomposition.
@@ -127,11 +121,6 @@ mocap::JobStatus PatchControlRotations(const PatchSetup& patch, const ExamplePos
     bone_matrix[b] = r;
     bone[b] = glm::normalize(glm::quat_cast(r));
     have[b] = true;
-    table_index[b] = static_cast<std::uint32_t>(num_table);
-    if (num_table < kMaxTableBones) {
-      for (int e = 0; e < 9; ++e) table_matrix[num_table][static_cast<std::size_t>(e)] = r[e / 3][e % 3] + D2{};
-      ++num_table;
-    }
     return true;
   };
   const auto general = [&] {
@@ -144,11 +133,8 @@ mocap::JobStatus PatchControlRotations(const PatchSetup& patch, const ExamplePos
   std::array<std::uint32_t, kChunk> moving, mask;
   std::array<std::uint32_t, kChunk> one, two, many;  // indices into `moving`
   // The 3+-bone blends, rounded to float and laid out as the float lanes load
-  // them (PolarRotationsNewtonFloatRows: entry e of blend i at rows[e][i]),
-  // from the weights of the table's bones (table_weight[t][i], 0 where blend
-  // i does not use bone t).
+  // them (PolarRotationsNewtonFloatRows: entry e of blend i at rows[e][i]).
   alignas(32) std::array<std::array<float, kChunk>, 9> rows;
-  alignas(16) std::array<std::array<double, kChunk>, kMaxTableBones> table_weight;
   std::array<glm::quat, kChunk> quats;
   std::array<std::uint8_t, kChunk> converged;
   std::array<glm::dmat3, kChunk> retry_blends;
@@ -169,10 +155,27 @@ mocap::JobStatus PatchControlRotations(const PatchSetup& patch, const ExamplePos
     // The control points that move, listed without a branch per point; the
     // others keep the identity.
     std::size_t num_moving = 0;
-    for (std::size_t c = c0; c < c0 + count; ++c) {
-      rotations[c] = kIdentity;
-      moving[num_moving] = static_cast<std::uint32_t>(c);
-      num_moving += moves(c) ? 1 : 0;
+    std::size_t at = c0;
+    if (ds != nullptr) {
+      // Four at a time: their 12 components' != 0 (NaN included) as bits,
+      // three per control point.
+      const float* const d = &ds[0].x;
+      const __m128 zero = _mm_setzero_ps();
+      for (; at + 4 <= c0 + count; at += 4) {
+        const int nonzero = _mm_movemask_ps(_mm_cmpneq_ps(_mm_loadu_ps(d + 3 * at), zero)) |
+                            _mm_movemask_ps(_mm_cmpneq_ps(_mm_loadu_ps(d + 3 * at + 4), zero)) << 4 |
+                            _mm_movemask_ps(_mm_cmpneq_ps(_mm_loadu_ps(d + 3 * at + 8), zero)) << 8;
+        for (std::size_t p = 0; p < 4; ++p) {
+          rotations[at + p] = kIdentity;
+          moving[num_moving] = static_cast<std::uint32_t>(at + p);
+          num_moving += ((nonzero >> (3 * p)) & 7) != 0 ? 1 : 0;
+        }
+      }
+    }
+    for (; at < c0 + count; ++at) {
+      rotations[at] = kIdentity;
+      moving[num_moving] = static_cast<std::uint32_t>(at);
+      num_moving += moves(at) ? 1 : 0;
     }
     // Their slot masks and kinds, without a branch per slot or point.
     const __m128i sign16 = _mm_set1_epi16(static_cast<short>(0x8000));
@@ -253,49 +256,37 @@ mocap::JobStatus PatchControlRotations(const PatchSetup& patch, const ExamplePos
       many[num_many++] = static_cast<std::uint32_t>(j);
     }
     // Three or more bones (and the two-bone blends above): the polar factor
-    // of sum_b w_b R_b, written straight into the float lanes' rows as the
-    // double sum rounded to float (as PolarRotationsNewtonFloat rounds a
-    // dmat3 blend). With the table: the weights per table bone, then two
-    // blends at a time, sum_t weight[t] R_t in table order.
-    // (The weights are zeroed and summed one double at a time: a wide store
-    // (memset) followed by narrow loads of its bytes stalls store
-    // forwarding.)
-    const std::size_t padded = (num_many + 1) & ~std::size_t{1};
-    bool dense = true;  // every bone of these blends is in the table
-    for (std::size_t i = 0; i < padded; ++i) {
-      for (std::size_t t = 0; t < kMaxTableBones; ++t) table_weight[t][i] = 0.0;
-    }
+    // of sum_b w_b R_b, in slot order from 0 in double (the operations of
+    // blend_of, so the same values, which PolarRotationsNewtonFloat rounded
+    // from a dmat3 before), written rounded to float into the lanes' rows.
     for (std::size_t i = 0; i < num_many; ++i) {
-      const std::size_t base = moving[many[i]] * kk;
-      for (std::uint32_t m = mask[many[i]]; m != 0; m &= m - 1) {
+      const std::size_t j = many[i], base = moving[j] * kk;
+      static_assert(sizeof(glm::dmat3) == 9 * sizeof(double));
+      D2 acc[4] = {};  // entries 0-7 in pairs; entry 8 alone
+      double acc8 = 0.0;
+      for (std::uint32_t m = mask[j]; m != 0; m &= m - 1) {
         const std::size_t slot = base + static_cast<std::size_t>(__builtin_ctz(m));
         const std::size_t b = joint[slot];
         if (!have[b] && !convert(b)) return general();
-        const std::size_t t = table_index[b];
-        if (t >= num_table) {
-          dense = false;
-          continue;
+        const double wt = weight[slot];
+        const double* const entry = &bone_matrix[b][0][0];
+        for (std::size_t e = 0; e < 4; ++e) {
+          D2 pair;
+          std::memcpy(&pair, entry + 2 * e, sizeof(pair));
+          acc[e] += wt * pair;  // blend += w R, entry by entry
         }
-        table_weight[t][i] += static_cast<double>(weight[slot]);
+        acc8 += wt * entry[8];
       }
+      for (std::size_t e = 0; e < 4; ++e) {
+        rows[2 * e][i] = static_cast<float>(acc[e][0]);
+        rows[2 * e + 1][i] = static_cast<float>(acc[e][1]);
+      }
+      rows[8][i] = static_cast<float>(acc8);
     }
-    if (dense) {
-      for (std::size_t i = 0; i < padded; i += 2) {
-        D2 acc[9] = {};
-        for (std::size_t t = 0; t < num_table; ++t) {
-          const D2 wt = {table_weight[t][i], table_weight[t][i + 1]};
-          for (std::size_t e = 0; e < 9; ++e) acc[e] += wt * table_matrix[t][e];
-        }
-        for (std::size_t e = 0; e < 9; ++e) {
-          rows[e][i] = static_cast<float>(acc[e][0]);
-          rows[e][i + 1] = static_cast<float>(acc[e][1]);
-        }
-      }
-    } else {
-      for (std::size_t i = 0; i < num_many; ++i) {
-        const glm::dmat3 blend = blend_of(many[i]);
-        for (int e = 0; e < 9; ++e) rows[static_cast<std::size_t>(e)][i] = static_cast<float>(blend[e / 3][e % 3]);
-      }
+    // The lanes load whole groups of 8: the columns up to the next multiple
+    // get a (replaced) value instead of an indeterminate one.
+    for (std::size_t i = num_many; i < std::min(kChunk, (num_many + 7) & ~std::size_t{7}); ++i) {
+      for (auto& row : rows) row[i] = 0.0f;
     }
     (void)PolarRotationsNewtonFloatRows(std::span(&rows[0][0], 9 * kChunk),
                                         std::span(quats.data(), num_many),

@@ -87,7 +87,8 @@ inline constexpr double kPolarFloatStop = 1e-4;
 // blends can write them straight into the iteration's input: `rows` holds 9
 // rows of stride = rows.size() / 9 floats, entry (column c, row r) of blend
 // i at rows[(3 c + r) * stride + i] (glm's column-major order), for i < #N;
-// entries at i >= #N are not read. quats[i], converged[i] are bit for bit
+// entries at i >= #N never change a result (they may be loaded with a whole
+// group of lanes, then replaced by the identity). quats[i], converged[i] are bit for bit
 // PolarRotationsNewtonFloat's on a blend whose double entries round to these
 // floats (the same lanes, the same operations). `quats`, `converged` #N;
 // kSizeMismatch unless rows.size() is 9 x stride with stride >= #N;

@@ -1,9 +1,9 @@
 // PatchControlRotations' SSD fast path (deform/patch_control_rotations.cpp):
-// the 3+-bone blends built from the bone table straight into the float
-// lanes' rows (and summed one by one past kMaxTableBones bones) against the
-// scalar definition (the double Newton iteration, the SVD), the slot masks
-// for 4 and for 8 influences, joints beyond the palette, and the patches it
-// hands to the general path.
+// the 3+-bone blends summed straight into the float lanes' rows give the
+// float iteration's bits on the dmat3 blend, and stay within the scalar
+// definition (the double Newton iteration, the SVD); the slot masks for 4
+// and for 8 influences, the moving control points found four at a time,
+// joints beyond the palette, and the patches it hands to the general path.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -98,17 +98,24 @@ void ExpectTheDefinition(const deform::PatchSetup& p, std::span<const glm::mat4>
     EXPECT_LT(QuatDistance(fast[c], svd), testsupport::kRotationTol) << c;
     if (bones < 3) continue;
     ++*three_plus;
-    glm::quat newton;
-    std::uint8_t ok = 0;
+    glm::quat newton, lanes;
+    std::uint8_t ok = 0, lanes_ok = 0;
     ASSERT_TRUE(deform::PolarRotationsNewton(std::span(&blend, 1), {}, std::span(&ok, 1),
                                              deform::PolarLanesPath::kScalar, std::span(&newton, 1)));
     if (ok) {
       EXPECT_LT(QuatDistance(fast[c], newton), testsupport::kPolarFloatTol) << c;
     }
+    // The float lanes on the dmat3 blend (what PatchControlRotations gave
+    // them before it built their rows itself): the same bits.
+    ASSERT_TRUE(deform::PolarRotationsNewtonFloat(std::span(&blend, 1), std::span(&lanes, 1),
+                                                  std::span(&lanes_ok, 1)));
+    if (lanes_ok) {
+      EXPECT_TRUE(SameBits(std::span(&fast[c], 1), std::span(&lanes, 1))) << c;
+    }
   }
 }
 
-TEST(PatchControlRotations, TableBlendsMatchTheDoubleIterationForAnyCount) {
+TEST(PatchControlRotations, ThreeBoneBlendsMatchTheIterationsForAnyCount) {
   std::mt19937 rng(23);
   for (int count = 1; count <= 70; count += 3) {  // chunks of 64; 3+-bone counts not multiples of 8
     const deform::PatchSetup p = Patch(rng, count, 5);
@@ -121,9 +128,9 @@ TEST(PatchControlRotations, TableBlendsMatchTheDoubleIterationForAnyCount) {
   }
 }
 
-TEST(PatchControlRotations, MoreBonesThanTheTableSumEachBlendAlone) {
+TEST(PatchControlRotations, ManyBonesMatchTheIterations) {
   std::mt19937 rng(29);
-  const int bones = 20;  // over kMaxTableBones (8): the blends are summed one by one
+  const int bones = 20;
   const deform::PatchSetup p = Patch(rng, 90, bones);
   const std::vector<glm::mat4> palette = Palette(rng, bones, 1.2);
   std::vector<glm::quat> fast(90);
@@ -213,6 +220,37 @@ TEST(PatchControlRotations, DegenerateBlendsKeepTheirFallbacks) {
     EXPECT_LT(QuatDistance(fast[c], general[c]), testsupport::kRotationTol) << c;
   }
   EXPECT_EQ(fast[0], general[0]);  // both the SVD of the same blend
+}
+
+// The moving control points are found four at a time: for every count (whole
+// groups of 4 and tails) a control point keeps the identity exactly where
+// its dS is (+-0, +-0, +-0), and gets the rotation computed without dS
+// elsewhere (NaN and tiny components count as nonzero).
+TEST(PatchControlRotations, FindsTheMovingControlPointsForAnyCount) {
+  std::mt19937 rng(43);
+  for (int count = 1; count <= 13; ++count) {
+    const deform::PatchSetup p = Patch(rng, count, 5);
+    const std::vector<glm::mat4> palette = Palette(rng, 5, 1.0);
+    std::vector<glm::vec3> ds(static_cast<std::size_t>(count));
+    for (std::size_t c = 0; c < ds.size(); ++c) {
+      switch ((c + static_cast<std::size_t>(count)) % 6) {
+        case 0: ds[c] = glm::vec3(0.0f); break;
+        case 1: ds[c] = glm::vec3(-0.0f, 0.0f, -0.0f); break;
+        case 2: ds[c] = glm::vec3(0.0f, 0.0f, 1e-38f); break;
+        case 3: ds[c] = glm::vec3(0.0f, NAN, 0.0f); break;
+        case 4: ds[c] = glm::vec3(-2.0f, 0.0f, 0.0f); break;
+        default: ds[c] = glm::vec3(0.3f, 0.1f, -0.2f); break;
+      }
+    }
+    std::vector<glm::quat> all(ds.size()), masked(ds.size());
+    ASSERT_TRUE(deform::PatchControlRotations(p, {.model_from_bind = palette}, all));
+    ASSERT_TRUE(deform::PatchControlRotations(p, {.model_from_bind = palette}, masked, ds));
+    for (std::size_t c = 0; c < ds.size(); ++c) {
+      const bool still = ds[c].x == 0.0f && ds[c].y == 0.0f && ds[c].z == 0.0f;
+      const glm::quat expected = still ? glm::quat(1.0f, 0.0f, 0.0f, 0.0f) : all[c];
+      EXPECT_TRUE(SameBits(std::span(&masked[c], 1), std::span(&expected, 1))) << count << " " << c;
+    }
+  }
 }
 
 }  // namespace
