@@ -90,10 +90,10 @@ mocap::Result<SculptedExample> SculptExample(const PatchSetup& patch, const Skin
 // polar(w1 R1 + w2 R2) = R1 Rot(a, atan2(w2 sin theta, w1 + w2 cos theta))),
 // by Newton's polar iteration for three or more: in float SIMD lanes for
 // blends with det in (1/8, 8] (PolarRotationsNewtonFloatRows on the blend
-// summed in double over the bones in use and rounded to float, within 1e-6
-// of the double iteration, which kRotationTolRad = 1e-5 leaves far apart),
-// else in double lanes (PolarRotationsNewton, PolarRotationNewton's bits, on
-// the blend summed in slot order as SsdControlRotations sums it).
+// summed in slot order in double, as SsdControlRotations sums it, rounded
+// to float: PolarRotationsNewtonFloat's bits, within 1e-6 of the double
+// iteration, which kRotationTolRad = 1e-5 leaves far apart), else in double
+// lanes (PolarRotationsNewton, PolarRotationNewton's bits).
 // Blends with det <= kPolarNewtonMinDet (reflecting or nearly singular), and
 // a palette that is not rigid, take PolarRotation / SsdControlRotations.
 // Defined in patch_control_rotations.cpp.
