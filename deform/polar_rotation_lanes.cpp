@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 
 #include <immintrin.h>
@@ -141,6 +142,10 @@ void NewtonSse2(const double* in, double* out, glm::quat* quats, std::uint8_t* o
 void NewtonSse2Float(const double* in, glm::quat* quats, std::uint8_t* ok, std::size_t count) {
   sse2_float::NewtonAll(in, nullptr, quats, ok, count);
 }
+void NewtonSse2FloatRows(const float* rows, std::size_t stride, glm::quat* quats, std::uint8_t* ok,
+                         std::size_t count) {
+  sse2_float::NewtonAllRows(rows, stride, quats, ok, count);
+}
 
 // AVX: 4 doubles, or 8 floats, in one register.
 #pragma GCC push_options
@@ -173,6 +178,10 @@ void NewtonAvx(const double* in, double* out, glm::quat* quats, std::uint8_t* ok
 }
 void NewtonAvxFloat(const double* in, glm::quat* quats, std::uint8_t* ok, std::size_t count) {
   avx_float::NewtonAll(in, nullptr, quats, ok, count);
+}
+void NewtonAvxFloatRows(const float* rows, std::size_t stride, glm::quat* quats, std::uint8_t* ok,
+                        std::size_t count) {
+  avx_float::NewtonAllRows(rows, stride, quats, ok, count);
 }
 #pragma GCC pop_options
 
@@ -243,6 +252,37 @@ mocap::JobStatus PolarRotationsNewtonFloat(std::span<const glm::dmat3> blends,
     NewtonAvxFloat(&blends[0][0][0], quats.data(), converged.data(), n);
   } else {
     NewtonSse2Float(&blends[0][0][0], quats.data(), converged.data(), n);
+  }
+  return mocap::kJobOk;
+}
+
+}  // namespace deform
+
+namespace deform {
+
+mocap::JobStatus PolarRotationsNewtonFloatRows(std::span<const float> rows,
+                                               std::span<glm::quat> quats,
+                                               std::span<std::uint8_t> converged,
+                                               PolarLanesPath path) {
+  const std::size_t n = quats.size(), stride = rows.size() / 9;
+  if (converged.size() != n || rows.size() % 9 != 0 || stride < n) {
+    return {mocap::JobStatus::kSizeMismatch,
+            "converged must be #N like quats, rows 9 x stride with stride >= #N"};
+  }
+  if (path == PolarLanesPath::kAuto) {
+    path = PolarLanesAvxAvailable() ? PolarLanesPath::kAvx : PolarLanesPath::kSse2;
+  }
+  if (path == PolarLanesPath::kAvx && !PolarLanesAvxAvailable()) {
+    return {mocap::JobStatus::kOutOfRange, "this CPU has no AVX"};
+  }
+  if (path == PolarLanesPath::kScalar) {
+    return {mocap::JobStatus::kOutOfRange, "the float iteration has no scalar path"};
+  }
+  if (n == 0) return mocap::kJobOk;
+  if (path == PolarLanesPath::kAvx) {
+    NewtonAvxFloatRows(rows.data(), stride, quats.data(), converged.data(), n);
+  } else {
+    NewtonSse2FloatRows(rows.data(), stride, quats.data(), converged.data(), n);
   }
   return mocap::kJobOk;
 }

@@ -82,4 +82,19 @@ inline constexpr double kPolarFloatStop = 1e-4;
                                                          std::span<std::uint8_t> converged,
                                                          PolarLanesPath path = PolarLanesPath::kAuto);
 
+// PolarRotationsNewtonFloat on blends already rounded to float and laid out
+// as the lanes load them (structure of arrays), so a caller that builds the
+// blends can write them straight into the iteration's input: `rows` holds 9
+// rows of stride = rows.size() / 9 floats, entry (column c, row r) of blend
+// i at rows[(3 c + r) * stride + i] (glm's column-major order), for i < #N;
+// entries at i >= #N never change a result (they may be loaded with a whole
+// group of lanes, then replaced by the identity). quats[i], converged[i] are bit for bit
+// PolarRotationsNewtonFloat's on a blend whose double entries round to these
+// floats (the same lanes, the same operations). `quats`, `converged` #N;
+// kSizeMismatch unless rows.size() is 9 x stride with stride >= #N;
+// kOutOfRange for kScalar, or kAvx without AVX. Never allocates.
+[[nodiscard]] mocap::JobStatus PolarRotationsNewtonFloatRows(
+    std::span<const float> rows, std::span<glm::quat> quats, std::span<std::uint8_t> converged,
+    PolarLanesPath path = PolarLanesPath::kAuto);
+
 }  // namespace deform

@@ -484,11 +484,31 @@ JobStatus PoseSpaceJob::Run() const {
   }
   float* __restrict out = &displacement[0].x;
   const float* __restrict w = m.weights.data();
-  for (size_t v = 0; v < nv; ++v) out[v] = 0.0f;
-  for (size_t k = 0; k < static_cast<size_t>(m.num_centres); ++k) {
-    const float pk = phi[k];
-    const float* __restrict row = w + k * nv;
-    for (size_t v = 0; v < nv; ++v) out[v] += pk * row[v];
+  const size_t num_centres = static_cast<size_t>(m.num_centres);
+  // Four values at a time with the K centres inside, in registers: each
+  // value is still ((0 + phi_0 W_0) + phi_1 W_1) + ..., in centre order (the
+  // same bits as one pass over the output per centre), without loading and
+  // storing the output K times.
+  typedef float F4 __attribute__((vector_size(16)));
+  size_t at = 0;
+  for (; at + 8 <= nv; at += 8) {
+    F4 acc0 = {0.0f, 0.0f, 0.0f, 0.0f}, acc1 = acc0;
+    const float* __restrict row = w + at;
+    for (size_t k = 0; k < num_centres; ++k, row += nv) {
+      F4 r0, r1;
+      __builtin_memcpy(&r0, row, sizeof(r0));  // unaligned loads
+      __builtin_memcpy(&r1, row + 4, sizeof(r1));
+      const F4 pk = phi[k] - F4{};  // phi_k in every lane (x - 0 is x)
+      acc0 += pk * r0;
+      acc1 += pk * r1;
+    }
+    __builtin_memcpy(out + at, &acc0, sizeof(acc0));
+    __builtin_memcpy(out + at + 4, &acc1, sizeof(acc1));
+  }
+  for (; at < nv; ++at) {
+    float acc = 0.0f;
+    for (size_t k = 0; k < num_centres; ++k) acc += phi[k] * w[k * nv + at];
+    out[at] = acc;
   }
   if (!m.poly.empty()) {
     const size_t rows = m.poly.size() / nv;

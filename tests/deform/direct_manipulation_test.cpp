@@ -3,7 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <random>
+
+#include <glm/gtc/quaternion.hpp>
 
 #include "deform/patch_fit.h"
 #include "support/bound_tube.h"
@@ -378,6 +381,37 @@ TEST(ControlFrames, StoredExampleFollowsARigidRotationOfTheBody) {
     const glm::vec3 expected = r0 * glm::vec3(world[static_cast<size_t>(c)]);
     EXPECT_LT(glm::length(q[static_cast<size_t>(c)] - global[static_cast<size_t>(c)] - expected),
               1e-5f);
+  }
+}
+
+// Q = G + A dS in SSE lanes, four control points at a time, is glm's
+// G + q * dS bit for bit (and G where dS is exactly zero, whatever A holds
+// there), for every count (whole groups and tails) and in place.
+TEST(PoseSpaceApplyJob, GivesGlmsBitsForEveryCountAndInPlace) {
+  std::mt19937 rng(53);
+  std::uniform_real_distribution<float> uni(-2.0f, 2.0f);
+  for (std::size_t count = 0; count <= 13; ++count) {
+    std::vector<glm::vec3> global(count), ds(count), q(count);
+    std::vector<glm::quat> a(count);
+    for (std::size_t c = 0; c < count; ++c) {
+      global[c] = glm::vec3(uni(rng), uni(rng), uni(rng));
+      ds[c] = c % 3 == 1 ? glm::vec3(0.0f) : glm::vec3(uni(rng), uni(rng), uni(rng));
+      a[c] = glm::normalize(glm::quat(uni(rng), uni(rng), uni(rng), uni(rng)));
+      if (c % 3 == 1 && c % 2 == 0) a[c] = glm::quat(NAN, NAN, NAN, NAN);  // never read
+    }
+    if (count > 5) ds[5] = glm::vec3(0.0f, -0.0f, 1e-30f);  // not zero: turned
+    ASSERT_TRUE((deform::PoseSpaceApplyJob{.global = global, .rotations = a, .displacement = ds,
+                                           .control = q}
+                     .Run()));
+    for (std::size_t c = 0; c < count; ++c) {
+      const glm::vec3 expected = ds[c] == glm::vec3(0.0f) ? global[c] : global[c] + a[c] * ds[c];
+      EXPECT_EQ(std::memcmp(&q[c], &expected, sizeof(expected)), 0) << count << " " << c;
+    }
+    std::vector<glm::vec3> in_place = global;
+    ASSERT_TRUE((deform::PoseSpaceApplyJob{.global = in_place, .rotations = a,
+                                           .displacement = ds, .control = in_place}
+                     .Run()));
+    EXPECT_EQ(std::memcmp(in_place.data(), q.data(), count * sizeof(glm::vec3)), 0) << count;
   }
 }
 

@@ -10,6 +10,7 @@
 #include <limits>
 #include <numbers>
 #include <random>
+#include <span>
 #include <vector>
 
 #include <glm/gtc/quaternion.hpp>
@@ -272,6 +273,75 @@ TEST(PolarRotationsNewtonFloat, AnyCountGivesTheSameResults) {
   std::vector<std::uint8_t> ok(4);
   EXPECT_EQ(deform::PolarRotationsNewtonFloat(std::span(blends).first(4), q, ok).code,
             mocap::JobStatus::kSizeMismatch);
+}
+
+// The blends as PolarRotationsNewtonFloatRows takes them: entry e of blend i
+// at rows[e * stride + i], rounded to float; the rest NaN (never read).
+std::vector<float> Rows(std::span<const glm::dmat3> blends, std::size_t stride) {
+  std::vector<float> rows(9 * stride, std::numeric_limits<float>::quiet_NaN());
+  for (std::size_t i = 0; i < blends.size(); ++i) {
+    for (int e = 0; e < 9; ++e) {
+      rows[static_cast<std::size_t>(e) * stride + i] = static_cast<float>(blends[i][e / 3][e % 3]);
+    }
+  }
+  return rows;
+}
+
+TEST(PolarRotationsNewtonFloatRows, GivesTheFloatIterationsBitsForAnyCountAndStride) {
+  std::mt19937 rng(41);
+  const std::vector<glm::dmat3> blends = MixedBlends(rng, 60);
+  std::vector<PolarLanesPath> paths = {PolarLanesPath::kSse2, PolarLanesPath::kAuto};
+  if (deform::PolarLanesAvxAvailable()) paths.push_back(PolarLanesPath::kAvx);
+  for (PolarLanesPath path : paths) {
+    std::vector<glm::quat> whole(blends.size());
+    std::vector<std::uint8_t> whole_ok(blends.size());
+    ASSERT_TRUE(deform::PolarRotationsNewtonFloat(blends, whole, whole_ok, path));
+    int taken = 0;
+    for (std::size_t first = 0; first < 40; first += 13) {
+      // Counts below, at and past the lane widths (4 and 8), and strides
+      // equal to the count or longer.
+      for (std::size_t count = 0; count <= 20; ++count) {
+        for (std::size_t stride : {count, count + 3}) {
+          const std::vector<float> rows = Rows(std::span(blends).subspan(first, count), stride);
+          std::vector<glm::quat> q(count + 1, glm::quat(5.0f, 5.0f, 5.0f, 5.0f));
+          std::vector<std::uint8_t> ok(count + 1, 9);
+          ASSERT_TRUE(deform::PolarRotationsNewtonFloatRows(rows, std::span(q).first(count),
+                                                            std::span(ok).first(count), path));
+          for (std::size_t i = 0; i < count; ++i) {
+            ASSERT_EQ(ok[i], whole_ok[first + i]) << first << " " << count << " " << i;
+            if (ok[i]) {
+              ++taken;
+              EXPECT_TRUE(SameBits(q[i], whole[first + i])) << first << " " << count << " " << i;
+            } else {
+              EXPECT_TRUE(SameBits(q[i], glm::quat(5.0f, 5.0f, 5.0f, 5.0f))) << "left alone";
+            }
+          }
+          EXPECT_EQ(ok[count], 9);  // past #N: untouched
+          EXPECT_TRUE(SameBits(q[count], glm::quat(5.0f, 5.0f, 5.0f, 5.0f)));
+        }
+      }
+    }
+    EXPECT_GT(taken, 400) << int(path);
+  }
+}
+
+TEST(PolarRotationsNewtonFloatRows, RejectsBadSizesAndTheScalarPath) {
+  const std::vector<glm::dmat3> blends(5, glm::dmat3(1.0));
+  const std::vector<float> rows = Rows(blends, 5);
+  std::vector<glm::quat> q(5);
+  std::vector<std::uint8_t> ok(5);
+  ASSERT_TRUE(deform::PolarRotationsNewtonFloatRows(rows, q, ok));
+  for (const glm::quat& r : q) EXPECT_TRUE(SameBits(r, glm::quat(1.0f, 0.0f, 0.0f, 0.0f)));
+  std::vector<glm::quat> six(6);
+  std::vector<std::uint8_t> six_ok(6);
+  EXPECT_EQ(deform::PolarRotationsNewtonFloatRows(rows, six, six_ok).code,
+            mocap::JobStatus::kSizeMismatch);  // stride 5 < 6
+  EXPECT_EQ(deform::PolarRotationsNewtonFloatRows(std::span(rows).first(44), q, ok).code,
+            mocap::JobStatus::kSizeMismatch);  // not 9 rows
+  EXPECT_EQ(deform::PolarRotationsNewtonFloatRows(rows, q, std::span(ok).first(4)).code,
+            mocap::JobStatus::kSizeMismatch);
+  EXPECT_EQ(deform::PolarRotationsNewtonFloatRows(rows, q, ok, PolarLanesPath::kScalar).code,
+            mocap::JobStatus::kOutOfRange);
 }
 
 }  // namespace

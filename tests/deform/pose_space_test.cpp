@@ -235,6 +235,42 @@ TEST(PoseSpaceJob, Validity) {
   EXPECT_TRUE((PoseSpaceJob{.model = &*model, .features = x, .displacement = out}.Validate().ok()));
 }
 
+// The job sums each value over the centres in centre order, from 0: the
+// same float operations as the definition written out below (Gaussian
+// kernel, no wrapping), so the same bits, for #C whose 3#C values fill the
+// job's blocks of 8 exactly or leave a tail.
+TEST(PoseSpaceJob, SumsEveryValueOverTheCentresInOrder) {
+  for (int num_control : {1, 3, 5, 8, 12}) {
+    std::mt19937 rng(static_cast<unsigned>(num_control));
+    std::uniform_real_distribution<float> uni(-1.0f, 1.0f);
+    std::vector<PoseExample> examples = MakeExamples(7);
+    for (PoseExample& e : examples) {
+      e.displacement.resize(static_cast<size_t>(num_control));
+      for (glm::vec3& d : e.displacement) d = glm::vec3(uni(rng), uni(rng), uni(rng));
+    }
+    auto model = RbfPoseSpace::Fit(examples, 3, num_control);
+    ASSERT_TRUE(model.ok()) << model.error().ToString();
+    const float x[3] = {0.31f, -0.42f, 0.77f};
+    const std::vector<glm::vec3> out = Eval(*model, x);
+    const auto k = static_cast<size_t>(model->num_centres), nv = static_cast<size_t>(model->num_values);
+    std::vector<float> phi(k);
+    for (size_t c = 0; c < k; ++c) {
+      float r2 = 0.0f;
+      for (size_t d = 0; d < 3; ++d) {
+        const float delta = x[d] - model->centres[c * 3 + d];
+        r2 += delta * delta;
+      }
+      const float q = std::sqrt(r2) / model->width;
+      phi[c] = std::exp(-q * q);
+    }
+    for (size_t v = 0; v < nv; ++v) {
+      float expected = 0.0f;
+      for (size_t c = 0; c < k; ++c) expected += phi[c] * model->weights[c * nv + v];
+      EXPECT_EQ(out[v / 3][static_cast<int>(v % 3)], expected) << num_control << " " << v;
+    }
+  }
+}
+
 // A root plus an "elbow" with ZXY channels and a non-identity rest rotation.
 mocap::Skeleton ElbowSkeleton() {
   mocap::Skeleton s;
