@@ -2,7 +2,8 @@
 // The modal RK4 step of the elastic layer (deform/mass_spring.h) on padded
 // structure-of-arrays mode data: modes in groups of 8 lanes, and a last mode
 // left over (a 5x5 or 7x7 grid has 8 k + 1 modes) as (x, y, z, unused) in one
-// 4-float register beside the last group. One template compiled three times,
+// 4-float register (beside the group when there is one, by itself before the
+// groups when there are several). One template compiled three times,
 // chosen at run time:
 //  - SSE2 (baseline x86-64, pairs of registers) and AVX: the same IEEE
 //    operations in the same order, the scalar formulation below (the build uses
