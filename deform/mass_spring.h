@@ -247,7 +247,7 @@ struct MassSpringStepJob {
   bool allow_avx = true;   // modal solver: the AVX step if the CPU has it, else SSE2; both
                            // give the scalar order's bits (internal/mass_spring_modal.h)
   bool allow_fma = false;  // with allow_avx: the AVX2+FMA step where the CPU has it, about
-                           // twice as fast but rounded differently, so frames would then
+                           // 10% fewer instructions but rounded differently, so frames would then
                            // differ between CPUs with and without FMA (a render farm's chunks
                            // must match); off by default
 
