@@ -189,6 +189,25 @@ void NewtonAvxFloatRows(const float* rows, std::size_t stride, glm::quat* quats,
 
 bool PolarLanesAvxAvailable() { return internal::CpuHasAvx(); }
 
+namespace {
+
+// kAuto made concrete (AVX where the CPU has it, else SSE2); AVX asked for on a
+// CPU without it refused, and the scalar path where the caller has none.
+mocap::JobStatus ResolvePath(PolarLanesPath& path, bool has_scalar) {
+  if (path == PolarLanesPath::kAuto) {
+    path = PolarLanesAvxAvailable() ? PolarLanesPath::kAvx : PolarLanesPath::kSse2;
+  }
+  if (path == PolarLanesPath::kAvx && !PolarLanesAvxAvailable()) {
+    return {mocap::JobStatus::kOutOfRange, "this CPU has no AVX"};
+  }
+  if (path == PolarLanesPath::kScalar && !has_scalar) {
+    return {mocap::JobStatus::kOutOfRange, "the float iteration has no scalar path"};
+  }
+  return mocap::kJobOk;
+}
+
+}  // namespace
+
 mocap::JobStatus PolarRotationsNewton(std::span<const glm::dmat3> blends,
                                       std::span<glm::dmat3> rotations,
                                       std::span<std::uint8_t> converged, PolarLanesPath path,
@@ -199,12 +218,7 @@ mocap::JobStatus PolarRotationsNewton(std::span<const glm::dmat3> blends,
     return {mocap::JobStatus::kSizeMismatch,
             "converged must be #N like blends, rotations and quats #N or empty"};
   }
-  if (path == PolarLanesPath::kAuto) {
-    path = PolarLanesAvxAvailable() ? PolarLanesPath::kAvx : PolarLanesPath::kSse2;
-  }
-  if (path == PolarLanesPath::kAvx && !PolarLanesAvxAvailable()) {
-    return {mocap::JobStatus::kOutOfRange, "this CPU has no AVX"};
-  }
+  if (const mocap::JobStatus status = ResolvePath(path, true); !status) return status;
   if (n == 0) return mocap::kJobOk;
   if (path == PolarLanesPath::kScalar) {
     for (std::size_t i = 0; i < n; ++i) {
@@ -238,15 +252,7 @@ mocap::JobStatus PolarRotationsNewtonFloat(std::span<const glm::dmat3> blends,
   if (quats.size() != n || converged.size() != n) {
     return {mocap::JobStatus::kSizeMismatch, "quats and converged must be #N like blends"};
   }
-  if (path == PolarLanesPath::kAuto) {
-    path = PolarLanesAvxAvailable() ? PolarLanesPath::kAvx : PolarLanesPath::kSse2;
-  }
-  if (path == PolarLanesPath::kAvx && !PolarLanesAvxAvailable()) {
-    return {mocap::JobStatus::kOutOfRange, "this CPU has no AVX"};
-  }
-  if (path == PolarLanesPath::kScalar) {
-    return {mocap::JobStatus::kOutOfRange, "the float iteration has no scalar path"};
-  }
+  if (const mocap::JobStatus status = ResolvePath(path, false); !status) return status;
   if (n == 0) return mocap::kJobOk;
   if (path == PolarLanesPath::kAvx) {
     NewtonAvxFloat(&blends[0][0][0], quats.data(), converged.data(), n);
@@ -269,15 +275,7 @@ mocap::JobStatus PolarRotationsNewtonFloatRows(std::span<const float> rows,
     return {mocap::JobStatus::kSizeMismatch,
             "converged must be #N like quats, rows 9 x stride with stride >= #N"};
   }
-  if (path == PolarLanesPath::kAuto) {
-    path = PolarLanesAvxAvailable() ? PolarLanesPath::kAvx : PolarLanesPath::kSse2;
-  }
-  if (path == PolarLanesPath::kAvx && !PolarLanesAvxAvailable()) {
-    return {mocap::JobStatus::kOutOfRange, "this CPU has no AVX"};
-  }
-  if (path == PolarLanesPath::kScalar) {
-    return {mocap::JobStatus::kOutOfRange, "the float iteration has no scalar path"};
-  }
+  if (const mocap::JobStatus status = ResolvePath(path, false); !status) return status;
   if (n == 0) return mocap::kJobOk;
   if (path == PolarLanesPath::kAvx) {
     NewtonAvxFloatRows(rows.data(), stride, quats.data(), converged.data(), n);
