@@ -150,13 +150,7 @@ class Integrator {
     if (sum_x <= e_max * e_max) return;
     std::span<glm::vec3> e(st_.position), v(st_.velocity);
     for (std::size_t a = 0; a < n; ++a) {
-      const float len = glm::length(e[a]);
-      if (len <= e_max) continue;
-      const glm::vec3 dir = e[a] / len;
-      e[a] = dir * e_max;
-      const float outward = glm::dot(v[a], dir);
-      if (outward > 0.0f) v[a] -= outward * dir;
-      ++st_.counters.displacement_clamps;
+      if (internal::ClampDisplacement(e[a], v[a], e_max)) ++st_.counters.displacement_clamps;
     }
   }
 

@@ -257,12 +257,7 @@ class ModalRunner {
     ModalToPoints(net_, v, ev, job_.allow_avx);
     for (std::size_t a = 0; a < n_; ++a) {
       glm::vec3 ea = point(e, a), va = point(ev, a);
-      const float len = glm::length(ea);
-      if (len <= e_max) continue;
-      const glm::vec3 dir = ea / len;
-      ea = dir * e_max;
-      const float outward = glm::dot(va, dir);
-      if (outward > 0.0f) va -= outward * dir;
+      if (!ClampDisplacement(ea, va, e_max)) continue;
       ++st_.counters.displacement_clamps;
       for (std::size_t c = 0; c < 3; ++c) {
         e[c * stride + a] = ea[static_cast<int>(c)];

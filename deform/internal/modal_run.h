@@ -12,6 +12,8 @@
 // the bits of stepping one step at a time with every stage time sampled
 // (tests/deform/stage_forcing_test.cpp, modal_run_test.cpp).
 
+#include <glm/glm.hpp>
+
 #include "deform/mass_spring.h"
 
 namespace deform::internal {
@@ -20,5 +22,18 @@ namespace deform::internal {
 // step time is below `until_s`, then writes job.displacements (if not empty) at
 // job.time_s. `job` has passed Validate() and uses the modal solver.
 void RunModal(const MassSpringStepJob& job, double until_s);
+
+// The displacement limit of one point (ALGORITHMS.md 6): e longer than e_max is
+// projected back onto the sphere of radius e_max and the outward part of v
+// removed. Returns whether it clamped. Shared by the modal and point-space runs.
+inline bool ClampDisplacement(glm::vec3& e, glm::vec3& v, float e_max) {
+  const float len = glm::length(e);
+  if (len <= e_max) return false;
+  const glm::vec3 dir = e / len;
+  e = dir * e_max;
+  const float outward = glm::dot(v, dir);
+  if (outward > 0.0f) v -= outward * dir;
+  return true;
+}
 
 }  // namespace deform::internal
