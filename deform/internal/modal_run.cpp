@@ -1,6 +1,7 @@
 #include "deform/internal/modal_run.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstring>
 #include <utility>
@@ -226,46 +227,14 @@ class ModalRunner {
   }
 
   // The displacement limit and the non-finite reset (ALGORITHMS.md 6) on the
-  // modes (3 x stride each) of the newest step.
+  // modes (3 x stride each) of the newest step (ModalDisplacementLimit).
   void Limits(const ModalStepSums& sums, float* x, float* v, float* prev_x, float* prev_v) {
     if (!std::isfinite(sums.sum_x) || !std::isfinite(sums.sum_v)) {
       ++st_.counters.non_finite_resets;
       for (float* a : {x, v, prev_x, prev_v}) std::fill(a, a + 3 * stride_, 0.0f);
       return;
     }
-    // U is orthonormal, so |e_a|^2 <= sum_k |eta_k|^2; also |e_a| <= sum_k u_k |eta_k|
-    // with u_k = max_a |U[a, k]|. Below e_max by either bound nothing can exceed.
-    const float e_max = net_.params.max_displacement;
-    if (sums.sum_x <= e_max * e_max) return;
-    const std::size_t stride = stride_;
-    const float* u_max = net_.mode_lanes.data() + kLaneMaxAbs * stride;
-    float bound = 0.0f;
-    for (std::size_t k = 0; k < n_; ++k) {
-      bound += u_max[k] * glm::length(glm::vec3(x[k], x[stride + k], x[2 * stride + k]));
-    }
-    if (bound <= e_max) return;
-    alignas(32) float e[3 * kMaxModeStride];
-    ModalToPoints(net_, x, e, job_.allow_avx);
-    const auto point = [stride](const float* f, std::size_t a) {
-      return glm::vec3(f[a], f[stride + a], f[2 * stride + a]);
-    };
-    bool any = false;
-    for (std::size_t a = 0; a < n_ && !any; ++a) any = glm::length(point(e, a)) > e_max;
-    if (!any) return;
-    // The clamp itself (rare): point space, then back to modes.
-    alignas(32) float ev[3 * kMaxModeStride];
-    ModalToPoints(net_, v, ev, job_.allow_avx);
-    for (std::size_t a = 0; a < n_; ++a) {
-      glm::vec3 ea = point(e, a), va = point(ev, a);
-      if (!ClampDisplacement(ea, va, e_max)) continue;
-      ++st_.counters.displacement_clamps;
-      for (std::size_t c = 0; c < 3; ++c) {
-        e[c * stride + a] = ea[static_cast<int>(c)];
-        ev[c * stride + a] = va[static_cast<int>(c)];
-      }
-    }
-    PointsToModal(net_, e, x, job_.allow_avx);
-    PointsToModal(net_, ev, v, job_.allow_avx);
+    st_.counters.displacement_clamps += ModalDisplacementLimit(net_, sums.sum_x, x, v, job_.allow_avx);
   }
 
   // e(time_s) = U (prev + alpha (x - prev)): linear interpolation between the
@@ -293,7 +262,90 @@ class ModalRunner {
   const std::size_t n_, stride_;
 };
 
+
+// sum_k u_k |eta_k|, four modes at a time: each length as glm::length computes
+// it, the lanes summed in a fixed order.
+float ModeBound(const MassSpringNetwork& net, const float* x) {
+  const std::size_t n = static_cast<std::size_t>(net.num_free);
+  const std::size_t stride = static_cast<std::size_t>(net.mode_stride);
+  const float* u_max = net.mode_lanes.data() + kLaneMaxAbs * stride;
+  __m128 sum = _mm_setzero_ps();
+  for (std::size_t k = 0; k < n; k += 4) {  // padding lanes: u = 0, eta = 0
+    const __m128 ex = _mm_load_ps(x + k), ey = _mm_load_ps(x + stride + k),
+                 ez = _mm_load_ps(x + 2 * stride + k);
+    const __m128 len = _mm_sqrt_ps(
+        _mm_add_ps(_mm_add_ps(_mm_mul_ps(ex, ex), _mm_mul_ps(ey, ey)), _mm_mul_ps(ez, ez)));
+    sum = _mm_add_ps(sum, _mm_mul_ps(_mm_loadu_ps(u_max + k), len));
+  }
+  alignas(16) float lanes[4];
+  _mm_store_ps(lanes, sum);
+  return (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]);
+}
+
+// The limit at free point p with displacement e = (U eta)_p: its velocity
+// (U eta')_p summed as ModalToPoints sums it (k ascending from 0: the same
+// bits), ClampDisplacement, and a clamp's change d taken back to the modes as
+// eta_k += U[p, k] d (the same for eta'). Returns whether it clamped.
+bool ClampPoint(const MassSpringNetwork& net, std::size_t p, glm::vec3 e, float e_max, float* x,
+                float* v) {
+  const std::size_t n = static_cast<std::size_t>(net.num_free);
+  const std::size_t stride = static_cast<std::size_t>(net.mode_stride);
+  const float* u = net.modes_by_point.data() + p * stride;  // U[p, k] at u[k]; 0 past #free
+  glm::vec3 vel(0.0f);
+  for (std::size_t k = 0; k < n; ++k) {
+    vel.x = vel.x + u[k] * v[k];
+    vel.y = vel.y + u[k] * v[stride + k];
+    vel.z = vel.z + u[k] * v[2 * stride + k];
+  }
+  const glm::vec3 e0 = e, v0 = vel;
+  if (!ClampDisplacement(e, vel, e_max)) return false;
+  const glm::vec3 de = e - e0, dv = vel - v0;
+  for (int c = 0; c < 3; ++c) {
+    const __m128 dec = _mm_set1_ps(de[c]), dvc = _mm_set1_ps(dv[c]);
+    float* xr = x + static_cast<std::size_t>(c) * stride;
+    float* vr = v + static_cast<std::size_t>(c) * stride;
+    for (std::size_t k = 0; k < n; k += 4) {  // padding lanes: U = 0 adds +0
+      const __m128 uk = _mm_loadu_ps(u + k);
+      _mm_store_ps(xr + k, _mm_add_ps(_mm_load_ps(xr + k), _mm_mul_ps(uk, dec)));
+      _mm_store_ps(vr + k, _mm_add_ps(_mm_load_ps(vr + k), _mm_mul_ps(uk, dvc)));
+    }
+  }
+  return true;
+}
+
 }  // namespace
+
+int ModalDisplacementLimit(const MassSpringNetwork& net, float sum_x, float* x, float* v,
+                           bool allow_avx) {
+  // U is orthonormal, so |e_a|^2 <= sum_k |eta_k|^2; also |e_a| <= sum_k u_k |eta_k|
+  // with u_k = max_a |U[a, k]|. Below e_max by either bound nothing can exceed.
+  const float e_max = net.params.max_displacement;
+  if (sum_x <= e_max * e_max) return 0;
+  if (ModeBound(net, x) <= e_max) return 0;
+  const std::size_t n = static_cast<std::size_t>(net.num_free);
+  const std::size_t stride = static_cast<std::size_t>(net.mode_stride);
+  alignas(32) float e[3 * kMaxModeStride];
+  ModalToPoints(net, x, e, allow_avx);
+  // Candidates: |e_a|^2 above e_max^2 less a margin far wider than the
+  // rounding of either side; ClampDisplacement makes the exact decision.
+  const __m128 candidate2 = _mm_set1_ps(0.9999f * e_max * e_max);
+  int clamps = 0;
+  for (std::size_t a = 0; a < n; a += 4) {  // padding lanes hold 0: never candidates
+    const __m128 ex = _mm_load_ps(e + a), ey = _mm_load_ps(e + stride + a),
+                 ez = _mm_load_ps(e + 2 * stride + a);
+    const __m128 len2 =
+        _mm_add_ps(_mm_add_ps(_mm_mul_ps(ex, ex), _mm_mul_ps(ey, ey)), _mm_mul_ps(ez, ez));
+    unsigned mask = static_cast<unsigned>(_mm_movemask_ps(_mm_cmpgt_ps(len2, candidate2)));
+    while (mask != 0) {
+      const std::size_t p = a + static_cast<std::size_t>(std::countr_zero(mask));
+      mask &= mask - 1;
+      if (ClampPoint(net, p, glm::vec3(e[p], e[stride + p], e[2 * stride + p]), e_max, x, v)) {
+        ++clamps;
+      }
+    }
+  }
+  return clamps;
+}
 
 void RunModal(const MassSpringStepJob& job, double until_s) { ModalRunner(job).Run(until_s); }
 

@@ -23,6 +23,19 @@ namespace deform::internal {
 // job.time_s. `job` has passed Validate() and uses the modal solver.
 void RunModal(const MassSpringStepJob& job, double until_s);
 
+// The displacement limit (ALGORITHMS.md 6) on a modal state x, v (3 x
+// mode_stride rows each, 32-byte aligned, padding lanes 0) whose sum_k |x_k|^2
+// is sum_x: every free point a with |e_a| > e_max, e = U x, is clamped by
+// ClampDisplacement with its velocity (U v)_a, and the change d at a taken back
+// to the modes as x_k += U[a, k] d (the same for v: U is orthonormal, so every
+// other point keeps its displacement and velocity up to float rounding). Points
+// in ascending order; each point's e and velocity are computed from the state
+// before any clamp (a clamp at a changes no other point, in exact arithmetic).
+// Cheap exits first: sum_x <= e_max^2, or sum_k max_a |U[a, k]| |x_k| <= e_max.
+// Returns the number of points clamped.
+int ModalDisplacementLimit(const MassSpringNetwork& network, float sum_x, float* x, float* v,
+                           bool allow_avx);
+
 // The displacement limit of one point (ALGORITHMS.md 6): e longer than e_max is
 // projected back onto the sphere of radius e_max and the outward part of v
 // removed. Returns whether it clamped. Shared by the modal and point-space runs.
