@@ -175,6 +175,8 @@ void BM_MassSpringKernelIndependent(benchmark::State& bench, int size,
 
 BENCHMARK_CAPTURE(BM_MassSpringKernel, exact_5x5, 5, deform::internal::ModalKernel::kExactAvx);
 BENCHMARK_CAPTURE(BM_MassSpringKernel, exact_7x7, 7, deform::internal::ModalKernel::kExactAvx);
+BENCHMARK_CAPTURE(BM_MassSpringKernel, fma_5x5, 5, deform::internal::ModalKernel::kFastest);
+BENCHMARK_CAPTURE(BM_MassSpringKernel, fma_7x7, 7, deform::internal::ModalKernel::kFastest);
 BENCHMARK_CAPTURE(BM_MassSpringKernelIndependent, exact_5x5, 5, deform::internal::ModalKernel::kExactAvx);
 BENCHMARK_CAPTURE(BM_MassSpringKernelIndependent, exact_7x7, 7, deform::internal::ModalKernel::kExactAvx);
 BENCHMARK_CAPTURE(BM_MassSpringCallback, modal_5x5, 5, deform::MassSpringSolver::kModal);
