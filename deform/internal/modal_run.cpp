@@ -283,19 +283,26 @@ float ModeBound(const MassSpringNetwork& net, const float* x) {
 }
 
 // The limit at free point p with displacement e = (U eta)_p: its velocity
-// (U eta')_p summed as ModalToPoints sums it (k ascending from 0: the same
-// bits), ClampDisplacement, and a clamp's change d taken back to the modes as
+// (U eta')_p (four partial sums over k, then added in a fixed order),
+// ClampDisplacement, and a clamp's change d taken back to the modes as
 // eta_k += U[p, k] d (the same for eta'). Returns whether it clamped.
 bool ClampPoint(const MassSpringNetwork& net, std::size_t p, glm::vec3 e, float e_max, float* x,
                 float* v) {
   const std::size_t n = static_cast<std::size_t>(net.num_free);
   const std::size_t stride = static_cast<std::size_t>(net.mode_stride);
   const float* u = net.modes_by_point.data() + p * stride;  // U[p, k] at u[k]; 0 past #free
-  glm::vec3 vel(0.0f);
-  for (std::size_t k = 0; k < n; ++k) {
-    vel.x = vel.x + u[k] * v[k];
-    vel.y = vel.y + u[k] * v[stride + k];
-    vel.z = vel.z + u[k] * v[2 * stride + k];
+  __m128 sum[3] = {_mm_setzero_ps(), _mm_setzero_ps(), _mm_setzero_ps()};
+  for (std::size_t k = 0; k < n; k += 4) {  // padding lanes: U = 0, v = 0
+    const __m128 uk = _mm_loadu_ps(u + k);
+    for (std::size_t c = 0; c < 3; ++c) {
+      sum[c] = _mm_add_ps(sum[c], _mm_mul_ps(uk, _mm_load_ps(v + c * stride + k)));
+    }
+  }
+  glm::vec3 vel;
+  for (int c = 0; c < 3; ++c) {
+    alignas(16) float lanes[4];
+    _mm_store_ps(lanes, sum[c]);
+    vel[c] = (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]);
   }
   const glm::vec3 e0 = e, v0 = vel;
   if (!ClampDisplacement(e, vel, e_max)) return false;
