@@ -99,6 +99,7 @@ using namespace native;
 ModalStepSums StepFma(const MassSpringNetwork& net, const StageCoefficients& s0,
                       const StageCoefficients& sm, const StageCoefficients& s1, float h,
                       const float* x, const float* v, float* x_out, float* v_out) {
+  const SubnormalsFlushed flush;
   return fused::StepBody(net, s0, sm, s1, h, x, v, x_out, v_out);
 }
 #pragma GCC pop_options
@@ -106,6 +107,7 @@ ModalStepSums StepFma(const MassSpringNetwork& net, const StageCoefficients& s0,
 ModalStepSums StepSse(const MassSpringNetwork& net, const StageCoefficients& s0,
                       const StageCoefficients& sm, const StageCoefficients& s1, float h,
                       const float* x, const float* v, float* x_out, float* v_out) {
+  const SubnormalsFlushed flush;
   return exact_sse2::StepBody(net, s0, sm, s1, h, x, v, x_out, v_out);
 }
 
@@ -114,6 +116,7 @@ ModalStepSums StepSse(const MassSpringNetwork& net, const StageCoefficients& s0,
                                              const StageCoefficients& sm,
                                              const StageCoefficients& s1, float h, const float* x,
                                              const float* v, float* x_out, float* v_out) {
+  const SubnormalsFlushed flush;
   return exact_avx::StepBody(net, s0, sm, s1, h, x, v, x_out, v_out);
 }
 
