@@ -90,11 +90,21 @@ void BM_MassSpringTable(benchmark::State& bench, int size) {
   bench.counters["paper_updates_per_s"] = size == 5 ? 1122.0 : 400.0;
 }
 
+// Floats of a state (two arrays of n) in the subnormal range, where each
+// float operation on this machine costs a microcode assist.
+int SubnormalFloats(const float* x, const float* v, std::size_t n) {
+  int count = 0;
+  for (const float* a : {x, v})
+    for (std::size_t i = 0; i < n; ++i) count += std::fpclassify(a[i]) == FP_SUBNORMAL ? 1 : 0;
+  return count;
+}
+
 // A character standing still after a push: the driving frame at rest in the
 // bind orientation, the patch pushed for the first three frames and then left
-// to settle, as a patch at rest costs per frame. Without the subnormal flush
-// (internal/mass_spring_modal.h) the modes would end in the subnormal range (25
-// of a 7x7's 150 state floats, measured); with it they settle at ~1e-36.
+// to settle, as a patch at rest costs per frame. Its modes end in the subnormal
+// floats (25 of a 7x7's 150 state floats, measured); flushing subnormals to zero
+// (FTZ/DAZ around the steps) was measured no faster here and 4-14% slower on
+// the driven rows (MXCSR writes), so it is not done.
 void BM_MassSpringAtRest(benchmark::State& bench, int size) {
   const deform::MassSpringNetwork net = MakeNetwork(size, deform::MassSpringSolver::kModal);
   deform::MassSpringState state;
@@ -114,6 +124,8 @@ void BM_MassSpringAtRest(benchmark::State& bench, int size) {
     benchmark::DoNotOptimize(disp.data());
   }
   bench.SetItemsProcessed(bench.iterations());
+  bench.counters["subnormal_floats"] =
+      SubnormalFloats(&state.position[0].x, &state.velocity[0].x, 3 * state.position.size());
 }
 
 // Driving frame sampled from the jump's per-frame kinematics (hips, 120 fps) by
@@ -146,35 +158,45 @@ void BM_MassSpringSampled(benchmark::State& bench, int size, bool fma) {
 }
 
 // The modal RK4 kernel alone (no sampling, limits or conversions): 8 steps per
-// iteration, i.e. one 30 fps frame's worth, with fixed stage coefficients.
+// iteration, i.e. one 30 fps frame's worth, with fixed stage coefficients
+// (no symmetry between their entries) whose sign flips every frame (a 15 Hz
+// square wave on every term). Before, under a constant drive from a state that
+// excited every mode, the undriven mode and the settled
+// velocities decayed into the subnormal floats and the row measured microcode
+// assists rather than the kernel (~1100 against ~800 ns for 5x5); the
+// subnormal_floats counter says how many state floats ended subnormal.
 void BM_MassSpringKernel(benchmark::State& bench, int size, deform::internal::ModalKernel kernel) {
   const deform::MassSpringNetwork net = MakeNetwork(size, deform::MassSpringSolver::kModal);
   const auto step = deform::internal::SelectModalStep(kernel);
   const std::size_t n = 3 * static_cast<std::size_t>(net.mode_stride);
   alignas(32) float buffers[4][3 * deform::internal::kMaxModeStride] = {};
+  // From rest, as a run starts: a mode no drive reaches (on this flat square
+  // grid, mode 3 has sum_a U[a, 3] = 0 and no rest term) then stays exactly 0.
   float *x = buffers[0], *v = buffers[1], *x1 = buffers[2], *v1 = buffers[3];
-  for (std::size_t i = 0; i < n; ++i) x[i] = (i % static_cast<std::size_t>(net.mode_stride)) <
-                                                      static_cast<std::size_t>(net.num_free)
-                                                  ? 0.01f * static_cast<float>(i % 7)
-                                                  : 0.0f;
-  deform::internal::StageCoefficients c;
+  deform::internal::StageCoefficients c[2];
   for (int r = 0; r < 3; ++r) {
     for (int k = 0; k < 3; ++k) {
-      c.mx[r][k] = 0.1f * static_cast<float>(r - k);
-      c.mv[r][k] = r == k ? 0.0f : 0.2f * static_cast<float>(k - r);
+      c[0].mx[r][k] = 0.1f * static_cast<float>(r - k) + 0.013f * static_cast<float>(1 + 3 * r + k);
+      c[0].mv[r][k] = r == k ? 0.0f : 0.2f * static_cast<float>(k - r);
+      c[1].mx[r][k] = -c[0].mx[r][k];
+      c[1].mv[r][k] = -c[0].mv[r][k];
     }
-    c.common[r] = 10.0f * static_cast<float>(r);
+    c[0].common[r] = 10.0f * static_cast<float>(r + 1);
+    c[1].common[r] = -c[0].common[r];
   }
   const float h = static_cast<float>(net.time_step_s);
+  int frame = 0;
   for (auto _ : bench) {
+    const deform::internal::StageCoefficients& s = c[frame++ & 1];
     for (int i = 0; i < 8; ++i) {
-      benchmark::DoNotOptimize(step(net, c, c, c, h, x, v, x1, v1));
+      benchmark::DoNotOptimize(step(net, s, s, s, h, x, v, x1, v1));
       std::swap(x, x1);
       std::swap(v, v1);
     }
     benchmark::ClobberMemory();
   }
   bench.SetItemsProcessed(bench.iterations());
+  bench.counters["subnormal_floats"] = SubnormalFloats(x, v, n);
 }
 
 // The same 8 steps, each from the same input (no step waits for the one before):

@@ -99,7 +99,6 @@ using namespace native;
 ModalStepSums StepFma(const MassSpringNetwork& net, const StageCoefficients& s0,
                       const StageCoefficients& sm, const StageCoefficients& s1, float h,
                       const float* x, const float* v, float* x_out, float* v_out) {
-  const SubnormalsFlushed flush;
   return fused::StepBody(net, s0, sm, s1, h, x, v, x_out, v_out);
 }
 #pragma GCC pop_options
@@ -107,7 +106,6 @@ ModalStepSums StepFma(const MassSpringNetwork& net, const StageCoefficients& s0,
 ModalStepSums StepSse(const MassSpringNetwork& net, const StageCoefficients& s0,
                       const StageCoefficients& sm, const StageCoefficients& s1, float h,
                       const float* x, const float* v, float* x_out, float* v_out) {
-  const SubnormalsFlushed flush;
   return exact_sse2::StepBody(net, s0, sm, s1, h, x, v, x_out, v_out);
 }
 
@@ -116,7 +114,6 @@ ModalStepSums StepSse(const MassSpringNetwork& net, const StageCoefficients& s0,
                                              const StageCoefficients& sm,
                                              const StageCoefficients& s1, float h, const float* x,
                                              const float* v, float* x_out, float* v_out) {
-  const SubnormalsFlushed flush;
   return exact_avx::StepBody(net, s0, sm, s1, h, x, v, x_out, v_out);
 }
 

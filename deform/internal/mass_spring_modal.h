@@ -13,11 +13,6 @@
 //    equal to the exact paths up to float round-off (a damped linear system:
 //    differences stay at round-off level, mass_spring_simd_test).
 // Each is deterministic: same inputs, same bits, whatever the thread count.
-// All three run with subnormals flushed to zero (SubnormalsFlushed below): a
-// subnormal input reads as 0 and a result under FLT_MIN is 0. A mode the drive
-// leaves alone decays through the subnormal range, where each operation costs a
-// microcode assist (a 5x5 step at rest ~1.7x slower); the scalar formulation
-// below holds exactly wherever no value is subnormal.
 //
 // Scalar formulation: per mode k (omega2, damping, sum, rest: its mode_lanes
 // entries) and component c, with a(c) < b(c) the other two axes
@@ -41,34 +36,9 @@
 
 #include <cstddef>
 
-#include <xmmintrin.h>
-
 #include "deform/mass_spring.h"
 
 namespace deform::internal {
-
-// While alive: subnormal floats flushed to zero in this thread's SSE/AVX
-// arithmetic, results (FTZ) and inputs (DAZ), MXCSR bits 15 and 6; the previous
-// mode comes back on destruction. Every ModalStepFn holds one. Setting MXCSR
-// stalls the pipeline (measured ~15 ns a step when set and reset around each
-// step), so it is written only when the bits are not already set: a caller
-// that steps several times (a frame's 8 steps) can hold one around the loop and
-// leave each step a read of MXCSR and a compare.
-class SubnormalsFlushed {
- public:
-  SubnormalsFlushed() : saved_(_mm_getcsr()) {
-    if ((saved_ & kFtzDaz) != kFtzDaz) _mm_setcsr(saved_ | kFtzDaz);
-  }
-  ~SubnormalsFlushed() {
-    if ((saved_ & kFtzDaz) != kFtzDaz) _mm_setcsr(saved_);
-  }
-  SubnormalsFlushed(const SubnormalsFlushed&) = delete;
-  SubnormalsFlushed& operator=(const SubnormalsFlushed&) = delete;
-
- private:
-  static constexpr unsigned kFtzDaz = 0x8040;
-  unsigned saved_;  // the MXCSR found on construction
-};
 
 // Floats per SIMD lane group; MassSpringNetwork::mode_stride is a multiple of it.
 inline constexpr int kModeLanes = 8;
@@ -100,8 +70,7 @@ struct StageCoefficients {
 
 // Sums of the new state the limit check needs (ALGORITHMS.md 6 limits); the
 // exact paths add the terms in the same order (per mode (x^2 + y^2) + z^2, the
-// 8 lanes of the groups in a fixed tree, then the lone mode; squares under
-// FLT_MIN are 0, see the flush above):
+// 8 lanes of the groups in a fixed tree, then the lone mode):
 struct ModalStepSums {
   float sum_x = 0.0f;  // sum_k |eta_k|^2 (>= |e_a|^2 for every point: U orthonormal)
   float sum_v = 0.0f;  // sum_k |eta'_k|^2

@@ -212,9 +212,6 @@ class ModalRunner {
       driving.CheckAll({frames, 2 * count}, last_checks);
       StageCoefficientsOfEach({frames, 2 * count}, driving.forcing(), {coeffs + 1, 2 * count},
                               job_.allow_avx);
-      // The steps (and their limits) with subnormals flushed, set once for
-      // the batch instead of by each step (mass_spring_modal.h).
-      const SubnormalsFlushed flush;
       for (std::size_t i = 0; i < count; ++i) {
         const ModalStepSums sums = step(net_, coeffs[2 * i], coeffs[2 * i + 1], coeffs[2 * i + 2],
                                         static_cast<float>(h), x, v, prev_x, prev_v);
