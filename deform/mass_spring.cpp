@@ -123,7 +123,6 @@ class Integrator {
       sx[a] += vs[a];
       sv[a] += acc[a];
       st_.prev_position[a] = x[a];
-      st_.prev_velocity[a] = v[a];
       x[a] += (h / 6.0f) * sx[a];
       v[a] += (h / 6.0f) * sv[a];
     }
@@ -144,7 +143,6 @@ class Integrator {
       std::fill(st_.position.begin(), st_.position.end(), glm::vec3(0.0f));
       std::fill(st_.velocity.begin(), st_.velocity.end(), glm::vec3(0.0f));
       std::fill(st_.prev_position.begin(), st_.prev_position.end(), glm::vec3(0.0f));
-      std::fill(st_.prev_velocity.begin(), st_.prev_velocity.end(), glm::vec3(0.0f));
       return;
     }
     if (sum_x <= e_max * e_max) return;
@@ -173,7 +171,6 @@ void MassSpringState::Resize(const MassSpringNetwork& network) {
   position.assign(n, glm::vec3(0.0f));
   velocity.assign(n, glm::vec3(0.0f));
   prev_position.assign(n, glm::vec3(0.0f));
-  prev_velocity.assign(n, glm::vec3(0.0f));
   work.assign(5 * n, glm::vec3(0.0f));
   Reset();
 }
@@ -185,7 +182,6 @@ void MassSpringState::Reset() {
   std::fill(position.begin(), position.end(), glm::vec3(0.0f));
   std::fill(velocity.begin(), velocity.end(), glm::vec3(0.0f));
   std::fill(prev_position.begin(), prev_position.end(), glm::vec3(0.0f));
-  std::fill(prev_velocity.begin(), prev_velocity.end(), glm::vec3(0.0f));
 }
 
 JobStatus MassSpringStepJob::Validate() const {
@@ -195,7 +191,7 @@ JobStatus MassSpringStepJob::Validate() const {
   }
   const std::size_t n = static_cast<std::size_t>(network->num_free);
   if (state->position.size() != n || state->velocity.size() != n ||
-      state->prev_position.size() != n || state->prev_velocity.size() != n ||
+      state->prev_position.size() != n ||
       state->work.size() != 5 * n) {
     return {JobStatus::kSizeMismatch, "state not sized for the network (call Resize)"};
   }

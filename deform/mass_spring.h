@@ -187,8 +187,10 @@ struct MassSpringState {
   double step_time_s = 0.0;   // time of the newest step
   double output_time_s = 0.0; // time of the last run's output
   // Point space, #free each (kPointSpace / kLength), or modal, #free each (kModal).
-  std::vector<glm::vec3> position, velocity;            // newest step
-  std::vector<glm::vec3> prev_position, prev_velocity;  // the step before
+  std::vector<glm::vec3> position, velocity;  // newest step
+  // The step before's displacement: the output is interpolated between it and
+  // the newest (its velocity is never needed, so not kept).
+  std::vector<glm::vec3> prev_position;
   // Workspace for the RK4 stages (4 x #free each) and point-space outputs.
   std::vector<glm::vec3> work;
   MassSpringCounters counters;

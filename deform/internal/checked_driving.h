@@ -60,6 +60,10 @@ class CheckedDriving {
   glm::quat bind_rotation_{1, 0, 0, 0};
   float max_accel_ = 0.0f;            // the |a| clamp, model units/s^2
   float surely_below_accel2_ = 0.0f;  // |a|^2 below this needs no square root
+  // MayNeedChecks' per-lane bounds on a frame's floats 4..7 (a_x, a_y, a_z,
+  // w_x): |a_i| at most the first three keeps |a|^2 below surely_below_accel2_;
+  // w_x is not tested (+inf).
+  alignas(16) float accel_lane_bounds_[4] = {};
   std::optional<KinematicsDrivingSampler> sampler_;
   ForcingConstants forcing_;
 };

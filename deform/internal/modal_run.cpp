@@ -92,7 +92,6 @@ class ModalRunner {
       Store(x, st_.position);
       Store(v, st_.velocity);
       Store(prev_x, st_.prev_position);
-      Store(prev_v, st_.prev_velocity);
     } else {
       Load(st_.position, x);
       Load(st_.prev_position, prev_x);
@@ -109,6 +108,12 @@ class ModalRunner {
     float* const xs = to;
     float* const ys = to + stride_;
     float* const zs = to + 2 * stride_;
+    // Padding lanes 0: each row's last partial group of four and the groups after
+    // it zeroed first with aligned stores (rows start 32-byte aligned, the stride
+    // is a multiple of 8), then the tail's points written over them.
+    for (float* row : {xs, ys, zs}) {
+      for (std::size_t z = n_ / 4 * 4; z < stride_; z += 4) _mm_store_ps(row + z, _mm_setzero_ps());
+    }
     std::size_t k = 0;
     for (; k + 4 <= n_; k += 4, in += 12) {
       const __m128 a = _mm_loadu_ps(in), b = _mm_loadu_ps(in + 4), c = _mm_loadu_ps(in + 8);
@@ -129,7 +134,6 @@ class ModalRunner {
       ys[k] = in[1];
       zs[k] = in[2];
     }
-    for (float* row : {xs, ys, zs}) std::fill(row + n_, row + stride_, 0.0f);
   }
   // The inverse of Load (padding lanes dropped).
   void Store(const float* from, std::vector<glm::vec3>& to) const {

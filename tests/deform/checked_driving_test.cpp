@@ -7,6 +7,7 @@
 #include <cstring>
 #include <functional>
 #include <limits>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -142,6 +143,68 @@ TEST(CheckedDriving, CheckAllMatchesSamplingOneAtATime) {
     EXPECT_EQ(checks_batch.non_finite, last_kind == 1);
     EXPECT_EQ(checks_batch.clamped, last_kind == 2);
   }
+}
+
+// CheckAll's quick test lets a frame skip the exact checks only when they would
+// change nothing: frames at the edges of its bounds (rotations whose |q|^2 is
+// near 1e-12 or overflows, accelerations near the clamp along an axis and along
+// the diagonal, where each component is smallest for the length, and every
+// single field NaN or Inf) give the frames and counts of Sample on each.
+TEST(CheckedDriving, CheckAllQuickTestKeepsEveryFrameTheChecksWouldChange) {
+  const float inf = std::numeric_limits<float>::infinity();
+  std::vector<DrivingFrame> frames;
+  for (float scale = 1e-7f; scale < 1e-5f; scale *= 1.07f) {  // |q| around 1e-6
+    DrivingFrame d = Ordinary();
+    d.rotation = glm::quat(scale * 0.5f, scale * 0.5f, -scale * 0.5f, scale * 0.5f);
+    frames.push_back(d);
+    d.rotation = glm::quat(scale, 0.0f, 0.0f, 0.0f);
+    frames.push_back(d);
+  }
+  for (const float big : {1e18f, 1.8e19f, 2e19f, 1e20f, 3e38f}) {  // |q|^2 near overflow
+    DrivingFrame d = Ordinary();
+    d.rotation = glm::quat(0.5f, big, 0.0f, 0.0f);
+    frames.push_back(d);
+    d.rotation = glm::quat(big, big, big, big);
+    frames.push_back(d);
+  }
+  const float max_accel = 20000.0f;  // 200 m/s^2 at 100 units per metre
+  for (float r = 0.97f; r < 1.03f; r += 0.0005f) {
+    for (const glm::vec3 dir : {glm::vec3(1, 0, 0), glm::vec3(0, -1, 0), glm::vec3(0, 0, 1),
+                                glm::normalize(glm::vec3(1, -1, 1)),
+                                glm::normalize(glm::vec3(1, 1, 0))}) {
+      DrivingFrame d = Ordinary();
+      d.linear_acceleration = r * max_accel * dir;
+      frames.push_back(d);
+    }
+  }
+  for (int field = 0; field < 13; ++field) {
+    for (const float bad : {std::numeric_limits<float>::quiet_NaN(), inf, -inf}) {
+      DrivingFrame d = Ordinary();
+      (&d.rotation.x)[field] = bad;
+      frames.push_back(d);
+    }
+  }
+  Fixture one, batch;
+  const auto replay = [&frames](double t) {
+    return frames[static_cast<std::size_t>(std::lround(t * 1000.0))];
+  };
+  one.drive = replay;
+  batch.drive = replay;
+  CheckedDriving by_one(one.job), by_batch(batch.job);
+  std::vector<DrivingFrame> a(frames.size()), b(frames.size());
+  SampleChecks checks_one, checks_batch;
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    by_one.Sample(static_cast<double>(i) / 1000.0, a[i], checks_one);
+    by_batch.SampleRaw(static_cast<double>(i) / 1000.0, b[i]);
+  }
+  by_batch.CheckAll(b, checks_batch);
+  for (std::size_t i = 0; i < frames.size(); ++i) EXPECT_TRUE(SameBits(a[i], b[i])) << "frame " << i;
+  EXPECT_EQ(one.state.counters.non_finite_inputs, batch.state.counters.non_finite_inputs);
+  EXPECT_EQ(one.state.counters.acceleration_clamps, batch.state.counters.acceleration_clamps);
+  // The sweeps reach both sides of each bound.
+  EXPECT_GT(batch.state.counters.non_finite_inputs, 39 + 10);
+  EXPECT_GT(batch.state.counters.acceleration_clamps, 100);
+  EXPECT_LT(batch.state.counters.acceleration_clamps, 5 * 120 - 100);
 }
 
 }  // namespace
