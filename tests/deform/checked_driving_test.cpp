@@ -180,7 +180,11 @@ TEST(CheckedDriving, CheckAllQuickTestKeepsEveryFrameTheChecksWouldChange) {
   for (int field = 0; field < 13; ++field) {
     for (const float bad : {std::numeric_limits<float>::quiet_NaN(), inf, -inf}) {
       DrivingFrame d = Ordinary();
-      (&d.rotation.x)[field] = bad;
+      float raw[13];  // the frame's floats in memory order
+      static_assert(sizeof raw == sizeof d);
+      std::memcpy(raw, &d, sizeof raw);
+      raw[field] = bad;
+      std::memcpy(&d, raw, sizeof raw);
       frames.push_back(d);
     }
   }
