@@ -10,6 +10,7 @@
 
 #include <benchmark/benchmark.h>
 
+#include "deform/internal/driving_sampler.h"
 #include "deform/internal/mass_spring_modal.h"
 #include "deform/mass_spring.h"
 #include "mocap/kinematics.h"
@@ -157,6 +158,43 @@ void BM_MassSpringSampled(benchmark::State& bench, int size, bool fma) {
                                        static_cast<double>(bench.iterations());
 }
 
+// How the driving sampler is called.
+enum class SamplerCall { kSample, kSampleManySse2, kSampleMany };
+
+// The kinematics sampler alone (deform/internal/driving_sampler.h), one output
+// frame's worth per iteration as ModalRunner::Steps asks for it: a new sampler,
+// then the 16 RK4 stage times of 8 steps at h = 1/240 s. `joint` of the jump
+// at 120 fps: the hips (no turn: the slerp's nearly-equal lerp) or the left
+// leg (turning: the slerp's sines), looping over the clip.
+void BM_DrivingSampler(benchmark::State& bench, const char* joint, SamplerCall call) {
+  const mocap::Skeleton skel = mocap::MakeHumanoidSkeleton();
+  mocap::JumpOptions options;
+  options.frame_time_s = 1.0 / 120;
+  const mocap::Motion motion = mocap::MakeJumpMotion(skel, options).value();
+  const std::vector<mocap::JointKinematics> kin = mocap::ComputeKinematics(skel, motion).value();
+  const int frames30 = static_cast<int>(motion.duration_s() * 30.0);
+  const double h = 1.0 / 240;
+  int frame = 0;
+  double times[16];
+  deform::DrivingFrame out[16];
+  for (auto _ : bench) {
+    double t = (frame++ % frames30) / 30.0;
+    for (int i = 0; i < 8; ++i, t = t + h) {
+      times[2 * i] = t + 0.5 * h;
+      times[2 * i + 1] = t + h;
+    }
+    deform::internal::KinematicsDrivingSampler sampler(kin, skel.num_joints(),
+                                                       skel.FindJoint(joint), options.frame_time_s);
+    if (call == SamplerCall::kSample) {
+      for (int i = 0; i < 16; ++i) out[i] = sampler.Sample(times[i]);
+    } else {
+      sampler.SampleMany(times, out, call == SamplerCall::kSampleMany);
+    }
+    benchmark::DoNotOptimize(out);
+  }
+  bench.SetItemsProcessed(16 * bench.iterations());
+}
+
 // The modal RK4 kernel alone (no sampling, limits or conversions): 8 steps per
 // iteration, i.e. one 30 fps frame's worth, with fixed stage coefficients
 // (no symmetry between their entries) whose sign flips every frame (a 15 Hz
@@ -239,5 +277,11 @@ BENCHMARK_CAPTURE(BM_MassSpringSampled, modal_5x5, 5, false);
 BENCHMARK_CAPTURE(BM_MassSpringSampled, modal_7x7, 7, false);
 BENCHMARK_CAPTURE(BM_MassSpringSampled, modal_5x5_fma, 5, true);
 BENCHMARK_CAPTURE(BM_MassSpringSampled, modal_7x7_fma, 7, true);
+BENCHMARK_CAPTURE(BM_DrivingSampler, hips_sample, "Hips", SamplerCall::kSample);
+BENCHMARK_CAPTURE(BM_DrivingSampler, hips_many_sse2, "Hips", SamplerCall::kSampleManySse2);
+BENCHMARK_CAPTURE(BM_DrivingSampler, hips_many, "Hips", SamplerCall::kSampleMany);
+BENCHMARK_CAPTURE(BM_DrivingSampler, leg_sample, "LeftUpLeg", SamplerCall::kSample);
+BENCHMARK_CAPTURE(BM_DrivingSampler, leg_many_sse2, "LeftUpLeg", SamplerCall::kSampleManySse2);
+BENCHMARK_CAPTURE(BM_DrivingSampler, leg_many, "LeftUpLeg", SamplerCall::kSampleMany);
 
 BENCHMARK_MAIN();
