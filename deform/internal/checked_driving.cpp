@@ -56,6 +56,14 @@ void CheckedDriving::SampleRaw(double time_s, DrivingFrame& d) {
   }
 }
 
+void CheckedDriving::SampleRawMany(std::span<const double> times, DrivingFrame* frames) {
+  if (sampler_) {
+    sampler_->SampleMany(times, frames, job_.allow_avx);
+    return;
+  }
+  for (std::size_t i = 0; i < times.size(); ++i) SampleRaw(times[i], frames[i]);
+}
+
 // Conservative tests on the frame's 13 floats in four SSE2 registers: a frame
 // passes only if every float is finite, some |q_i| >= 2e-6 (so the rounded
 // |q|^2 >= 4e-12 (1 - 3 eps) is above 1e-12), every |q_i| <= 1e18 (|q|^2 stays

@@ -46,6 +46,9 @@ class CheckedDriving {
   // frames that may need them. `last_checks`: what the checks did to the last
   // frame.
   void SampleRaw(double time_s, DrivingFrame& frame);
+  // SampleRaw on each of `times` in order, into frames[0, times.size()): the
+  // sampler's batch form (KinematicsDrivingSampler::SampleMany, same bits).
+  void SampleRawMany(std::span<const double> times, DrivingFrame* frames);
   void CheckAll(std::span<DrivingFrame> frames, SampleChecks& last_checks);
 
   // gain, push and gravity of the run.

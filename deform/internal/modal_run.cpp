@@ -209,10 +209,12 @@ class ModalRunner {
       for (double t = st_.step_time_s; count < kBatchSteps && t < until_s; t = t + h) {
         starts[count++] = t;
       }
+      double times[2 * kBatchSteps];
       for (std::size_t i = 0; i < count; ++i) {
-        driving.SampleRaw(starts[i] + 0.5 * h, frames[2 * i]);
-        driving.SampleRaw(starts[i] + h, frames[2 * i + 1]);
+        times[2 * i] = starts[i] + 0.5 * h;
+        times[2 * i + 1] = starts[i] + h;
       }
+      driving.SampleRawMany({times, 2 * count}, frames);
       driving.CheckAll({frames, 2 * count}, last_checks);
       StageCoefficientsOfEach({frames, 2 * count}, driving.forcing(), {coeffs + 1, 2 * count},
                               job_.allow_avx);
