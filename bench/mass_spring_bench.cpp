@@ -132,23 +132,35 @@ void BM_MassSpringAtRest(benchmark::State& bench, int size) {
 // Driving frame sampled from the jump's per-frame kinematics (hips, 120 fps) by
 // mocap::SampleJointKinematics at every RK4 stage time; loops over the clip.
 // fma: MassSpringStepJob::allow_fma (the AVX2+FMA step; rounded differently, off by default).
+// The generated jump at 120 fps and its per-frame kinematics.
+struct JumpClip {
+  mocap::Skeleton skel = mocap::MakeHumanoidSkeleton();
+  double frame_time_s = 1.0 / 120;
+  std::vector<mocap::JointKinematics> kin;
+  int frames30 = 0;  // whole 30 fps frames in the clip
+
+  JumpClip() {
+    mocap::JumpOptions options;
+    options.frame_time_s = frame_time_s;
+    const mocap::Motion motion = mocap::MakeJumpMotion(skel, options).value();
+    kin = mocap::ComputeKinematics(skel, motion).value();
+    frames30 = static_cast<int>(motion.duration_s() * 30.0);
+  }
+};
+
 void BM_MassSpringSampled(benchmark::State& bench, int size, bool fma) {
   const deform::MassSpringNetwork net = MakeNetwork(size, deform::MassSpringSolver::kModal);
   deform::MassSpringState state;
   state.Resize(net);
-  const mocap::Skeleton skel = mocap::MakeHumanoidSkeleton();
-  mocap::JumpOptions options;
-  options.frame_time_s = 1.0 / 120;
-  const mocap::Motion motion = mocap::MakeJumpMotion(skel, options).value();
-  const std::vector<mocap::JointKinematics> kin = mocap::ComputeKinematics(skel, motion).value();
-  const int frames30 = static_cast<int>(motion.duration_s() * 30.0);
+  const JumpClip clip;
   std::vector<glm::vec3> disp(static_cast<std::size_t>(size * size));
   int frame = 0;
   for (auto _ : bench) {
     const deform::MassSpringStepJob job{
-        .network = &net, .state = &state, .time_s = (frame++ % frames30) / 30.0,
-        .kinematics = kin, .num_joints = skel.num_joints(), .joint = skel.FindJoint("Hips"),
-        .frame_time_s = options.frame_time_s, .displacements = disp, .allow_fma = fma};
+        .network = &net, .state = &state, .time_s = (frame++ % clip.frames30) / 30.0,
+        .kinematics = clip.kin, .num_joints = clip.skel.num_joints(),
+        .joint = clip.skel.FindJoint("Hips"), .frame_time_s = clip.frame_time_s,
+        .displacements = disp, .allow_fma = fma};
     benchmark::DoNotOptimize(job.Run());
     benchmark::DoNotOptimize(disp.data());
   }
@@ -167,24 +179,19 @@ enum class SamplerCall { kSample, kSampleManySse2, kSampleMany };
 // at 120 fps: the hips (no turn: the slerp's nearly-equal lerp) or the left
 // leg (turning: the slerp's sines), looping over the clip.
 void BM_DrivingSampler(benchmark::State& bench, const char* joint, SamplerCall call) {
-  const mocap::Skeleton skel = mocap::MakeHumanoidSkeleton();
-  mocap::JumpOptions options;
-  options.frame_time_s = 1.0 / 120;
-  const mocap::Motion motion = mocap::MakeJumpMotion(skel, options).value();
-  const std::vector<mocap::JointKinematics> kin = mocap::ComputeKinematics(skel, motion).value();
-  const int frames30 = static_cast<int>(motion.duration_s() * 30.0);
+  const JumpClip clip;
   const double h = 1.0 / 240;
   int frame = 0;
   double times[16];
   deform::DrivingFrame out[16];
   for (auto _ : bench) {
-    double t = (frame++ % frames30) / 30.0;
+    double t = (frame++ % clip.frames30) / 30.0;
     for (int i = 0; i < 8; ++i, t = t + h) {
       times[2 * i] = t + 0.5 * h;
       times[2 * i + 1] = t + h;
     }
-    deform::internal::KinematicsDrivingSampler sampler(kin, skel.num_joints(),
-                                                       skel.FindJoint(joint), options.frame_time_s);
+    deform::internal::KinematicsDrivingSampler sampler(clip.kin, clip.skel.num_joints(),
+                                                       clip.skel.FindJoint(joint), clip.frame_time_s);
     if (call == SamplerCall::kSample) {
       for (int i = 0; i < 16; ++i) out[i] = sampler.Sample(times[i]);
     } else {

@@ -14,6 +14,7 @@
 #include <limits>
 #include <vector>
 
+#include "deform/fast_turns_clip.h"
 #include "deform/internal/driving_sampler.h"
 #include "mocap/kinematics.h"
 #include "mocap/synthetic.h"
@@ -149,16 +150,9 @@ TEST(KinematicsDrivingSampler, SampleManyMatchesSampleOnAJumpAt120Fps) {
 // shorter-arc flip), then a stretch of identical frames (the nearly-equal lerp)
 // and two zero quaternions (a glitch: the blend has length 0, glm's identity).
 TEST(KinematicsDrivingSampler, SampleManyMatchesSampleOnFastTurnsAndSignFlips) {
-  std::vector<mocap::JointKinematics> kin(40);
-  for (std::size_t f = 0; f < kin.size(); ++f) {
-    const float angle = f < 30 ? 0.9f * static_cast<float>(f) : 27.0f;
-    kin[f].rotation = glm::angleAxis(angle, glm::normalize(glm::vec3(1.0f, 2.0f, 0.5f)));
-    if (f % 2 == 1) kin[f].rotation = -kin[f].rotation;
-    if (f == 36 || f == 37) kin[f].rotation = glm::quat(0.0f, 0.0f, 0.0f, 0.0f);
-    kin[f].angular_velocity = glm::vec3(0.0f, 27.0f, static_cast<float>(f));
-    kin[f].linear_acceleration = glm::vec3(static_cast<float>(f), -3.0f, 1e3f);
-    kin[f].angular_acceleration = glm::vec3(-2.0f, static_cast<float>(f * f), 5.0f);
-  }
+  std::vector<mocap::JointKinematics> kin = test_clips::FastTurnsClip();
+  kin[36].rotation = glm::quat(0.0f, 0.0f, 0.0f, 0.0f);
+  kin[37].rotation = glm::quat(0.0f, 0.0f, 0.0f, 0.0f);
   const double frame_time_s = 1.0 / 30;
   int turning = 0;
   ExpectManySameAsSample(kin, 1, frame_time_s, Batches(frame_time_s, 39.0 / 30), turning);

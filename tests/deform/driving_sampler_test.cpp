@@ -11,6 +11,7 @@
 
 #include <gtest/gtest.h>
 
+#include "deform/fast_turns_clip.h"
 #include "mocap/kinematics.h"
 #include "mocap/synthetic.h"
 
@@ -62,15 +63,7 @@ TEST(KinematicsDrivingSampler, WalkAt30FpsMatchesSampleJointKinematics) {
 // One joint turning 0.9 rad per frame with every other quaternion negated (the
 // shorter-arc flip) and a stretch of identical frames (the lerp branch).
 TEST(KinematicsDrivingSampler, FastTurnsAndSignFlipsMatchSampleJointKinematics) {
-  std::vector<mocap::JointKinematics> kin(40);
-  for (std::size_t f = 0; f < kin.size(); ++f) {
-    const float angle = f < 30 ? 0.9f * static_cast<float>(f) : 27.0f;
-    kin[f].rotation = glm::angleAxis(angle, glm::normalize(glm::vec3(1.0f, 2.0f, 0.5f)));
-    if (f % 2 == 1) kin[f].rotation = -kin[f].rotation;
-    kin[f].angular_velocity = glm::vec3(0.0f, 27.0f, static_cast<float>(f));
-    kin[f].linear_acceleration = glm::vec3(static_cast<float>(f), -3.0f, 1e3f);
-    kin[f].angular_acceleration = glm::vec3(-2.0f, static_cast<float>(f * f), 5.0f);
-  }
+  const std::vector<mocap::JointKinematics> kin = test_clips::FastTurnsClip();
   ExpectSame(kin, 1, 1.0 / 30, 39.0 / 30);
 }
 
