@@ -122,10 +122,10 @@ void StoreRotated(__m128 q, __m128 vx, __m128 vy, __m128 vz, float* out) {
   double ca0, cb0, ca1, cb1;
   SlerpWeights(in0, w0, ca0, cb0);
   SlerpWeights(in1, w1, ca1, cb1);
-  const __m256d r0 = _mm256_add_pd(_mm256_mul_pd(_mm256_load_pd(in0.a), _mm256_set1_pd(ca0)),
-                                   _mm256_mul_pd(_mm256_load_pd(in0.b), _mm256_set1_pd(cb0)));
-  const __m256d r1 = _mm256_add_pd(_mm256_mul_pd(_mm256_load_pd(in1.a), _mm256_set1_pd(ca1)),
-                                   _mm256_mul_pd(_mm256_load_pd(in1.b), _mm256_set1_pd(cb1)));
+  const __m256d r0 = _mm256_add_pd(_mm256_mul_pd(_mm256_loadu_pd(in0.a), _mm256_set1_pd(ca0)),
+                                   _mm256_mul_pd(_mm256_loadu_pd(in0.b), _mm256_set1_pd(cb0)));
+  const __m256d r1 = _mm256_add_pd(_mm256_mul_pd(_mm256_loadu_pd(in1.a), _mm256_set1_pd(ca1)),
+                                   _mm256_mul_pd(_mm256_loadu_pd(in1.b), _mm256_set1_pd(cb1)));
   // Squares x y z w plus w z y x: xx+ww, yy+zz in lanes 0 and 1; hadd then
   // gives each dot (ww + xx) + (yy + zz).
   const __m256d sq0 = _mm256_mul_pd(r0, r0), sq1 = _mm256_mul_pd(r1, r1);

@@ -63,9 +63,10 @@ class KinematicsDrivingSampler {
   // initializer, as a sampler is built for each run, i.e. each output frame.
   struct Interval {
     int frame0 = -1;
-    // q0 and the shorter-arc q1, in double, in glm's x, y, z, w memory order.
-    alignas(16) double a[4];
-    alignas(16) double b[4];
+    // q0 and the shorter-arc q1, in double, in glm's x, y, z, w memory order;
+    // 32-byte aligned so WritePairAvx's 256-bit loads never split a line.
+    alignas(32) double a[4];
+    alignas(32) double b[4];
     // Linear acceleration, angular velocity and angular acceleration by
     // component: x0[c][v] is component c of vector v at frame0, dx[c][v] the
     // difference frame0 + 1 minus frame0; lane 3 is 0.
