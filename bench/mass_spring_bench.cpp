@@ -129,9 +129,6 @@ void BM_MassSpringAtRest(benchmark::State& bench, int size) {
       SubnormalFloats(&state.position[0].x, &state.velocity[0].x, 3 * state.position.size());
 }
 
-// Driving frame sampled from the jump's per-frame kinematics (hips, 120 fps) by
-// mocap::SampleJointKinematics at every RK4 stage time; loops over the clip.
-// fma: MassSpringStepJob::allow_fma (the AVX2+FMA step; rounded differently, off by default).
 // The generated jump at 120 fps and its per-frame kinematics.
 struct JumpClip {
   mocap::Skeleton skel = mocap::MakeHumanoidSkeleton();
@@ -148,6 +145,9 @@ struct JumpClip {
   }
 };
 
+// Driving frame sampled from the jump's per-frame kinematics (hips, 120 fps) at
+// every RK4 stage time, as mocap::SampleJointKinematics would; loops over the clip.
+// fma: MassSpringStepJob::allow_fma (the AVX2+FMA step; rounded differently, off by default).
 void BM_MassSpringSampled(benchmark::State& bench, int size, bool fma) {
   const deform::MassSpringNetwork net = MakeNetwork(size, deform::MassSpringSolver::kModal);
   deform::MassSpringState state;
