@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <limits>
+#include <utility>
 #include <vector>
 
 #include <benchmark/benchmark.h>
@@ -210,9 +212,14 @@ void BM_DrivingSampler(benchmark::State& bench, const char* joint, SamplerCall c
 // velocities decayed into the subnormal floats and the row measured microcode
 // assists rather than the kernel (~1100 against ~800 ns for 5x5); the
 // subnormal_floats counter says how many state floats ended subnormal.
-void BM_MassSpringKernel(benchmark::State& bench, int size, deform::internal::ModalKernel kernel) {
+// The 8 steps go to the several-step kernel in one call, as the runner makes
+// it when no step needs the limits (ModalStepsFn); with one_step, 8 calls of
+// the one-step kernel (ModalStepFn) instead.
+void BM_MassSpringKernel(benchmark::State& bench, int size, deform::internal::ModalKernel kernel,
+                         bool one_step = false) {
   const deform::MassSpringNetwork net = MakeNetwork(size, deform::MassSpringSolver::kModal);
   const auto step = deform::internal::SelectModalStep(kernel);
+  const auto steps = deform::internal::SelectModalSteps(kernel);
   const std::size_t n = 3 * static_cast<std::size_t>(net.mode_stride);
   alignas(32) float buffers[4][3 * deform::internal::kMaxModeStride] = {};
   // From rest, as a run starts: a mode no drive reaches (on this flat square
@@ -231,12 +238,26 @@ void BM_MassSpringKernel(benchmark::State& bench, int size, deform::internal::Mo
   }
   const float h = static_cast<float>(net.time_step_s);
   int frame = 0;
+  // The same 17 stage coefficients for the several-step kernel.
+  std::vector<deform::internal::StageCoefficients> same[2] = {
+      std::vector<deform::internal::StageCoefficients>(17, c[0]),
+      std::vector<deform::internal::StageCoefficients>(17, c[1])};
+  const float no_limit = std::numeric_limits<float>::infinity();
   for (auto _ : bench) {
-    const deform::internal::StageCoefficients& s = c[frame++ & 1];
-    for (int i = 0; i < 8; ++i) {
-      benchmark::DoNotOptimize(step(net, s, s, s, h, x, v, x1, v1));
-      std::swap(x, x1);
-      std::swap(v, v1);
+    const int parity = frame++ & 1;
+    if (one_step) {
+      const deform::internal::StageCoefficients& s = c[parity];
+      for (int i = 0; i < 8; ++i) {
+        benchmark::DoNotOptimize(step(net, s, s, s, h, x, v, x1, v1));
+        std::swap(x, x1);
+        std::swap(v, v1);
+      }
+    } else {
+      deform::internal::ModalBuffers b{x, v, x1, v1};
+      deform::internal::ModalStepSums sums;
+      for (int i = 0; i < 8;) i += steps(net, same[parity].data() + 2 * i, 8 - i, h, no_limit, b, sums);
+      benchmark::DoNotOptimize(sums);
+      x = b.x, v = b.v, x1 = b.prev_x, v1 = b.prev_v;
     }
     benchmark::ClobberMemory();
   }
@@ -270,6 +291,8 @@ BENCHMARK_CAPTURE(BM_MassSpringKernel, exact_5x5, 5, deform::internal::ModalKern
 BENCHMARK_CAPTURE(BM_MassSpringKernel, exact_7x7, 7, deform::internal::ModalKernel::kExactAvx);
 BENCHMARK_CAPTURE(BM_MassSpringKernel, fma_5x5, 5, deform::internal::ModalKernel::kFastest);
 BENCHMARK_CAPTURE(BM_MassSpringKernel, fma_7x7, 7, deform::internal::ModalKernel::kFastest);
+BENCHMARK_CAPTURE(BM_MassSpringKernel, exact_5x5_one_step, 5, deform::internal::ModalKernel::kExactAvx, true);
+BENCHMARK_CAPTURE(BM_MassSpringKernel, exact_7x7_one_step, 7, deform::internal::ModalKernel::kExactAvx, true);
 BENCHMARK_CAPTURE(BM_MassSpringKernelIndependent, exact_5x5, 5, deform::internal::ModalKernel::kExactAvx);
 BENCHMARK_CAPTURE(BM_MassSpringKernelIndependent, exact_7x7, 7, deform::internal::ModalKernel::kExactAvx);
 BENCHMARK_CAPTURE(BM_MassSpringCallback, modal_5x5, 5, deform::MassSpringSolver::kModal);

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstring>
+#include <utility>
 
 #include "deform/internal/cpu_features.h"
 
@@ -101,6 +102,11 @@ ModalStepSums StepFma(const MassSpringNetwork& net, const StageCoefficients& s0,
                       const float* x, const float* v, float* x_out, float* v_out) {
   return fused::StepBody(net, s0, sm, s1, h, x, v, x_out, v_out);
 }
+
+int StepsFma(const MassSpringNetwork& net, const StageCoefficients* c, int count, float h,
+             float sum_x_limit, ModalBuffers& b, ModalStepSums& sums) {
+  return fused::StepsBody(net, c, count, h, sum_x_limit, b, sums);
+}
 #pragma GCC pop_options
 
 ModalStepSums StepSse(const MassSpringNetwork& net, const StageCoefficients& s0,
@@ -115,6 +121,17 @@ ModalStepSums StepSse(const MassSpringNetwork& net, const StageCoefficients& s0,
                                              const StageCoefficients& s1, float h, const float* x,
                                              const float* v, float* x_out, float* v_out) {
   return exact_avx::StepBody(net, s0, sm, s1, h, x, v, x_out, v_out);
+}
+
+int StepsSse(const MassSpringNetwork& net, const StageCoefficients* c, int count, float h,
+             float sum_x_limit, ModalBuffers& b, ModalStepSums& sums) {
+  return exact_sse2::StepsBody(net, c, count, h, sum_x_limit, b, sums);
+}
+
+[[gnu::target("avx")]] int StepsAvx(const MassSpringNetwork& net, const StageCoefficients* c,
+                                    int count, float h, float sum_x_limit, ModalBuffers& b,
+                                    ModalStepSums& sums) {
+  return exact_avx::StepsBody(net, c, count, h, sum_x_limit, b, sums);
 }
 
 void MatrixSse(const MassSpringNetwork& net, const float* m, const float* in, float* out) {
@@ -137,6 +154,17 @@ ModalStepFn SelectModalStep(ModalKernel kernel) {
 ModalStepFn SelectModalStep(bool allow_avx, bool allow_fma) {
   if (!allow_avx) return SelectModalStep(ModalKernel::kPortable);
   return SelectModalStep(allow_fma ? ModalKernel::kFastest : ModalKernel::kExactAvx);
+}
+
+ModalStepsFn SelectModalSteps(ModalKernel kernel) {
+  if (kernel == ModalKernel::kFastest && CpuHasAvx2Fma()) return &StepsFma;
+  if (kernel != ModalKernel::kPortable && CpuHasAvx()) return &StepsAvx;
+  return &StepsSse;
+}
+
+ModalStepsFn SelectModalSteps(bool allow_avx, bool allow_fma) {
+  if (!allow_avx) return SelectModalSteps(ModalKernel::kPortable);
+  return SelectModalSteps(allow_fma ? ModalKernel::kFastest : ModalKernel::kExactAvx);
 }
 
 void ModalToPoints(const MassSpringNetwork& network, const float* modal, float* points,

@@ -84,6 +84,29 @@ using ModalStepFn = ModalStepSums (*)(const MassSpringNetwork& network,
                                       const StageCoefficients& s1, float h, const float* x,
                                       const float* v, float* x_out, float* v_out);
 
+// The runner's four modal fields: the newest step's displacement and velocity
+// (x, v) and the step's before (prev_x, prev_v), each 3 x mode_stride.
+struct ModalBuffers {
+  float* x;
+  float* v;
+  float* prev_x;
+  float* prev_v;
+};
+
+// Up to `count` (>= 1) RK4 steps one after another, step i with the
+// coefficients c[2 i], c[2 i + 1], c[2 i + 2] (its start, middle and end; so
+// 2 count + 1 of them): each step goes from (b.x, b.v) into (b.prev_x,
+// b.prev_v), then the two pairs are swapped, so that b.x, b.v hold the newest
+// step and b.prev_x, b.prev_v the one before, as after `count` calls of the
+// ModalStepFn. Stops early after a step whose sums the limits must see: either
+// is not finite, or sum_x is not <= sum_x_limit (e_max^2). Returns the number
+// of steps taken, with that last step's sums in `sums`. Each step has the bits
+// of the ModalStepFn of the same kernel. The input padding lanes must hold 0;
+// the four arrays must not overlap.
+using ModalStepsFn = int (*)(const MassSpringNetwork& network, const StageCoefficients* c,
+                             int count, float h, float sum_x_limit, ModalBuffers& b,
+                             ModalStepSums& sums);
+
 enum class ModalKernel {
   kFastest,   // AVX2 + FMA when the CPU has both, else AVX, else SSE2
   kExactAvx,  // AVX when the CPU has it, else SSE2 (same bits either way)
@@ -94,6 +117,9 @@ ModalStepFn SelectModalStep(ModalKernel kernel);
 // alone -> kExactAvx (the default: the same bits on every x86-64 CPU), neither ->
 // kPortable.
 ModalStepFn SelectModalStep(bool allow_avx, bool allow_fma);
+
+ModalStepsFn SelectModalSteps(ModalKernel kernel);
+ModalStepsFn SelectModalSteps(bool allow_avx, bool allow_fma);
 
 // Point-space field e_a = sum_k U[a, k] eta_k of a modal field (both 3 x stride;
 // k summed in ascending order from 0, as the scalar code does).

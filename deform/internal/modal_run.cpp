@@ -195,8 +195,10 @@ class ModalRunner {
   // [2 i + 2]: step i's start, middle and end.
   void Steps(double until_s, float*& x, float*& v, float*& prev_x, float*& prev_v) {
     CheckedDriving driving(job_);
-    const ModalStepFn step = SelectModalStep(job_.allow_avx, job_.allow_fma);
+    const ModalStepsFn steps = SelectModalSteps(job_.allow_avx, job_.allow_fma);
     const double h = net_.time_step_s;
+    const float e_max = net_.params.max_displacement;
+    const float sum_x_limit = e_max * e_max;  // ModalDisplacementLimit's first exit
     BatchStorage batch;  // left uninitialized: every entry is written before it is read
     DrivingFrame* const frames = batch.frames.at;
     StageCoefficients* const coeffs = batch.coeffs.at;
@@ -218,15 +220,22 @@ class ModalRunner {
       driving.CheckAll({frames, 2 * count}, last_checks);
       StageCoefficientsOfEach({frames, 2 * count}, driving.forcing(), {coeffs + 1, 2 * count},
                               job_.allow_avx);
-      for (std::size_t i = 0; i < count; ++i) {
-        const ModalStepSums sums = step(net_, coeffs[2 * i], coeffs[2 * i + 1], coeffs[2 * i + 2],
-                                        static_cast<float>(h), x, v, prev_x, prev_v);
-        std::swap(x, prev_x);
-        std::swap(v, prev_v);
-        Limits(sums, x, v, prev_x, prev_v);
-        st_.step_time_s = starts[i] + h;
-        ++st_.counters.steps;
+      // The steps run on until one needs the limits (internal/mass_spring_modal.h);
+      // Limits changes nothing after the others.
+      ModalBuffers b{x, v, prev_x, prev_v};
+      for (std::size_t i = 0; i < count;) {
+        ModalStepSums sums;
+        const int done = steps(net_, coeffs + 2 * i, static_cast<int>(count - i),
+                               static_cast<float>(h), sum_x_limit, b, sums);
+        i += static_cast<std::size_t>(done);
+        st_.step_time_s = starts[i - 1] + h;
+        st_.counters.steps += done;
+        Limits(sums, b.x, b.v, b.prev_x, b.prev_v);
       }
+      x = b.x;
+      v = b.v;
+      prev_x = b.prev_x;
+      prev_v = b.prev_v;
       coeffs[0] = coeffs[2 * count];
     }
     Remember(st_.last_stage, job_, st_.step_time_s, frames[2 * count - 1], last_checks, coeffs[0]);

@@ -88,6 +88,87 @@ TEST(MassSpringSimd, ExactAvxAndSse2KernelsGiveTheSameBits) {
   }
 }
 
+// Coefficients with no symmetry between their entries, different at each of
+// the 2 count + 1 stage times.
+std::vector<deform::internal::StageCoefficients> VaryingCoefficients(int count) {
+  std::vector<deform::internal::StageCoefficients> s(static_cast<std::size_t>(2 * count + 1));
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    const float t = 0.013f * static_cast<float>(i);
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) {
+        s[i].mx[r][c] = 2.0f * std::sin(t + static_cast<float>(r * 3 + c));
+        s[i].mv[r][c] = r == c ? 0.0f : std::cos(2.0f * t + static_cast<float>(r - c));
+      }
+      s[i].common[r] = 900.0f * std::sin(3.0f * t + static_cast<float>(r));
+    }
+  }
+  return s;
+}
+
+// The several-step kernels (ModalStepsFn) against the one-step ones of the same
+// instruction set called once per step: the same bits in all four buffers and
+// in the sums; and with a limit that the growing state passes, a stop right
+// after the first step whose sum_x is above it.
+TEST(MassSpringSimd, SeveralStepsGiveTheBitsOfOneStepAtATime) {
+  using deform::internal::ModalKernel;
+  for (const ModalKernel kernel : {ModalKernel::kPortable, ModalKernel::kExactAvx, ModalKernel::kFastest}) {
+    const auto one = deform::internal::SelectModalStep(kernel);
+    const auto several = deform::internal::SelectModalSteps(kernel);
+    for (const auto& [rows, cols] : kGrids) {
+      SCOPED_TRACE(testing::Message() << rows << "x" << cols << " kernel " << static_cast<int>(kernel));
+      const MassSpringNetwork net = CurvedGridNetwork(rows, cols);
+      const std::size_t size = 3 * static_cast<std::size_t>(net.mode_stride);
+      constexpr int kSteps = 8;
+      const std::vector<deform::internal::StageCoefficients> s = VaryingCoefficients(kSteps);
+      const float h = static_cast<float>(net.time_step_s);
+      // From rest, one step at a time; the previous step's buffers start as garbage
+      // (their padding lanes included), as the runner's do.
+      std::vector<float> ref[4];
+      for (auto& a : ref) a.assign(size, 0.0f);
+      std::vector<deform::internal::ModalStepSums> ref_sums;
+      for (int i = 0; i < kSteps; ++i) {
+        ref_sums.push_back(one(net, s[2 * i], s[2 * i + 1], s[2 * i + 2], h, ref[0].data(),
+                               ref[1].data(), ref[2].data(), ref[3].data()));
+        std::swap(ref[0], ref[2]);
+        std::swap(ref[1], ref[3]);
+      }
+      ASSERT_GT(ref_sums.back().sum_x, ref_sums[2].sum_x);
+      for (const float limit : {1e30f, ref_sums[2].sum_x}) {
+        alignas(32) float buffers[4][3 * deform::internal::kMaxModeStride];
+        std::fill_n(buffers[0], size, 0.0f);
+        std::fill_n(buffers[1], size, 0.0f);
+        std::fill_n(buffers[2], size, std::nanf(""));
+        std::fill_n(buffers[3], size, -7.0f);
+        deform::internal::ModalBuffers b{buffers[0], buffers[1], buffers[2], buffers[3]};
+        deform::internal::ModalStepSums sums;
+        int taken = 0;
+        while (taken < kSteps) {
+          const int done = several(net, s.data() + 2 * taken, kSteps - taken, h, limit, b, sums);
+          ASSERT_GE(done, 1);
+          taken += done;
+          ASSERT_LE(taken, kSteps);
+          const auto& want = ref_sums[static_cast<std::size_t>(taken - 1)];
+          ASSERT_EQ(std::memcmp(&sums, &want, sizeof sums), 0) << "after step " << taken;
+          // Stopped at the end, or right after the first step above the limit.
+          if (taken < kSteps) {
+            ASSERT_GT(sums.sum_x, limit);
+          }
+          for (int i = taken - done; i < taken - 1; ++i) {
+            ASSERT_LE(ref_sums[static_cast<std::size_t>(i)].sum_x, limit) << "ran past step " << i + 1;
+          }
+        }
+        if (limit < 1e30f) {
+          EXPECT_GT(ref_sums[3].sum_x, limit);  // so the run above stopped
+        }
+        const float* got[4] = {b.x, b.v, b.prev_x, b.prev_v};
+        for (int a = 0; a < 4; ++a) {
+          ASSERT_EQ(std::memcmp(got[a], ref[a].data(), size * sizeof(float)), 0) << "buffer " << a;
+        }
+      }
+    }
+  }
+}
+
 // The job with the fastest kernel (AVX2 + FMA where the CPU has it) against the
 // portable one over 100 s of a gentle drive (no limit reached): FMA rounds once
 // where the exact kernels round twice, and the damped linear system keeps the
