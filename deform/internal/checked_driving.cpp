@@ -1,10 +1,13 @@
 #include "deform/internal/checked_driving.h"
 
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <new>
 
 #include <emmintrin.h>
+
+#include "deform/internal/cpu_features.h"
 
 namespace deform::internal {
 namespace {
@@ -37,6 +40,7 @@ CheckedDriving::CheckedDriving(const MassSpringStepJob& job)
   // the square is far inside 1%), so most samples skip the square root.
   surely_below_accel2_ = 0.99f * max_accel_ * max_accel_;
   const float lane_bound = 0.999f * std::sqrt(surely_below_accel2_ / 3.0f);
+  quick_ = {.min_abs_q = 2e-6f, .max_abs_q = 1e18f, .max_abs_a = lane_bound};
   for (int i = 0; i < 3; ++i) accel_lane_bounds_[i] = lane_bound;
   accel_lane_bounds_[3] = std::numeric_limits<float>::infinity();
   if (!job.kinematics.empty()) {
@@ -70,6 +74,8 @@ void CheckedDriving::SampleRawMany(std::span<const double> times, DrivingFrame* 
 // finite) and every |a_i| is within accel_lane_bounds_ (3 b^2 with rounding is
 // below surely_below_accel2_); Check then provably changes and counts nothing.
 // About half the instructions of the per-field tests, run on every stage time.
+// (The bounds are quick_'s; QuickTestedCoefficientsOfEight runs the same test
+// in AVX lanes.)
 bool CheckedDriving::MayNeedChecks(const DrivingFrame& d) const {
   const float* f = &d.rotation.x;
   const __m128 q = _mm_loadu_ps(f), b = _mm_loadu_ps(f + 4), c = _mm_loadu_ps(f + 8);
@@ -80,10 +86,10 @@ bool CheckedDriving::MayNeedChecks(const DrivingFrame& d) const {
   const __m128 q_abs = _mm_and_ps(q, abs_bits);
   const __m128 flags =
       _mm_or_ps(_mm_or_ps(_mm_cmpunord_ps(nan_if_not_finite, nan_if_not_finite),
-                          _mm_cmpgt_ps(q_abs, _mm_set1_ps(1e18f))),
+                          _mm_cmpgt_ps(q_abs, _mm_set1_ps(quick_.max_abs_q))),
                 _mm_cmpgt_ps(_mm_and_ps(b, abs_bits), _mm_load_ps(accel_lane_bounds_)));
   if (_mm_movemask_ps(flags) != 0) return true;
-  return _mm_movemask_ps(_mm_cmplt_ps(q_abs, _mm_set1_ps(2e-6f))) == 0xF;
+  return _mm_movemask_ps(_mm_cmplt_ps(q_abs, _mm_set1_ps(quick_.min_abs_q))) == 0xF;
 }
 
 void CheckedDriving::Check(DrivingFrame& d, SampleChecks& checks) {
@@ -119,6 +125,30 @@ void CheckedDriving::CheckAll(std::span<DrivingFrame> frames, SampleChecks& last
     Check(frames[i], checks);
     if (i + 1 == frames.size()) last_checks = checks;
   }
+}
+
+void CheckedDriving::CheckAndCoefficients(std::span<DrivingFrame> frames,
+                                          std::span<StageCoefficients> out,
+                                          SampleChecks& last_checks, bool allow_avx) {
+  const std::size_t n = frames.size();
+  last_checks = {};
+  std::size_t i = 0;
+  if (allow_avx && CpuHasAvx()) {
+    for (; i + 8 <= n; i += 8) {
+      unsigned flags = QuickTestedCoefficientsOfEight(&frames[i], forcing_, quick_, &out[i]);
+      if (flags == 0) continue;
+      for (; flags != 0; flags &= flags - 1) {  // CheckAll's exact checks, in order
+        const std::size_t at = i + static_cast<std::size_t>(std::countr_zero(flags));
+        SampleChecks checks;
+        Check(frames[at], checks);
+        if (at + 1 == n) last_checks = checks;
+      }
+      StageCoefficientsOfEach(frames.subspan(i, 8), forcing_, out.subspan(i, 8), true);
+    }
+  }
+  if (i == n) return;
+  CheckAll(frames.subspan(i), last_checks);  // ends with the last frame
+  StageCoefficientsOfEach(frames.subspan(i), forcing_, out.subspan(i), allow_avx);
 }
 
 }  // namespace deform::internal

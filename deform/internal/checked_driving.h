@@ -51,6 +51,16 @@ class CheckedDriving {
   void SampleRawMany(std::span<const double> times, DrivingFrame* frames);
   void CheckAll(std::span<DrivingFrame> frames, SampleChecks& last_checks);
 
+  // CheckAll on `frames`, then their stage coefficients into `out` (as long as
+  // frames): the frames, counts, last_checks and coefficient bits of CheckAll
+  // followed by StageCoefficientsOfEach(frames, forcing(), out, allow_avx). With
+  // allow_avx on a CPU with AVX, eight frames at a time take the quick test in
+  // the coefficients' own pass (QuickTestedCoefficientsOfEight); a block with a
+  // frame that fails it gets the exact checks on those frames and then its
+  // coefficients.
+  void CheckAndCoefficients(std::span<DrivingFrame> frames, std::span<StageCoefficients> out,
+                            SampleChecks& last_checks, bool allow_avx);
+
   // gain, push and gravity of the run.
   const ForcingConstants& forcing() const { return forcing_; }
 
@@ -63,9 +73,11 @@ class CheckedDriving {
   glm::quat bind_rotation_{1, 0, 0, 0};
   float max_accel_ = 0.0f;            // the |a| clamp, model units/s^2
   float surely_below_accel2_ = 0.0f;  // |a|^2 below this needs no square root
-  // MayNeedChecks' per-lane bounds on a frame's floats 4..7 (a_x, a_y, a_z,
-  // w_x): |a_i| at most the first three keeps |a|^2 below surely_below_accel2_;
-  // w_x is not tested (+inf).
+  // MayNeedChecks' bounds (see there); quick_.max_abs_a keeps |a|^2 below
+  // surely_below_accel2_.
+  QuickTestBounds quick_;
+  // The same |a_i| bound for a frame's floats 4..7 (a_x, a_y, a_z, w_x) as one
+  // SSE2 register: w_x is not tested (+inf).
   alignas(16) float accel_lane_bounds_[4] = {};
   std::optional<KinematicsDrivingSampler> sampler_;
   ForcingConstants forcing_;

@@ -217,9 +217,8 @@ class ModalRunner {
         times[2 * i + 1] = starts[i] + h;
       }
       driving.SampleRawMany({times, 2 * count}, frames);
-      driving.CheckAll({frames, 2 * count}, last_checks);
-      StageCoefficientsOfEach({frames, 2 * count}, driving.forcing(), {coeffs + 1, 2 * count},
-                              job_.allow_avx);
+      driving.CheckAndCoefficients({frames, 2 * count}, {coeffs + 1, 2 * count}, last_checks,
+                                   job_.allow_avx);
       // The steps run on until one needs the limits (internal/mass_spring_modal.h);
       // Limits changes nothing after the others.
       ModalBuffers b{x, v, prev_x, prev_v};

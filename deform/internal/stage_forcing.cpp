@@ -144,18 +144,57 @@ typedef float F8 __attribute__((vector_size(32)));  // an AVX register in EightA
   return F8{x, x, x, x, x, x, x, x};
 }
 
-[[gnu::target("avx")]] void EightAvx(const DrivingFrame* frames, const ForcingConstants& k,
-                                     StageCoefficients* out) {
+// Eight frames by field: lo[i] and hi[i] hold float i and 8 + i of every frame
+// (lane l: frames[l]), i.e. lo: qx qy qz qw ax ay az wx, hi: wy wz alx aly alz.
+struct EightFrames {
+  __m256 lo[8], hi[8];
+};
+
+[[gnu::target("avx"), gnu::always_inline]] inline void LoadEight(const DrivingFrame* frames,
+                                                                 EightFrames& f) {
   // Floats 0..7 and 8..12 of each frame (a masked load: nothing past the frame).
   const __m256i first5 = _mm256_setr_epi32(-1, -1, -1, -1, -1, 0, 0, 0);
-  __m256 lo[8], hi[8];
   for (int l = 0; l < 8; ++l) {
     const float* p = reinterpret_cast<const float*>(frames + l);
-    lo[l] = _mm256_loadu_ps(p);
-    hi[l] = _mm256_maskload_ps(p + 8, first5);
+    f.lo[l] = _mm256_loadu_ps(p);
+    f.hi[l] = _mm256_maskload_ps(p + 8, first5);
   }
-  Transpose8(lo);  // qx qy qz qw ax ay az wx
-  Transpose8(hi);  // wy wz alx aly alz - - -
+  Transpose8(f.lo);
+  Transpose8(f.hi);
+}
+
+// QuickTestBounds' test on each lane (see stage_forcing.h): bit l set when
+// frame l may need the exact checks.
+[[gnu::target("avx"), gnu::always_inline]] inline unsigned QuickFlags(const EightFrames& f,
+                                                                      const QuickTestBounds& b) {
+  // x - x is +0 for a finite x and NaN otherwise; a sum with a NaN term is NaN.
+  __m256 nan_if_not_finite = _mm256_sub_ps(f.hi[0], f.hi[0]);
+  for (int i = 0; i < 8; ++i) {
+    nan_if_not_finite = _mm256_add_ps(nan_if_not_finite, _mm256_sub_ps(f.lo[i], f.lo[i]));
+  }
+  for (int i = 1; i < 5; ++i) {
+    nan_if_not_finite = _mm256_add_ps(nan_if_not_finite, _mm256_sub_ps(f.hi[i], f.hi[i]));
+  }
+  const __m256 abs_bits = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff));
+  const __m256 q_big = _mm256_set1_ps(b.max_abs_q), q_small = _mm256_set1_ps(b.min_abs_q);
+  const __m256 a_bound = _mm256_set1_ps(b.max_abs_a);
+  __m256 flags = _mm256_cmp_ps(nan_if_not_finite, nan_if_not_finite, _CMP_UNORD_Q);
+  __m256 all_small = _mm256_castsi256_ps(_mm256_set1_epi32(-1));
+  for (int i = 0; i < 4; ++i) {  // the quaternion
+    const __m256 q_abs = _mm256_and_ps(f.lo[i], abs_bits);
+    flags = _mm256_or_ps(flags, _mm256_cmp_ps(q_abs, q_big, _CMP_GT_OQ));
+    all_small = _mm256_and_ps(all_small, _mm256_cmp_ps(q_abs, q_small, _CMP_LT_OQ));
+  }
+  for (int i = 4; i < 7; ++i) {  // the linear acceleration
+    flags = _mm256_or_ps(flags, _mm256_cmp_ps(_mm256_and_ps(f.lo[i], abs_bits), a_bound, _CMP_GT_OQ));
+  }
+  return static_cast<unsigned>(_mm256_movemask_ps(_mm256_or_ps(flags, all_small)));
+}
+
+[[gnu::target("avx"), gnu::always_inline]] inline void CoefficientsOfEight(
+    const EightFrames& f, const ForcingConstants& k, StageCoefficients* out) {
+  const __m256 *lo = f.lo, *hi = f.hi;
+  const __m256i first5 = _mm256_setr_epi32(-1, -1, -1, -1, -1, 0, 0, 0);
   const F8 qx0 = lo[0], qy0 = lo[1], qz0 = lo[2], qw0 = lo[3];
   const F8 a[3] = {lo[4], lo[5], lo[6]};
   const F8 w[3] = {lo[7], hi[0], hi[1]};
@@ -210,6 +249,13 @@ typedef float F8 __attribute__((vector_size(32)));  // an AVX register in EightA
   }
 }
 
+[[gnu::target("avx")]] void EightAvx(const DrivingFrame* frames, const ForcingConstants& k,
+                                     StageCoefficients* out) {
+  EightFrames f;
+  LoadEight(frames, f);
+  CoefficientsOfEight(f, k, out);
+}
+
 }  // namespace
 
 StageCoefficients StageCoefficientsOf(const DrivingFrame& d, const ForcingConstants& k) {
@@ -248,6 +294,17 @@ void StageCoefficientsOfEach(std::span<const DrivingFrame> frames, const Forcing
       Four(padded, count, k, out.data() + i);
     }
   }
+}
+
+[[gnu::target("avx")]] unsigned QuickTestedCoefficientsOfEight(const DrivingFrame* frames,
+                                                               const ForcingConstants& k,
+                                                               const QuickTestBounds& bounds,
+                                                               StageCoefficients* out) {
+  EightFrames f;
+  LoadEight(frames, f);
+  const unsigned flags = QuickFlags(f, bounds);
+  if (flags == 0) CoefficientsOfEight(f, k, out);
+  return flags;
 }
 
 }  // namespace deform::internal

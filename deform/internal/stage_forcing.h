@@ -41,4 +41,21 @@ StageCoefficients StageCoefficientsOf(const DrivingFrame& frame, const ForcingCo
 void StageCoefficientsOfEach(std::span<const DrivingFrame> frames, const ForcingConstants& k,
                              std::span<StageCoefficients> out, bool allow_avx = true);
 
+// The quick test of CheckedDriving (internal/checked_driving.h) on a frame's
+// floats: the frame passes when every float is finite, some |q_i| >= min_abs_q,
+// every |q_i| <= max_abs_q and |a_x|, |a_y|, |a_z| <= max_abs_a; a frame that
+// fails may need the exact checks.
+struct QuickTestBounds {
+  float min_abs_q = 0.0f;
+  float max_abs_q = 0.0f;
+  float max_abs_a = 0.0f;
+};
+
+// Eight frames at once, in the AVX lanes of StageCoefficientsOfEach (needs a
+// CPU with AVX): the quick test on each first; if every frame passes, out[0..7]
+// get StageCoefficientsOf(frames[l], k)'s bits and 0 is returned; else nothing
+// is written and bit l of the result is set for each frame l that failed.
+unsigned QuickTestedCoefficientsOfEight(const DrivingFrame* frames, const ForcingConstants& k,
+                                        const QuickTestBounds& bounds, StageCoefficients* out);
+
 }  // namespace deform::internal

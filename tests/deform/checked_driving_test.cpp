@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include "deform/internal/checked_driving.h"
+#include "deform/internal/stage_forcing.h"
 #include "deform/mass_spring.h"
 #include "support/mass_spring_networks.h"
 
@@ -150,7 +151,7 @@ TEST(CheckedDriving, CheckAllMatchesSamplingOneAtATime) {
 // near 1e-12 or overflows, accelerations near the clamp along an axis and along
 // the diagonal, where each component is smallest for the length, and every
 // single field NaN or Inf) give the frames and counts of Sample on each.
-TEST(CheckedDriving, CheckAllQuickTestKeepsEveryFrameTheChecksWouldChange) {
+std::vector<DrivingFrame> EdgeFrames() {
   const float inf = std::numeric_limits<float>::infinity();
   std::vector<DrivingFrame> frames;
   for (float scale = 1e-7f; scale < 1e-5f; scale *= 1.07f) {  // |q| around 1e-6
@@ -188,6 +189,11 @@ TEST(CheckedDriving, CheckAllQuickTestKeepsEveryFrameTheChecksWouldChange) {
       frames.push_back(d);
     }
   }
+  return frames;
+}
+
+TEST(CheckedDriving, CheckAllQuickTestKeepsEveryFrameTheChecksWouldChange) {
+  const std::vector<DrivingFrame> frames = EdgeFrames();
   Fixture one, batch;
   const auto replay = [&frames](double t) {
     return frames[static_cast<std::size_t>(std::lround(t * 1000.0))];
@@ -209,6 +215,51 @@ TEST(CheckedDriving, CheckAllQuickTestKeepsEveryFrameTheChecksWouldChange) {
   EXPECT_GT(batch.state.counters.non_finite_inputs, 39 + 10);
   EXPECT_GT(batch.state.counters.acceleration_clamps, 100);
   EXPECT_LT(batch.state.counters.acceleration_clamps, 5 * 120 - 100);
+}
+
+// CheckAndCoefficients (the quick test in the AVX coefficients' pass, eight
+// frames at a time) against CheckAll then StageCoefficientsOfEach: the same
+// frames, counts, last-frame checks and coefficient bits. The edge frames
+// above, shifted by 0..7 ordinary frames so that each falls in every lane, and
+// ending with an ordinary, a NaN or a clamped frame, at lengths that are and are
+// not whole blocks of eight; with AVX allowed and not.
+TEST(CheckedDriving, CheckAndCoefficientsMatchesCheckAllThenCoefficients) {
+  const std::vector<DrivingFrame> edges = EdgeFrames();
+  for (int shift = 0; shift < 8; ++shift) {
+    for (const int last_kind : {0, 1, 2}) {  // the last frame: ordinary, NaN, clamped
+      for (const std::size_t tail : {std::size_t{0}, std::size_t{3}}) {
+        SCOPED_TRACE(testing::Message() << "shift " << shift << " last kind " << last_kind
+                                        << " tail " << tail);
+        std::vector<DrivingFrame> frames(static_cast<std::size_t>(shift), Ordinary());
+        frames.insert(frames.end(), edges.begin(), edges.end());
+        while ((frames.size() + 1) % 8 != 0) frames.push_back(Ordinary());
+        frames.insert(frames.end(), tail, Ordinary());
+        DrivingFrame last = Ordinary();
+        if (last_kind == 1) last.angular_velocity.y = std::numeric_limits<float>::quiet_NaN();
+        if (last_kind == 2) last.linear_acceleration = glm::vec3(0.0f, 0.0f, -3e5f);
+        frames.push_back(last);
+        for (const bool avx : {true, false}) {
+          Fixture ref, merged;
+          CheckedDriving by_ref(ref.job), by_merged(merged.job);
+          std::vector<DrivingFrame> a = frames, b = frames;
+          std::vector<deform::internal::StageCoefficients> ca(frames.size()), cb(frames.size());
+          SampleChecks checks_ref, checks_merged;
+          by_ref.CheckAll(a, checks_ref);
+          deform::internal::StageCoefficientsOfEach(a, by_ref.forcing(), ca, avx);
+          by_merged.CheckAndCoefficients(b, cb, checks_merged, avx);
+          ASSERT_EQ(std::memcmp(a.data(), b.data(), a.size() * sizeof(DrivingFrame)), 0);
+          ASSERT_EQ(std::memcmp(ca.data(), cb.data(), ca.size() * sizeof(ca[0])), 0);
+          EXPECT_EQ(ref.state.counters.non_finite_inputs, merged.state.counters.non_finite_inputs);
+          EXPECT_EQ(ref.state.counters.acceleration_clamps, merged.state.counters.acceleration_clamps);
+          EXPECT_GT(merged.state.counters.non_finite_inputs, 39 + 10);
+          EXPECT_EQ(checks_merged.non_finite, last_kind == 1);
+          EXPECT_EQ(checks_merged.clamped, last_kind == 2);
+          EXPECT_EQ(checks_merged.non_finite, checks_ref.non_finite);
+          EXPECT_EQ(checks_merged.clamped, checks_ref.clamped);
+        }
+      }
+    }
+  }
 }
 
 }  // namespace
