@@ -253,17 +253,24 @@ class ModalRunner {
 
   // e(time_s) = U (prev + alpha (x - prev)): linear interpolation between the
   // last two steps (exact when no step was taken since a reset: both are the
-  // same zero state), in point space. Padding lanes stay 0.
+  // same zero state), in point space (eta's padding lanes past #free rounded up
+  // to 4 are not written: ModalToPoints reads only the first #free).
   void Output(const float* x, const float* prev_x) const {
     const double h = net_.time_step_s;
     const float alpha =
         static_cast<float>(std::clamp((job_.time_s - (st_.step_time_s - h)) / h, 0.0, 1.0));
     alignas(32) float eta[3 * kMaxModeStride];
     alignas(32) float e[3 * kMaxModeStride];
-    for (std::size_t i = 0; i < 3 * stride_; ++i) eta[i] = prev_x[i] + alpha * (x[i] - prev_x[i]);
+    const __m128 a4 = _mm_set1_ps(alpha);
+    for (std::size_t c = 0; c < 3; ++c) {
+      for (std::size_t k = c * stride_; k < c * stride_ + n_; k += 4) {
+        const __m128 p = _mm_load_ps(prev_x + k);
+        _mm_store_ps(eta + k, _mm_add_ps(p, _mm_mul_ps(a4, _mm_sub_ps(_mm_load_ps(x + k), p))));
+      }
+    }
     ModalToPoints(net_, eta, e, job_.allow_avx);
     std::span<glm::vec3> out = job_.displacements;
-    std::fill(out.begin(), out.end(), glm::vec3(0.0f));  // boundary points
+    std::memset(static_cast<void*>(out.data()), 0, out.size_bytes());  // boundary points
     for (std::size_t a = 0; a < n_; ++a) {
       out[static_cast<std::size_t>(net_.point_of_free[a])] =
           glm::vec3(e[a], e[stride_ + a], e[2 * stride_ + a]);
