@@ -228,10 +228,11 @@ void BM_MassSpringKernel(benchmark::State& bench, int size, deform::internal::Mo
   deform::internal::StageCoefficients c[2];
   for (int r = 0; r < 3; ++r) {
     for (int k = 0; k < 3; ++k) {
-      c[0].mx[r][k] = 0.1f * static_cast<float>(r - k) + 0.013f * static_cast<float>(1 + 3 * r + k);
-      c[0].mv[r][k] = r == k ? 0.0f : 0.2f * static_cast<float>(k - r);
-      c[1].mx[r][k] = -c[0].mx[r][k];
-      c[1].mv[r][k] = -c[0].mv[r][k];
+      c[0].Mx(r, k) = 0.1f * static_cast<float>(r - k) + 0.013f * static_cast<float>(1 + 3 * r + k);
+      c[1].Mx(r, k) = -c[0].Mx(r, k);
+      if (r == k) continue;  // mv is skew: no diagonal
+      c[0].Mv(r, k) = 0.2f * static_cast<float>(k - r);
+      c[1].Mv(r, k) = -c[0].Mv(r, k);
     }
     c[0].common[r] = 10.0f * static_cast<float>(r + 1);
     c[1].common[r] = -c[0].common[r];

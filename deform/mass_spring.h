@@ -215,7 +215,7 @@ struct MassSpringState {
     bool non_finite = false;               // the sample was non-finite (counted)
     bool clamped = false;                  // |a| was clamped (counted)
     glm::vec3 user_acceleration{0.0f};     // the push `coefficients` include
-    float coefficients[21] = {};           // internal::StageCoefficients (mx, mv, common)
+    float coefficients[24] = {};           // internal::StageCoefficients (common, mx, mv)
   } last_stage;
 
   void Resize(const MassSpringNetwork& network);

@@ -57,15 +57,22 @@ enum ModeLaneField : int {
 };
 
 // The moving-frame terms of one RK4 stage time, per unit mass, as matrices
-// acting on all modes alike (row-major):
+// acting on all modes alike:
 //   eta_k'' = sum_k common + mx (rest_k + eta_k) + mv eta_k' - omega2_k eta_k - damping_k eta_k'
-// with mx = -gam ([al]x + [w]x^2), mv = -2 gam [w]x (skew: the step reads only
-// its off-diagonal entries) and common = -gam a + gravity + push; the order of
-// evaluation is the scalar formulation above.
-struct StageCoefficients {
-  float mx[3][3] = {};
-  float mv[3][3] = {};
-  float common[3] = {};
+// with mx = -gam ([al]x + [w]x^2), mv = -2 gam [w]x (skew: only its
+// off-diagonal entries are kept) and common = -gam a + gravity + push; the
+// order of evaluation is the scalar formulation above. Stored as the four-float
+// columns a lone mode multiplies by (x, y, z) (the 4th float 0), so that it
+// reads them as they are; a lane group broadcasts single entries from them.
+struct alignas(16) StageCoefficients {
+  float common[4] = {};     // (common_x, common_y, common_z, 0)
+  float mx_col[3][4] = {};  // mx_col[j] = column j of mx, (mx[0][j], mx[1][j], mx[2][j], 0)
+  float mv_a[4] = {};       // mv[c][a(c)]: (mv[0][1], mv[1][0], mv[2][0], 0)
+  float mv_b[4] = {};       // mv[c][b(c)]: (mv[0][2], mv[1][2], mv[2][1], 0)
+
+  // Entry (r, c) of mx, and of mv off its diagonal (r != c).
+  float& Mx(int r, int c) { return mx_col[c][r]; }
+  float& Mv(int r, int c) { return c == (r == 0 ? 1 : 0) ? mv_a[r] : mv_b[r]; }
 };
 
 // Sums of the new state the limit check needs (ALGORITHMS.md 6 limits); the

@@ -92,10 +92,11 @@ void Four(const DrivingFrame* frames, int count, const ForcingConstants& k,
   }
   for (int l = 0; l < count; ++l) {
     StageCoefficients& o = out[l];
+    o = StageCoefficients{};  // the 4th floats 0
     for (int r = 0; r < 3; ++r) {
       for (int c = 0; c < 3; ++c) {
-        o.mx[r][c] = mx[r][c][l];
-        o.mv[r][c] = mv[r][c][l];
+        o.Mx(r, c) = mx[r][c][l];
+        if (r != c) o.Mv(r, c) = mv[r][c][l];
       }
       o.common[r] = common[r][l];
     }
@@ -111,10 +112,11 @@ static_assert(sizeof(DrivingFrame) == 13 * sizeof(float) &&
                   offsetof(DrivingFrame, angular_velocity) == 7 * sizeof(float) &&
                   offsetof(DrivingFrame, angular_acceleration) == 10 * sizeof(float),
               "DrivingFrame: quaternion x y z w, then three vec3");
-static_assert(sizeof(StageCoefficients) == 21 * sizeof(float) &&
-                  offsetof(StageCoefficients, mv) == 9 * sizeof(float) &&
-                  offsetof(StageCoefficients, common) == 18 * sizeof(float),
-              "StageCoefficients: mx, mv, common, packed");
+static_assert(sizeof(StageCoefficients) == 24 * sizeof(float) &&
+                  offsetof(StageCoefficients, mx_col) == 4 * sizeof(float) &&
+                  offsetof(StageCoefficients, mv_a) == 16 * sizeof(float) &&
+                  offsetof(StageCoefficients, mv_b) == 20 * sizeof(float),
+              "StageCoefficients: common, mx columns, mv_a, mv_b, four floats each");
 static_assert(offsetof(glm::quat, x) == 0 && offsetof(glm::quat, w) == 3 * sizeof(float),
               "glm::quat stored x, y, z, w");
 
@@ -194,7 +196,6 @@ struct EightFrames {
 [[gnu::target("avx"), gnu::always_inline]] inline void CoefficientsOfEight(
     const EightFrames& f, const ForcingConstants& k, StageCoefficients* out) {
   const __m256 *lo = f.lo, *hi = f.hi;
-  const __m256i first5 = _mm256_setr_epi32(-1, -1, -1, -1, -1, 0, 0, 0);
   const F8 qx0 = lo[0], qy0 = lo[1], qz0 = lo[2], qw0 = lo[3];
   const F8 a[3] = {lo[4], lo[5], lo[6]};
   const F8 w[3] = {lo[7], hi[0], hi[1]};
@@ -227,17 +228,23 @@ struct EightFrames {
   const F8 skew_al[3][3] = {{zero, -al[2], al[1]}, {al[2], zero, -al[0]}, {-al[1], al[0], zero}};
   const F8 skew_w[3][3] = {{zero, -w[2], w[1]}, {w[2], zero, -w[0]}, {-w[1], w[0], zero}};
   const F8 mv_scale = Splat8(-2.0f * k.gain);
-  // The 21 outputs in StageCoefficients order (mx, mv, common), 3 rows of padding.
+  // The 24 floats of StageCoefficients in order: common, the columns of mx,
+  // mv[c][a(c)], mv[c][b(c)], each followed by a 0.
   __m256 rows[24];
   for (int r = 0; r < 3; ++r) {
+    rows[r] = common[r];
     for (int c = 0; c < 3; ++c) {
       const F8 w2 = w[r] * w[c] - (r == c ? ww : zero);
-      rows[3 * r + c] = neg_gain * (skew_al[r][c] + w2);
-      rows[9 + 3 * r + c] = mv_scale * skew_w[r][c];
+      rows[4 + 4 * c + r] = neg_gain * (skew_al[r][c] + w2);
     }
-    rows[18 + r] = common[r];
   }
-  rows[21] = rows[22] = rows[23] = zero;
+  rows[16] = mv_scale * skew_w[0][1];
+  rows[17] = mv_scale * skew_w[1][0];
+  rows[18] = mv_scale * skew_w[2][0];
+  rows[20] = mv_scale * skew_w[0][2];
+  rows[21] = mv_scale * skew_w[1][2];
+  rows[22] = mv_scale * skew_w[2][1];
+  rows[3] = rows[7] = rows[11] = rows[15] = rows[19] = rows[23] = zero;
   Transpose8(rows);
   Transpose8(rows + 8);
   Transpose8(rows + 16);
@@ -245,7 +252,7 @@ struct EightFrames {
     float* o = reinterpret_cast<float*>(out + l);
     _mm256_storeu_ps(o, rows[l]);
     _mm256_storeu_ps(o + 8, rows[8 + l]);
-    _mm256_maskstore_ps(o + 16, first5, rows[16 + l]);
+    _mm256_storeu_ps(o + 16, rows[16 + l]);
   }
 }
 
@@ -269,8 +276,8 @@ StageCoefficients StageCoefficientsOf(const DrivingFrame& d, const ForcingConsta
   for (int r = 0; r < 3; ++r) {
     for (int c = 0; c < 3; ++c) {
       const float w2 = w[r] * w[c] - (r == c ? ww : 0.0f);  // [w]x^2 = w w^T - |w|^2 I
-      m.mx[r][c] = -k.gain * (skew_al[r][c] + w2);
-      m.mv[r][c] = -2.0f * k.gain * skew_w[r][c];
+      m.Mx(r, c) = -k.gain * (skew_al[r][c] + w2);
+      if (r != c) m.Mv(r, c) = -2.0f * k.gain * skew_w[r][c];
     }
     m.common[r] = common[r];
   }

@@ -69,8 +69,8 @@ TEST(MassSpringSimd, ExactAvxAndSse2KernelsGiveTheSameBits) {
         const float t = 0.01f * static_cast<float>(step * 3 + i);
         for (int r = 0; r < 3; ++r) {
           for (int c = 0; c < 3; ++c) {
-            s[i].mx[r][c] = 2.0f * std::sin(t + static_cast<float>(r * 3 + c));
-            s[i].mv[r][c] = r == c ? 0.0f : std::cos(2.0f * t + static_cast<float>(r - c));
+            s[i].Mx(r, c) = 2.0f * std::sin(t + static_cast<float>(r * 3 + c));
+            if (r != c) s[i].Mv(r, c) = std::cos(2.0f * t + static_cast<float>(r - c));
           }
           s[i].common[r] = 400.0f * std::sin(3.0f * t + static_cast<float>(r));
         }
@@ -96,8 +96,8 @@ std::vector<deform::internal::StageCoefficients> VaryingCoefficients(int count) 
     const float t = 0.013f * static_cast<float>(i);
     for (int r = 0; r < 3; ++r) {
       for (int c = 0; c < 3; ++c) {
-        s[i].mx[r][c] = 2.0f * std::sin(t + static_cast<float>(r * 3 + c));
-        s[i].mv[r][c] = r == c ? 0.0f : std::cos(2.0f * t + static_cast<float>(r - c));
+        s[i].Mx(r, c) = 2.0f * std::sin(t + static_cast<float>(r * 3 + c));
+        if (r != c) s[i].Mv(r, c) = std::cos(2.0f * t + static_cast<float>(r - c));
       }
       s[i].common[r] = 900.0f * std::sin(3.0f * t + static_cast<float>(r));
     }

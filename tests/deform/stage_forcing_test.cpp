@@ -92,7 +92,7 @@ TEST(StageForcing, PartialGroupsWriteOnlyTheirEntries) {
   const ForcingConstants k = Constants(true, 1.0f);
   StageCoefficients marker;
   marker.common[0] = 12345.0f;
-  marker.mx[0][0] = -7.0f;
+  marker.Mx(0, 0) = -7.0f;
   for (std::size_t count = 1; count <= 19; ++count) {
     std::vector<StageCoefficients> out(20, marker);
     deform::internal::StageCoefficientsOfEach(std::span(frames).first(count), k,
