@@ -128,7 +128,8 @@ void BM_MassSpringAtRest(benchmark::State& bench, int size) {
   }
   bench.SetItemsProcessed(bench.iterations());
   bench.counters["subnormal_floats"] =
-      SubnormalFloats(&state.position[0].x, &state.velocity[0].x, 3 * state.position.size());
+      SubnormalFloats(state.ModalField(2 * state.modal_newest),
+                      state.ModalField(2 * state.modal_newest + 1), 3 * state.modal_stride);
 }
 
 // The generated jump at 120 fps and its per-frame kinematics.

@@ -167,11 +167,14 @@ bool UsesModes(const MassSpringNetwork& net) {
 }  // namespace
 
 void MassSpringState::Resize(const MassSpringNetwork& network) {
-  const std::size_t n = static_cast<std::size_t>(network.num_free);
+  const bool modes = UsesModes(network);
+  const std::size_t n = modes ? 0 : static_cast<std::size_t>(network.num_free);
   position.assign(n, glm::vec3(0.0f));
   velocity.assign(n, glm::vec3(0.0f));
   prev_position.assign(n, glm::vec3(0.0f));
   work.assign(5 * n, glm::vec3(0.0f));
+  modal_stride = modes ? static_cast<std::size_t>(network.mode_stride) : 0;
+  modal.assign(4 * 3 * modal_stride, 0.0f);
   Reset();
 }
 
@@ -182,6 +185,8 @@ void MassSpringState::Reset() {
   std::fill(position.begin(), position.end(), glm::vec3(0.0f));
   std::fill(velocity.begin(), velocity.end(), glm::vec3(0.0f));
   std::fill(prev_position.begin(), prev_position.end(), glm::vec3(0.0f));
+  std::fill(modal.begin(), modal.end(), 0.0f);
+  modal_newest = 0;
 }
 
 JobStatus MassSpringStepJob::Validate() const {
@@ -189,10 +194,13 @@ JobStatus MassSpringStepJob::Validate() const {
   if (kinematics.empty() && (driving == nullptr || !*driving)) {
     return {JobStatus::kMissingInput, "no kinematics and no driving callback"};
   }
-  const std::size_t n = static_cast<std::size_t>(network->num_free);
+  const bool modes = UsesModes(*network);
+  const std::size_t n = modes ? 0 : static_cast<std::size_t>(network->num_free);
+  const std::size_t stride = modes ? static_cast<std::size_t>(network->mode_stride) : 0;
   if (state->position.size() != n || state->velocity.size() != n ||
-      state->prev_position.size() != n ||
-      state->work.size() != 5 * n) {
+      state->prev_position.size() != n || state->work.size() != 5 * n ||
+      state->modal_stride != stride || state->modal.size() != 4 * 3 * stride ||
+      (state->modal_newest != 0 && state->modal_newest != 1)) {
     return {JobStatus::kSizeMismatch, "state not sized for the network (call Resize)"};
   }
   const std::size_t num_points = static_cast<std::size_t>(network->rows * network->cols);
@@ -274,18 +282,39 @@ void ToPointSpace(const MassSpringNetwork& net, std::span<const glm::vec3> in,
     out[a] = sum;
   }
 }
+
+// The newest step's displacement and velocity as stored: per point, or per
+// mode for the modal solver.
+void NewestStep(const MassSpringNetwork& net, const MassSpringState& state,
+                std::vector<glm::vec3>& x, std::vector<glm::vec3>& v) {
+  if (!UsesModes(net)) {
+    x = state.position;
+    v = state.velocity;
+    return;
+  }
+  const std::size_t n = static_cast<std::size_t>(net.num_free);
+  x.resize(n);
+  v.resize(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    x[k] = state.ModalDisplacement(k);
+    v[k] = state.ModalVelocity(k);
+  }
+}
 }  // namespace
 
 void MassSpringPointDisplacements(const MassSpringNetwork& network, const MassSpringState& state,
                                   std::span<glm::vec3> out) {
-  ToPointSpace(network, state.position, out);
+  std::vector<glm::vec3> x, v;
+  NewestStep(network, state, x, v);
+  ToPointSpace(network, x, out);
 }
 
 double MassSpringEnergy(const MassSpringNetwork& network, const MassSpringState& state) {
   const std::size_t n = static_cast<std::size_t>(network.num_free);
-  std::vector<glm::vec3> e(n), v(n);
-  ToPointSpace(network, state.position, e);
-  ToPointSpace(network, state.velocity, v);
+  std::vector<glm::vec3> e(n), v(n), modes_x, modes_v;
+  NewestStep(network, state, modes_x, modes_v);
+  ToPointSpace(network, modes_x, e);
+  ToPointSpace(network, modes_v, v);
   double energy = 0.0;
   for (std::size_t a = 0; a < n; ++a) {
     energy += 0.5 * network.params.mass * glm::dot(glm::dvec3(v[a]), glm::dvec3(v[a]));

@@ -186,13 +186,33 @@ struct MassSpringState {
   bool started = false;       // false: the next run resets (first frame)
   double step_time_s = 0.0;   // time of the newest step
   double output_time_s = 0.0; // time of the last run's output
-  // Point space, #free each (kPointSpace / kLength), or modal, #free each (kModal).
+  // Point space, #free each (kPointSpace, kLength); empty with the modal solver.
   std::vector<glm::vec3> position, velocity;  // newest step
   // The step before's displacement: the output is interpolated between it and
   // the newest (its velocity is never needed, so not kept).
   std::vector<glm::vec3> prev_position;
   // Workspace for the RK4 stages (4 x #free each) and point-space outputs.
   std::vector<glm::vec3> work;
+  // The modal solver's state (kModal with the linear force model), in its SIMD
+  // step's layout (internal/mass_spring_modal.h): four fields of 3 rows of
+  // modal_stride floats (x, y, z rows, padding lanes 0), kept in it between runs
+  // instead of being converted each run. Fields 2 i and 2 i + 1 are a step's
+  // displacement and velocity; pair modal_newest is the newest step, the other
+  // the step before (whose velocity is only scratch). Empty for the other solvers.
+  std::vector<float> modal;
+  std::size_t modal_stride = 0;
+  int modal_newest = 0;
+  float* ModalField(int field) { return modal.data() + static_cast<std::size_t>(field) * 3 * modal_stride; }
+  const float* ModalField(int field) const {
+    return modal.data() + static_cast<std::size_t>(field) * 3 * modal_stride;
+  }
+  // Mode k of the newest step's displacement and velocity (modal solver).
+  glm::vec3 ModalDisplacement(std::size_t k) const { return ModeOf(2 * modal_newest, k); }
+  glm::vec3 ModalVelocity(std::size_t k) const { return ModeOf(2 * modal_newest + 1, k); }
+  glm::vec3 ModeOf(int field, std::size_t k) const {
+    const float* f = ModalField(field);
+    return glm::vec3(f[k], f[modal_stride + k], f[2 * modal_stride + k]);
+  }
   MassSpringCounters counters;
 
   // The newest step's end stage time, as the modal solver last sampled it. A run's

@@ -80,87 +80,19 @@ class ModalRunner {
   void Run(double until_s) {
     const bool stepping = st_.step_time_s < until_s;
     if (!stepping && job_.displacements.empty()) return;
-    alignas(32) float buffers[4][3 * kMaxModeStride];
-    float* x = buffers[0];
-    float* v = buffers[1];
-    float* prev_x = buffers[2];
-    float* prev_v = buffers[3];
+    // The state's fields, in place (MassSpringState::modal): the newest pair
+    // and the one before; a run that ends on the other pair flips modal_newest.
+    const int newest = st_.modal_newest;
+    ModalBuffers b{st_.ModalField(2 * newest), st_.ModalField(2 * newest + 1),
+                   st_.ModalField(2 - 2 * newest), st_.ModalField(3 - 2 * newest)};
     if (stepping) {
-      Load(st_.position, x);
-      Load(st_.velocity, v);
-      Steps(until_s, x, v, prev_x, prev_v);
-      Store(x, st_.position);
-      Store(v, st_.velocity);
-      Store(prev_x, st_.prev_position);
-    } else {
-      Load(st_.position, x);
-      Load(st_.prev_position, prev_x);
+      Steps(until_s, b);
+      if (b.x != st_.ModalField(2 * newest)) st_.modal_newest = 1 - newest;
     }
-    if (!job_.displacements.empty()) Output(x, prev_x);
+    if (!job_.displacements.empty()) Output(b.x, b.prev_x);
   }
 
  private:
-  // State vec3 array (#free) -> 3 x stride rows; padding lanes 0. Four points
-  // at a time are three SSE2 loads, [x0 y0 z0 x1] [y1 z1 x2 y2] [z2 x3 y3 z3],
-  // shuffled into x, y and z rows (moves only).
-  void Load(const std::vector<glm::vec3>& from, float* to) const {
-    const float* in = &from[0].x;
-    float* const xs = to;
-    float* const ys = to + stride_;
-    float* const zs = to + 2 * stride_;
-    // Padding lanes 0: each row's last partial group of four and the groups after
-    // it zeroed first with aligned stores (rows start 32-byte aligned, the stride
-    // is a multiple of 8), then the tail's points written over them.
-    for (float* row : {xs, ys, zs}) {
-      for (std::size_t z = n_ / 4 * 4; z < stride_; z += 4) _mm_store_ps(row + z, _mm_setzero_ps());
-    }
-    std::size_t k = 0;
-    for (; k + 4 <= n_; k += 4, in += 12) {
-      const __m128 a = _mm_loadu_ps(in), b = _mm_loadu_ps(in + 4), c = _mm_loadu_ps(in + 8);
-      const __m128 x = _mm_shuffle_ps(a, _mm_shuffle_ps(b, c, _MM_SHUFFLE(1, 1, 2, 2)),
-                                      _MM_SHUFFLE(2, 0, 3, 0));
-      const __m128 y = _mm_shuffle_ps(_mm_shuffle_ps(a, b, _MM_SHUFFLE(0, 0, 1, 1)),
-                                      _mm_shuffle_ps(b, c, _MM_SHUFFLE(2, 2, 3, 3)),
-                                      _MM_SHUFFLE(2, 0, 2, 0));
-      const __m128 z = _mm_shuffle_ps(_mm_shuffle_ps(a, b, _MM_SHUFFLE(1, 1, 2, 2)),
-                                      _mm_shuffle_ps(c, c, _MM_SHUFFLE(3, 3, 0, 0)),
-                                      _MM_SHUFFLE(2, 0, 2, 0));
-      _mm_storeu_ps(xs + k, x);
-      _mm_storeu_ps(ys + k, y);
-      _mm_storeu_ps(zs + k, z);
-    }
-    for (; k < n_; ++k, in += 3) {
-      xs[k] = in[0];
-      ys[k] = in[1];
-      zs[k] = in[2];
-    }
-  }
-  // The inverse of Load (padding lanes dropped).
-  void Store(const float* from, std::vector<glm::vec3>& to) const {
-    float* out = &to[0].x;
-    const float* const xs = from;
-    const float* const ys = from + stride_;
-    const float* const zs = from + 2 * stride_;
-    std::size_t k = 0;
-    for (; k + 4 <= n_; k += 4, out += 12) {
-      const __m128 x = _mm_loadu_ps(xs + k), y = _mm_loadu_ps(ys + k), z = _mm_loadu_ps(zs + k);
-      _mm_storeu_ps(out, _mm_shuffle_ps(_mm_shuffle_ps(x, y, _MM_SHUFFLE(0, 0, 0, 0)),
-                                        _mm_shuffle_ps(z, x, _MM_SHUFFLE(1, 1, 0, 0)),
-                                        _MM_SHUFFLE(2, 0, 2, 0)));
-      _mm_storeu_ps(out + 4, _mm_shuffle_ps(_mm_shuffle_ps(y, z, _MM_SHUFFLE(1, 1, 1, 1)),
-                                            _mm_shuffle_ps(x, y, _MM_SHUFFLE(2, 2, 2, 2)),
-                                            _MM_SHUFFLE(2, 0, 2, 0)));
-      _mm_storeu_ps(out + 8, _mm_shuffle_ps(_mm_shuffle_ps(z, x, _MM_SHUFFLE(3, 3, 2, 2)),
-                                            _mm_shuffle_ps(y, z, _MM_SHUFFLE(3, 3, 3, 3)),
-                                            _MM_SHUFFLE(2, 0, 2, 0)));
-    }
-    for (; k < n_; ++k, out += 3) {
-      out[0] = xs[k];
-      out[1] = ys[k];
-      out[2] = zs[k];
-    }
-  }
-
   // The coefficients at the run's first stage time (the state's step time):
   // the previous run's last when it is the same stage, else sampled.
   StageCoefficients FirstStage(CheckedDriving& driving) {
@@ -186,14 +118,15 @@ class ModalRunner {
     return c;
   }
 
-  // Whole RK4 steps of every mode until the step time reaches `until_s`; x, v
-  // hold the newest step on entry and on return, prev_x, prev_v the one before.
+  // Whole RK4 steps of every mode until the step time reaches `until_s`; b.x,
+  // b.v hold the newest step on entry and on return, b.prev_x, b.prev_v the one
+  // before.
   // Steps go in batches of up to kBatchSteps: the frames at the batch's stage
   // times first (t + h/2, t + h, t + 3h/2, ...: the times and the order of the
   // step-by-step loop), their coefficients together (internal/stage_forcing.h:
   // the same bits as one at a time), then the steps. coeffs[2 i], [2 i + 1],
   // [2 i + 2]: step i's start, middle and end.
-  void Steps(double until_s, float*& x, float*& v, float*& prev_x, float*& prev_v) {
+  void Steps(double until_s, ModalBuffers& b) {
     CheckedDriving driving(job_);
     const ModalStepsFn steps = SelectModalSteps(job_.allow_avx, job_.allow_fma);
     const double h = net_.time_step_s;
@@ -221,7 +154,6 @@ class ModalRunner {
                                    job_.allow_avx);
       // The steps run on until one needs the limits (internal/mass_spring_modal.h);
       // Limits changes nothing after the others.
-      ModalBuffers b{x, v, prev_x, prev_v};
       for (std::size_t i = 0; i < count;) {
         ModalStepSums sums;
         const int done = steps(net_, coeffs + 2 * i, static_cast<int>(count - i),
@@ -231,10 +163,6 @@ class ModalRunner {
         st_.counters.steps += done;
         Limits(sums, b.x, b.v, b.prev_x, b.prev_v);
       }
-      x = b.x;
-      v = b.v;
-      prev_x = b.prev_x;
-      prev_v = b.prev_v;
       coeffs[0] = coeffs[2 * count];
     }
     Remember(st_.last_stage, job_, st_.step_time_s, frames[2 * count - 1], last_checks, coeffs[0]);

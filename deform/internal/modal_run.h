@@ -3,9 +3,9 @@
 // steps of every mode up to the output time, the displacement limit after each
 // step, and the output displacement interpolated between the last two steps.
 //
-// Per run, the modes are copied once from the state's vec3 arrays into padded
-// structure-of-arrays buffers (internal/mass_spring_modal.h layout) and once
-// back; the output is blended and taken to point space from those buffers. The
+// The modes stay in the state in the padded structure-of-arrays layout of the
+// SIMD step (MassSpringState::modal, internal/mass_spring_modal.h) and are
+// stepped there; the output is blended and taken to point space from them. The
 // stage coefficients of up to 8 steps are computed together before the steps
 // (internal/stage_forcing.h), and the run's first stage time, the previous run's
 // last, comes from MassSpringState::last_stage when it matches. The results are
