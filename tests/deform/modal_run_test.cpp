@@ -6,6 +6,7 @@
 // check that a change of push or source is not served from the old stage.
 
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <functional>
 #include <limits>
@@ -183,6 +184,54 @@ TEST(ModalRun, KinematicsSourceReusesTheLastStage) {
   EXPECT_EQ(states[0].counters.acceleration_clamps, states[1].counters.acceleration_clamps);
   EXPECT_TRUE(states[0].last_stage.valid);
   EXPECT_EQ(states[0].last_stage.time_s, states[0].step_time_s);
+}
+
+}  // namespace
+
+namespace {
+
+// A patch pushed and then left alone in the bind pose decays to rest: its modes
+// are set to exactly 0 once their squares sum below 1e-24 (modal_run.cpp,
+// kRestSum), before any float of the state reaches the subnormal range; until
+// then the decay is left alone.
+TEST(ModalRun, AStateThatHasDecayedIsSetToExactlyZero) {
+  const MassSpringNetwork net = testsupport::CurvedGridNetwork(5, 5);
+  const DriveFn still = [](double) { return DrivingFrame{glm::quat(1, 0, 0, 0)}; };
+  MassSpringState state;
+  state.Resize(net);
+  std::vector<glm::vec3> disp(25);
+  const auto sum_of_squares = [&state](int field) {
+    const float* f = state.ModalField(field);
+    double s = 0.0;
+    for (std::size_t i = 0; i < 3 * state.modal_stride; ++i) s += double(f[i]) * double(f[i]);
+    return s;
+  };
+  bool seen_small = false;  // a frame whose state was small but not yet at rest
+  int zero_from = -1;
+  for (int frame = 0; frame < 30 * 60; ++frame) {
+    const MassSpringStepJob job{
+        .network = &net, .state = &state, .time_s = frame / 30.0, .driving = &still,
+        .user_acceleration = frame >= 1 && frame <= 3 ? glm::vec3(0, 50.0f, 0) : glm::vec3(0.0f),
+        .displacements = disp};
+    ASSERT_TRUE(job.Run());
+    for (const float f : state.modal) {
+      ASSERT_NE(std::fpclassify(f), FP_SUBNORMAL) << "frame " << frame;
+    }
+    const double x2 = sum_of_squares(2 * state.modal_newest);
+    const double v2 = sum_of_squares(2 * state.modal_newest + 1);
+    if (frame <= 3) continue;  // at rest before the push
+    if (x2 == 0.0 && v2 == 0.0) {
+      if (zero_from < 0) zero_from = frame;
+      for (const glm::vec3& d : disp) ASSERT_EQ(d, glm::vec3(0.0f)) << "frame " << frame;
+    } else {
+      ASSERT_LT(zero_from, 0) << "the state left 0 at frame " << frame;
+      seen_small = seen_small || (x2 < 1e-20 && x2 > 1e-24);
+    }
+  }
+  EXPECT_GT(zero_from, 3);
+  EXPECT_TRUE(seen_small);
+  std::printf("at rest (exactly 0) from frame %d\n", zero_from);
+  EXPECT_EQ(state.counters.any_limit(), 0) << state.counters.displacement_clamps;
 }
 
 }  // namespace
