@@ -143,28 +143,33 @@ void MatrixSse(const MassSpringNetwork& net, const float* m, const float* in, fl
   exact_avx::MatrixBody(net, m, in, out);
 }
 
-}  // namespace
-
-ModalStepFn SelectModalStep(ModalKernel kernel) {
-  if (kernel == ModalKernel::kFastest && CpuHasAvx2Fma()) return &StepFma;
-  if (kernel != ModalKernel::kPortable && CpuHasAvx()) return &StepAvx;
-  return &StepSse;
+// The kernel `kernel` asks for, among the three compilations of one function.
+template <typename Fn>
+Fn Pick(ModalKernel kernel, Fn fma, Fn avx, Fn sse) {
+  if (kernel == ModalKernel::kFastest && CpuHasAvx2Fma()) return fma;
+  if (kernel != ModalKernel::kPortable && CpuHasAvx()) return avx;
+  return sse;
 }
 
+ModalKernel KernelFor(bool allow_avx, bool allow_fma) {
+  if (!allow_avx) return ModalKernel::kPortable;
+  return allow_fma ? ModalKernel::kFastest : ModalKernel::kExactAvx;
+}
+
+}  // namespace
+
+ModalStepFn SelectModalStep(ModalKernel kernel) { return Pick(kernel, &StepFma, &StepAvx, &StepSse); }
+
 ModalStepFn SelectModalStep(bool allow_avx, bool allow_fma) {
-  if (!allow_avx) return SelectModalStep(ModalKernel::kPortable);
-  return SelectModalStep(allow_fma ? ModalKernel::kFastest : ModalKernel::kExactAvx);
+  return SelectModalStep(KernelFor(allow_avx, allow_fma));
 }
 
 ModalStepsFn SelectModalSteps(ModalKernel kernel) {
-  if (kernel == ModalKernel::kFastest && CpuHasAvx2Fma()) return &StepsFma;
-  if (kernel != ModalKernel::kPortable && CpuHasAvx()) return &StepsAvx;
-  return &StepsSse;
+  return Pick(kernel, &StepsFma, &StepsAvx, &StepsSse);
 }
 
 ModalStepsFn SelectModalSteps(bool allow_avx, bool allow_fma) {
-  if (!allow_avx) return SelectModalSteps(ModalKernel::kPortable);
-  return SelectModalSteps(allow_fma ? ModalKernel::kFastest : ModalKernel::kExactAvx);
+  return SelectModalSteps(KernelFor(allow_avx, allow_fma));
 }
 
 void ModalToPoints(const MassSpringNetwork& network, const float* modal, float* points,
