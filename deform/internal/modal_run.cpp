@@ -4,7 +4,6 @@
 #include <bit>
 #include <cmath>
 #include <cstring>
-#include <utility>
 
 #include <emmintrin.h>
 
@@ -29,7 +28,6 @@ constexpr float kRestSum = 1e-24f;
 
 static_assert(sizeof(StageCoefficients) == sizeof(MassSpringState::LastStage::coefficients),
               "MassSpringState::LastStage holds a StageCoefficients");
-static_assert(sizeof(glm::vec3) == 3 * sizeof(float), "vec3 arrays are packed floats");
 
 // A batch's frames and coefficients without the default member initializers'
 // zero fill (2.3 KB a run).
@@ -169,11 +167,9 @@ class ModalRunner {
         i += static_cast<std::size_t>(done);
         st_.step_time_s = starts[i - 1] + h;
         st_.counters.steps += done;
-        Limits(sums, b.x, b.v, b.prev_x, b.prev_v);
+        Limits(sums, b);
       }
-      if (sums.sum_x < kRestSum && sums.sum_v < kRestSum) {
-        for (float* a : {b.x, b.v, b.prev_x, b.prev_v}) std::fill(a, a + 3 * stride_, 0.0f);
-      }
+      if (sums.sum_x < kRestSum && sums.sum_v < kRestSum) Zero(b);
       coeffs[0] = coeffs[2 * count];
     }
     Remember(st_.last_stage, job_, st_.step_time_s, frames[2 * count - 1], last_checks, coeffs[0]);
@@ -181,13 +177,19 @@ class ModalRunner {
 
   // The displacement limit and the non-finite reset (ALGORITHMS.md 6) on the
   // modes (3 x stride each) of the newest step (ModalDisplacementLimit).
-  void Limits(const ModalStepSums& sums, float* x, float* v, float* prev_x, float* prev_v) {
+  void Limits(const ModalStepSums& sums, const ModalBuffers& b) {
     if (!std::isfinite(sums.sum_x) || !std::isfinite(sums.sum_v)) {
       ++st_.counters.non_finite_resets;
-      for (float* a : {x, v, prev_x, prev_v}) std::fill(a, a + 3 * stride_, 0.0f);
+      Zero(b);
       return;
     }
-    st_.counters.displacement_clamps += ModalDisplacementLimit(net_, sums.sum_x, x, v, job_.allow_avx);
+    st_.counters.displacement_clamps +=
+        ModalDisplacementLimit(net_, sums.sum_x, b.x, b.v, job_.allow_avx);
+  }
+
+  // All four fields 0 (padding lanes included).
+  void Zero(const ModalBuffers& b) const {
+    for (float* a : {b.x, b.v, b.prev_x, b.prev_v}) std::fill(a, a + 3 * stride_, 0.0f);
   }
 
   // e(time_s) = U (prev + alpha (x - prev)): linear interpolation between the
