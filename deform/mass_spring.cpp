@@ -128,8 +128,9 @@ class Integrator {
     }
   }
 
-  // |e_a| <= e_max with the outward velocity removed; non-finite state resets
-  // (point-space state; ModalLimits does the same for the modes).
+  // |e_a| <= e_max with the outward velocity removed; non-finite state resets;
+  // a state at rest is set to 0 (internal::kRestSumOfSquares). Point-space
+  // state; the modal run does the same for the modes.
   void ApplyLimits() {
     const std::size_t n = static_cast<std::size_t>(net_.num_free);
     const float e_max = p_.max_displacement;
@@ -138,8 +139,9 @@ class Integrator {
       sum_x += glm::dot(st_.position[a], st_.position[a]);
       sum_v += glm::dot(st_.velocity[a], st_.velocity[a]);
     }
-    if (!std::isfinite(sum_x) || !std::isfinite(sum_v)) {
-      ++st_.counters.non_finite_resets;
+    const bool finite = std::isfinite(sum_x) && std::isfinite(sum_v);
+    if (!finite || (sum_x < internal::kRestSumOfSquares && sum_v < internal::kRestSumOfSquares)) {
+      if (!finite) ++st_.counters.non_finite_resets;
       std::fill(st_.position.begin(), st_.position.end(), glm::vec3(0.0f));
       std::fill(st_.velocity.begin(), st_.velocity.end(), glm::vec3(0.0f));
       std::fill(st_.prev_position.begin(), st_.prev_position.end(), glm::vec3(0.0f));

@@ -253,10 +253,11 @@ struct MassSpringState {
 // goes back, or when it jumps ahead by more than max_time_gap_s. The modal
 // solver samples each stage time once: a run starts from the previous run's last
 // stage (MassSpringState::last_stage) and takes its other stage times in batches
-// of up to 8 steps before stepping (internal/modal_run.h). It also sets a state
-// that has decayed to nothing (the squares of its modal displacements and of
-// its velocities each summing below 1e-24 after a batch) to exactly 0, rather
-// than let it decay on into the subnormal floats.
+// of up to 8 steps before stepping (internal/modal_run.h). Both solvers set a
+// state that has decayed to nothing (the squares of its displacements and of
+// its velocities each summing below 1e-24: after each step in point space,
+// after each batch of steps for the modes) to exactly 0, rather than let it
+// decay on into the subnormal floats.
 struct MassSpringStepJob {
   const MassSpringNetwork* network = nullptr;     // required
   MassSpringState* state = nullptr;               // required, Resize()d for network

@@ -18,13 +18,6 @@ namespace {
 // at h = 1/240 s).
 constexpr std::size_t kBatchSteps = 8;
 
-// Rest: after a batch, a state with sum_k |eta_k|^2 and sum_k |eta'_k|^2 both
-// below this (every mode under 1e-12 model units and units/s) is set to exactly
-// 0. Left alone, a patch whose drive has stopped decays on into the subnormal
-// floats, where every operation costs a microcode assist (a 5x5 patch at rest
-// measured about half again slower per frame than a moving one); at 0 with no
-// drive it stays exactly 0.
-constexpr float kRestSum = 1e-24f;
 
 static_assert(sizeof(StageCoefficients) == sizeof(MassSpringState::LastStage::coefficients),
               "MassSpringState::LastStage holds a StageCoefficients");
@@ -169,7 +162,7 @@ class ModalRunner {
         st_.counters.steps += done;
         Limits(sums, b);
       }
-      if (sums.sum_x < kRestSum && sums.sum_v < kRestSum) Zero(b);
+      if (sums.sum_x < kRestSumOfSquares && sums.sum_v < kRestSumOfSquares) Zero(b);  // rest
       coeffs[0] = coeffs[2 * count];
     }
     Remember(st_.last_stage, job_, st_.step_time_s, frames[2 * count - 1], last_checks, coeffs[0]);

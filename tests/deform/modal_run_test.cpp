@@ -235,3 +235,49 @@ TEST(ModalRun, AStateThatHasDecayedIsSetToExactlyZero) {
 }
 
 }  // namespace
+
+namespace {
+
+// The same rule in the point-space solver (both force models), after each step.
+TEST(ModalRun, PointSpaceStateThatHasDecayedIsSetToExactlyZeroToo) {
+  for (const auto model : {deform::SpringForceModel::kLinear, deform::SpringForceModel::kLength}) {
+    SCOPED_TRACE(model == deform::SpringForceModel::kLinear ? "linear" : "length");
+    deform::MassSpringParams p;
+    p.solver = deform::MassSpringSolver::kPointSpace;
+    p.force_model = model;
+    const MassSpringNetwork net = testsupport::CurvedGridNetwork(5, 5, p);
+    const DriveFn still = [](double) { return DrivingFrame{glm::quat(1, 0, 0, 0)}; };
+    MassSpringState state;
+    state.Resize(net);
+    ASSERT_EQ(state.position.size(), 9u);
+    bool seen_small = false;
+    int zero_from = -1;
+    for (int frame = 0; frame < 30 * 60; ++frame) {
+      const MassSpringStepJob job{
+          .network = &net, .state = &state, .time_s = frame / 30.0, .driving = &still,
+          .user_acceleration = frame >= 1 && frame <= 3 ? glm::vec3(0, 50.0f, 0) : glm::vec3(0.0f)};
+      ASSERT_TRUE(job.Run());
+      double x2 = 0.0, v2 = 0.0;
+      for (std::size_t a = 0; a < state.position.size(); ++a) {
+        for (int c = 0; c < 3; ++c) {
+          ASSERT_NE(std::fpclassify(state.position[a][c]), FP_SUBNORMAL) << "frame " << frame;
+          ASSERT_NE(std::fpclassify(state.velocity[a][c]), FP_SUBNORMAL) << "frame " << frame;
+          x2 += double(state.position[a][c]) * double(state.position[a][c]);
+          v2 += double(state.velocity[a][c]) * double(state.velocity[a][c]);
+        }
+      }
+      if (frame <= 3) continue;
+      if (x2 == 0.0 && v2 == 0.0) {
+        if (zero_from < 0) zero_from = frame;
+      } else {
+        ASSERT_LT(zero_from, 0) << "the state left 0 at frame " << frame;
+        seen_small = seen_small || (x2 < 1e-20 && x2 > 1e-24);
+      }
+    }
+    EXPECT_GT(zero_from, 3);
+    EXPECT_TRUE(seen_small);
+    EXPECT_EQ(state.counters.any_limit(), 0);
+  }
+}
+
+}  // namespace
