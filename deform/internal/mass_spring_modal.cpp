@@ -143,6 +143,29 @@ void MatrixSse(const MassSpringNetwork& net, const float* m, const float* in, fl
   exact_avx::MatrixBody(net, m, in, out);
 }
 
+void PointVelocitiesSse(const MassSpringNetwork& net, const std::size_t* points, int count,
+                        const float* v, float* vel) {
+  exact_sse2::PointVelocitiesBody(net, points, count, v, vel);
+}
+
+[[gnu::target("avx")]] void PointVelocitiesAvx(const MassSpringNetwork& net,
+                                               const std::size_t* points, int count,
+                                               const float* v, float* vel) {
+  exact_avx::PointVelocitiesBody(net, points, count, v, vel);
+}
+
+void AddPointChangesSse(const MassSpringNetwork& net, const std::size_t* points, int count,
+                        const float* dx, const float* dv, float* x, float* v) {
+  exact_sse2::AddPointChangesBody(net, points, count, dx, dv, x, v);
+}
+
+[[gnu::target("avx")]] void AddPointChangesAvx(const MassSpringNetwork& net,
+                                               const std::size_t* points, int count,
+                                               const float* dx, const float* dv, float* x,
+                                               float* v) {
+  exact_avx::AddPointChangesBody(net, points, count, dx, dv, x, v);
+}
+
 // The kernel `kernel` asks for, among the three compilations of one function.
 template <typename Fn>
 Fn Pick(ModalKernel kernel, Fn fma, Fn avx, Fn sse) {
@@ -182,6 +205,18 @@ void PointsToModal(const MassSpringNetwork& network, const float* points, float*
                    bool allow_avx) {
   const float* m = network.modes_by_point.data();
   (allow_avx && CpuHasAvx() ? MatrixAvx : MatrixSse)(network, m, points, modal);
+}
+
+void PointVelocities(const MassSpringNetwork& network, const std::size_t* points, int count,
+                     const float* v, float* velocities, bool allow_avx) {
+  (allow_avx && CpuHasAvx() ? PointVelocitiesAvx : PointVelocitiesSse)(network, points, count, v,
+                                                                       velocities);
+}
+
+void AddPointChanges(const MassSpringNetwork& network, const std::size_t* points, int count,
+                     const float* dx, const float* dv, float* x, float* v, bool allow_avx) {
+  (allow_avx && CpuHasAvx() ? AddPointChangesAvx : AddPointChangesSse)(network, points, count, dx,
+                                                                       dv, x, v);
 }
 
 }  // namespace deform::internal

@@ -137,4 +137,14 @@ void ModalToPoints(const MassSpringNetwork& network, const float* modal, float* 
 void PointsToModal(const MassSpringNetwork& network, const float* points, float* modal,
                    bool allow_avx);
 
+// The displacement limit's two products (internal/modal_run.h), the same bits
+// on every path. PointVelocities: velocities[3 j + c] = (U v)_{points[j]}, row
+// c, for j < count. AddPointChanges: x_k += sum_j U[points[j], k] dx[3 j + c]
+// and v_k += sum_j U[points[j], k] dv[3 j + c] for every row c and mode k, the
+// products added one at a time, j ascending.
+void PointVelocities(const MassSpringNetwork& network, const std::size_t* points, int count,
+                     const float* v, float* velocities, bool allow_avx);
+void AddPointChanges(const MassSpringNetwork& network, const std::size_t* points, int count,
+                     const float* dx, const float* dv, float* x, float* v, bool allow_avx);
+
 }  // namespace deform::internal

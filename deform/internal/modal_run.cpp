@@ -237,44 +237,6 @@ float ModeBound(const MassSpringNetwork& net, const float* x) {
   return (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]);
 }
 
-// The limit at free point p with displacement e = (U eta)_p: its velocity
-// (U eta')_p (four partial sums over k, then added in a fixed order),
-// ClampDisplacement, and a clamp's change d taken back to the modes as
-// eta_k += U[p, k] d (the same for eta'). Returns whether it clamped.
-bool ClampPoint(const MassSpringNetwork& net, std::size_t p, glm::vec3 e, float e_max, float* x,
-                float* v) {
-  const std::size_t n = static_cast<std::size_t>(net.num_free);
-  const std::size_t stride = static_cast<std::size_t>(net.mode_stride);
-  const float* u = net.modes_by_point.data() + p * stride;  // U[p, k] at u[k]; 0 past #free
-  __m128 sum[3] = {_mm_setzero_ps(), _mm_setzero_ps(), _mm_setzero_ps()};
-  for (std::size_t k = 0; k < n; k += 4) {  // padding lanes: U = 0, v = 0
-    const __m128 uk = _mm_loadu_ps(u + k);
-    for (std::size_t c = 0; c < 3; ++c) {
-      sum[c] = _mm_add_ps(sum[c], _mm_mul_ps(uk, _mm_load_ps(v + c * stride + k)));
-    }
-  }
-  glm::vec3 vel;
-  for (int c = 0; c < 3; ++c) {
-    alignas(16) float lanes[4];
-    _mm_store_ps(lanes, sum[c]);
-    vel[c] = (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]);
-  }
-  const glm::vec3 e0 = e, v0 = vel;
-  if (!ClampDisplacement(e, vel, e_max)) return false;
-  const glm::vec3 de = e - e0, dv = vel - v0;
-  for (int c = 0; c < 3; ++c) {
-    const __m128 dec = _mm_set1_ps(de[c]), dvc = _mm_set1_ps(dv[c]);
-    float* xr = x + static_cast<std::size_t>(c) * stride;
-    float* vr = v + static_cast<std::size_t>(c) * stride;
-    for (std::size_t k = 0; k < n; k += 4) {  // padding lanes: U = 0 adds +0
-      const __m128 uk = _mm_loadu_ps(u + k);
-      _mm_store_ps(xr + k, _mm_add_ps(_mm_load_ps(xr + k), _mm_mul_ps(uk, dec)));
-      _mm_store_ps(vr + k, _mm_add_ps(_mm_load_ps(vr + k), _mm_mul_ps(uk, dvc)));
-    }
-  }
-  return true;
-}
-
 }  // namespace
 
 int ModalDisplacementLimit(const MassSpringNetwork& net, float sum_x, float* x, float* v,
@@ -289,23 +251,39 @@ int ModalDisplacementLimit(const MassSpringNetwork& net, float sum_x, float* x, 
   alignas(32) float e[3 * kMaxModeStride];
   ModalToPoints(net, x, e, allow_avx);
   // Candidates: |e_a|^2 above e_max^2 less a margin far wider than the
-  // rounding of either side; ClampDisplacement makes the exact decision.
+  // rounding of either side; ClampDisplacement makes the exact decision. Every
+  // point's e and velocity are those before any clamp (a clamp at a changes no
+  // other point, U being orthonormal), and the clamps reach the modes together.
   const __m128 candidate2 = _mm_set1_ps(0.9999f * e_max * e_max);
-  int clamps = 0;
+  std::size_t points[kMaxModeStride];  // candidates, then the points clamped
+  int candidates = 0;
   for (std::size_t a = 0; a < n; a += 4) {  // padding lanes hold 0: never candidates
     const __m128 ex = _mm_load_ps(e + a), ey = _mm_load_ps(e + stride + a),
                  ez = _mm_load_ps(e + 2 * stride + a);
     const __m128 len2 =
         _mm_add_ps(_mm_add_ps(_mm_mul_ps(ex, ex), _mm_mul_ps(ey, ey)), _mm_mul_ps(ez, ez));
     unsigned mask = static_cast<unsigned>(_mm_movemask_ps(_mm_cmpgt_ps(len2, candidate2)));
-    while (mask != 0) {
-      const std::size_t p = a + static_cast<std::size_t>(std::countr_zero(mask));
-      mask &= mask - 1;
-      if (ClampPoint(net, p, glm::vec3(e[p], e[stride + p], e[2 * stride + p]), e_max, x, v)) {
-        ++clamps;
-      }
+    for (; mask != 0; mask &= mask - 1) {
+      points[candidates++] = a + static_cast<std::size_t>(std::countr_zero(mask));
     }
   }
+  if (candidates == 0) return 0;
+  float vel[3 * kMaxModeStride], dx[3 * kMaxModeStride], dv[3 * kMaxModeStride];
+  PointVelocities(net, points, candidates, v, vel, allow_avx);
+  int clamps = 0;
+  for (int j = 0; j < candidates; ++j) {
+    const std::size_t p = points[j];
+    const glm::vec3 e0(e[p], e[stride + p], e[2 * stride + p]);
+    const glm::vec3 v0(vel[3 * j], vel[3 * j + 1], vel[3 * j + 2]);
+    glm::vec3 e1 = e0, v1 = v0;
+    if (!ClampDisplacement(e1, v1, e_max)) continue;
+    for (int c = 0; c < 3; ++c) {
+      dx[3 * clamps + c] = e1[c] - e0[c];
+      dv[3 * clamps + c] = v1[c] - v0[c];
+    }
+    points[clamps++] = p;
+  }
+  if (clamps > 0) AddPointChanges(net, points, clamps, dx, dv, x, v, allow_avx);
   return clamps;
 }
 

@@ -26,11 +26,13 @@ void RunModal(const MassSpringStepJob& job, double until_s);
 // The displacement limit (ALGORITHMS.md 6) on a modal state x, v (3 x
 // mode_stride rows each, 32-byte aligned, padding lanes 0) whose sum_k |x_k|^2
 // is sum_x: every free point a with |e_a| > e_max, e = U x, is clamped by
-// ClampDisplacement with its velocity (U v)_a, and the change d at a taken back
-// to the modes as x_k += U[a, k] d (the same for v: U is orthonormal, so every
-// other point keeps its displacement and velocity up to float rounding). Points
-// in ascending order; each point's e and velocity are computed from the state
-// before any clamp (a clamp at a changes no other point, in exact arithmetic).
+// ClampDisplacement with its velocity (U v)_a, and the changes d_a taken back
+// to the modes together as x_k += sum_a U[a, k] d_a, a ascending (the same for
+// v: U is orthonormal, so every other point keeps its displacement and
+// velocity up to float rounding). Each point's e and velocity are computed
+// from the state before any clamp (a clamp at a changes no other point, in
+// exact arithmetic), the velocities of the candidates only
+// (internal/mass_spring_modal.h: PointVelocities, AddPointChanges).
 // Cheap exits first: sum_x <= e_max^2, or sum_k max_a |U[a, k]| |x_k| <= e_max.
 // Returns the number of points clamped.
 int ModalDisplacementLimit(const MassSpringNetwork& network, float sum_x, float* x, float* v,

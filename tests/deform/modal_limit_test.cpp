@@ -23,7 +23,9 @@ namespace {
 
 using deform::MassSpringNetwork;
 using deform::internal::kMaxModeStride;
+using deform::internal::AddPointChanges;
 using deform::internal::ModalDisplacementLimit;
+using deform::internal::PointVelocities;
 
 // A modal field: 3 rows of mode_stride floats, padding lanes 0.
 struct Modal {
@@ -191,6 +193,66 @@ TEST(ModalDisplacementLimit, CheapExitsTouchNothing) {
   EXPECT_EQ(ModalDisplacementLimit(net, 1e30f, s.x, s.v, true), 0);  // the bound decides
   EXPECT_EQ(std::memcmp(s.x, before.x, sizeof s.x), 0);
   EXPECT_EQ(std::memcmp(s.v, before.v, sizeof s.v), 0);
+}
+
+// The limit's two products on their own, for every stride (8 lanes, 16 with
+// an 8-lane tail, ...): PointVelocities against (U v)_p in double, and
+// AddPointChanges against x + sum_j U[p_j, .] dx_j in double; the AVX and SSE2
+// paths give the same bits, and the padding lanes stay 0.
+TEST(ModalLimitProducts, MatchDoublesAndAreTheSameOnBothPaths) {
+  std::mt19937 rng(5);
+  std::normal_distribution<float> normal(0.0f, 1.0f);
+  for (int size : {3, 4, 5, 6, 7, 9, 12, 16}) {
+    SCOPED_TRACE(testing::Message() << "grid " << size);
+    const MassSpringNetwork net = testsupport::CurvedGridNetwork(size, size);
+    const std::size_t n = static_cast<std::size_t>(net.num_free);
+    const std::size_t stride = static_cast<std::size_t>(net.mode_stride);
+    Modal s = RandomState(net, rng, 2.0);
+    // Points in ascending order, some skipped; each one's change.
+    std::vector<std::size_t> points;
+    for (std::size_t a = 0; a < n; ++a) {
+      if (a % 3 != 1) points.push_back(a);
+    }
+    const int count = static_cast<int>(points.size());
+    std::vector<float> dx(3 * points.size()), dv(3 * points.size());
+    for (float& d : dx) d = normal(rng);
+    for (float& d : dv) d = 30.0f * normal(rng);
+
+    std::vector<float> vel_avx(3 * points.size()), vel_sse(3 * points.size());
+    PointVelocities(net, points.data(), count, s.v, vel_avx.data(), true);
+    PointVelocities(net, points.data(), count, s.v, vel_sse.data(), false);
+    EXPECT_EQ(std::memcmp(vel_avx.data(), vel_sse.data(), vel_avx.size() * sizeof(float)), 0);
+    const std::vector<glm::dvec3> v_points = ToPoints(net, s.v);
+    for (int j = 0; j < count; ++j) {
+      const glm::dvec3 want = v_points[points[static_cast<std::size_t>(j)]];
+      for (int c = 0; c < 3; ++c) {
+        EXPECT_NEAR(vel_avx[3 * j + c], want[c], 1e-5 * (1.0 + glm::length(want)));
+      }
+    }
+
+    Modal avx = s, sse = s;
+    AddPointChanges(net, points.data(), count, dx.data(), dv.data(), avx.x, avx.v, true);
+    AddPointChanges(net, points.data(), count, dx.data(), dv.data(), sse.x, sse.v, false);
+    EXPECT_EQ(std::memcmp(avx.x, sse.x, sizeof avx.x), 0);
+    EXPECT_EQ(std::memcmp(avx.v, sse.v, sizeof avx.v), 0);
+    for (std::size_t c = 0; c < 3; ++c) {
+      for (std::size_t k = 0; k < stride; ++k) {
+        double want_x = s.x[c * stride + k], want_v = s.v[c * stride + k];
+        for (std::size_t j = 0; j < points.size(); ++j) {
+          const double u = k < n ? double(net.modes[points[j] * n + k]) : 0.0;
+          want_x += u * dx[3 * j + c];
+          want_v += u * dv[3 * j + c];
+        }
+        if (k >= n) {
+          EXPECT_EQ(avx.x[c * stride + k], 0.0f);
+          EXPECT_EQ(avx.v[c * stride + k], 0.0f);
+          continue;
+        }
+        EXPECT_NEAR(avx.x[c * stride + k], want_x, 1e-5 * (1.0 + std::abs(want_x)));
+        EXPECT_NEAR(avx.v[c * stride + k], want_v, 1e-5 * (30.0 + std::abs(want_v)));
+      }
+    }
+  }
 }
 
 }  // namespace
