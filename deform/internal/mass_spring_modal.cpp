@@ -5,6 +5,8 @@
 #include <cstring>
 #include <utility>
 
+#include <emmintrin.h>
+
 #include "deform/internal/cpu_features.h"
 
 // The 8-lane helpers pass vectors by value, but all of them are internal and
@@ -37,6 +39,12 @@ typedef float V8Unaligned __attribute__((vector_size(32), aligned(4)));
   asm("vbroadcastss %1, %0" : "=x"(r) : "m"(*p), "x"(after));
   return r;
 }
+// Each lane's square root (vsqrtps, correctly rounded as sqrtps is).
+[[gnu::always_inline]] inline V8 SqrtV8(const V8& v) {
+  V8 r;
+  asm("vsqrtps %1, %0" : "=x"(r) : "x"(v));
+  return r;
+}
 [[gnu::always_inline]] inline V8 LoadV8(const float* p) { return *reinterpret_cast<const V8Unaligned*>(p); }
 [[gnu::always_inline]] inline void StoreV8(float* p, const V8& v) { *reinterpret_cast<V8Unaligned*>(p) = v; }
 [[gnu::always_inline]] inline void HalvesV8(const V8& v, V4& lo, V4& hi) {
@@ -64,6 +72,10 @@ struct V8 {
   return {*reinterpret_cast<const V4Unaligned*>(p), *reinterpret_cast<const V4Unaligned*>(p + 4)};
 }
 [[gnu::always_inline]] inline V8 BroadcastV8(const float* p) { return SplatV8(*p); }
+[[gnu::always_inline]] inline V8 SqrtV8(const V8& v) {
+  return {reinterpret_cast<V4>(_mm_sqrt_ps(reinterpret_cast<__m128>(v.lo))),
+          reinterpret_cast<V4>(_mm_sqrt_ps(reinterpret_cast<__m128>(v.hi)))};
+}
 [[gnu::always_inline]] inline V8 BroadcastAfter(const float* p, const V8&) { return SplatV8(*p); }
 [[gnu::always_inline]] inline void StoreV8(float* p, const V8& v) {
   *reinterpret_cast<V4Unaligned*>(p) = v.lo;
@@ -79,11 +91,13 @@ struct V8 {
 // has -ffp-contract=off).
 namespace exact_sse2 {
 using namespace sse2;
+inline constexpr bool kContracted = false;
 #include "deform/internal/mass_spring_modal_kernel.inc"
 }  // namespace exact_sse2
 
 namespace exact_avx {
 using namespace native;
+inline constexpr bool kContracted = false;
 #include "deform/internal/mass_spring_modal_kernel.inc"
 }  // namespace exact_avx
 
@@ -94,6 +108,7 @@ using namespace native;
 #pragma GCC optimize("fp-contract=fast")
 namespace fused {
 using namespace native;
+inline constexpr bool kContracted = true;
 #include "deform/internal/mass_spring_modal_kernel.inc"
 }  // namespace fused
 
@@ -104,8 +119,8 @@ ModalStepSums StepFma(const MassSpringNetwork& net, const StageCoefficients& s0,
 }
 
 int StepsFma(const MassSpringNetwork& net, const StageCoefficients* c, int count, float h,
-             float sum_x_limit, ModalBuffers& b, ModalStepSums& sums) {
-  return fused::StepsBody(net, c, count, h, sum_x_limit, b, sums);
+             ModalBuffers& b, ModalStepSums& sums) {
+  return fused::StepsBody(net, c, count, h, b, sums);
 }
 #pragma GCC pop_options
 
@@ -124,14 +139,13 @@ ModalStepSums StepSse(const MassSpringNetwork& net, const StageCoefficients& s0,
 }
 
 int StepsSse(const MassSpringNetwork& net, const StageCoefficients* c, int count, float h,
-             float sum_x_limit, ModalBuffers& b, ModalStepSums& sums) {
-  return exact_sse2::StepsBody(net, c, count, h, sum_x_limit, b, sums);
+             ModalBuffers& b, ModalStepSums& sums) {
+  return exact_sse2::StepsBody(net, c, count, h, b, sums);
 }
 
 [[gnu::target("avx")]] int StepsAvx(const MassSpringNetwork& net, const StageCoefficients* c,
-                                    int count, float h, float sum_x_limit, ModalBuffers& b,
-                                    ModalStepSums& sums) {
-  return exact_avx::StepsBody(net, c, count, h, sum_x_limit, b, sums);
+                                    int count, float h, ModalBuffers& b, ModalStepSums& sums) {
+  return exact_avx::StepsBody(net, c, count, h, b, sums);
 }
 
 void MatrixSse(const MassSpringNetwork& net, const float* m, const float* in, float* out) {
@@ -141,6 +155,14 @@ void MatrixSse(const MassSpringNetwork& net, const float* m, const float* in, fl
 [[gnu::target("avx")]] void MatrixAvx(const MassSpringNetwork& net, const float* m,
                                       const float* in, float* out) {
   exact_avx::MatrixBody(net, m, in, out);
+}
+
+float ModeBoundSse(const MassSpringNetwork& net, const float* x) {
+  return exact_sse2::ModeBoundBody(net, x);
+}
+
+[[gnu::target("avx")]] float ModeBoundAvx(const MassSpringNetwork& net, const float* x) {
+  return exact_avx::ModeBoundBody(net, x);
 }
 
 void PointVelocitiesSse(const MassSpringNetwork& net, const std::size_t* points, int count,
@@ -205,6 +227,10 @@ void PointsToModal(const MassSpringNetwork& network, const float* points, float*
                    bool allow_avx) {
   const float* m = network.modes_by_point.data();
   (allow_avx && CpuHasAvx() ? MatrixAvx : MatrixSse)(network, m, points, modal);
+}
+
+float ModeBound(const MassSpringNetwork& network, const float* x, bool allow_avx) {
+  return (allow_avx && CpuHasAvx() ? ModeBoundAvx : ModeBoundSse)(network, x);
 }
 
 void PointVelocities(const MassSpringNetwork& network, const std::size_t* points, int count,

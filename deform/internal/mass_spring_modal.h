@@ -105,14 +105,15 @@ struct ModalBuffers {
 // 2 count + 1 of them): each step goes from (b.x, b.v) into (b.prev_x,
 // b.prev_v), then the two pairs are swapped, so that b.x, b.v hold the newest
 // step and b.prev_x, b.prev_v the one before, as after `count` calls of the
-// ModalStepFn. Stops early after a step whose sums the limits must see: either
-// is not finite, or sum_x is not <= sum_x_limit (e_max^2). Returns the number
+// ModalStepFn. Stops early after a step the limits could change: either sum is
+// not finite, or neither of ModalDisplacementLimit's cheap exits holds, with
+// e_max the network's max_displacement (sum_x <= e_max^2; in the exact kernels
+// also ModeBound <= e_max). Returns the number
 // of steps taken, with that last step's sums in `sums`. Each step has the bits
 // of the ModalStepFn of the same kernel. The input padding lanes must hold 0;
 // the four arrays must not overlap.
 using ModalStepsFn = int (*)(const MassSpringNetwork& network, const StageCoefficients* c,
-                             int count, float h, float sum_x_limit, ModalBuffers& b,
-                             ModalStepSums& sums);
+                             int count, float h, ModalBuffers& b, ModalStepSums& sums);
 
 enum class ModalKernel {
   kFastest,   // AVX2 + FMA when the CPU has both, else AVX, else SSE2
@@ -136,6 +137,11 @@ void ModalToPoints(const MassSpringNetwork& network, const float* modal, float* 
 // The inverse, eta_k = sum_a U[a, k] e_a (a ascending from 0, as the scalar code).
 void PointsToModal(const MassSpringNetwork& network, const float* points, float* modal,
                    bool allow_avx);
+
+// sum_k max_a |U[a, k]| |x_k| for a modal displacement x (3 x stride, padding
+// lanes 0): an upper bound on every |(U x)_a|, the same bits on every path
+// (the exact several-step kernels test it too).
+float ModeBound(const MassSpringNetwork& network, const float* x, bool allow_avx);
 
 // The displacement limit's two products (internal/modal_run.h), the same bits
 // on every path. PointVelocities: velocities[3 j + c] = (U v)_{points[j]}, row

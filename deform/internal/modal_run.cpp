@@ -129,8 +129,6 @@ class ModalRunner {
     CheckedDriving driving(job_);
     const ModalStepsFn steps = SelectModalSteps(job_.allow_avx, job_.allow_fma);
     const double h = net_.time_step_s;
-    const float e_max = net_.params.max_displacement;
-    const float sum_x_limit = e_max * e_max;  // ModalDisplacementLimit's first exit
     BatchStorage batch;  // left uninitialized: every entry is written before it is read
     DrivingFrame* const frames = batch.frames.at;
     StageCoefficients* const coeffs = batch.coeffs.at;
@@ -156,7 +154,7 @@ class ModalRunner {
       ModalStepSums sums;
       for (std::size_t i = 0; i < count;) {
         const int done = steps(net_, coeffs + 2 * i, static_cast<int>(count - i),
-                               static_cast<float>(h), sum_x_limit, b, sums);
+                               static_cast<float>(h), b, sums);
         i += static_cast<std::size_t>(done);
         st_.step_time_s = starts[i - 1] + h;
         st_.counters.steps += done;
@@ -218,25 +216,6 @@ class ModalRunner {
 };
 
 
-// sum_k u_k |eta_k|, four modes at a time: each length as glm::length computes
-// it, the lanes summed in a fixed order.
-float ModeBound(const MassSpringNetwork& net, const float* x) {
-  const std::size_t n = static_cast<std::size_t>(net.num_free);
-  const std::size_t stride = static_cast<std::size_t>(net.mode_stride);
-  const float* u_max = net.mode_lanes.data() + kLaneMaxAbs * stride;
-  __m128 sum = _mm_setzero_ps();
-  for (std::size_t k = 0; k < n; k += 4) {  // padding lanes: u = 0, eta = 0
-    const __m128 ex = _mm_load_ps(x + k), ey = _mm_load_ps(x + stride + k),
-                 ez = _mm_load_ps(x + 2 * stride + k);
-    const __m128 len = _mm_sqrt_ps(
-        _mm_add_ps(_mm_add_ps(_mm_mul_ps(ex, ex), _mm_mul_ps(ey, ey)), _mm_mul_ps(ez, ez)));
-    sum = _mm_add_ps(sum, _mm_mul_ps(_mm_loadu_ps(u_max + k), len));
-  }
-  alignas(16) float lanes[4];
-  _mm_store_ps(lanes, sum);
-  return (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]);
-}
-
 }  // namespace
 
 int ModalDisplacementLimit(const MassSpringNetwork& net, float sum_x, float* x, float* v,
@@ -245,7 +224,7 @@ int ModalDisplacementLimit(const MassSpringNetwork& net, float sum_x, float* x, 
   // with u_k = max_a |U[a, k]|. Below e_max by either bound nothing can exceed.
   const float e_max = net.params.max_displacement;
   if (sum_x <= e_max * e_max) return 0;
-  if (ModeBound(net, x) <= e_max) return 0;
+  if (ModeBound(net, x, allow_avx) <= e_max) return 0;
   const std::size_t n = static_cast<std::size_t>(net.num_free);
   const std::size_t stride = static_cast<std::size_t>(net.mode_stride);
   alignas(32) float e[3 * kMaxModeStride];

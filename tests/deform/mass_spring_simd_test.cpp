@@ -18,6 +18,7 @@
 #include <gtest/gtest.h>
 
 #include "deform/mass_spring.h"
+#include "deform/internal/cpu_features.h"
 #include "deform/internal/mass_spring_modal.h"
 #include "support/mass_spring_networks.h"
 #include "support/tolerances.h"
@@ -107,13 +108,17 @@ std::vector<deform::internal::StageCoefficients> VaryingCoefficients(int count) 
 
 // The several-step kernels (ModalStepsFn) against the one-step ones of the same
 // instruction set called once per step: the same bits in all four buffers and
-// in the sums; and with a limit that the growing state passes, a stop right
-// after the first step whose sum_x is above it.
+// in the sums; and with an e_max that the growing state passes, a stop right
+// after the first step the limit could change (sum_x above e_max^2 and, in the
+// exact kernels, the mode bound above e_max), never after one it could not.
 TEST(MassSpringSimd, SeveralStepsGiveTheBitsOfOneStepAtATime) {
   using deform::internal::ModalKernel;
+  int bound_decided = 0;  // steps past e_max^2 that the exact kernels ran on past
+  int stops = 0;          // early returns
   for (const ModalKernel kernel : {ModalKernel::kPortable, ModalKernel::kExactAvx, ModalKernel::kFastest}) {
     const auto one = deform::internal::SelectModalStep(kernel);
     const auto several = deform::internal::SelectModalSteps(kernel);
+    const bool bound_tested = kernel != ModalKernel::kFastest || !deform::internal::CpuHasAvx2Fma();
     for (const auto& [rows, cols] : kGrids) {
       SCOPED_TRACE(testing::Message() << rows << "x" << cols << " kernel " << static_cast<int>(kernel));
       const MassSpringNetwork net = CurvedGridNetwork(rows, cols);
@@ -126,14 +131,33 @@ TEST(MassSpringSimd, SeveralStepsGiveTheBitsOfOneStepAtATime) {
       std::vector<float> ref[4];
       for (auto& a : ref) a.assign(size, 0.0f);
       std::vector<deform::internal::ModalStepSums> ref_sums;
+      std::vector<float> ref_bound;  // ModeBound of each step's displacement
       for (int i = 0; i < kSteps; ++i) {
         ref_sums.push_back(one(net, s[2 * i], s[2 * i + 1], s[2 * i + 2], h, ref[0].data(),
                                ref[1].data(), ref[2].data(), ref[3].data()));
         std::swap(ref[0], ref[2]);
         std::swap(ref[1], ref[3]);
+        ref_bound.push_back(deform::internal::ModeBound(net, ref[0].data(), true));
       }
       ASSERT_GT(ref_sums.back().sum_x, ref_sums[2].sum_x);
-      for (const float limit : {1e30f, ref_sums[2].sum_x}) {
+      // e_max: never reached; reached by sum_x from step 4 on; and between the
+      // bound and sqrt(sum_x) of the step where they are furthest apart, so that
+      // the bound alone decides there.
+      std::size_t apart = 0;
+      for (std::size_t i = 1; i < ref_bound.size(); ++i) {
+        if (ref_bound[i] / std::sqrt(ref_sums[i].sum_x) <
+            ref_bound[apart] / std::sqrt(ref_sums[apart].sum_x)) {
+          apart = i;
+        }
+      }
+      for (const float e_max : {1e15f, std::sqrt(ref_sums[2].sum_x) * (1.0f + 1e-6f),
+                                0.5f * (ref_bound[apart] + std::sqrt(ref_sums[apart].sum_x))}) {
+        MassSpringNetwork limited = net;
+        limited.params.max_displacement = e_max;
+        const auto needs = [&](int step) {  // step >= 1
+          const std::size_t i = static_cast<std::size_t>(step - 1);
+          return ref_sums[i].sum_x > e_max * e_max && (!bound_tested || ref_bound[i] > e_max);
+        };
         alignas(32) float buffers[4][3 * deform::internal::kMaxModeStride];
         std::fill_n(buffers[0], size, 0.0f);
         std::fill_n(buffers[1], size, 0.0f);
@@ -143,22 +167,20 @@ TEST(MassSpringSimd, SeveralStepsGiveTheBitsOfOneStepAtATime) {
         deform::internal::ModalStepSums sums;
         int taken = 0;
         while (taken < kSteps) {
-          const int done = several(net, s.data() + 2 * taken, kSteps - taken, h, limit, b, sums);
+          const int done = several(limited, s.data() + 2 * taken, kSteps - taken, h, b, sums);
           ASSERT_GE(done, 1);
           taken += done;
           ASSERT_LE(taken, kSteps);
           const auto& want = ref_sums[static_cast<std::size_t>(taken - 1)];
           ASSERT_EQ(std::memcmp(&sums, &want, sizeof sums), 0) << "after step " << taken;
-          // Stopped at the end, or right after the first step above the limit.
           if (taken < kSteps) {
-            ASSERT_GT(sums.sum_x, limit);
+            ASSERT_TRUE(needs(taken)) << "stopped after step " << taken;
+            ++stops;
           }
-          for (int i = taken - done; i < taken - 1; ++i) {
-            ASSERT_LE(ref_sums[static_cast<std::size_t>(i)].sum_x, limit) << "ran past step " << i + 1;
+          for (int i = taken - done + 1; i < taken; ++i) {
+            ASSERT_FALSE(needs(i)) << "ran past step " << i;
+            if (ref_sums[static_cast<std::size_t>(i - 1)].sum_x > e_max * e_max) ++bound_decided;
           }
-        }
-        if (limit < 1e30f) {
-          EXPECT_GT(ref_sums[3].sum_x, limit);  // so the run above stopped
         }
         const float* got[4] = {b.x, b.v, b.prev_x, b.prev_v};
         for (int a = 0; a < 4; ++a) {
@@ -166,6 +188,44 @@ TEST(MassSpringSimd, SeveralStepsGiveTheBitsOfOneStepAtATime) {
         }
       }
     }
+  }
+  EXPECT_GT(bound_decided, 0);
+  EXPECT_GT(stops, 0);
+}
+
+// The limit's cheap exits as the kernels test them: ModeBound is the same on
+// both paths, and bounds every point's |e_a| (computed in double).
+TEST(MassSpringSimd, ModeBoundIsTheSameOnBothPathsAndBoundsEveryPoint) {
+  for (const auto& [rows, cols] : kGrids) {
+    SCOPED_TRACE(testing::Message() << rows << "x" << cols);
+    const MassSpringNetwork net = CurvedGridNetwork(rows, cols);
+    const std::size_t n = static_cast<std::size_t>(net.num_free);
+    const std::size_t stride = static_cast<std::size_t>(net.mode_stride);
+    std::vector<float> x(3 * stride, 0.0f);
+    for (std::size_t c = 0; c < 3; ++c) {
+      for (std::size_t k = 0; k < n; ++k) {
+        x[c * stride + k] = std::sin(1.7f * static_cast<float>(k) + static_cast<float>(c)) /
+                            static_cast<float>(1 + k);
+      }
+    }
+    const float avx = deform::internal::ModeBound(net, x.data(), true);
+    const float sse = deform::internal::ModeBound(net, x.data(), false);
+    EXPECT_EQ(std::memcmp(&avx, &sse, sizeof avx), 0);
+    double largest = 0.0, bound = 0.0;
+    for (std::size_t k = 0; k < n; ++k) {
+      const glm::dvec3 eta(x[k], x[stride + k], x[2 * stride + k]);
+      bound += double(net.mode_max_abs[k]) * glm::length(eta);
+    }
+    for (std::size_t a = 0; a < n; ++a) {
+      glm::dvec3 e(0.0);
+      for (std::size_t k = 0; k < n; ++k) {
+        const glm::dvec3 eta(x[k], x[stride + k], x[2 * stride + k]);
+        e += double(net.modes[a * n + k]) * eta;
+      }
+      largest = std::max(largest, glm::length(e));
+    }
+    EXPECT_NEAR(avx, bound, 1e-5 * bound);
+    EXPECT_LE(largest, bound * (1.0 + 1e-6));
   }
 }
 
