@@ -196,12 +196,14 @@ Fn Pick(ModalKernel kernel, Fn fma, Fn avx, Fn sse) {
   return sse;
 }
 
+}  // namespace
+
 ModalKernel KernelFor(bool allow_avx, bool allow_fma) {
   if (!allow_avx) return ModalKernel::kPortable;
   return allow_fma ? ModalKernel::kFastest : ModalKernel::kExactAvx;
 }
 
-}  // namespace
+bool StepsTestModeBound(ModalKernel kernel) { return Pick(kernel, false, true, true); }
 
 ModalStepFn SelectModalStep(ModalKernel kernel) { return Pick(kernel, &StepFma, &StepAvx, &StepSse); }
 

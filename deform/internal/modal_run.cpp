@@ -127,7 +127,10 @@ class ModalRunner {
   // [2 i + 2]: step i's start, middle and end.
   void Steps(double until_s, ModalBuffers& b) {
     CheckedDriving driving(job_);
-    const ModalStepsFn steps = SelectModalSteps(job_.allow_avx, job_.allow_fma);
+    const ModalKernel kernel = KernelFor(job_.allow_avx, job_.allow_fma);
+    const ModalStepsFn steps = SelectModalSteps(kernel);
+    // A kernel that stops early has seen the limit's cheap exits fail.
+    const bool bound_tested = StepsTestModeBound(kernel);
     const double h = net_.time_step_s;
     BatchStorage batch;  // left uninitialized: every entry is written before it is read
     DrivingFrame* const frames = batch.frames.at;
@@ -155,10 +158,11 @@ class ModalRunner {
       for (std::size_t i = 0; i < count;) {
         const int done = steps(net_, coeffs + 2 * i, static_cast<int>(count - i),
                                static_cast<float>(h), b, sums);
+        const bool stopped = i + static_cast<std::size_t>(done) < count;
         i += static_cast<std::size_t>(done);
         st_.step_time_s = starts[i - 1] + h;
         st_.counters.steps += done;
-        Limits(sums, b);
+        Limits(sums, b, stopped && bound_tested);
       }
       if (sums.sum_x < kRestSumOfSquares && sums.sum_v < kRestSumOfSquares) Zero(b);  // rest
       coeffs[0] = coeffs[2 * count];
@@ -168,14 +172,15 @@ class ModalRunner {
 
   // The displacement limit and the non-finite reset (ALGORITHMS.md 6) on the
   // modes (3 x stride each) of the newest step (ModalDisplacementLimit).
-  void Limits(const ModalStepSums& sums, const ModalBuffers& b) {
+  // `exits_failed`: ModalDisplacementLimit's.
+  void Limits(const ModalStepSums& sums, const ModalBuffers& b, bool exits_failed) {
     if (!std::isfinite(sums.sum_x) || !std::isfinite(sums.sum_v)) {
       ++st_.counters.non_finite_resets;
       Zero(b);
       return;
     }
     st_.counters.displacement_clamps +=
-        ModalDisplacementLimit(net_, sums.sum_x, b.x, b.v, job_.allow_avx);
+        ModalDisplacementLimit(net_, sums.sum_x, b.x, b.v, job_.allow_avx, exits_failed);
   }
 
   // All four fields 0 (padding lanes included).
@@ -219,12 +224,11 @@ class ModalRunner {
 }  // namespace
 
 int ModalDisplacementLimit(const MassSpringNetwork& net, float sum_x, float* x, float* v,
-                           bool allow_avx) {
+                           bool allow_avx, bool exits_failed) {
   // U is orthonormal, so |e_a|^2 <= sum_k |eta_k|^2; also |e_a| <= sum_k u_k |eta_k|
   // with u_k = max_a |U[a, k]|. Below e_max by either bound nothing can exceed.
   const float e_max = net.params.max_displacement;
-  if (sum_x <= e_max * e_max) return 0;
-  if (ModeBound(net, x, allow_avx) <= e_max) return 0;
+  if (!exits_failed && (sum_x <= e_max * e_max || ModeBound(net, x, allow_avx) <= e_max)) return 0;
   const std::size_t n = static_cast<std::size_t>(net.num_free);
   const std::size_t stride = static_cast<std::size_t>(net.mode_stride);
   alignas(32) float e[3 * kMaxModeStride];

@@ -33,10 +33,13 @@ void RunModal(const MassSpringStepJob& job, double until_s);
 // from the state before any clamp (a clamp at a changes no other point, in
 // exact arithmetic), the velocities of the candidates only
 // (internal/mass_spring_modal.h: PointVelocities, AddPointChanges).
-// Cheap exits first: sum_x <= e_max^2, or sum_k max_a |U[a, k]| |x_k| <= e_max.
+// Cheap exits first: sum_x <= e_max^2, or ModeBound(x) = sum_k max_a |U[a, k]|
+// |x_k| <= e_max; a caller that has seen both fail for this x (an exact
+// several-step kernel that stopped early) says so with `exits_failed`. (The
+// exits only save work: ClampDisplacement decides, so no bit depends on them.)
 // Returns the number of points clamped.
 int ModalDisplacementLimit(const MassSpringNetwork& network, float sum_x, float* x, float* v,
-                           bool allow_avx);
+                           bool allow_avx, bool exits_failed = false);
 
 // Rest: a state whose displacements' squares and whose velocities' squares each
 // sum below this (every point or mode under 1e-12 model units and units/s) is
