@@ -16,9 +16,10 @@
 namespace {
 
 TEST(ModalConversion, BothPathsGiveTheScalarSums) {
-  // 4x4: 4 modes (one 8-lane group), 5x5: 9 (one 16-lane group), 8x8: 36 (two
-  // 16-lane groups and an 8-lane one), 16x16: 196.
-  for (const auto& [rows, cols] : {std::pair{4, 4}, {5, 5}, {8, 8}, {16, 16}}) {
+  // 4x4: 4 modes (one 8-lane group), 5x5: 9 (one 16-lane group), 7x7: 25 (one
+  // 32-lane group), 8x8: 36 (a 32-lane group and an 8-lane one), 9x9: 49 (32,
+  // 16 and 8 lanes), 16x16: 196.
+  for (const auto& [rows, cols] : {std::pair{4, 4}, {5, 5}, {7, 7}, {8, 8}, {9, 9}, {16, 16}}) {
     SCOPED_TRACE(testing::Message() << rows << "x" << cols);
     const deform::MassSpringNetwork net = testsupport::CurvedGridNetwork(rows, cols);
     const std::size_t n = static_cast<std::size_t>(net.num_free);
