@@ -196,14 +196,12 @@ Fn Pick(ModalKernel kernel, Fn fma, Fn avx, Fn sse) {
   return sse;
 }
 
-}  // namespace
-
 ModalKernel KernelFor(bool allow_avx, bool allow_fma) {
   if (!allow_avx) return ModalKernel::kPortable;
   return allow_fma ? ModalKernel::kFastest : ModalKernel::kExactAvx;
 }
 
-bool StepsTestModeBound(ModalKernel kernel) { return Pick(kernel, false, true, true); }
+}  // namespace
 
 ModalStepFn SelectModalStep(ModalKernel kernel) { return Pick(kernel, &StepFma, &StepAvx, &StepSse); }
 
@@ -215,8 +213,9 @@ ModalStepsFn SelectModalSteps(ModalKernel kernel) {
   return Pick(kernel, &StepsFma, &StepsAvx, &StepsSse);
 }
 
-ModalStepsFn SelectModalSteps(bool allow_avx, bool allow_fma) {
-  return SelectModalSteps(KernelFor(allow_avx, allow_fma));
+ModalStepsChoice ChooseModalSteps(bool allow_avx, bool allow_fma) {
+  const ModalKernel kernel = KernelFor(allow_avx, allow_fma);
+  return {SelectModalSteps(kernel), Pick(kernel, false, true, true)};
 }
 
 void ModalToPoints(const MassSpringNetwork& network, const float* modal, float* points,

@@ -120,18 +120,21 @@ enum class ModalKernel {
   kExactAvx,  // AVX when the CPU has it, else SSE2 (same bits either way)
   kPortable,  // SSE2
 };
+ModalStepFn SelectModalStep(ModalKernel kernel);
 // MassSpringStepJob's switches: allow_avx and allow_fma -> kFastest, allow_avx
 // alone -> kExactAvx (the default: the same bits on every x86-64 CPU), neither ->
 // kPortable.
-ModalKernel KernelFor(bool allow_avx, bool allow_fma);
-ModalStepFn SelectModalStep(ModalKernel kernel);
-ModalStepFn SelectModalStep(bool allow_avx, bool allow_fma);  // KernelFor's
+ModalStepFn SelectModalStep(bool allow_avx, bool allow_fma);
 
 ModalStepsFn SelectModalSteps(ModalKernel kernel);
-ModalStepsFn SelectModalSteps(bool allow_avx, bool allow_fma);
-// Whether SelectModalSteps(kernel) is one of the exact kernels, which test
-// ModeBound before they stop early (the FMA one tests sum_x alone).
-bool StepsTestModeBound(ModalKernel kernel);
+// The several-step kernel for MassSpringStepJob's switches (as SelectModalStep),
+// and whether it is one of the exact kernels, which test ModeBound before they
+// stop early (the FMA one tests sum_x alone).
+struct ModalStepsChoice {
+  ModalStepsFn steps;
+  bool tests_mode_bound;
+};
+ModalStepsChoice ChooseModalSteps(bool allow_avx, bool allow_fma);
 
 // Point-space field e_a = sum_k U[a, k] eta_k of a modal field (both 3 x stride;
 // k summed in ascending order from 0, as the scalar code does).

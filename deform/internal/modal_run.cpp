@@ -127,10 +127,8 @@ class ModalRunner {
   // [2 i + 2]: step i's start, middle and end.
   void Steps(double until_s, ModalBuffers& b) {
     CheckedDriving driving(job_);
-    const ModalKernel kernel = KernelFor(job_.allow_avx, job_.allow_fma);
-    const ModalStepsFn steps = SelectModalSteps(kernel);
-    // A kernel that stops early has seen the limit's cheap exits fail.
-    const bool bound_tested = StepsTestModeBound(kernel);
+    // An exact kernel that stops early has seen the limit's cheap exits fail.
+    const auto [steps, bound_tested] = ChooseModalSteps(job_.allow_avx, job_.allow_fma);
     const double h = net_.time_step_s;
     BatchStorage batch;  // left uninitialized: every entry is written before it is read
     DrivingFrame* const frames = batch.frames.at;
@@ -221,14 +219,10 @@ class ModalRunner {
 };
 
 
-}  // namespace
-
-int ModalDisplacementLimit(const MassSpringNetwork& net, float sum_x, float* x, float* v,
-                           bool allow_avx, bool exits_failed) {
-  // U is orthonormal, so |e_a|^2 <= sum_k |eta_k|^2; also |e_a| <= sum_k u_k |eta_k|
-  // with u_k = max_a |U[a, k]|. Below e_max by either bound nothing can exceed.
+// ModalDisplacementLimit past its cheap exits; out of line, so that the exits
+// do not pay for this part's prologue (saved registers, an aligned 11 KB frame).
+[[gnu::noinline]] int LimitPoints(const MassSpringNetwork& net, float* x, float* v, bool allow_avx) {
   const float e_max = net.params.max_displacement;
-  if (!exits_failed && (sum_x <= e_max * e_max || ModeBound(net, x, allow_avx) <= e_max)) return 0;
   const std::size_t n = static_cast<std::size_t>(net.num_free);
   const std::size_t stride = static_cast<std::size_t>(net.mode_stride);
   alignas(32) float e[3 * kMaxModeStride];
@@ -268,6 +262,17 @@ int ModalDisplacementLimit(const MassSpringNetwork& net, float sum_x, float* x, 
   }
   if (clamps > 0) AddPointChanges(net, points, clamps, dx, dv, x, v, allow_avx);
   return clamps;
+}
+
+}  // namespace
+
+int ModalDisplacementLimit(const MassSpringNetwork& net, float sum_x, float* x, float* v,
+                           bool allow_avx, bool exits_failed) {
+  // U is orthonormal, so |e_a|^2 <= sum_k |eta_k|^2; also |e_a| <= sum_k u_k |eta_k|
+  // with u_k = max_a |U[a, k]|. Below e_max by either bound nothing can exceed.
+  const float e_max = net.params.max_displacement;
+  if (!exits_failed && (sum_x <= e_max * e_max || ModeBound(net, x, allow_avx) <= e_max)) return 0;
+  return LimitPoints(net, x, v, allow_avx);
 }
 
 void RunModal(const MassSpringStepJob& job, double until_s) { ModalRunner(job).Run(until_s); }
