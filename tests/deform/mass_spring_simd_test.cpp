@@ -193,42 +193,6 @@ TEST(MassSpringSimd, SeveralStepsGiveTheBitsOfOneStepAtATime) {
   EXPECT_GT(stops, 0);
 }
 
-// The limit's cheap exits as the kernels test them: ModeBound is the same on
-// both paths, and bounds every point's |e_a| (computed in double).
-TEST(MassSpringSimd, ModeBoundIsTheSameOnBothPathsAndBoundsEveryPoint) {
-  for (const auto& [rows, cols] : kGrids) {
-    SCOPED_TRACE(testing::Message() << rows << "x" << cols);
-    const MassSpringNetwork net = CurvedGridNetwork(rows, cols);
-    const std::size_t n = static_cast<std::size_t>(net.num_free);
-    const std::size_t stride = static_cast<std::size_t>(net.mode_stride);
-    std::vector<float> x(3 * stride, 0.0f);
-    for (std::size_t c = 0; c < 3; ++c) {
-      for (std::size_t k = 0; k < n; ++k) {
-        x[c * stride + k] = std::sin(1.7f * static_cast<float>(k) + static_cast<float>(c)) /
-                            static_cast<float>(1 + k);
-      }
-    }
-    const float avx = deform::internal::ModeBound(net, x.data(), true);
-    const float sse = deform::internal::ModeBound(net, x.data(), false);
-    EXPECT_EQ(std::memcmp(&avx, &sse, sizeof avx), 0);
-    double largest = 0.0, bound = 0.0;
-    for (std::size_t k = 0; k < n; ++k) {
-      const glm::dvec3 eta(x[k], x[stride + k], x[2 * stride + k]);
-      bound += double(net.mode_max_abs[k]) * glm::length(eta);
-    }
-    for (std::size_t a = 0; a < n; ++a) {
-      glm::dvec3 e(0.0);
-      for (std::size_t k = 0; k < n; ++k) {
-        const glm::dvec3 eta(x[k], x[stride + k], x[2 * stride + k]);
-        e += double(net.modes[a * n + k]) * eta;
-      }
-      largest = std::max(largest, glm::length(e));
-    }
-    EXPECT_NEAR(avx, bound, 1e-5 * bound);
-    EXPECT_LE(largest, bound * (1.0 + 1e-6));
-  }
-}
-
 // The job with the fastest kernel (AVX2 + FMA where the CPU has it) against the
 // portable one over 100 s of a gentle drive (no limit reached): FMA rounds once
 // where the exact kernels round twice, and the damped linear system keeps the

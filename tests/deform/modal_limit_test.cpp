@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstring>
 #include <random>
+#include <utility>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -43,6 +44,16 @@ std::vector<glm::dvec3> ToPoints(const MassSpringNetwork& net, const float* m) {
       for (std::size_t c = 0; c < 3; ++c)
         p[a][static_cast<int>(c)] += double(net.modes[a * n + k]) * double(m[c * stride + k]);
   return p;
+}
+
+// sum_k max_a |U[a, k]| |m_k| in double: the limit's per-mode bound.
+double DoubleModeBound(const MassSpringNetwork& net, const float* m) {
+  const std::size_t stride = static_cast<std::size_t>(net.mode_stride);
+  double bound = 0.0;
+  for (std::size_t k = 0; k < static_cast<std::size_t>(net.num_free); ++k) {
+    bound += net.mode_max_abs[k] * glm::length(glm::dvec3(m[k], m[stride + k], m[2 * stride + k]));
+  }
+  return bound;
 }
 
 float SumOfSquares(const MassSpringNetwork& net, const float* m) {
@@ -182,17 +193,39 @@ TEST(ModalDisplacementLimit, CheapExitsTouchNothing) {
   const Modal before = RandomState(net, rng, 0.05);
   Modal s = before;
   const float e_max = net.params.max_displacement;
-  const std::size_t stride = static_cast<std::size_t>(net.mode_stride);
-  double bound = 0.0;  // the per-mode bound, which must be what lets it exit
-  for (std::size_t k = 0; k < static_cast<std::size_t>(net.num_free); ++k) {
-    bound += net.mode_max_abs[k] * glm::length(glm::dvec3(s.x[k], s.x[stride + k], s.x[2 * stride + k]));
-  }
+  const double bound = DoubleModeBound(net, s.x);  // what must let it exit
   ASSERT_LT(bound, 0.9 * e_max);
   ASSERT_GT(SumOfSquares(net, s.x), 0.0f);
   EXPECT_EQ(ModalDisplacementLimit(net, 0.5f * e_max * e_max, s.x, s.v, true), 0);
   EXPECT_EQ(ModalDisplacementLimit(net, 1e30f, s.x, s.v, true), 0);  // the bound decides
   EXPECT_EQ(std::memcmp(s.x, before.x, sizeof s.x), 0);
   EXPECT_EQ(std::memcmp(s.v, before.v, sizeof s.v), 0);
+}
+
+// The limit's cheap exits as the kernels test them: ModeBound is the same on
+// both paths, and bounds every point's |e_a| (computed in double).
+TEST(ModalDisplacementLimit, ModeBoundIsTheSameOnBothPathsAndBoundsEveryPoint) {
+  for (const auto& [rows, cols] : {std::pair{3, 3}, {4, 4}, {5, 5}, {5, 8}, {6, 9}, {8, 8}, {16, 16}}) {
+    SCOPED_TRACE(testing::Message() << rows << "x" << cols);
+    const MassSpringNetwork net = testsupport::CurvedGridNetwork(rows, cols);
+    const std::size_t n = static_cast<std::size_t>(net.num_free);
+    const std::size_t stride = static_cast<std::size_t>(net.mode_stride);
+    Modal s;
+    for (std::size_t c = 0; c < 3; ++c) {
+      for (std::size_t k = 0; k < n; ++k) {
+        s.x[c * stride + k] = std::sin(1.7f * static_cast<float>(k) + static_cast<float>(c)) /
+                              static_cast<float>(1 + k);
+      }
+    }
+    const float avx = deform::internal::ModeBound(net, s.x, true);
+    const float sse = deform::internal::ModeBound(net, s.x, false);
+    EXPECT_EQ(std::memcmp(&avx, &sse, sizeof avx), 0);
+    const double bound = DoubleModeBound(net, s.x);
+    double largest = 0.0;
+    for (const glm::dvec3& e : ToPoints(net, s.x)) largest = std::max(largest, glm::length(e));
+    EXPECT_NEAR(avx, bound, 1e-5 * bound);
+    EXPECT_LE(largest, bound * (1.0 + 1e-6));
+  }
 }
 
 // The limit's two products on their own, for every stride (8 lanes, 16 with
