@@ -20,13 +20,16 @@
 
 namespace {
 
-deform::MassSpringNetwork MakeNetwork(int size, deform::MassSpringSolver solver) {
+// max_displacement: e_max (0: the default, half the spacing).
+deform::MassSpringNetwork MakeNetwork(int size, deform::MassSpringSolver solver,
+                                      float max_displacement = 0.0f) {
   std::vector<glm::vec3> pts;
   for (int i = 0; i < size; ++i)
     for (int j = 0; j < size; ++j)
       pts.emplace_back(6.0f * static_cast<float>(j), 0.0f, 6.0f * static_cast<float>(i));
   deform::MassSpringParams p;  // defaults: belly, f0 = 3 Hz, h = 1/240 s
   p.solver = solver;
+  p.max_displacement = max_displacement;
   auto net = deform::BuildMassSpringNetwork(
       {.rows = size, .cols = size, .rest_points = pts, .max_angular_speed_rad_s = 2.0f}, p);
   return std::move(net).value();
@@ -149,22 +152,65 @@ struct JumpClip {
   }
 };
 
+// Where a jump row's driving frames come from: the kinematics sampler at every
+// RK4 stage time, as the runner does with MassSpringStepJob::kinematics; or a
+// table of the same samples (mocap::SampleJointKinematics every h/2, made
+// before timing) read through the callback, which takes the sampler's cost out.
+enum class JumpDriving { kSampler, kTable };
+
+// The sampled frames of a clip every `half_step` seconds, for JumpDriving::kTable.
+std::vector<deform::DrivingFrame> JumpTable(const JumpClip& clip, double half_step) {
+  const int joint = clip.skel.FindJoint("Hips");
+  std::vector<deform::DrivingFrame> table(
+      static_cast<std::size_t>(clip.frames30 / 30.0 / half_step) + 3);
+  for (std::size_t i = 0; i < table.size(); ++i) {
+    mocap::JointKinematics k;
+    if (!mocap::SampleJointKinematics(clip.kin, clip.skel.num_joints(), joint, clip.frame_time_s,
+                                      static_cast<double>(i) * half_step, &k)) {
+      return {};
+    }
+    table[i] = deform::DrivingFrame{k.rotation, k.local_linear_acceleration,
+                                    k.local_angular_velocity, k.local_angular_acceleration};
+  }
+  return table;
+}
+
 // Driving frame sampled from the jump's per-frame kinematics (hips, 120 fps) at
 // every RK4 stage time, as mocap::SampleJointKinematics would; loops over the clip.
 // fma: MassSpringStepJob::allow_fma (the AVX2+FMA step; rounded differently, off by default).
-void BM_MassSpringSampled(benchmark::State& bench, int size, bool fma) {
-  const deform::MassSpringNetwork net = MakeNetwork(size, deform::MassSpringSolver::kModal);
+// The parts of a frame's time: `driving` kTable takes the sampler out; with
+// limit false, e_max is 1e6 cm, so the displacement limit never acts (its
+// cheap exits still run) and clamps_per_frame is 0.
+void BM_MassSpringSampled(benchmark::State& bench, int size, bool fma,
+                          JumpDriving driving = JumpDriving::kSampler, bool limit = true) {
+  const deform::MassSpringNetwork net =
+      MakeNetwork(size, deform::MassSpringSolver::kModal, limit ? 0.0f : 1e6f);
   deform::MassSpringState state;
   state.Resize(net);
   const JumpClip clip;
+  const double half_step = 0.5 * net.time_step_s;
+  const std::vector<deform::DrivingFrame> table =
+      driving == JumpDriving::kTable ? JumpTable(clip, half_step) : std::vector<deform::DrivingFrame>{};
+  if (driving == JumpDriving::kTable && table.empty()) {
+    bench.SkipWithError("sampling the jump failed");
+    return;
+  }
+  const std::function<deform::DrivingFrame(double)> from_table = [&table, half_step](double t) {
+    const long i = std::lround(t / half_step);
+    return table[static_cast<std::size_t>(std::clamp(i, 0L, static_cast<long>(table.size()) - 1))];
+  };
   std::vector<glm::vec3> disp(static_cast<std::size_t>(size * size));
   int frame = 0;
   for (auto _ : bench) {
-    const deform::MassSpringStepJob job{
+    deform::MassSpringStepJob job{
         .network = &net, .state = &state, .time_s = (frame++ % clip.frames30) / 30.0,
         .kinematics = clip.kin, .num_joints = clip.skel.num_joints(),
         .joint = clip.skel.FindJoint("Hips"), .frame_time_s = clip.frame_time_s,
         .displacements = disp, .allow_fma = fma};
+    if (driving == JumpDriving::kTable) {
+      job.kinematics = {};
+      job.driving = &from_table;
+    }
     benchmark::DoNotOptimize(job.Run());
     benchmark::DoNotOptimize(disp.data());
   }
@@ -310,6 +356,14 @@ BENCHMARK_CAPTURE(BM_MassSpringSampled, modal_5x5, 5, false);
 BENCHMARK_CAPTURE(BM_MassSpringSampled, modal_7x7, 7, false);
 BENCHMARK_CAPTURE(BM_MassSpringSampled, modal_5x5_fma, 5, true);
 BENCHMARK_CAPTURE(BM_MassSpringSampled, modal_7x7_fma, 7, true);
+BENCHMARK_CAPTURE(BM_MassSpringSampled, modal_5x5_from_table, 5, false, JumpDriving::kTable);
+BENCHMARK_CAPTURE(BM_MassSpringSampled, modal_7x7_from_table, 7, false, JumpDriving::kTable);
+BENCHMARK_CAPTURE(BM_MassSpringSampled, modal_5x5_no_limit, 5, false, JumpDriving::kSampler, false);
+BENCHMARK_CAPTURE(BM_MassSpringSampled, modal_7x7_no_limit, 7, false, JumpDriving::kSampler, false);
+BENCHMARK_CAPTURE(BM_MassSpringSampled, modal_5x5_from_table_no_limit, 5, false,
+                  JumpDriving::kTable, false);
+BENCHMARK_CAPTURE(BM_MassSpringSampled, modal_7x7_from_table_no_limit, 7, false,
+                  JumpDriving::kTable, false);
 BENCHMARK_CAPTURE(BM_DrivingSampler, hips_sample, "Hips", SamplerCall::kSample);
 BENCHMARK_CAPTURE(BM_DrivingSampler, hips_many_sse2, "Hips", SamplerCall::kSampleManySse2);
 BENCHMARK_CAPTURE(BM_DrivingSampler, hips_many, "Hips", SamplerCall::kSampleMany);
