@@ -37,13 +37,6 @@ bool SameBits(const std::vector<glm::vec3>& a, const std::vector<glm::vec3>& b) 
   return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(glm::vec3)) == 0;
 }
 
-// Grid sizes, their mode counts and lane groups: 3x3: 1 (a lone mode), 4x4: 4
-// (one padded 8-lane group), 5x5: 9 (a group and a lone mode beside it), 5x8:
-// 18 (two groups and a padded one), 6x9: 28, 8x8: 36 (three and four groups and
-// a padded one), 16x16: 196 (24 and a padded one). 7x7 (25: three groups and a
-// lone mode) is in BothPathsMatchTheScalarFormulation.
-constexpr std::pair<int, int> kGrids[] = {{3, 3}, {4, 4}, {5, 5}, {5, 8}, {6, 9}, {8, 8}, {16, 16}};
-
 // The exact kernels (SSE2 and AVX) step by step from the same states and
 // coefficients: the same bits, sums included.
 TEST(MassSpringSimd, ExactAvxAndSse2KernelsGiveTheSameBits) {
@@ -52,7 +45,7 @@ TEST(MassSpringSimd, ExactAvxAndSse2KernelsGiveTheSameBits) {
   const auto avx = deform::internal::SelectModalStep(ModalKernel::kExactAvx);
   const auto sse = deform::internal::SelectModalStep(ModalKernel::kPortable);
   ASSERT_NE(avx, sse);
-  for (const auto& [rows, cols] : kGrids) {
+  for (const auto& [rows, cols] : testsupport::kModalGrids) {
     SCOPED_TRACE(testing::Message() << rows << "x" << cols);
     const MassSpringNetwork net = CurvedGridNetwork(rows, cols);
     const std::size_t size = 3 * static_cast<std::size_t>(net.mode_stride);
@@ -119,7 +112,7 @@ TEST(MassSpringSimd, SeveralStepsGiveTheBitsOfOneStepAtATime) {
     const auto one = deform::internal::SelectModalStep(kernel);
     const auto several = deform::internal::SelectModalSteps(kernel);
     const bool bound_tested = kernel != ModalKernel::kFastest || !deform::internal::CpuHasAvx2Fma();
-    for (const auto& [rows, cols] : kGrids) {
+    for (const auto& [rows, cols] : testsupport::kModalGrids) {
       SCOPED_TRACE(testing::Message() << rows << "x" << cols << " kernel " << static_cast<int>(kernel));
       const MassSpringNetwork net = CurvedGridNetwork(rows, cols);
       const std::size_t size = 3 * static_cast<std::size_t>(net.mode_stride);
@@ -204,7 +197,7 @@ TEST(MassSpringSimd, FastestKernelFollowsThePortableOne) {
                         glm::vec3(150.0f * s, 60.0f * c, -40.0f * s * c), glm::vec3(0.2f, 0.8f * c, 0.1f),
                         glm::vec3(0.5f, -2.0f * s, 0.3f * c)};
   };
-  for (const auto& [rows, cols] : kGrids) {
+  for (const auto& [rows, cols] : testsupport::kModalGrids) {
     SCOPED_TRACE(testing::Message() << rows << "x" << cols);
     const MassSpringNetwork net = CurvedGridNetwork(rows, cols);
     MassSpringState fast, portable;

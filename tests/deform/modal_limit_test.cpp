@@ -9,7 +9,6 @@
 #include <cmath>
 #include <cstring>
 #include <random>
-#include <utility>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -205,7 +204,7 @@ TEST(ModalDisplacementLimit, CheapExitsTouchNothing) {
 // The limit's cheap exits as the kernels test them: ModeBound is the same on
 // both paths, and bounds every point's |e_a| (computed in double).
 TEST(ModalDisplacementLimit, ModeBoundIsTheSameOnBothPathsAndBoundsEveryPoint) {
-  for (const auto& [rows, cols] : {std::pair{3, 3}, {4, 4}, {5, 5}, {5, 8}, {6, 9}, {8, 8}, {16, 16}}) {
+  for (const auto& [rows, cols] : testsupport::kModalGrids) {
     SCOPED_TRACE(testing::Message() << rows << "x" << cols);
     const MassSpringNetwork net = testsupport::CurvedGridNetwork(rows, cols);
     const std::size_t n = static_cast<std::size_t>(net.num_free);

@@ -13,6 +13,14 @@
 
 namespace testsupport {
 
+// Grid sizes, their mode counts and lane groups: 3x3: 1 (a lone mode), 4x4: 4
+// (one padded 8-lane group), 5x5: 9 (a group and a lone mode beside it), 5x8:
+// 18 (two groups and a padded one), 6x9: 28, 8x8: 36 (three and four groups and
+// a padded one), 16x16: 196 (24 and a padded one). 7x7 (25: three groups and a
+// lone mode) is in MassSpringSimd.BothPathsMatchTheScalarFormulation.
+inline constexpr std::pair<int, int> kModalGrids[] = {{3, 3}, {4, 4}, {5, 5}, {5, 8},
+                                                      {6, 9}, {8, 8}, {16, 16}};
+
 inline deform::MassSpringNetwork CurvedGridNetwork(int rows, int cols,
                                                    const deform::MassSpringParams& params = {}) {
   std::vector<glm::vec3> points;
