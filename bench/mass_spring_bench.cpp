@@ -61,6 +61,16 @@ void BM_MassSpringCallback(benchmark::State& bench, int size, deform::MassSpring
   bench.counters["paper_updates_per_s"] = size == 5 ? 1122.0 : 400.0;
 }
 
+// A driving callback that reads `table` (frames every `half_step` seconds from
+// t = 0) at the entry nearest t, clamped to its ends; `table` must outlive it.
+std::function<deform::DrivingFrame(double)> TableDriving(const std::vector<deform::DrivingFrame>& table,
+                                                         double half_step) {
+  return [&table, half_step](double t) {
+    const long i = std::lround(t / half_step);
+    return table[static_cast<std::size_t>(std::clamp(i, 0L, static_cast<long>(table.size()) - 1))];
+  };
+}
+
 // The Callback row's motion read from a table made before timing (every h/2 over
 // 10 s, the clip looped): the same job with the bench's own sin/cos and most of
 // its callback cost taken out, to show the elastic layer's share alone. Labelled
@@ -79,10 +89,7 @@ void BM_MassSpringTable(benchmark::State& bench, int size) {
                                     glm::vec3(300.0f * s, 100.0f * c, 0), glm::vec3(0, 1.4f * c, 0),
                                     glm::vec3(0, -9.8f * s, 0)};
   }
-  const std::function<deform::DrivingFrame(double)> drive = [&table, half_step](double t) {
-    const long i = std::lround(t / half_step);
-    return table[static_cast<std::size_t>(std::clamp(i, 0L, static_cast<long>(table.size()) - 1))];
-  };
+  const std::function<deform::DrivingFrame(double)> drive = TableDriving(table, half_step);
   std::vector<glm::vec3> disp(static_cast<std::size_t>(size * size));
   int frame = 0;
   for (auto _ : bench) {
@@ -139,6 +146,7 @@ void BM_MassSpringAtRest(benchmark::State& bench, int size) {
 // The generated jump at 120 fps and its per-frame kinematics.
 struct JumpClip {
   mocap::Skeleton skel = mocap::MakeHumanoidSkeleton();
+  int hips = skel.FindJoint("Hips");  // the rows' driving joint
   double frame_time_s = 1.0 / 120;
   std::vector<mocap::JointKinematics> kin;
   int frames30 = 0;  // whole 30 fps frames in the clip
@@ -160,12 +168,11 @@ enum class JumpDriving { kSampler, kTable };
 
 // The sampled frames of a clip every `half_step` seconds, for JumpDriving::kTable.
 std::vector<deform::DrivingFrame> JumpTable(const JumpClip& clip, double half_step) {
-  const int joint = clip.skel.FindJoint("Hips");
   std::vector<deform::DrivingFrame> table(
       static_cast<std::size_t>(clip.frames30 / 30.0 / half_step) + 3);
   for (std::size_t i = 0; i < table.size(); ++i) {
     mocap::JointKinematics k;
-    if (!mocap::SampleJointKinematics(clip.kin, clip.skel.num_joints(), joint, clip.frame_time_s,
+    if (!mocap::SampleJointKinematics(clip.kin, clip.skel.num_joints(), clip.hips, clip.frame_time_s,
                                       static_cast<double>(i) * half_step, &k)) {
       return {};
     }
@@ -195,21 +202,20 @@ void BM_MassSpringSampled(benchmark::State& bench, int size, bool fma,
     bench.SkipWithError("sampling the jump failed");
     return;
   }
-  const std::function<deform::DrivingFrame(double)> from_table = [&table, half_step](double t) {
-    const long i = std::lround(t / half_step);
-    return table[static_cast<std::size_t>(std::clamp(i, 0L, static_cast<long>(table.size()) - 1))];
-  };
+  const std::function<deform::DrivingFrame(double)> from_table = TableDriving(table, half_step);
   std::vector<glm::vec3> disp(static_cast<std::size_t>(size * size));
   int frame = 0;
   for (auto _ : bench) {
-    deform::MassSpringStepJob job{
-        .network = &net, .state = &state, .time_s = (frame++ % clip.frames30) / 30.0,
-        .kinematics = clip.kin, .num_joints = clip.skel.num_joints(),
-        .joint = clip.skel.FindJoint("Hips"), .frame_time_s = clip.frame_time_s,
-        .displacements = disp, .allow_fma = fma};
+    deform::MassSpringStepJob job{.network = &net, .state = &state,
+                                  .time_s = (frame++ % clip.frames30) / 30.0,
+                                  .displacements = disp, .allow_fma = fma};
     if (driving == JumpDriving::kTable) {
-      job.kinematics = {};
       job.driving = &from_table;
+    } else {
+      job.kinematics = clip.kin;
+      job.num_joints = clip.skel.num_joints();
+      job.joint = clip.hips;
+      job.frame_time_s = clip.frame_time_s;
     }
     benchmark::DoNotOptimize(job.Run());
     benchmark::DoNotOptimize(disp.data());
@@ -230,6 +236,7 @@ enum class SamplerCall { kSample, kSampleManySse2, kSampleMany };
 // leg (turning: the slerp's sines), looping over the clip.
 void BM_DrivingSampler(benchmark::State& bench, const char* joint, SamplerCall call) {
   const JumpClip clip;
+  const int joint_index = clip.skel.FindJoint(joint);
   const double h = 1.0 / 240;
   int frame = 0;
   double times[16];
@@ -241,7 +248,7 @@ void BM_DrivingSampler(benchmark::State& bench, const char* joint, SamplerCall c
       times[2 * i + 1] = t + h;
     }
     deform::internal::KinematicsDrivingSampler sampler(clip.kin, clip.skel.num_joints(),
-                                                       clip.skel.FindJoint(joint), clip.frame_time_s);
+                                                       joint_index, clip.frame_time_s);
     if (call == SamplerCall::kSample) {
       for (int i = 0; i < 16; ++i) out[i] = sampler.Sample(times[i]);
     } else {
