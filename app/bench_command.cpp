@@ -35,13 +35,13 @@
 #include "app/frame_render.h"
 #include "app/motion_source.h"
 #include "app/pipeline.h"
-#include "deform/patch_binding.h"
-#include "deform/skinning_job.h"
+#include "deform/patch/patch_binding.h"
+#include "deform/global/skinning_job.h"
 #include "mocap/bvh_reader.h"
 #include "mocap/bvh_writer.h"
 #include "mocap/synthetic.h"
-#include "render/async_writer.h"
-#include "render/image_io.h"
+#include "render/output/async_writer.h"
+#include "render/output/image_io.h"
 
 #ifndef PATCHSKIN_BUILD_TYPE
 #define PATCHSKIN_BUILD_TYPE "unknown"

@@ -8,12 +8,12 @@
 
 #include <glm/gtc/quaternion.hpp>
 
-#include "deform/direct_manipulation.h"
-#include "deform/mass_spring.h"
+#include "deform/shapes/direct_manipulation.h"
+#include "deform/elastic/mass_spring.h"
 #include "deform/mesh.h"
-#include "deform/patch_binding.h"
-#include "deform/patch_fit.h"
-#include "deform/pose_space.h"
+#include "deform/patch/patch_binding.h"
+#include "deform/patch/patch_fit.h"
+#include "deform/shapes/pose_space.h"
 
 namespace app::bench {
 namespace {

@@ -5,7 +5,7 @@
 // vertices, and the total (one update + one rebuild), each per second of the
 // thread's CPU time. Regions are generated open tubes (200 degrees of a
 // cylinder, radius 4, height 20) with the paper's vertex counts, fitted and
-// bound as the rig's patches are (deform/patch_fit.h, deform/patch_binding.h).
+// bound as the rig's patches are (deform/patch/patch_fit.h, deform/patch/patch_binding.h).
 
 #include "app/bench_timing.h"
 #include "mocap/error.h"

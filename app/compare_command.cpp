@@ -5,8 +5,8 @@
 
 #include <CLI/CLI.hpp>
 
-#include "render/image_compare.h"
-#include "render/image_io.h"
+#include "render/output/image_compare.h"
+#include "render/output/image_io.h"
 
 namespace app {
 namespace {

@@ -7,11 +7,11 @@
 #include <vector>
 
 #include "app/motion_source.h"
-#include "deform/mass_spring.h"
+#include "deform/elastic/mass_spring.h"
 #include "mocap/kinematics.h"
 #include "mocap/synthetic.h"
-#include "render/image_io.h"
-#include "render/plot.h"
+#include "render/output/image_io.h"
+#include "render/output/plot.h"
 
 namespace app {
 namespace {

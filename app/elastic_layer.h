@@ -1,6 +1,6 @@
 #pragma once
 // The elastic layer dE of the per-frame pipeline (ALGORITHMS.md 0 step 2 and
-// 6): one damped mass-spring network (deform/mass_spring.h) per elastic patch,
+// 6): one damped mass-spring network (deform/elastic/mass_spring.h) per elastic patch,
 // driven by the kinematics of its driving joint, its state carried from frame
 // to frame.
 //
@@ -21,8 +21,8 @@
 
 #include <glm/glm.hpp>
 
-#include "deform/mass_spring.h"
-#include "deform/patch_layer.h"
+#include "deform/elastic/mass_spring.h"
+#include "deform/patch/patch_layer.h"
 #include "mocap/error.h"
 #include "mocap/kinematics.h"
 

@@ -17,10 +17,10 @@
 #include "app/progress.h"
 #include "app/rig_file.h"
 #include "app/rig_setup.h"
-#include "deform/file_output.h"
-#include "deform/gltf_export.h"
-#include "deform/obj_writer.h"
-#include "render/image_io.h"
+#include "deform/io/file_output.h"
+#include "deform/io/gltf_export.h"
+#include "deform/io/obj_writer.h"
+#include "render/output/image_io.h"
 
 namespace app {
 namespace {

@@ -8,10 +8,10 @@
 // (app/rig_setup.h): the export is the layered mesh, i.e. the right half of a
 // split render. Outputs:
 //   * --out ending in .obj (with a #### placeholder): one OBJ per frame
-//     (deform/obj_writer.h), written as the frames are evaluated; one frame is
+//     (deform/io/obj_writer.h), written as the frames are evaluated; one frame is
 //     held in memory whatever the frame count;
 //   * --out ending in .glb: one glTF 2.0 file with the deformation as a
-//     morph-target animation or baked per-frame meshes (deform/gltf_export.h).
+//     morph-target animation or baked per-frame meshes (deform/io/gltf_export.h).
 // --with-camera also writes camera_####.json per frame next to the output: the
 // camera `render` would use for that frame (see CameraJson).
 

@@ -14,7 +14,7 @@
 #include "app/frame_plan.h"
 #include "app/motion_source.h"
 #include "app/rig_file.h"
-#include "render/image_io.h"
+#include "render/output/image_io.h"
 
 extern char** environ;
 

@@ -2,7 +2,7 @@
 
 #include <utility>
 
-#include "render/overlay.h"
+#include "render/raster/overlay.h"
 
 namespace app {
 namespace {

@@ -9,8 +9,8 @@
 
 #include "app/motion_source.h"
 #include "app/pipeline.h"
-#include "deform/rig_artifacts.h"
-#include "deform/swd_rig.h"
+#include "deform/global/rig_artifacts.h"
+#include "deform/global/swd_rig.h"
 #include "mocap/joint_angles.h"
 #include "mocap/pose.h"
 

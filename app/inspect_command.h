@@ -5,7 +5,7 @@
 // file's own units and axes unless --scale / --y-up ask otherwise. The JSON
 // schema is documented in the README ("inspect --json"). With --artifacts it
 // prints the collapse and candy-wrapper figures of SSD, DQS and SWD on the
-// file's body (deform/rig_artifacts.h) instead.
+// file's body (deform/global/rig_artifacts.h) instead.
 
 #include <optional>
 #include <string>

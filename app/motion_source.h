@@ -8,7 +8,7 @@
 #include <string_view>
 #include <vector>
 
-#include "deform/gltf_import.h"
+#include "deform/io/gltf_import.h"
 #include "mocap/error.h"
 #include "mocap/motion.h"
 #include "mocap/skeleton.h"

@@ -8,11 +8,11 @@
 #include <thread>
 
 #include "app/motion_source.h"
-#include "deform/bind_pose.h"
-#include "deform/dqs_job.h"
-#include "deform/skinning_job.h"
-#include "deform/swd_job.h"
-#include "deform/swd_rig.h"
+#include "deform/body/bind_pose.h"
+#include "deform/global/dqs_job.h"
+#include "deform/global/skinning_job.h"
+#include "deform/global/swd_job.h"
+#include "deform/global/swd_rig.h"
 #include "mocap/bvh_reader.h"
 #include "mocap/pose.h"
 #include "mocap/sampling.h"

@@ -20,10 +20,10 @@
 #include <glm/glm.hpp>
 
 #include "app/elastic_layer.h"
-#include "deform/example_shapes.h"
-#include "deform/mannequin.h"
+#include "deform/shapes/example_shapes.h"
+#include "deform/body/mannequin.h"
 #include "deform/mesh.h"
-#include "deform/patch_layer.h"
+#include "deform/patch/patch_layer.h"
 #include "mocap/error.h"
 #include "mocap/motion.h"
 #include "mocap/skeleton.h"

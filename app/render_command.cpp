@@ -22,15 +22,15 @@
 #include "app/rig_file.h"
 #include "app/rig_patches.h"
 #include "app/rig_setup.h"
-#include "render/async_writer.h"
+#include "render/output/async_writer.h"
 #include "render/camera.h"
-#include "render/contact_sheet.h"
-#include "render/image_io.h"
-#include "render/overlay.h"
+#include "render/output/contact_sheet.h"
+#include "render/output/image_io.h"
+#include "render/raster/overlay.h"
 #include "render/renderer.h"
-#include "render/serial_task_queue.h"
-#include "render/stored_image.h"
-#include "render/video_writer.h"
+#include "render/output/serial_task_queue.h"
+#include "render/output/stored_image.h"
+#include "render/output/video_writer.h"
 
 namespace app {
 namespace {
@@ -394,7 +394,7 @@ int RunRender(const RenderOptions& options) {
   Progress progress(demo ? "render demo" : "render " + name, static_cast<int>(num_frames), o.quiet);
   render::Image image, right_image;
   int next_sheet = 0;
-  // The sheet gets every frame as its file will read back (render/stored_image.h),
+  // The sheet gets every frame as its file will read back (render/output/stored_image.h),
   // so a --resume that rebuilds it from finished frames on disk gives the same
   // bytes; formats whose round trip is not modelled (JPEG) use the frame as is.
   const mocap::Result<render::ImageFormat> frame_format = render::ImageFormatFromPath(pattern);

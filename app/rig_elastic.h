@@ -14,7 +14,7 @@
 #include <optional>
 #include <string>
 
-#include "deform/mass_spring.h"
+#include "deform/elastic/mass_spring.h"
 #include "mocap/error.h"
 
 namespace app {

@@ -5,9 +5,9 @@
 
 #include "app/pipeline.h"
 #include "app/rig_file.h"
-#include "deform/dqs_job.h"
-#include "deform/example_shapes.h"
-#include "deform/skinning_job.h"
+#include "deform/global/dqs_job.h"
+#include "deform/shapes/example_shapes.h"
+#include "deform/global/skinning_job.h"
 #include "mocap/pose.h"
 
 namespace app {

@@ -11,7 +11,7 @@
 // The rig file parser (rig_file.cpp) fills RigPatch::examples and
 // RigPatch::pose_space through app/internal/rig_examples_parse.h; this header
 // turns them into each patch's fitted pose space on a loaded character
-// (deform/example_shapes.h, deform/pose_space.h).
+// (deform/shapes/example_shapes.h, deform/shapes/pose_space.h).
 
 #include <string>
 #include <utility>

@@ -3,9 +3,9 @@
 #include <optional>
 #include <string>
 
-#include "deform/patch_region.h"
+#include "deform/patch/patch_region.h"
 #include "render/camera.h"
-#include "render/region_select.h"
+#include "render/raster/region_select.h"
 
 namespace app {
 namespace {

@@ -7,9 +7,9 @@
 #include <vector>
 
 #include "app/frame_plan.h"
-#include "render/contact_sheet.h"
-#include "render/image_io.h"
-#include "render/video_writer.h"
+#include "render/output/contact_sheet.h"
+#include "render/output/image_io.h"
+#include "render/output/video_writer.h"
 
 namespace app {
 namespace {

@@ -28,8 +28,8 @@
 #include "app/rig_examples.h"
 #include "app/rig_file.h"
 #include "app/rig_patches.h"
-#include "deform/example_shapes.h"
-#include "deform/skinning_job.h"
+#include "deform/shapes/example_shapes.h"
+#include "deform/global/skinning_job.h"
 #include "mocap/pose.h"
 
 namespace {

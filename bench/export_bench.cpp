@@ -9,8 +9,8 @@
 
 #include <benchmark/benchmark.h>
 
-#include "deform/gltf_export.h"
-#include "deform/obj_writer.h"
+#include "deform/io/gltf_export.h"
+#include "deform/io/obj_writer.h"
 
 namespace {
 

@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "deform/gltf_import.h"
+#include "deform/io/gltf_import.h"
 
 namespace {
 

@@ -9,8 +9,8 @@
 #include <filesystem>
 #include <string>
 
-#include "render/async_writer.h"
-#include "render/image_io.h"
+#include "render/output/async_writer.h"
+#include "render/output/image_io.h"
 
 namespace {
 

@@ -42,7 +42,7 @@
 #include "bench/body_scene.h"
 #include "render/camera.h"
 #include "render/renderer.h"
-#include "render/shading.h"
+#include "render/raster/shading.h"
 
 namespace {
 

@@ -12,9 +12,9 @@
 
 #include <benchmark/benchmark.h>
 
-#include "deform/internal/driving_sampler.h"
-#include "deform/internal/mass_spring_modal.h"
-#include "deform/mass_spring.h"
+#include "deform/elastic/internal/driving_sampler.h"
+#include "deform/elastic/internal/mass_spring_modal.h"
+#include "deform/elastic/mass_spring.h"
 #include "mocap/kinematics.h"
 #include "mocap/synthetic.h"
 
@@ -229,7 +229,7 @@ void BM_MassSpringSampled(benchmark::State& bench, int size, bool fma,
 // How the driving sampler is called.
 enum class SamplerCall { kSample, kSampleManySse2, kSampleMany };
 
-// The kinematics sampler alone (deform/internal/driving_sampler.h), one output
+// The kinematics sampler alone (deform/elastic/internal/driving_sampler.h), one output
 // frame's worth per iteration as ModalRunner::Steps asks for it: a new sampler,
 // then the 16 RK4 stage times of 8 steps at h = 1/240 s. `joint` of the jump
 // at 120 fps: the hips (no turn: the slerp's nearly-equal lerp) or the left

@@ -9,8 +9,8 @@
 
 #include <vector>
 
-#include "deform/patch_binding.h"
-#include "deform/patch_fit.h"
+#include "deform/patch/patch_binding.h"
+#include "deform/patch/patch_fit.h"
 #include "support/patch_meshes.h"
 
 namespace {

@@ -1,4 +1,4 @@
-// Patch layer benchmark on the mannequin (tests/deform/patch_layer_fixture.h):
+// Patch layer benchmark on the mannequin (tests/support/patch_layer_fixture.h):
 // the left elbow and knee patches at the 120 degree bend. Reports, one core:
 //  - CarryAndRebuild/<patch>: one patch's per-frame work (carry its control
 //    points by SSD, rebuild its bound vertices), bound vertices per second;
@@ -11,7 +11,7 @@
 
 #include <vector>
 
-#include "deform/patch_layer_fixture.h"
+#include "support/patch_layer_fixture.h"
 
 namespace {
 

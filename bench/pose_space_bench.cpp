@@ -15,8 +15,8 @@
 #include <random>
 #include <vector>
 
-#include "deform/direct_manipulation.h"
-#include "deform/pose_space.h"
+#include "deform/shapes/direct_manipulation.h"
+#include "deform/shapes/pose_space.h"
 
 namespace {
 

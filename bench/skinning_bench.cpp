@@ -9,8 +9,8 @@
 #include <benchmark/benchmark.h>
 #include <glm/gtc/matrix_transform.hpp>
 
-#include "deform/dqs_job.h"
-#include "deform/skinning_job.h"
+#include "deform/global/dqs_job.h"
+#include "deform/global/skinning_job.h"
 
 namespace {
 

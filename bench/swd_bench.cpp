@@ -12,8 +12,8 @@
 #include <glm/glm.hpp>
 #include <glm/gtc/quaternion.hpp>
 
-#include "deform/swd_job.h"
-#include "deform/sweep.h"
+#include "deform/global/swd_job.h"
+#include "deform/global/sweep.h"
 
 namespace {
 

@@ -47,7 +47,7 @@ struct SkinWeights {
 // skeleton joint each skin joint is, with the inverse bind matrices
 // (bind_from_joint maps model-space bind positions into the joint's frame).
 // Where a generated body's vertex came from: the body chain whose tube holds it
-// (index into BuildBodyChains' chains, deform/body_chains.h) and its ring's chain
+// (index into BuildBodyChains' chains, deform/body/body_chains.h) and its ring's chain
 // coordinate u = k + t (on bone k, points k -> k+1, t in [0, 1]; caps carry their end
 // ring's u). chain = -1: not on a tube (the mannequin's head).
 struct BodyChainCoord {

@@ -9,7 +9,7 @@
 #include <cstdint>
 #include <span>
 
-#include "deform/gltf_import.h"
+#include "deform/io/gltf_import.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   deform::GltfReadOptions options;

@@ -13,7 +13,7 @@
 #endif
 
 #include "render/internal/parallel.h"
-#include "render/shading4.h"
+#include "render/raster/shading4.h"
 
 namespace render {
 namespace {

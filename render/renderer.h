@@ -20,14 +20,14 @@
 #include <glm/glm.hpp>
 
 #include "mocap/error.h"
-#include "render/background_fill.h"
+#include "render/raster/background_fill.h"
 #include "render/camera.h"
-#include "render/ground_shader.h"
+#include "render/raster/ground_shader.h"
 #include "render/image.h"
-#include "render/overlay.h"
-#include "render/rasterizer.h"
-#include "render/shading.h"
-#include "render/shading4.h"
+#include "render/raster/overlay.h"
+#include "render/raster/rasterizer.h"
+#include "render/raster/shading.h"
+#include "render/raster/shading4.h"
 
 namespace render {
 

@@ -6,12 +6,12 @@
 #include <cstdlib>
 #include <vector>
 
-#include "deform/mannequin.h"
-#include "deform/skinning_job.h"
+#include "deform/body/mannequin.h"
+#include "deform/global/skinning_job.h"
 #include "mocap/bvh_reader.h"
 #include "mocap/pose.h"
 #include "render/camera.h"
-#include "render/image_io.h"
+#include "render/output/image_io.h"
 #include "render/renderer.h"
 
 namespace {

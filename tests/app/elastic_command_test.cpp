@@ -11,7 +11,7 @@
 
 #include <gtest/gtest.h>
 
-#include "render/image_io.h"
+#include "render/output/image_io.h"
 #include "support/data_paths.h"
 
 namespace {

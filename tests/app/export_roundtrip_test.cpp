@@ -1,5 +1,5 @@
 // `patchskin export` read back with the project's own importer
-// (deform/gltf_import.h, morph targets and rigid mesh nodes; GltfMeshSampler):
+// (deform/io/gltf_import.h, morph targets and rigid mesh nodes; GltfMeshSampler):
 // a patch rig and a plain BVH, each exported over several frames, give back at
 // every key time the vertices the pipeline computed for that frame, and the
 // key times are frame / fps. The OBJ of a patch rig, drawn with its camera
@@ -18,9 +18,9 @@
 #include "app/pipeline.h"
 #include "app/rig_file.h"
 #include "app/rig_setup.h"
-#include "deform/gltf_import.h"
-#include "deform/gltf_mesh_sampler.h"
-#include "render/image_io.h"
+#include "deform/io/gltf_import.h"
+#include "deform/io/gltf_mesh_sampler.h"
+#include "render/output/image_io.h"
 #include "render/renderer.h"
 #include "support/data_paths.h"
 #include "support/exported_geometry.h"

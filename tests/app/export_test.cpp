@@ -18,7 +18,7 @@
 #include "app/frame_plan.h"
 #include "app/motion_source.h"
 #include "app/pipeline.h"
-#include "render/image_io.h"
+#include "render/output/image_io.h"
 #include "render/renderer.h"
 #include "support/data_paths.h"
 #include "support/exported_geometry.h"

@@ -20,7 +20,7 @@
 #include "app/character_motion.h"
 #include "app/motion_source.h"
 #include "app/pipeline.h"
-#include "render/image_io.h"
+#include "render/output/image_io.h"
 #include "support/data_paths.h"
 #include "support/gltf_writer.h"
 #include "support/run_process.h"

@@ -1,4 +1,4 @@
-// Newton's polar iteration in lanes (deform/polar_rotation_lanes.h) on real
+// Newton's polar iteration in lanes (deform/shapes/polar_rotation_lanes.h) on real
 // blends: every control point of the shoulder demo's patch
 // (samples/data/shoulder.json, 9x6, three bones for most points) at every
 // 3rd frame of shoulder.bvh. The double lanes give the scalar iteration's
@@ -14,10 +14,10 @@
 
 #include <glm/gtc/quaternion.hpp>
 
-#include "deform/direct_manipulation.h"
-#include "deform/polar_rotation.h"
-#include "deform/polar_rotation_lanes.h"
-#include "deform/skinning_job.h"
+#include "deform/shapes/direct_manipulation.h"
+#include "deform/shapes/polar_rotation.h"
+#include "deform/shapes/polar_rotation_lanes.h"
+#include "deform/global/skinning_job.h"
 #include "mocap/pose.h"
 #include "support/example_demos.h"
 #include "support/tolerances.h"

@@ -12,7 +12,7 @@
 
 #include "app/motion_source.h"
 #include "app/rig_patches.h"
-#include "render/image_io.h"
+#include "render/output/image_io.h"
 #include "support/data_paths.h"
 
 namespace {

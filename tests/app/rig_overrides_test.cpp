@@ -12,7 +12,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include "render/image_io.h"
+#include "render/output/image_io.h"
 #include "support/data_paths.h"
 #include "support/run_process.h"
 

@@ -17,7 +17,7 @@
 #include "app/pipeline.h"
 #include "app/rig_file.h"
 #include "app/rig_patches.h"
-#include "render/image_io.h"
+#include "render/output/image_io.h"
 #include "support/data_paths.h"
 #include "support/run_process.h"
 #include "support/tolerances.h"

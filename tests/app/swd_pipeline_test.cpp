@@ -24,8 +24,8 @@
 
 #include "app/motion_source.h"
 #include "app/pipeline.h"
-#include "deform/skinning_job.h"
-#include "deform/swd_rig.h"
+#include "deform/global/skinning_job.h"
+#include "deform/global/swd_rig.h"
 #include "mocap/synthetic.h"
 #include "support/data_paths.h"
 #include "support/tolerances.h"

@@ -18,7 +18,7 @@
 #include <cmath>
 #include <numbers>
 
-#include "deform/patch_layer_fixture.h"
+#include "support/patch_layer_fixture.h"
 #include "render/camera.h"
 #include "render/image.h"
 #include "render/renderer.h"

@@ -7,9 +7,9 @@
 #include <optional>
 #include <vector>
 
-#include "deform/bspline.h"
-#include "deform/patch_binding.h"
-#include "deform/patch_fit.h"
+#include "deform/patch/bspline.h"
+#include "deform/patch/patch_binding.h"
+#include "deform/patch/patch_fit.h"
 #include "support/patch_meshes.h"
 
 namespace testsupport {

@@ -8,7 +8,7 @@
 
 #include <gtest/gtest.h>
 
-#include "render/image_io.h"
+#include "render/output/image_io.h"
 
 namespace testsupport {
 namespace {

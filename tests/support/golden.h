@@ -19,7 +19,7 @@
 #include <string>
 
 #include "render/image.h"
-#include "render/image_compare.h"
+#include "render/output/image_compare.h"
 
 namespace testsupport {
 

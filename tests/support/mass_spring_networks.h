@@ -9,7 +9,7 @@
 #include <glm/glm.hpp>
 #include <gtest/gtest.h>
 
-#include "deform/mass_spring.h"
+#include "deform/elastic/mass_spring.h"
 
 namespace testsupport {
 

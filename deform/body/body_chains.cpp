@@ -1,0 +1,261 @@
+#include "deform/body/body_chains.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "deform/mesh.h"
+
+namespace deform {
+
+using mocap::ErrorCode;
+using mocap::MakeError;
+
+namespace {
+constexpr float kMergeFraction = 1e-4f;
+// Two subtrees whose total bone lengths differ by less than this fraction (of the
+// longer) can be a mirror pair; captured left and right limbs differ by a few percent.
+constexpr float kMirrorLengthTolerance = 0.2f;
+
+// Total bone length of the subtree under `child`, including the bone into it.
+float SubtreeLength(const std::vector<BodyPoint>& pts, int child) {
+  float total = 0.0f;
+  std::vector<int> stack = {child};
+  while (!stack.empty()) {
+    const BodyPoint& p = pts[static_cast<std::size_t>(stack.back())];
+    stack.pop_back();
+    total += glm::distance(p.pos, pts[static_cast<std::size_t>(p.parent)].pos);
+    for (int g : p.children) stack.push_back(g);
+  }
+  return total;
+}
+
+// Per child of one point: 1 when it belongs to a mirror pair, a sibling whose subtree has
+// as many points and about the same total bone length (left and right arm or leg). A
+// pose-independent test: it reads bone lengths and topology only, never directions, so
+// arms raised beside the head or legs lying along the spine in a rest pose change
+// nothing. When every child is paired (a fork into two equal halves) none is marked.
+std::vector<std::uint8_t> MirrorPaired(const std::vector<BodyPoint>& pts,
+                                       const std::vector<int>& children) {
+  const std::size_t n = children.size();
+  std::vector<std::uint8_t> paired(n, 0);
+  std::vector<float> length(n);
+  for (std::size_t i = 0; i < n; ++i) length[i] = SubtreeLength(pts, children[i]);
+  for (std::size_t a = 0; a < n; ++a) {
+    for (std::size_t b = a + 1; b < n; ++b) {
+      const BodyPoint& pa = pts[static_cast<std::size_t>(children[a])];
+      const BodyPoint& pb = pts[static_cast<std::size_t>(children[b])];
+      const float longer = std::max(length[a], length[b]);
+      if (pa.descendants == pb.descendants &&
+          std::abs(length[a] - length[b]) <= kMirrorLengthTolerance * longer) {
+        paired[a] = paired[b] = 1;
+      }
+    }
+  }
+  if (std::find(paired.begin(), paired.end(), std::uint8_t{0}) == paired.end()) {
+    std::fill(paired.begin(), paired.end(), std::uint8_t{0});
+  }
+  return paired;
+}
+}  // namespace
+
+mocap::Result<BodyChains> BuildBodyChains(const mocap::Skeleton& skeleton,
+                                          std::span<const glm::mat4> rest_model_from_joint,
+                                          float min_branch_extent) {
+  const int nj = skeleton.num_joints();
+  if (rest_model_from_joint.size() != static_cast<std::size_t>(nj)) {
+    return MakeError(ErrorCode::kCountMismatch, {},
+                     "mannequin needs one rest matrix per joint: expected " + std::to_string(nj) +
+                         ", found " + std::to_string(rest_model_from_joint.size()));
+  }
+  if (nj == 0) return MakeError(ErrorCode::kInvalidArgument, {}, "skeleton has no joints");
+  std::vector<glm::vec3> joint_pos(static_cast<std::size_t>(nj));
+  Bounds bounds;
+  for (int j = 0; j < nj; ++j) {
+    const int p = skeleton.parents[static_cast<std::size_t>(j)];
+    if (p < mocap::kNoParent || p >= j) {
+      return MakeError(ErrorCode::kInvalidArgument, {},
+                       "joint " + std::to_string(j) + " has parent " + std::to_string(p) +
+                           ", expected a parent listed before it");
+    }
+    const glm::mat4& m = rest_model_from_joint[static_cast<std::size_t>(j)];
+    for (int c = 0; c < 4; ++c) {
+      for (int r = 0; r < 4; ++r) {
+        if (!std::isfinite(m[c][r])) {
+          return MakeError(ErrorCode::kNonFinite, {},
+                           "rest matrix of joint '" + skeleton.names[static_cast<std::size_t>(j)] +
+                               "' is not finite");
+        }
+      }
+    }
+    joint_pos[static_cast<std::size_t>(j)] = glm::vec3(m[3]);
+    bounds.Extend(glm::vec3(m[3]));
+  }
+  std::vector<std::pair<int, glm::vec3>> end_sites;  // parent joint, model position
+  for (const mocap::EndSite& e : skeleton.end_sites) {
+    if (e.parent < 0 || e.parent >= nj) continue;
+    const glm::vec3 p(rest_model_from_joint[static_cast<std::size_t>(e.parent)] *
+                      glm::vec4(e.offset, 1.0f));
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) continue;
+    end_sites.emplace_back(e.parent, p);
+    bounds.Extend(p);
+  }
+  const glm::vec3 extent = bounds.size();
+  const float raw_size = std::max({extent.x, extent.y, extent.z});
+  if (!(raw_size > 0.0f) || !std::isfinite(raw_size)) {
+    return MakeError(ErrorCode::kInvalidArgument, {},
+                     "skeleton has no bone of non-zero length (all joints at one point); "
+                     "cannot build a mannequin");
+  }
+  const float merge_dist = kMergeFraction * raw_size;
+
+  // 1. The point tree without zero-length bones.
+  BodyChains out;
+  std::vector<BodyPoint>& pts = out.points;
+  std::vector<int> point_of(static_cast<std::size_t>(nj), -1);
+  const auto add_point = [&pts](const glm::vec3& pos, int parent, int joint, int bone_joint) {
+    BodyPoint pt;
+    pt.pos = pos;
+    pt.parent = parent;
+    pt.joint = joint;
+    pt.bone_joint = bone_joint;
+    pts.push_back(pt);
+    const int id = static_cast<int>(pts.size()) - 1;
+    if (parent >= 0) pts[static_cast<std::size_t>(parent)].children.push_back(id);
+    return id;
+  };
+  for (int j = 0; j < nj; ++j) {
+    const int p = skeleton.parents[static_cast<std::size_t>(j)];
+    const glm::vec3 pos = joint_pos[static_cast<std::size_t>(j)];
+    if (p < 0) {
+      point_of[static_cast<std::size_t>(j)] = add_point(pos, -1, j, j);
+      continue;
+    }
+    const int pp = point_of[static_cast<std::size_t>(p)];
+    point_of[static_cast<std::size_t>(j)] =
+        glm::distance(pos, pts[static_cast<std::size_t>(pp)].pos) <= merge_dist
+            ? pp
+            : add_point(pos, pp, j, p);
+  }
+  for (const auto& [parent_joint, pos] : end_sites) {
+    const int pp = point_of[static_cast<std::size_t>(parent_joint)];
+    if (glm::distance(pos, pts[static_cast<std::size_t>(pp)].pos) > merge_dist) {
+      add_point(pos, pp, -1, parent_joint);
+    }
+  }
+  for (std::size_t i = pts.size(); i-- > 0;) {  // children come after their parents
+    if (pts[i].parent >= 0) {
+      pts[static_cast<std::size_t>(pts[i].parent)].descendants += pts[i].descendants + 1;
+    }
+  }
+  const auto pos_of = [&pts](int i) { return pts[static_cast<std::size_t>(i)].pos; };
+  const auto reach = [&](int from, int child) {  // farthest point of child's subtree from `from`
+    float best = 0.0f;
+    std::vector<int> stack = {child};
+    while (!stack.empty()) {
+      const int c = stack.back();
+      stack.pop_back();
+      best = std::max(best, glm::distance(pos_of(from), pos_of(c)));
+      for (int g : pts[static_cast<std::size_t>(c)].children) stack.push_back(g);
+    }
+    return best;
+  };
+
+  // 2. Chains by topology.
+  struct Pending {
+    int start, first, parent_chain;
+    BodyChainKind kind;
+  };
+  std::vector<Pending> todo;
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    if (pts[i].parent >= 0) continue;
+    int r = static_cast<int>(i);
+    // A root that only positions the body (Bandai's joint_Root on the floor) is skipped.
+    while (pts[static_cast<std::size_t>(r)].children.size() == 1 &&
+           pts[static_cast<std::size_t>(pts[static_cast<std::size_t>(r)].children[0])]
+                   .children.size() >= 2) {
+      r = pts[static_cast<std::size_t>(r)].children[0];
+    }
+    const std::vector<int>& ch = pts[static_cast<std::size_t>(r)].children;
+    if (ch.empty()) continue;
+    int heavy = ch[0];
+    for (int c : ch) {
+      if (pts[static_cast<std::size_t>(c)].descendants > pts[static_cast<std::size_t>(heavy)].descendants) heavy = c;
+    }
+    todo.push_back({r, heavy, -1, BodyChainKind::kSpine});
+  }
+  // Body size S over the points that make up the body: a positioning root
+  // (often left at the origin while the capture walks away) must not count.
+  Bounds body;
+  for (const Pending& spine : todo) {
+    std::vector<int> stack = {spine.start};
+    while (!stack.empty()) {
+      const int c = stack.back();
+      stack.pop_back();
+      body.Extend(pos_of(c));
+      for (int g : pts[static_cast<std::size_t>(c)].children) stack.push_back(g);
+    }
+  }
+  const float size = body.empty() ? 0.0f : std::max({body.size().x, body.size().y, body.size().z});
+  if (!(size > merge_dist)) {
+    return MakeError(ErrorCode::kInvalidArgument, {},
+                     "skeleton has no bone of non-zero length; cannot build a mannequin");
+  }
+  std::vector<BodyChain>& chains = out.chains;
+  for (std::size_t t = 0; t < todo.size(); ++t) {
+    const Pending job = todo[t];
+    BodyChain c;
+    c.kind = job.kind;
+    c.parent_chain = job.parent_chain;
+    c.points = {job.start, job.first};
+    const int chain_id = static_cast<int>(chains.size());
+    int cur = job.first;
+    glm::vec3 dir = glm::normalize(pos_of(job.first) - pos_of(job.start));
+    if (job.kind == BodyChainKind::kSpine) {  // siblings of the spine's first bone hang from the root
+      for (int s : pts[static_cast<std::size_t>(job.start)].children) {
+        if (s != job.first) todo.push_back({job.start, s, chain_id, BodyChainKind::kLimb});
+      }
+    }
+    while (!pts[static_cast<std::size_t>(cur)].children.empty()) {
+      const std::vector<int>& ch = pts[static_cast<std::size_t>(cur)].children;
+      // A spine never continues into one of a mirror pair (arms, legs): mocapbank's
+      // collars and neck all start at one point, and the straightest of them was an arm.
+      const std::vector<std::uint8_t> paired = job.kind == BodyChainKind::kSpine
+                                                   ? MirrorPaired(pts, ch)
+                                                   : std::vector<std::uint8_t>(ch.size(), 0);
+      int best = ch[0];
+      float best_dot = -2.0f;
+      for (std::size_t i = 0; i < ch.size(); ++i) {
+        const int k = ch[i];
+        if (paired[i] != 0) continue;
+        const float d = glm::dot(glm::normalize(pos_of(k) - pos_of(cur)), dir);
+        if (d > best_dot) best_dot = d, best = k;
+      }
+      for (int k : ch) {
+        if (k == best) continue;
+        if (reach(cur, k) < min_branch_extent * size) {
+          if (!c.folded_branches) c.first_folded = static_cast<int>(c.points.size()) - 1;
+          c.folded_branches = true;
+        } else {
+          todo.push_back({cur, k, chain_id, BodyChainKind::kLimb});
+        }
+      }
+      dir = glm::normalize(pos_of(best) - pos_of(cur));
+      c.points.push_back(best);
+      cur = best;
+    }
+    chains.push_back(std::move(c));
+  }
+  if (chains.empty()) {
+    return MakeError(ErrorCode::kInvalidArgument, {},
+                     "skeleton has no bone of non-zero length; cannot build a mannequin");
+  }
+
+  out.size = size;
+  return out;
+}
+
+}  // namespace deform

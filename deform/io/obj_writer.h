@@ -1,0 +1,50 @@
+#pragma once
+// Wavefront OBJ output of deformed meshes, one file per frame.
+//
+// Each file holds, in this order: comment lines ("# ..."), one object "o NAME",
+// #V "v x y z" lines, #V "vn x y z" lines (when normals are given) and #T
+// "f a//a b//b c//c" lines (1-based indices, counter-clockwise seen from
+// outside; "f a b c" without normals). Every frame of a sequence has the same
+// vertex order and the same faces, so tools can treat the files as one
+// animated mesh. Floats are written with the shortest decimal text that reads
+// back to the same float (std::to_chars), so parsing a file gives the written
+// positions bit for bit. Writes are atomic (deform/io/file_output.h).
+
+#include <span>
+#include <string>
+
+#include <glm/glm.hpp>
+
+#include "mocap/error.h"
+
+namespace deform {
+
+// The geometry of one frame. positions and normals are #V (normals may be
+// empty), triangles #T with indices < #V.
+struct ObjFrame {
+  std::span<const glm::vec3> positions{}; // #V, any space (the exporter writes world space)
+  std::span<const glm::vec3> normals{};   // #V unit normals, or empty
+  std::span<const glm::uvec3> triangles{}; // #T
+  std::string comment{};                  // written as "# " lines (newlines split lines); may be empty
+  std::string object_name = "mesh";       // the "o" line; no whitespace
+};
+
+// Appends the OBJ text of `frame` to `out` (out is not cleared). Errors:
+// kInvalidArgument when sizes disagree, an index is out of range or a value
+// is not finite (nothing is appended then).
+mocap::Status AppendObj(const ObjFrame& frame, std::string& out);
+
+// Writes frames to files one at a time, reusing one text buffer: memory held
+// is one frame's text, whatever the number of frames.
+class ObjSequenceWriter {
+ public:
+  // Formats `frame` and writes it atomically to `path` (the folder must exist).
+  mocap::Status Write(const ObjFrame& frame, const std::string& path);
+  // Bytes of the reused text buffer (its capacity): one frame's worth.
+  std::size_t buffer_bytes() const { return buffer_.capacity(); }
+
+ private:
+  std::string buffer_;
+};
+
+}  // namespace deform

@@ -1,0 +1,106 @@
+#include "render/output/async_writer.h"
+
+#include <algorithm>
+#include <utility>
+
+namespace render {
+namespace {
+
+// A whole-file location (no line): FileLoc has more fields than a designated
+// initializer should name here.
+mocap::FileLoc LocOf(const std::string& file) {
+  mocap::FileLoc loc;
+  loc.file = file;
+  return loc;
+}
+
+}  // namespace
+
+AsyncImageWriter::AsyncImageWriter(AsyncWriterOptions options) : options_(options) {
+  options_.num_workers = std::max(options_.num_workers, 1);
+  options_.max_in_flight = std::max(options_.max_in_flight, options_.num_workers);
+  workers_.reserve(static_cast<std::size_t>(options_.num_workers));
+  for (int i = 0; i < options_.num_workers; ++i) workers_.emplace_back([this] { WorkerLoop(); });
+}
+
+AsyncImageWriter::~AsyncImageWriter() { (void)Finish(); }
+
+Status AsyncImageWriter::Submit(Image image, std::string path, WriteOptions options) {
+  std::unique_lock<std::mutex> lock(mutex_);
+  if (finished_) {
+    return mocap::MakeError(mocap::ErrorCode::kInvalidArgument, LocOf(path),
+                            "frame submitted after the writer finished");
+  }
+  slot_free_.wait(lock, [&] { return in_flight_ < options_.max_in_flight || first_error_; });
+  if (first_error_) return *first_error_;
+  queue_.push_back(Job{std::move(image), std::move(path), std::move(options), next_sequence_++});
+  ++in_flight_;
+  peak_in_flight_ = std::max(peak_in_flight_, in_flight_);
+  work_ready_.notify_one();
+  return Status::Ok();
+}
+
+Status AsyncImageWriter::Finish() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!finished_) {
+      finished_ = true;
+      stopping_ = true;
+      work_ready_.notify_all();
+    }
+  }
+  for (std::thread& t : workers_) {
+    if (t.joinable()) t.join();
+  }
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (first_error_) return *first_error_;
+  return Status::Ok();
+}
+
+Image AsyncImageWriter::TakeSpareImage() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (spares_.empty()) return Image();
+  Image image = std::move(spares_.back());
+  spares_.pop_back();
+  return image;
+}
+
+std::int64_t AsyncImageWriter::frames_written() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return frames_written_;
+}
+
+int AsyncImageWriter::peak_in_flight() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return peak_in_flight_;
+}
+
+void AsyncImageWriter::WorkerLoop() {
+  for (;;) {
+    Job job;
+    {
+      std::unique_lock<std::mutex> lock(mutex_);
+      work_ready_.wait(lock, [&] { return !queue_.empty() || stopping_; });
+      if (queue_.empty()) return;  // stopping and drained
+      job = std::move(queue_.front());
+      queue_.pop_front();
+    }
+    const Status status = WriteImage(job.image, job.path, job.options);
+    std::lock_guard<std::mutex> lock(mutex_);
+    // Keep the buffers for TakeSpareImage, or release them before signalling a free slot.
+    if (static_cast<int>(spares_.size()) < options_.max_in_flight && !stopping_) {
+      spares_.push_back(std::move(job.image));
+    }
+    job.image = Image();
+    if (status) {
+      ++frames_written_;
+    } else if (!first_error_ || job.sequence < first_error_sequence_) {
+      first_error_ = status.error();
+      first_error_sequence_ = job.sequence;
+    }
+    --in_flight_;
+    slot_free_.notify_all();
+  }
+}
+
+}  // namespace render

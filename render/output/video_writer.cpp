@@ -1,0 +1,158 @@
+#include "render/output/video_writer.h"
+
+#include <filesystem>
+#include <system_error>
+
+#include <opencv2/core.hpp>
+#include <opencv2/videoio.hpp>
+
+#include "render/output/image_io.h"
+
+namespace render {
+namespace {
+
+using mocap::ErrorCode;
+using mocap::FileLoc;
+using mocap::MakeError;
+
+// A whole-file location (no line): FileLoc has more fields than a designated
+// initializer should name here.
+mocap::FileLoc LocOf(const std::string& file) {
+  mocap::FileLoc loc;
+  loc.file = file;
+  return loc;
+}
+
+struct CodecInfo {
+  const char* fourcc;
+  const char* extension;
+};
+
+CodecInfo Info(VideoCodec codec) {
+  switch (codec) {
+    case VideoCodec::kH264Mp4: return {"avc1", ".mp4"};
+    case VideoCodec::kMpeg4Mp4: return {"mp4v", ".mp4"};
+    case VideoCodec::kMjpegAvi: return {"MJPG", ".avi"};
+  }
+  return {"MJPG", ".avi"};
+}
+
+}  // namespace
+
+struct VideoWriter::Impl {
+  cv::VideoWriter writer;
+  cv::Mat bgr;  // reused conversion buffer, height x width 8-bit BGR
+};
+
+const char* VideoCodecName(VideoCodec codec) {
+  switch (codec) {
+    case VideoCodec::kH264Mp4: return "mp4/avc1";
+    case VideoCodec::kMpeg4Mp4: return "mp4/mp4v";
+    case VideoCodec::kMjpegAvi: return "avi/MJPG";
+  }
+  return "?";
+}
+
+Result<std::unique_ptr<VideoWriter>> VideoWriter::Open(const std::string& path, int width,
+                                                       int height, const VideoOptions& options) {
+  const FileLoc loc = LocOf(path);
+  if (width <= 0 || height <= 0 || !(options.fps > 0.0)) {
+    return MakeError(ErrorCode::kInvalidArgument, loc, "expected a positive size and fps");
+  }
+  if (options.codecs.empty()) {
+    return MakeError(ErrorCode::kInvalidArgument, loc, "expected at least one codec to try");
+  }
+  const std::filesystem::path parent = std::filesystem::path(path).parent_path();
+  if (!parent.empty() && !std::filesystem::is_directory(parent)) {
+    return MakeError(ErrorCode::kIo, loc, "the output folder does not exist");
+  }
+  std::unique_ptr<VideoWriter> w(new VideoWriter());
+  w->impl_ = std::make_unique<Impl>();
+  w->width_ = width;
+  w->height_ = height;
+  std::string tried;
+  for (VideoCodec codec : options.codecs) {
+    const CodecInfo info = Info(codec);
+    std::filesystem::path final_path(path);
+    final_path.replace_extension(info.extension);
+    // OpenCV picks the container from the extension, so the temporary name keeps it.
+    const std::filesystem::path temp = TemporaryPathFor(final_path.string(), info.extension);
+    bool opened = false;
+    try {
+      const int fourcc =
+          cv::VideoWriter::fourcc(info.fourcc[0], info.fourcc[1], info.fourcc[2], info.fourcc[3]);
+      opened = w->impl_->writer.open(temp.string(), cv::CAP_FFMPEG, fourcc, options.fps,
+                                     cv::Size(width, height), true);
+    } catch (const cv::Exception&) {
+      opened = false;
+    }
+    if (opened) {
+      w->codec_ = codec;
+      w->path_ = final_path.string();
+      w->temp_path_ = temp.string();
+      return w;
+    }
+    std::error_code ec;
+    std::filesystem::remove(temp, ec);
+    tried += std::string(tried.empty() ? "" : ", ") + VideoCodecName(codec);
+  }
+  return MakeError(ErrorCode::kUnsupported, loc,
+                   "OpenCV could not open a video writer with any of: " + tried);
+}
+
+VideoWriter::~VideoWriter() {
+  if (impl_ && impl_->writer.isOpened()) {
+    impl_->writer.release();
+    std::error_code ec;
+    std::filesystem::remove(temp_path_, ec);
+  }
+}
+
+Status VideoWriter::AddFrame(const Image& frame) {
+  if (!impl_->writer.isOpened()) {
+    return MakeError(ErrorCode::kIo, LocOf(path_), "video is closed");
+  }
+  if (frame.width != width_ || frame.height != height_ ||
+      frame.rgba.size() != static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_)) {
+    return MakeError(ErrorCode::kInvalidArgument, LocOf(path_),
+                     "expected a " + std::to_string(width_) + "x" + std::to_string(height_) +
+                         " frame, found " + std::to_string(frame.width) + "x" +
+                         std::to_string(frame.height));
+  }
+  cv::Mat& bgr = impl_->bgr;
+  bgr.create(height_, width_, CV_8UC3);
+  for (int y = 0; y < height_; ++y) {
+    auto* row = bgr.ptr<std::uint8_t>(y);
+    for (int x = 0; x < width_; ++x) {
+      const glm::vec4& p = frame.at(x, y);
+      row[3 * x + 0] = LinearToSrgb8(p.b);  // OpenCV stores BGR
+      row[3 * x + 1] = LinearToSrgb8(p.g);
+      row[3 * x + 2] = LinearToSrgb8(p.r);
+    }
+  }
+  try {
+    impl_->writer.write(bgr);
+  } catch (const cv::Exception& e) {
+    return MakeError(ErrorCode::kIo, LocOf(path_), std::string("OpenCV: ") + e.what());
+  }
+  ++frames_;
+  return Status::Ok();
+}
+
+Status VideoWriter::Close() {
+  if (!impl_->writer.isOpened()) {
+    return MakeError(ErrorCode::kIo, LocOf(path_), "video is already closed");
+  }
+  impl_->writer.release();
+  std::error_code ec;
+  std::filesystem::rename(temp_path_, path_, ec);
+  if (ec) {
+    std::error_code ignored;
+    std::filesystem::remove(temp_path_, ignored);
+    return MakeError(ErrorCode::kIo, LocOf(path_),
+                     "cannot rename the finished video into place: " + ec.message());
+  }
+  return Status::Ok();
+}
+
+}  // namespace render

@@ -1,0 +1,211 @@
+#include "render/raster/ground_shader.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
+namespace render {
+namespace {
+
+// 2^f = sum c_k f^k (Taylor coefficients ln(2)^k / k!), |f| <= 1/2: relative
+// error below 2.5e-7 in float.
+constexpr float kExp2C1 = 0.693147180559945f, kExp2C2 = 0.240226506959101f,
+                kExp2C3 = 0.0555041086648216f, kExp2C4 = 0.00961812910762848f,
+                kExp2C5 = 0.00133335581464284f, kExp2C6 = 0.000154035303933816f;
+constexpr float kLog2E = 1.44269504088896f;
+constexpr float kIntegerFloat = 8388608.0f;  // 2^23: floats this large are integers
+constexpr float kShadowCutR2 = 9.0f;        // ContactShadowFactor's cut (3 radii)
+
+}  // namespace
+
+GroundShader GroundShader::Create(const GroundShaderParams& params) {
+  GroundShader g;
+  // Ray through NDC (x, y): h = world_from_clip * (x, y, 0, 1) lies on it, so
+  // d = h.xyz - eye * h.w points along it (any scale or sign serves: p below
+  // divides by d.y). h is linear in (x, y), and so in the sample coordinates.
+  const glm::dmat4 inv = glm::inverse(glm::dmat4(params.clip_from_world));
+  const glm::dvec3 eye(params.eye);
+  auto along = [&](const glm::dvec4& h) { return glm::dvec3(h) - eye * h.w; };
+  const glm::dvec3 d0 = along(inv[3]), dx = along(inv[0]), dy = along(inv[1]);
+  const double w = std::max(params.raster_width, 1), h = std::max(params.raster_height, 1);
+  // ndc_x = (sx + 0.5) * 2 / w - 1, ndc_y = 1 - (sy + 0.5) * 2 / h.
+  g.ray_x_ = glm::vec3(dx * (2.0 / w));
+  g.ray_y_ = glm::vec3(dy * (-2.0 / h));
+  g.ray_c_ = glm::vec3(d0 + dx * (1.0 / w - 1.0) + dy * (1.0 - 1.0 / h));
+  g.eye_ = params.eye;
+  g.height_ = params.ground_y - params.eye.y;
+  const GroundStyle& style = params.style;
+  g.grid_ = params.grid_spacing > 0.0f;
+  g.inv_spacing_ = g.grid_ ? 1.0f / params.grid_spacing : 1.0f;
+  g.half_width_ = 0.5f * style.line_width;
+  g.soft_ = std::max(g.half_width_, 1e-6f);
+  g.inv_soft_ = 1.0f / g.soft_;
+  g.inv_fade_ = 1.0f / std::max(style.fade_start, 1e-3f);
+  g.color_ = style.color;
+  g.line_delta_ = style.line_color - style.color;
+  g.light_ = params.light;
+  g.shadows_.clear();
+  for (const ContactShadow& s : params.shadows) {
+    if (!(s.strength > 0.0f)) continue;  // a factor of exactly 1
+    g.shadows_.push_back({s.centre_xz.x, s.centre_xz.y, 1.0f / s.radius_xz.x,
+                          1.0f / s.radius_xz.y, s.strength});
+  }
+  return g;
+}
+
+#if defined(__SSE2__)
+
+namespace {
+
+inline __m128 Abs(__m128 x) { return _mm_andnot_ps(_mm_set1_ps(-0.0f), x); }
+
+// |x - nearest integer|, 0 where |x| >= 2^23 (or x is not finite), as
+// DistanceToInteger in shading.cpp.
+inline __m128 DistanceToInteger4(__m128 x) {
+  const __m128 small = _mm_cmplt_ps(Abs(x), _mm_set1_ps(kIntegerFloat));
+  const __m128 nearest = _mm_cvtepi32_ps(_mm_cvtps_epi32(x));
+  return _mm_and_ps(small, Abs(_mm_sub_ps(x, nearest)));
+}
+
+inline __m128 Clamp01(__m128 x) {
+  return _mm_min_ps(_mm_max_ps(x, _mm_setzero_ps()), _mm_set1_ps(1.0f));
+}
+
+// exp(x) for x in [-126 ln 2, 0].
+inline __m128 ExpNonPositive4(__m128 x) {
+  const __m128 y = _mm_max_ps(_mm_mul_ps(x, _mm_set1_ps(kLog2E)), _mm_set1_ps(-126.0f));
+  const __m128i k = _mm_cvtps_epi32(y);  // nearest integer
+  const __m128 f = _mm_sub_ps(y, _mm_cvtepi32_ps(k));
+  __m128 p = _mm_set1_ps(kExp2C6);
+  p = _mm_add_ps(_mm_mul_ps(p, f), _mm_set1_ps(kExp2C5));
+  p = _mm_add_ps(_mm_mul_ps(p, f), _mm_set1_ps(kExp2C4));
+  p = _mm_add_ps(_mm_mul_ps(p, f), _mm_set1_ps(kExp2C3));
+  p = _mm_add_ps(_mm_mul_ps(p, f), _mm_set1_ps(kExp2C2));
+  p = _mm_add_ps(_mm_mul_ps(p, f), _mm_set1_ps(kExp2C1));
+  p = _mm_add_ps(_mm_mul_ps(p, f), _mm_set1_ps(1.0f));
+  // Times 2^k: add k to the exponent field (p is in [0.7, 1.5], k >= -126).
+  return _mm_castsi128_ps(_mm_add_epi32(_mm_castps_si128(p), _mm_slli_epi32(k, 23)));
+}
+
+}  // namespace
+
+void GroundShader::Shade4(int sx, int sy, float* r, float* g, float* b) const {
+  const __m128 x = _mm_add_ps(_mm_set1_ps(static_cast<float>(sx)), _mm_setr_ps(0, 1, 2, 3));
+  const auto fy = static_cast<float>(sy);
+  const glm::vec3 c = ray_c_ + ray_y_ * fy;  // the row's part of the ray
+  const __m128 dx = _mm_add_ps(_mm_set1_ps(c.x), _mm_mul_ps(_mm_set1_ps(ray_x_.x), x));
+  const __m128 dy = _mm_add_ps(_mm_set1_ps(c.y), _mm_mul_ps(_mm_set1_ps(ray_x_.y), x));
+  const __m128 dz = _mm_add_ps(_mm_set1_ps(c.z), _mm_mul_ps(_mm_set1_ps(ray_x_.z), x));
+  const __m128 t = _mm_div_ps(_mm_set1_ps(height_), dy);  // ray parameter of the ground
+  const __m128 ox = _mm_mul_ps(dx, t), oz = _mm_mul_ps(dz, t);  // p - eye, xz
+  const __m128 px = _mm_add_ps(_mm_set1_ps(eye_.x), ox);
+  const __m128 pz = _mm_add_ps(_mm_set1_ps(eye_.z), oz);
+
+  __m128 line = _mm_setzero_ps();  // grid line weight, 0..1
+  if (grid_) {
+    const __m128 inv_spacing = _mm_set1_ps(inv_spacing_);
+    const __m128 d = _mm_min_ps(DistanceToInteger4(_mm_mul_ps(px, inv_spacing)),
+                                DistanceToInteger4(_mm_mul_ps(pz, inv_spacing)));
+    const __m128 from_edge = _mm_sub_ps(d, _mm_set1_ps(half_width_));
+    // Between lines (from_edge >= soft) the weight is exactly 0.
+    const __m128 near = _mm_cmplt_ps(from_edge, _mm_set1_ps(soft_));
+    if (_mm_movemask_ps(near) != 0) {
+      const __m128 one = _mm_set1_ps(1.0f);
+      line = _mm_sub_ps(one, Clamp01(_mm_mul_ps(from_edge, _mm_set1_ps(inv_soft_))));
+      const __m128 dist2 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(ox, ox), _mm_mul_ps(oz, oz)),
+                                      _mm_set1_ps(height_ * height_));
+      const __m128 spacings = _mm_mul_ps(_mm_sqrt_ps(dist2), inv_spacing);
+      const __m128 fade = _mm_sub_ps(
+          one, Clamp01(_mm_sub_ps(_mm_mul_ps(spacings, _mm_set1_ps(inv_fade_)), one)));
+      line = _mm_and_ps(near, _mm_mul_ps(line, fade));
+    }
+  }
+
+  __m128 shadow = _mm_set1_ps(1.0f);
+  for (const Shadow& s : shadows_) {
+    const __m128 ux = _mm_mul_ps(_mm_sub_ps(px, _mm_set1_ps(s.cx)), _mm_set1_ps(s.inv_rx));
+    const __m128 uz = _mm_mul_ps(_mm_sub_ps(pz, _mm_set1_ps(s.cz)), _mm_set1_ps(s.inv_rz));
+    const __m128 r2 = _mm_add_ps(_mm_mul_ps(ux, ux), _mm_mul_ps(uz, uz));
+    const __m128 inside = _mm_cmplt_ps(r2, _mm_set1_ps(kShadowCutR2));
+    if (_mm_movemask_ps(inside) == 0) continue;
+    const __m128 e = ExpNonPositive4(_mm_mul_ps(_mm_set1_ps(-2.0f), _mm_and_ps(inside, r2)));
+    const __m128 f = _mm_sub_ps(_mm_set1_ps(1.0f), _mm_mul_ps(_mm_set1_ps(s.strength), e));
+    shadow = _mm_mul_ps(shadow, _mm_or_ps(_mm_and_ps(inside, f),
+                                          _mm_andnot_ps(inside, _mm_set1_ps(1.0f))));
+  }
+
+  auto channel = [&](float base, float delta, float light, float* out) {
+    const __m128 albedo = _mm_add_ps(_mm_set1_ps(base), _mm_mul_ps(_mm_set1_ps(delta), line));
+    _mm_storeu_ps(out, _mm_mul_ps(_mm_mul_ps(albedo, _mm_set1_ps(light)), shadow));
+  };
+  channel(color_.x, line_delta_.x, light_.x, r);
+  channel(color_.y, line_delta_.y, light_.y, g);
+  channel(color_.z, line_delta_.z, light_.z, b);
+}
+
+#else  // the same operations, one lane at a time
+
+namespace {
+
+float DistanceToInteger1(float x) {
+  if (!(std::abs(x) < kIntegerFloat)) return 0.0f;
+  return std::abs(x - std::nearbyint(x));
+}
+
+float ExpNonPositive1(float x) {
+  const float y = std::max(x * kLog2E, -126.0f);
+  const float k = std::nearbyint(y);
+  const float f = y - k;
+  float p = kExp2C6;
+  for (float c : {kExp2C5, kExp2C4, kExp2C3, kExp2C2, kExp2C1, 1.0f}) p = p * f + c;
+  return std::ldexp(p, static_cast<int>(k));
+}
+
+}  // namespace
+
+void GroundShader::Shade4(int sx, int sy, float* r, float* g, float* b) const {
+  const glm::vec3 c = ray_c_ + ray_y_ * static_cast<float>(sy);
+  for (int k = 0; k < 4; ++k) {
+    const float x = static_cast<float>(sx) + static_cast<float>(k);
+    const float dx = c.x + ray_x_.x * x, dy = c.y + ray_x_.y * x, dz = c.z + ray_x_.z * x;
+    const float t = height_ / dy;
+    const float ox = dx * t, oz = dz * t;
+    const float px = eye_.x + ox, pz = eye_.z + oz;
+    float line = 0.0f;
+    if (grid_) {
+      const float d = std::min(DistanceToInteger1(px * inv_spacing_),
+                               DistanceToInteger1(pz * inv_spacing_));
+      const float from_edge = d - half_width_;
+      if (from_edge < soft_) {
+        line = 1.0f - std::clamp(from_edge * inv_soft_, 0.0f, 1.0f);
+        const float spacings = std::sqrt(ox * ox + oz * oz + height_ * height_) * inv_spacing_;
+        line *= 1.0f - std::clamp(spacings * inv_fade_ - 1.0f, 0.0f, 1.0f);
+      }
+    }
+    float shadow = 1.0f;
+    for (const Shadow& s : shadows_) {
+      const float ux = (px - s.cx) * s.inv_rx, uz = (pz - s.cz) * s.inv_rz;
+      const float r2 = ux * ux + uz * uz;
+      if (r2 < kShadowCutR2) shadow *= 1.0f - s.strength * ExpNonPositive1(-2.0f * r2);
+    }
+    const glm::vec3 albedo = color_ + line_delta_ * line;
+    r[k] = albedo.x * light_.x * shadow;
+    g[k] = albedo.y * light_.y * shadow;
+    b[k] = albedo.z * light_.z * shadow;
+  }
+}
+
+#endif
+
+glm::vec3 GroundShader::Shade(int sx, int sy) const {
+  float r[4], g[4], b[4];
+  Shade4(sx, sy, r, g, b);
+  return {r[0], g[0], b[0]};
+}
+
+}  // namespace render

@@ -1,0 +1,110 @@
+// VideoWriter: what this machine's OpenCV writes, read back with cv::VideoCapture.
+
+#include "render/output/video_writer.h"
+
+#include <cmath>
+#include <filesystem>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <opencv2/core.hpp>
+#include <opencv2/videoio.hpp>
+
+#include "render/output/image_io.h"
+#include "support/data_paths.h"
+#include "support/tolerances.h"
+
+namespace render {
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path FreshDir(const std::string& name) {
+  fs::path dir = testsupport::TestOutputPath("video/" + name + "/x").parent_path();
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+constexpr int kWidth = 64;
+constexpr int kHeight = 48;
+constexpr int kFrames = 10;
+
+glm::vec4 Grey(int f) {
+  const float v = SrgbToLinear(static_cast<float>(40 + 15 * f) / 255.0f);
+  return glm::vec4(v, v, v, 1.0f);
+}
+
+// Writes kFrames flat grey frames with `codecs` and checks them read back.
+void RoundTrip(const std::vector<VideoCodec>& codecs, VideoCodec expected,
+               const std::string& expected_ext) {
+  const fs::path dir = FreshDir(VideoCodecName(expected) + std::string("x") + expected_ext.substr(1));
+  VideoOptions options;
+  options.codecs = codecs;
+  auto video = VideoWriter::Open((dir / "preview.mp4").string(), kWidth, kHeight, options);
+  ASSERT_TRUE(video.ok()) << video.error().ToString();
+  EXPECT_EQ((*video)->codec(), expected);
+  EXPECT_EQ(fs::path((*video)->path()).extension(), expected_ext);
+  for (int f = 0; f < kFrames; ++f) {
+    ASSERT_TRUE((*video)->AddFrame(Image(kWidth, kHeight, Grey(f))));
+  }
+  EXPECT_FALSE((*video)->AddFrame(Image(8, 8)).ok());
+  ASSERT_TRUE((*video)->Close());
+  const std::string path = (*video)->path();
+  ASSERT_TRUE(fs::exists(path));
+  std::size_t entries = 0;
+  for ([[maybe_unused]] const auto& e : fs::directory_iterator(dir)) ++entries;
+  EXPECT_EQ(entries, 1u) << "no temporary file left";
+
+  cv::VideoCapture cap(path);
+  ASSERT_TRUE(cap.isOpened());
+  EXPECT_EQ(cap.get(cv::CAP_PROP_FRAME_WIDTH), kWidth);
+  EXPECT_EQ(cap.get(cv::CAP_PROP_FRAME_HEIGHT), kHeight);
+  EXPECT_EQ(cap.get(cv::CAP_PROP_FRAME_COUNT), kFrames);
+  int read = 0;
+  cv::Mat bgr;
+  while (cap.read(bgr)) {
+    const cv::Scalar mean = cv::mean(bgr);
+    EXPECT_NEAR(mean[1], 40 + 15 * read, testsupport::kVideoFlatTol8) << "frame " << read;
+    ++read;
+  }
+  EXPECT_EQ(read, kFrames);
+}
+
+TEST(VideoWriter, PrefersH264InMp4) {
+  RoundTrip({VideoCodec::kH264Mp4, VideoCodec::kMpeg4Mp4, VideoCodec::kMjpegAvi},
+            VideoCodec::kH264Mp4, ".mp4");
+}
+
+TEST(VideoWriter, WritesMpeg4InMp4) {
+  RoundTrip({VideoCodec::kMpeg4Mp4}, VideoCodec::kMpeg4Mp4, ".mp4");
+}
+
+TEST(VideoWriter, MjpegFallbackWritesAvi) {
+  RoundTrip({VideoCodec::kMjpegAvi}, VideoCodec::kMjpegAvi, ".avi");
+}
+
+TEST(VideoWriter, RejectsBadArgumentsAndUnwritablePaths) {
+  EXPECT_EQ(VideoWriter::Open("x.mp4", 0, 10).error().code, mocap::ErrorCode::kInvalidArgument);
+  VideoOptions none;
+  none.codecs.clear();
+  EXPECT_FALSE(VideoWriter::Open("x.mp4", 16, 16, none).ok());
+  const fs::path dir = FreshDir("bad");
+  auto r = VideoWriter::Open((dir / "missing" / "v.mp4").string(), 16, 16);
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.error().code, mocap::ErrorCode::kIo);
+  EXPECT_NE(r.error().ToString().find("v.mp4"), std::string::npos);
+}
+
+TEST(VideoWriter, DestroyingWithoutCloseLeavesNothing) {
+  const fs::path dir = FreshDir("abandon");
+  {
+    auto video = VideoWriter::Open((dir / "v.mp4").string(), kWidth, kHeight);
+    ASSERT_TRUE(video.ok());
+    ASSERT_TRUE((*video)->AddFrame(Image(kWidth, kHeight, Grey(1))));
+  }
+  EXPECT_TRUE(fs::is_empty(dir));
+}
+
+}  // namespace
+}  // namespace render
