@@ -18,6 +18,12 @@ inline std::filesystem::path SharedDataPath(const std::string& relative) {
   return std::filesystem::path(SHARED_DATA_DIR) / relative;
 }
 
+// A file of samples/data (the motions and rigs the demos use).
+inline std::filesystem::path SampleDataPath(const std::string& name) {
+  return (std::filesystem::path(TEST_DATA_DIR) / ".." / ".." / "samples" / "data" / name)
+      .lexically_normal();
+}
+
 inline bool HaveSharedData() { return std::filesystem::is_directory(SHARED_DATA_DIR); }
 
 // A folder under the build tree for files a test writes (created on demand).

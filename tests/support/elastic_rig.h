@@ -16,12 +16,9 @@
 #include "app/pipeline.h"
 #include "app/rig_file.h"
 #include "app/rig_patches.h"
+#include "support/data_paths.h"
 
 namespace testsupport {
-
-inline std::filesystem::path SampleDataPath(const std::string& name) {
-  return std::filesystem::path(GOLDEN_DIR) / ".." / ".." / "samples" / "data" / name;
-}
 
 struct RigPipeline {
   app::Rig rig;
