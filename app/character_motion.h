@@ -2,7 +2,7 @@
 // A glTF character driven by a separate BVH motion (`render MODEL.glb --motion
 // X.bvh`, or a rig with a glTF "character" and a "motion"): the BVH's joints
 // are matched to the skin's joints by name and its rotations retargeted onto
-// the glTF rest pose (conventions in mocap/retarget.h; README "Rig files").
+// the glTF rest pose (conventions in mocap/retarget.h; docs/retargeting.md).
 
 #include <string>
 

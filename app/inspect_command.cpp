@@ -212,7 +212,7 @@ CLI::App* AddInspectCommand(CLI::App& parent, InspectOptions& options) {
   CLI::App* cmd = parent.add_subcommand("inspect", "Print a capture's skeleton, timing and poses");
   cmd->add_option("file", options.file, "BVH, glTF or GLB file")->required();
   cmd->add_option("--frame", options.frame, "Also print world joint positions at this frame (0-based)");
-  cmd->add_flag("--json", options.json, "Print one JSON document (schema in the README)");
+  cmd->add_flag("--json", options.json, "Print one JSON document (schema in docs/command-line.md)");
   cmd->add_flag("--artifacts", options.artifacts,
                 "Print collapse (elbow/knee bent 90/120/150 deg) and candy-wrapper (hand "
                 "twisted 90/180 deg) figures of SSD, DQS and SWD on the file's body");

@@ -3,7 +3,7 @@
 // channels, frame count, frame time, duration, detected units and up axis; with
 // --frame, every joint's world position and rotation at that frame, in the
 // file's own units and axes unless --scale / --y-up ask otherwise. The JSON
-// schema is documented in the README ("inspect --json"). With --artifacts it
+// schema is documented in docs/command-line.md ("inspect --json"). With --artifacts it
 // prints the collapse and candy-wrapper figures of SSD, DQS and SWD on the
 // file's body (deform/global/rig_artifacts.h) instead.
 

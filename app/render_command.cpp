@@ -99,7 +99,7 @@ CLI::App* AddRenderCommand(CLI::App& parent, RenderOptions& o) {
                   "A:B[:STEP] frames the camera framing looks at (default: the output frames; "
                   "chunks of one render pass the whole range)");
   cmd->add_option("--motion", o.motion,
-                  "BVH motion driving a glTF INPUT (joints matched by name; see README)");
+                  "BVH motion driving a glTF INPUT (joints matched by name; docs/retargeting.md)");
   AddOutputFlags(*cmd, o);
   // Which options were given: with a rig file they override its settings.
   cmd->callback([&o, cmd] {
@@ -159,7 +159,7 @@ double PeakResidentMb() {
 int RunRender(const RenderOptions& options) {
   const auto started = std::chrono::steady_clock::now();
   double first_frame_s = -1.0;  // --stats: when the first frame went to the writer
-  // --- A rig file (README "Rig files") sets the inputs and render settings ---
+  // --- A rig file (docs/rig-file.md) sets the inputs and render settings ---
   RenderOptions o = options;
   std::optional<Rig> rig;
   const bool cli_split = o.split.has_value();

@@ -1,6 +1,6 @@
 #pragma once
 // The elastic part of a rig patch: `patches[i].elastic` (ALGORITHMS.md 6; every
-// field is documented in README.md, "Rig files"). Parsed by ParseRigElastic
+// field is documented in docs/rig-file.md, "Elastic"). Parsed by ParseRigElastic
 // (app/internal/rig_elastic_parse.h), hooked into rig_file.cpp's patch parser;
 // resolved against a loaded character (driving joint, model units) by
 // ResolveRigElastic (app/elastic_layer.h).

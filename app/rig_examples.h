@@ -1,6 +1,6 @@
 #pragma once
-// Example shapes in rig files (issue 6; README.md "Rig files", patch fields
-// `examples` and `pose_space`):
+// Example shapes in rig files (issue 6; docs/rig-file.md, "Example shapes":
+// patch fields `examples` and `pose_space`):
 //
 //   "examples": [{"pose": {"frame": 45} | {"joints": {"LeftForeArm": [0, -90, 0]}},
 //                 "edits": [{"vertex": 812, "move": [0, 0, 1.5]},

@@ -1,4 +1,4 @@
-// Parsing of a rig patch's `examples` and `pose_space` (README "Rig files"),
+// Parsing of a rig patch's `examples` and `pose_space` (docs/rig-file.md),
 // apart from app/rig_examples.cpp's building so the rig reader (patchskin_rig)
 // needs neither the deformation nor the renderer.
 #include "app/internal/rig_examples_parse.h"

@@ -1,6 +1,6 @@
 #pragma once
 // Rig files: a JSON document saying what to deform and how (DESIGN.md "The rig
-// file"; every field is documented in README.md, section "Rig files").
+// file"; every field is documented in docs/rig-file.md).
 //
 //   {
 //     "character": "mannequin" | "body.glb",
