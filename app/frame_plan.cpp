@@ -77,6 +77,11 @@ mocap::Result<FramePlan> PlanFrames(const mocap::Motion& motion, const FramePlan
   plan.range = *range;
   plan.turntable = o.turntable;
   plan.turntable_frames = o.turntable ? o.turntable_frames : 0;
+  if (o.start_number < 0 || o.start_number > kMaxStartNumber) {
+    return ArgError("--start-number", "expected 0.." + std::to_string(kMaxStartNumber) +
+                                          ", found " + std::to_string(o.start_number));
+  }
+  plan.start_number = o.start_number;
   if (o.list_frames) {
     const std::size_t n = plan.count();
     plan.frames.reserve(n);
@@ -94,10 +99,10 @@ std::size_t FramePlan::count() const {
 OutputFrame FramePlan::At(std::size_t i) const {
   if (turntable) {
     const int k = static_cast<int>(i);
-    return {k, range.first * frame_time_s, k};
+    return {start_number + k, range.first * frame_time_s, k};
   }
   const int f = static_cast<int>(range.first + static_cast<std::int64_t>(i) * range.step);
-  return {f, f * frame_time_s, f};
+  return {start_number + f, f * frame_time_s, f};
 }
 
 mocap::Result<CameraPlan> CameraPlan::Create(FramePipeline& pipeline, const FramePlan& plan,

@@ -41,7 +41,7 @@ mocap::Result<FrameRange> ParseFrames(const std::string& text, int num_frames);
 
 // Everything about one output frame that a frame loop needs.
 struct OutputFrame {
-  int number = 0;      // output frame number (names the file)
+  int number = 0;      // output frame number (names the file): start_number + frame or view
   double time_s = 0;   // motion time evaluated, seconds from the motion's first frame
   int camera = 0;      // turntable camera index, or the follow-camera frame
 };
@@ -51,6 +51,9 @@ struct FramePlanOptions {
   double fps = 0.0;           // output frame rate; 0 = the motion's own (30 when unknown)
   bool turntable = false;     // frames are turntable views of range.first
   int turntable_frames = 36;  // views of a turntable
+  // --start-number: the number of motion frame 0 (turntable: of the first
+  // view), e.g. 1001 for pipelines that count from there; 0..kMaxStartNumber.
+  int start_number = 0;
   // Fill FramePlan::frames. A render of every frame of an hour-long capture
   // has ~430,000 output frames; commands that walk the plan with count() and
   // At() (render) turn this off so the plan's memory stays constant.
@@ -64,6 +67,7 @@ struct FramePlan {
   FrameRange range;                  // the parsed --frames
   bool turntable = false;            // frames are turntable views of range.first
   int turntable_frames = 0;          // views of the turntable (when turntable)
+  int start_number = 0;              // added to every OutputFrame::number
   // In output order; time_s = number * frame_time_s. Empty when the plan was
   // made with list_frames = false; count() and At() work either way.
   std::vector<OutputFrame> frames;
@@ -74,7 +78,9 @@ struct FramePlan {
   OutputFrame At(std::size_t i) const;
 };
 
-// Errors: kInvalidArgument from ParseFrames.
+inline constexpr int kMaxStartNumber = 100'000'000;
+
+// Errors: kInvalidArgument from ParseFrames, or --start-number outside 0..kMaxStartNumber.
 mocap::Result<FramePlan> PlanFrames(const mocap::Motion& motion, const FramePlanOptions& options);
 
 // The camera of every output frame, as `render` uses it: "follow" (a smoothed
