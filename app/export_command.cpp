@@ -100,6 +100,7 @@ CLI::App* AddExportCommand(CLI::App& parent, ExportOptions& o) {
                   "capture in centimetres to metres")
       ->capture_default_str();
   cmd->add_option("--threads", o.threads, "Worker threads (0 = all cores)")->capture_default_str();
+  cmd->add_option("--up", o.up, "The BVH's up axis, y or z, when detection picks the wrong one (default: detected)");
   cmd->add_option("--start-number", o.start_number,
                   "File number of motion frame 0 (OBJ meshes, camera JSON), e.g. 1001")
       ->capture_default_str();
@@ -146,7 +147,9 @@ int RunExport(const ExportOptions& options) {
   const std::string name = demo  ? "demo"
                            : rig ? std::filesystem::path(rig->file).stem().string()
                                  : std::filesystem::path(o.input).stem().string();
-  mocap::Result<Character> character = LoadCommandCharacter(o.input, {}, o.quiet);
+  const mocap::Result<std::optional<mocap::UpAxis>> up = ParseUpAxis(o.up);
+  if (!up.ok()) return Fail(up.error());
+  mocap::Result<Character> character = LoadCommandCharacter(o.input, {}, o.quiet, *up);
   if (!character.ok()) return Fail(character.error());
   const Character& ch = *character;
   mocap::Result<FramePlan> plan = PlanFrames(

@@ -43,6 +43,7 @@ struct ExportOptions {
   int threads = 0;                // 0 = hardware concurrency
   bool quiet = false;
   int start_number = 0;           // file number of motion frame 0 (OBJ and camera JSON)
+  std::string up;                 // --up y|z: a BVH's up axis; empty = detected
 };
 
 CLI::App* AddExportCommand(CLI::App& parent, ExportOptions& options);

@@ -31,6 +31,13 @@ mocap::Result<glm::ivec2> ParseSize(const std::string& text) {
   return glm::ivec2(w, h);
 }
 
+mocap::Result<std::optional<mocap::UpAxis>> ParseUpAxis(const std::string& text) {
+  if (text.empty()) return std::optional<mocap::UpAxis>();
+  if (text == "y" || text == "Y") return std::optional<mocap::UpAxis>(mocap::UpAxis::kY);
+  if (text == "z" || text == "Z") return std::optional<mocap::UpAxis>(mocap::UpAxis::kZ);
+  return ArgError("--up", "expected y or z, found '" + text + "'");
+}
+
 mocap::Result<FrameRange> ParseFrames(const std::string& text, int num_frames) {
   FrameRange r{0, num_frames - 1, 1};
   if (text.empty()) return r;

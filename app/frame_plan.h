@@ -5,6 +5,7 @@
 // makes an exported frame and its camera JSON match the rendered image.
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -13,6 +14,7 @@
 #include "app/pipeline.h"
 #include "mocap/error.h"
 #include "mocap/motion.h"
+#include "mocap/skeleton.h"
 #include "render/camera.h"
 
 namespace app {
@@ -27,6 +29,9 @@ mocap::Error ArgError(const std::string& option, const std::string& message);
 
 // "WxH" with both sides in 16..16384.
 mocap::Result<glm::ivec2> ParseSize(const std::string& text);
+
+// --up: "y" or "z" (either case) -> that axis; "" -> empty (detect it).
+mocap::Result<std::optional<mocap::UpAxis>> ParseUpAxis(const std::string& text);
 
 // Output frames first..last (inclusive) every step.
 struct FrameRange {

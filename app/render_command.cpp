@@ -57,6 +57,7 @@ void AddOutputFlags(CLI::App& cmd, RenderOptions& o) {
   cmd.add_flag("--overwrite", o.overwrite, "Replace existing frames, contact sheet and video");
   cmd.add_flag("--resume", o.resume,
                "Keep the frames that exist (an interrupted render), render the missing ones");
+  cmd.add_option("--up", o.up, "The BVH's up axis, y or z, when detection picks the wrong one (default: detected)");
   cmd.add_option("--start-number", o.start_number,
                  "File number of motion frame 0 (turntable: of the first view), e.g. 1001")
       ->capture_default_str();
@@ -258,7 +259,9 @@ int RunRender(const RenderOptions& options) {
   const std::string name = demo  ? "demo"
                            : rig ? std::filesystem::path(rig->file).stem().string()
                                  : std::filesystem::path(o.input).stem().string();
-  mocap::Result<Character> character = LoadCommandCharacter(o.input, o.motion, o.quiet);
+  const mocap::Result<std::optional<mocap::UpAxis>> up = ParseUpAxis(o.up);
+  if (!up.ok()) return Fail(up.error());
+  mocap::Result<Character> character = LoadCommandCharacter(o.input, o.motion, o.quiet, *up);
   if (!character.ok()) return Fail(character.error());
   const Character& ch = *character;
 

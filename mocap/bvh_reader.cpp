@@ -5,6 +5,7 @@
 #include <cerrno>
 #include <cmath>
 #include <condition_variable>
+#include <cstdint>
 #include <cstring>
 #include <limits>
 #include <mutex>
@@ -373,6 +374,44 @@ UpAxis DetectBvhUpAxis(const Skeleton& skeleton) {
   return z_votes > y_votes ? UpAxis::kZ : UpAxis::kY;
 }
 
+UpAxis DetectBvhUpAxisFromPoses(const Skeleton& skeleton, const Motion& motion,
+                                UpAxisSource* source) {
+  constexpr int kSampleFrames = 32;
+  const std::size_t n = skeleton.rest_translations.size();
+  std::vector<JointTransform> locals(n);
+  std::vector<glm::mat4> model(n);
+  int y_frames = 0;
+  int z_frames = 0;
+  const int samples = std::min(motion.num_frames, kSampleFrames);
+  for (int i = 0; i < samples; ++i) {
+    const int f = samples > 1 ? static_cast<int>(std::int64_t{motion.num_frames - 1} * i / (samples - 1)) : 0;
+    if (!LocalPoseJob{&skeleton, motion.frame(f), locals}.Run()) continue;
+    if (!LocalToModelJob{skeleton.parents, locals, glm::mat4(1.0f), model}.Run()) continue;
+    int y_votes = 0;
+    int z_votes = 0;
+    const auto vote = [&y_votes, &z_votes](const glm::vec3& bone) {
+      const glm::vec3 a = glm::abs(bone);
+      if (a.y > a.x && a.y > a.z) ++y_votes;
+      if (a.z > a.x && a.z > a.y) ++z_votes;
+    };
+    for (std::size_t j = 0; j < n; ++j) {
+      const int p = skeleton.parents[j];
+      if (p != kNoParent) vote(glm::vec3(model[j][3] - model[static_cast<std::size_t>(p)][3]));
+    }
+    for (const EndSite& e : skeleton.end_sites) {
+      vote(glm::mat3(model[static_cast<std::size_t>(e.parent)]) * e.offset);
+    }
+    if (y_votes > z_votes) ++y_frames;
+    if (z_votes > y_votes) ++z_frames;
+  }
+  if (y_frames == z_frames) {
+    if (source != nullptr) *source = UpAxisSource::kRestPose;
+    return DetectBvhUpAxis(skeleton);
+  }
+  if (source != nullptr) *source = UpAxisSource::kAnimatedPoses;
+  return z_frames > y_frames ? UpAxis::kZ : UpAxis::kY;
+}
+
 float RestHeight(const Skeleton& skeleton, UpAxis up) {
   const int axis = up == UpAxis::kY ? 1 : 2;
   std::vector<glm::vec3> model(skeleton.rest_translations.size());
@@ -502,7 +541,12 @@ Result<BvhFile> ParseBvhText(std::string_view text, const std::string& file_name
     return s.error();
 
   SkeletonInfo& info = file.skeleton.info;
-  info.up_axis = options.up_axis.has_value() ? *options.up_axis : DetectBvhUpAxis(file.skeleton);
+  if (options.up_axis.has_value()) {
+    info.up_axis = *options.up_axis;
+    info.up_axis_source = UpAxisSource::kGiven;
+  } else {
+    info.up_axis = DetectBvhUpAxisFromPoses(file.skeleton, file.motion, &info.up_axis_source);
+  }
   const float raw_height = RestHeight(file.skeleton, info.up_axis);
   // A rest pose need not stand upright (Bandai Namco's bones lie along X), so
   // the units come from the taller of the rest pose and the first frame.

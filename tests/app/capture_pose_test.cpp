@@ -1,0 +1,104 @@
+// Captures that looked wrong (issue 27): a capture whose rest pose and animated
+// poses disagree on the up axis is detected from its poses and rendered
+// standing; `--up` still overrides.
+
+#include <filesystem>
+#include <fstream>
+#include <optional>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "app/character_motion.h"
+#include "app/pipeline.h"
+#include "mocap/bvh_reader.h"
+#include "support/data_paths.h"
+#include "support/posed_bvh.h"
+#include "support/run_process.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct UpCase {
+  const char* name;
+  bool z_up_offsets;
+  float root_x_deg;
+  mocap::UpAxis expected;
+};
+
+// Rest and poses agree (Y, Z), and the two mismatches: Z-up OFFSETs stood Y-up
+// by a root rotation of -90 degrees about X in every frame, and Y-up OFFSETs
+// laid Z-up by +90.
+constexpr UpCase kCases[] = {
+    {"y_agree", false, 0.0f, mocap::UpAxis::kY},
+    {"z_agree", true, 0.0f, mocap::UpAxis::kZ},
+    {"z_rest_y_poses", true, -90.0f, mocap::UpAxis::kY},
+    {"y_rest_z_poses", false, 90.0f, mocap::UpAxis::kZ},
+};
+
+fs::path WriteCase(const UpCase& c) {
+  const fs::path p = testsupport::TestOutputPath(std::string("capture_pose/") + c.name + ".bvh");
+  std::ofstream(p) << testsupport::HumanoidWalkBvh(c.z_up_offsets, c.root_x_deg);
+  return p;
+}
+
+// Height (Y, after loading Y-up) over depth (Z; the T-pose arms span X) of the
+// deformed body at frame 10: about 2.5 standing, below 1 lying on the floor.
+float Uprightness(const fs::path& bvh, std::optional<mocap::UpAxis> up = {}) {
+  mocap::Result<app::Character> ch = app::LoadCommandCharacter(bvh.string(), "", true, up);
+  EXPECT_TRUE(ch.ok()) << ch.error().ToString();
+  if (!ch.ok()) return 0.0f;
+  mocap::Result<app::FramePipeline> p = app::FramePipeline::Create(*ch, app::GlobalMethod::kSsd, 1);
+  EXPECT_TRUE(p.ok());
+  if (!p.ok()) return 0.0f;
+  app::DeformedFrame frame;
+  EXPECT_TRUE(p->Evaluate(10.0 / 30.0, frame).ok());
+  const glm::vec3 size = frame.bounds.size();
+  return size.y / size.z;
+}
+
+TEST(CapturePose, UpAxisComesFromTheAnimatedPoses) {
+  for (const UpCase& c : kCases) {
+    SCOPED_TRACE(c.name);
+    const mocap::Result<mocap::BvhFile> file =
+        mocap::ParseBvh(testsupport::HumanoidWalkBvh(c.z_up_offsets, c.root_x_deg), c.name);
+    ASSERT_TRUE(file.ok()) << file.error().ToString();
+    EXPECT_EQ(file->skeleton.info.up_axis, c.expected);
+    EXPECT_EQ(file->skeleton.info.up_axis_source, mocap::UpAxisSource::kAnimatedPoses);
+    // The rest pose alone says the offsets' axis.
+    EXPECT_EQ(mocap::DetectBvhUpAxis(file->skeleton),
+              c.z_up_offsets ? mocap::UpAxis::kZ : mocap::UpAxis::kY);
+  }
+}
+
+// Rendered (loaded Y-up as render and export load it) every case stands: the
+// body is more than 1.5 times as tall as it is deep. Given the wrong axis
+// with --up, the mismatched capture lies down again.
+TEST(CapturePose, EveryCaseIsRenderedStanding) {
+  for (const UpCase& c : kCases) {
+    SCOPED_TRACE(c.name);
+    EXPECT_GT(Uprightness(WriteCase(c)), 1.5f);
+  }
+  const fs::path mismatched = WriteCase(kCases[2]);
+  EXPECT_LT(Uprightness(mismatched, mocap::UpAxis::kZ), 1.0f);
+  EXPECT_GT(Uprightness(mismatched, mocap::UpAxis::kY), 1.5f);
+}
+
+// inspect says which axis it used and what decided it.
+TEST(CapturePose, InspectSaysWhichUpAxisAndWhy) {
+  const fs::path bvh = WriteCase(kCases[2]);
+  const fs::path logs = testsupport::TestOutputPath("capture_pose/logs/x").parent_path();
+  testsupport::ProcessResult r = testsupport::RunPatchskin({"inspect", bvh.string()}, logs);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("up axis:     Y (animated poses)"), std::string::npos) << r.out;
+  r = testsupport::RunPatchskin({"inspect", bvh.string(), "--up", "z", "--json"}, logs);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("\"up_axis\": \"Z\""), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("\"up_axis_from\": \"given\""), std::string::npos) << r.out;
+  r = testsupport::RunPatchskin({"inspect", bvh.string(), "--up", "x"}, logs);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_EQ(r.FirstErrLine(), "--up: error: expected y or z, found 'x'");
+}
+
+}  // namespace
