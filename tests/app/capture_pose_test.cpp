@@ -101,4 +101,30 @@ TEST(CapturePose, InspectSaysWhichUpAxisAndWhy) {
   EXPECT_EQ(r.FirstErrLine(), "--up: error: expected y or z, found 'x'");
 }
 
+// Bandai Namco's joint_Root stays at the origin while the hips walk away: the
+// body has no part (no tube, no weight) on it, so at every sampled frame the
+// deformed body is no wider or deeper than a person (it grew a limb to where
+// the body was bound, over 4 m long, before).
+TEST(CapturePose, BandaiPositioningRootGrowsNoLimb) {
+  int checked = 0;
+  for (const char* name : {"dataset-1_walk_normal_001.bvh", "dataset-2_run_active_034.bvh"}) {
+    const fs::path bvh = testsupport::SharedDataPath(std::string("bvh/bandai_namco/") + name);
+    if (!fs::exists(bvh)) continue;
+    SCOPED_TRACE(name);
+    mocap::Result<app::Character> ch = app::LoadCommandCharacter(bvh.string(), "", true);
+    ASSERT_TRUE(ch.ok()) << ch.error().ToString();
+    mocap::Result<app::FramePipeline> p = app::FramePipeline::Create(*ch, app::GlobalMethod::kSsd, 1);
+    ASSERT_TRUE(p.ok());
+    app::DeformedFrame frame;
+    for (int f = 0; f < ch->motion.num_frames; f += 10) {
+      ASSERT_TRUE(p->Evaluate(f * ch->motion.frame_time_s, frame).ok());
+      const glm::vec3 size = frame.bounds.size();  // centimetres
+      EXPECT_LT(std::max(size.x, size.z), 150.0f) << "frame " << f;
+      EXPECT_GT(size.y, 120.0f) << "frame " << f;
+    }
+    ++checked;
+  }
+  if (checked == 0) GTEST_SKIP() << "no Bandai Namco capture in " << testsupport::SharedDataPath("bvh/bandai_namco");
+}
+
 }  // namespace
