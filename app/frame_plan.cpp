@@ -4,6 +4,7 @@
 #include <climits>
 #include <cstdint>
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <sstream>
 
@@ -186,6 +187,45 @@ mocap::Result<CameraPlan> CameraPlan::Create(FramePipeline& pipeline, const Fram
   return cp;
 }
 
+namespace {
+
+// Largest |x| or |y| in normalised device coordinates of the corners of `box`.
+float ProjectedExtent(const deform::Bounds& box, const render::Camera& camera) {
+  const glm::mat4 clip_from_world = camera.ClipFromView() * camera.ViewFromWorld();
+  float worst = 0.0f;
+  for (int k = 0; k < 8; ++k) {
+    const glm::vec3 p((k & 1) ? box.max.x : box.min.x, (k & 2) ? box.max.y : box.min.y,
+                      (k & 4) ? box.max.z : box.min.z);
+    const glm::vec4 c = clip_from_world * glm::vec4(p, 1.0f);
+    if (!(c.w > 0.0f)) return std::numeric_limits<float>::infinity();
+    worst = std::max({worst, std::abs(c.x / c.w), std::abs(c.y / c.w)});
+  }
+  return worst;
+}
+
+}  // namespace
+
+void CameraPlan::KeepInFrame(const deform::Bounds& box, render::Camera& camera) const {
+  if (box.empty() || ProjectedExtent(box, camera) <= kFollowFrameLimit) return;
+  // Slide target and eye together toward the box's centre: the least pull s
+  // in [0, 1] that brings the box inside the limit (bisection; s = 1 centres it).
+  const glm::vec3 offset = camera.eye - camera.target;
+  const glm::vec3 lagging = camera.target;
+  const glm::vec3 centre = box.center();
+  const auto at = [&](float s) {
+    render::Camera c = camera;
+    c.target = lagging + s * (centre - lagging);
+    c.eye = c.target + offset;
+    return c;
+  };
+  float lo = 0.0f, hi = 1.0f;
+  for (int i = 0; i < 20; ++i) {
+    const float mid = 0.5f * (lo + hi);
+    (ProjectedExtent(box, at(mid)) <= kFollowFrameLimit ? hi : lo) = mid;
+  }
+  camera = at(hi);
+}
+
 render::Camera CameraPlan::At(const OutputFrame& frame) const {
   if (mode_ == "turntable") return turntable_[static_cast<std::size_t>(frame.camera)];
   if (mode_ == "fixed") return fixed_;
@@ -196,9 +236,11 @@ render::Camera CameraPlan::At(const OutputFrame& frame) const {
   const int cached_end = centre_base_ + static_cast<int>(centres_.size());
   if (first < centre_base_ || first > cached_end) {
     centres_.clear();
+    boxes_.clear();
     centre_base_ = first;
   } else if (first > centre_base_) {
     centres_.erase(centres_.begin(), centres_.begin() + (first - centre_base_));
+    boxes_.erase(boxes_.begin(), boxes_.begin() + (first - centre_base_));
     centre_base_ = first;
   }
   for (int g = centre_base_ + static_cast<int>(centres_.size()); g <= f; ++g) {
@@ -207,8 +249,11 @@ render::Camera CameraPlan::At(const OutputFrame& frame) const {
     const mocap::Status s = tracker_->Evaluate(g * frame_time_s_, scratch_);
     PATCHSKIN_CHECK(s.ok());
     centres_.push_back(scratch_.bounds.center());
+    boxes_.push_back(scratch_.bounds);
   }
-  return follow_.At(centres_, f - centre_base_);
+  render::Camera camera = follow_.At(centres_, f - centre_base_);
+  KeepInFrame(boxes_[static_cast<std::size_t>(f - centre_base_)], camera);
+  return camera;
 }
 
 }  // namespace app

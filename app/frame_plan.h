@@ -102,7 +102,12 @@ mocap::Result<FramePlan> PlanFrames(const mocap::Motion& motion, const FramePlan
 // - the follow camera of frame f reads the bounds centres of frames
 //   max(0, f - window) .. f only (render::FollowCamera), evaluated on demand and
 //   kept in a sliding window, so memory is constant and the first frame needs
-//   at most window + 1 evaluations, however long the capture.
+//   at most window + 1 evaluations, however long the capture. The smoothed
+//   target lags a fast body (a running dog); it is pulled toward frame f's
+//   bounds centre just far enough that the corners of frame f's bounding box
+//   project within kFollowFrameLimit of the image centre (normalised device
+//   coordinates), so the body stays in the frame with a margin. Framing puts a
+//   centred body inside that limit, so the pull always succeeds.
 // Bodies are evaluated with a private global-only SSD pipeline of the same
 // character (patches and the elastic layer move the surface by a few
 // percent of the body; the caller's pipeline and its state are never touched).
@@ -110,6 +115,9 @@ class CameraPlan {
  public:
   // Output frames of the whole motion sampled for framing and ground height.
   static constexpr int kFramingSamples = 64;
+  // Follow: the body's bounding box stays within this |x|, |y| (NDC, 1 = the
+  // frame's edge) whenever the camera's framing allows it.
+  static constexpr float kFollowFrameLimit = 0.9f;
 
   // mode: follow | fixed | turntable; elevation in degrees, |e| <= kMaxElevationDeg
   // (else kInvalidArgument naming --elevation); size in pixels.
@@ -128,6 +136,10 @@ class CameraPlan {
   float ground_y() const { return ground_y_; }
 
  private:
+  // Follow: pulls `camera` (target and eye together) toward the centre of
+  // `box` until the box projects within kFollowFrameLimit (see above).
+  void KeepInFrame(const deform::Bounds& box, render::Camera& camera) const;
+
   std::string mode_;
   std::vector<render::Camera> turntable_;
   render::Camera fixed_;
@@ -135,6 +147,7 @@ class CameraPlan {
   double frame_time_s_ = 1.0 / 30.0;           // output frame f is at f * frame_time_s_
   std::unique_ptr<FramePipeline> tracker_;     // global-only SSD body for bounds
   mutable std::vector<glm::vec3> centres_;     // follow: bounds centres of frames centre_base_..
+  mutable std::vector<deform::Bounds> boxes_;  // follow: their bounds
   mutable int centre_base_ = 0;
   mutable DeformedFrame scratch_;
   float ground_y_ = 0.0f;

@@ -2,6 +2,8 @@
 // poses disagree on the up axis is detected from its poses and rendered
 // standing; `--up` still overrides.
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <optional>
@@ -10,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include "app/character_motion.h"
+#include "app/frame_plan.h"
 #include "app/pipeline.h"
 #include "mocap/bvh_reader.h"
 #include "support/data_paths.h"
@@ -99,6 +102,76 @@ TEST(CapturePose, InspectSaysWhichUpAxisAndWhy) {
   r = testsupport::RunPatchskin({"inspect", bvh.string(), "--up", "x"}, logs);
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_EQ(r.FirstErrLine(), "--up: error: expected y or z, found 'x'");
+}
+
+// The follow camera at 1280x720 keeps the body in the picture: the largest
+// |x| or |y| in normalised device coordinates over a quarter of the body's
+// vertices, at every output frame (infinity when a vertex is behind the eye).
+float WorstFollowExtent(const app::Character& ch) {
+  mocap::Result<app::FramePipeline> p = app::FramePipeline::Create(ch, app::GlobalMethod::kSsd, 1);
+  EXPECT_TRUE(p.ok());
+  mocap::Result<app::FramePlan> plan = app::PlanFrames(ch.motion, {.frames = "", .list_frames = false});
+  EXPECT_TRUE(plan.ok());
+  if (!p.ok() || !plan.ok()) return INFINITY;
+  mocap::Result<app::CameraPlan> cameras =
+      app::CameraPlan::Create(*p, *plan, "follow", 15.0f, {1280, 720});
+  EXPECT_TRUE(cameras.ok());
+  if (!cameras.ok()) return INFINITY;
+  app::DeformedFrame frame;
+  float worst = 0.0f;
+  for (std::size_t i = 0; i < plan->count(); ++i) {
+    const app::OutputFrame of = plan->At(i);
+    EXPECT_TRUE(p->Evaluate(of.time_s, frame).ok());
+    const render::Camera camera = cameras->At(of);
+    const glm::mat4 clip_from_world = camera.ClipFromView() * camera.ViewFromWorld();
+    for (std::size_t v = 0; v < frame.positions.size(); v += 4) {
+      const glm::vec4 c = clip_from_world * glm::vec4(frame.positions[v], 1.0f);
+      if (!(c.w > 0.0f)) return INFINITY;
+      worst = std::max({worst, std::abs(c.x / c.w), std::abs(c.y / c.w)});
+    }
+  }
+  return worst;
+}
+
+// Inside the frame with a margin of 5% of its width and height on every side.
+constexpr float kMaxFollowExtent = 0.9f;
+
+TEST(CapturePose, FollowCameraKeepsGeneratedBodiesInFrame) {
+  const struct {
+    const char* name;
+    std::string text;
+  } cases[] = {
+      {"quadruped_run", testsupport::QuadrupedRunBvh()},
+      {"quadruped_trot", testsupport::QuadrupedRunBvh(150.0f)},
+      {"crawl", testsupport::HumanoidCrawlBvh()},
+      {"walk", testsupport::HumanoidWalkBvh(false, 0.0f, 90)},
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.name);
+    const fs::path bvh = testsupport::TestOutputPath(std::string("capture_pose/") + c.name + ".bvh");
+    std::ofstream(bvh) << c.text;
+    mocap::Result<app::Character> ch = app::LoadCommandCharacter(bvh.string(), "", true);
+    ASSERT_TRUE(ch.ok()) << ch.error().ToString();
+    EXPECT_EQ(ch->skeleton.info.up_axis_source, mocap::UpAxisSource::kAnimatedPoses);
+    EXPECT_LE(WorstFollowExtent(*ch), kMaxFollowExtent);
+  }
+}
+
+TEST(CapturePose, FollowCameraKeepsEveryRealCaptureInFrame) {
+  if (!testsupport::HaveSharedData()) GTEST_SKIP() << "no shared data at " << SHARED_DATA_DIR;
+  int checked = 0;
+  for (const auto& e : fs::recursive_directory_iterator(testsupport::SharedDataPath(""))) {
+    const std::string ext = e.path().extension().string();
+    if (ext != ".bvh" && ext != ".glb" && ext != ".gltf") continue;
+    SCOPED_TRACE(e.path().string());
+    mocap::Result<app::Character> ch = app::LoadCommandCharacter(e.path().string(), "", true);
+    ASSERT_TRUE(ch.ok()) << ch.error().ToString();
+    const float worst = WorstFollowExtent(*ch);
+    EXPECT_LE(worst, kMaxFollowExtent);
+    std::printf("%-60s %.3f\n", e.path().filename().string().c_str(), worst);
+    ++checked;
+  }
+  EXPECT_GT(checked, 0);
 }
 
 // Bandai Namco's joint_Root stays at the origin while the hips walk away: the

@@ -121,4 +121,82 @@ inline std::string HumanoidWalkBvh(bool z_up_offsets, float root_x_deg, int num_
   return WriteBvh(bones, frames);
 }
 
+// A dog-sized quadruped, Y-up, spine horizontal along +Z, trotting forward at
+// `speed_cm_s` (400: a fast run) with its legs swinging +-30 degrees.
+inline std::string QuadrupedRunBvh(float speed_cm_s = 400.0f, int num_frames = 90) {
+  const std::vector<BvhBone> bones = {
+      {"Pelvis", -1, {0, 55, 0}, {}},
+      {"Spine1", 0, {0, 2, 15}, {}},
+      {"Spine2", 1, {0, 0, 15}, {}},
+      {"Chest", 2, {0, 0, 15}, {}},
+      {"Neck", 3, {0, 8, 10}, {}},
+      {"Head", 4, {0, 10, 8}, {0, 0, 15}},
+      {"Tail1", 0, {0, 3, -8}, {}},
+      {"Tail2", 6, {0, 0, -12}, {0, -5, -15}},
+      {"LHip", 0, {8, -5, 0}, {}},
+      {"LKnee", 8, {0, -20, 5}, {}},
+      {"LHock", 9, {0, -15, -5}, {}},
+      {"LHindPaw", 10, {0, -12, 0}, {0, -2, 6}},
+      {"RHip", 0, {-8, -5, 0}, {}},
+      {"RKnee", 12, {0, -20, 5}, {}},
+      {"RHock", 13, {0, -15, -5}, {}},
+      {"RHindPaw", 14, {0, -12, 0}, {0, -2, 6}},
+      {"LShoulder", 3, {8, -5, 5}, {}},
+      {"LElbow", 16, {0, -20, -3}, {}},
+      {"LWrist", 17, {0, -20, 3}, {}},
+      {"LForePaw", 18, {0, -8, 0}, {0, -2, 6}},
+      {"RShoulder", 3, {-8, -5, 5}, {}},
+      {"RElbow", 20, {0, -20, -3}, {}},
+      {"RWrist", 21, {0, -20, 3}, {}},
+      {"RForePaw", 22, {0, -8, 0}, {0, -2, 6}},
+  };
+  std::vector<std::vector<float>> frames;
+  for (int f = 0; f < num_frames; ++f) {
+    const float t = static_cast<float>(f) / 30.0f;
+    const float phase = 2.0f * 3.14159265f * 2.5f * t;  // 2.5 strides a second
+    std::vector<float> row(6 + 3 * (bones.size() - 1), 0.0f);
+    row[1] = 55.0f + 3.0f * std::sin(2.0f * phase);
+    row[2] = speed_cm_s * t;
+    const auto set_x = [&row](int joint, float deg) { row[static_cast<std::size_t>(6 + 3 * (joint - 1) + 1)] = deg; };
+    const float swing = 30.0f * std::sin(phase);
+    set_x(8, swing);
+    set_x(12, -swing);
+    set_x(16, -swing);
+    set_x(20, swing);
+    set_x(6, 15.0f * std::sin(phase));  // the tail wags up and down
+    frames.push_back(row);
+  }
+  return WriteBvh(bones, frames);
+}
+
+// The humanoid crawling on hands and knees along +Z at `speed_cm_s`: the root
+// tips the torso forward (+90 degrees about X), thighs hang down, shins lie
+// back along the floor, arms reach down; limbs swing +-15 degrees.
+inline std::string HumanoidCrawlBvh(float speed_cm_s = 60.0f, int num_frames = 90) {
+  const std::vector<BvhBone> bones = HumanoidBones();
+  std::vector<std::vector<float>> frames;
+  for (int f = 0; f < num_frames; ++f) {
+    const float t = static_cast<float>(f) / 30.0f;
+    const float phase = 2.0f * 3.14159265f * t;
+    std::vector<float> row(6 + 3 * (bones.size() - 1), 0.0f);
+    row[1] = 60.0f;
+    row[2] = speed_cm_s * t;
+    row[4] = 90.0f;  // root Xrotation: the spine points forward, the chest faces down
+    const auto set = [&row](int joint, int channel, float deg) {
+      row[static_cast<std::size_t>(6 + 3 * (joint - 1) + channel)] = deg;  // 0 Z, 1 X, 2 Y
+    };
+    const float swing = 15.0f * std::sin(phase);
+    set(13, 1, -90.0f + swing);  // thighs down
+    set(16, 1, -90.0f - swing);
+    set(14, 1, 90.0f);           // shins back along the floor
+    set(17, 1, 90.0f);
+    set(6, 2, -90.0f);           // arms from the T-pose to down
+    set(10, 2, 90.0f);
+    set(6, 1, swing);
+    set(10, 1, -swing);
+    frames.push_back(row);
+  }
+  return WriteBvh(bones, frames);
+}
+
 }  // namespace testsupport
