@@ -233,7 +233,7 @@ int RunBench(const BenchOptions& o) {
                "bench: WARNING: this is not a Release build (%s, assertions on); its figures are "
                "meaningless. Build with -DCMAKE_BUILD_TYPE=Release.\n",
                PATCHSKIN_BUILD_TYPE);
-  if (!o.allow_debug) return 1;
+  if (!o.allow_debug) return 2;  // cannot run as given (README: exit codes)
   const bool release = false;
 #else
   const bool release = true;

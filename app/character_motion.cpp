@@ -31,9 +31,10 @@ mocap::Result<Character> MakeRetargetedCharacter(MotionSource&& character, Motio
 }
 
 mocap::Result<Character> LoadCommandCharacter(const std::string& input, const std::string& motion,
-                                              bool quiet) {
+                                              bool quiet, std::optional<mocap::UpAxis> up) {
   MotionSourceOptions load;
   load.y_up = true;  // frames are rendered Y-up with the ground at the feet
+  load.up = up;
   mocap::Result<MotionSource> src = input.empty()
                                         ? LoadBvhText(DemoBvhText(), "demo_walk.bvh", load)
                                         : LoadMotionSource(input, load);

@@ -4,6 +4,7 @@
 // are matched to the skin's joints by name and its rotations retargeted onto
 // the glTF rest pose (conventions in mocap/retarget.h; docs/retargeting.md).
 
+#include <optional>
 #include <string>
 
 #include "app/motion_source.h"
@@ -25,7 +26,8 @@ mocap::Result<Character> MakeRetargetedCharacter(MotionSource&& character, Motio
 // driven by the BVH `motion` when that is not empty (MakeRetargetedCharacter),
 // else by its own motion (MakeCharacter). Load and retarget warnings go to
 // stderr unless `quiet`. Errors: those of LoadMotionSource and the makers.
+// `up` (--up) gives the BVH's up axis instead of detecting it.
 mocap::Result<Character> LoadCommandCharacter(const std::string& input, const std::string& motion,
-                                              bool quiet);
+                                              bool quiet, std::optional<mocap::UpAxis> up = {});
 
 }  // namespace app

@@ -13,6 +13,7 @@
 #include "app/character_motion.h"
 #include "app/frame_plan.h"
 #include "app/motion_source.h"
+#include "app/output_guard.h"
 #include "app/pipeline.h"
 #include "app/progress.h"
 #include "app/rig_file.h"
@@ -50,16 +51,6 @@ mocap::Result<deform::GltfExportLayout> ParseLayout(const std::string& text) {
   if (text == "morph") return deform::GltfExportLayout::kMorphTargets;
   if (text == "baked") return deform::GltfExportLayout::kBakedMeshes;
   return ArgError("--layout", "expected auto, morph or baked, found '" + text + "'");
-}
-
-mocap::Status CreateFolder(const std::filesystem::path& dir) {
-  std::error_code ec;
-  if (!dir.empty()) std::filesystem::create_directories(dir, ec);
-  if (ec) {
-    return mocap::MakeError(mocap::ErrorCode::kIo, {dir.string(), 0, 0, {}},
-                            "cannot create the output folder: " + ec.message());
-  }
-  return mocap::Status::Ok();
 }
 
 }  // namespace
@@ -109,6 +100,10 @@ CLI::App* AddExportCommand(CLI::App& parent, ExportOptions& o) {
                   "capture in centimetres to metres")
       ->capture_default_str();
   cmd->add_option("--threads", o.threads, "Worker threads (0 = all cores)")->capture_default_str();
+  cmd->add_option("--up", o.up, "The BVH's up axis, y or z, when detection picks the wrong one (default: detected)");
+  cmd->add_option("--start-number", o.start_number,
+                  "File number of motion frame 0 (OBJ meshes, camera JSON), e.g. 1001")
+      ->capture_default_str();
   cmd->add_flag("--quiet", o.quiet, "No progress output");
   return cmd;
 }
@@ -152,10 +147,14 @@ int RunExport(const ExportOptions& options) {
   const std::string name = demo  ? "demo"
                            : rig ? std::filesystem::path(rig->file).stem().string()
                                  : std::filesystem::path(o.input).stem().string();
-  mocap::Result<Character> character = LoadCommandCharacter(o.input, {}, o.quiet);
+  const mocap::Result<std::optional<mocap::UpAxis>> up = ParseUpAxis(o.up);
+  if (!up.ok()) return Fail(up.error());
+  mocap::Result<Character> character = LoadCommandCharacter(o.input, {}, o.quiet, *up);
   if (!character.ok()) return Fail(character.error());
   const Character& ch = *character;
-  mocap::Result<FramePlan> plan = PlanFrames(ch.motion, {.frames = o.frames, .fps = o.fps, .list_frames = false});
+  mocap::Result<FramePlan> plan = PlanFrames(
+      ch.motion,
+      {.frames = o.frames, .fps = o.fps, .start_number = o.start_number, .list_frames = false});
   if (!plan.ok()) return Fail(plan.error());
 
   const std::string out = o.out.empty() ? "out/" + name + "_export/mesh_####.obj" : o.out;
@@ -171,7 +170,7 @@ int RunExport(const ExportOptions& options) {
   const std::filesystem::path out_dir =
       glb ? std::filesystem::path(out).parent_path()
           : std::filesystem::path(*render::ExpandFramePattern(out, 0)).parent_path();
-  if (mocap::Status s = CreateFolder(out_dir); !s) return Fail(s.error());
+  if (mocap::Status s = PrepareOutputFolder(out_dir); !s) return Fail(s.error());
 
   // --- Pipeline and cameras ----------------------------------------------------------
   // The layered result: with a rig, every layer it asks for (render draws the
@@ -215,7 +214,13 @@ int RunExport(const ExportOptions& options) {
   const std::string source = demo ? "demo_walk.bvh (built in)" : rig ? rig->file : o.input;
   // Frames are computed one at a time (plan->At): an export of every frame of
   // an hour-long capture holds no per-frame list (issue 8).
+  // Ctrl-C (SIGINT) or SIGTERM stops between frames, as in render: the frames
+  // written stay complete, the .glb (written only at the end) is not started.
+  OutputGuard guard({.overwrite = true});
+  int frames_done = 0;
+  int last_done_number = -1;
   for (std::size_t index = 0; index < plan->count(); ++index) {
+    if (guard.interrupted()) break;
     const OutputFrame of = plan->At(index);
     mocap::Status s = pipeline->Evaluate(of.time_s, frame);
     if (!s.ok()) return Fail(s.error());
@@ -254,6 +259,20 @@ int RunExport(const ExportOptions& options) {
       if (!s.ok()) return Fail(s.error());
     }
     progress.Step(of.number);
+    ++frames_done;
+    last_done_number = of.number;
+  }
+  if (guard.interrupted()) {
+    progress.Finish();
+    std::string m = std::string("interrupted by ") + guard.signal_name();
+    m += frames_done == 0 ? " before any frame was complete"
+                          : " after frame " + std::to_string(last_done_number) + ": " +
+                                std::to_string(frames_done) + " of " +
+                                std::to_string(plan->count()) + " frames were evaluated";
+    m += glb ? "; the .glb was not written" : "; the OBJ files written are complete";
+    std::fprintf(stderr, "%s: %s; run the same command again to export every frame\n",
+                 out.c_str(), m.c_str());
+    return guard.exit_code();
   }
   if (gltf) {
     if (mocap::Status s = gltf->Finish(out); !s) return Fail(s.error());

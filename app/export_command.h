@@ -42,11 +42,14 @@ struct ExportOptions {
                                   // e.g. 0.01: a capture in cm exported in metres
   int threads = 0;                // 0 = hardware concurrency
   bool quiet = false;
+  int start_number = 0;           // file number of motion frame 0 (OBJ and camera JSON)
+  std::string up;                 // --up y|z: a BVH's up axis; empty = detected
 };
 
 CLI::App* AddExportCommand(CLI::App& parent, ExportOptions& options);
 
-// Runs an export. Exit code: 0 ok, 2 bad input, 3 internal error.
+// Runs an export. Exit code: 0 ok, 2 bad input, 3 internal error, 128 + signal
+// when SIGINT or SIGTERM stopped it (no .glb then; the OBJ files written are complete).
 int RunExport(const ExportOptions& options);
 
 // The camera JSON of one frame (one object, keys in this order):

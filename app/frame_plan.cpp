@@ -4,6 +4,7 @@
 #include <climits>
 #include <cstdint>
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <sstream>
 
@@ -29,6 +30,13 @@ mocap::Result<glm::ivec2> ParseSize(const std::string& text) {
                                   ", found " + text);
   }
   return glm::ivec2(w, h);
+}
+
+mocap::Result<std::optional<mocap::UpAxis>> ParseUpAxis(const std::string& text) {
+  if (text.empty()) return std::optional<mocap::UpAxis>();
+  if (text == "y" || text == "Y") return std::optional<mocap::UpAxis>(mocap::UpAxis::kY);
+  if (text == "z" || text == "Z") return std::optional<mocap::UpAxis>(mocap::UpAxis::kZ);
+  return ArgError("--up", "expected y or z, found '" + text + "'");
 }
 
 mocap::Result<FrameRange> ParseFrames(const std::string& text, int num_frames) {
@@ -77,6 +85,11 @@ mocap::Result<FramePlan> PlanFrames(const mocap::Motion& motion, const FramePlan
   plan.range = *range;
   plan.turntable = o.turntable;
   plan.turntable_frames = o.turntable ? o.turntable_frames : 0;
+  if (o.start_number < 0 || o.start_number > kMaxStartNumber) {
+    return ArgError("--start-number", "expected 0.." + std::to_string(kMaxStartNumber) +
+                                          ", found " + std::to_string(o.start_number));
+  }
+  plan.start_number = o.start_number;
   if (o.list_frames) {
     const std::size_t n = plan.count();
     plan.frames.reserve(n);
@@ -94,10 +107,10 @@ std::size_t FramePlan::count() const {
 OutputFrame FramePlan::At(std::size_t i) const {
   if (turntable) {
     const int k = static_cast<int>(i);
-    return {k, range.first * frame_time_s, k};
+    return {start_number + k, range.first * frame_time_s, k};
   }
   const int f = static_cast<int>(range.first + static_cast<std::int64_t>(i) * range.step);
-  return {f, f * frame_time_s, f};
+  return {start_number + f, f * frame_time_s, f};
 }
 
 mocap::Result<CameraPlan> CameraPlan::Create(FramePipeline& pipeline, const FramePlan& plan,
@@ -174,6 +187,45 @@ mocap::Result<CameraPlan> CameraPlan::Create(FramePipeline& pipeline, const Fram
   return cp;
 }
 
+namespace {
+
+// Largest |x| or |y| in normalised device coordinates of the corners of `box`.
+float ProjectedExtent(const deform::Bounds& box, const render::Camera& camera) {
+  const glm::mat4 clip_from_world = camera.ClipFromView() * camera.ViewFromWorld();
+  float worst = 0.0f;
+  for (int k = 0; k < 8; ++k) {
+    const glm::vec3 p((k & 1) ? box.max.x : box.min.x, (k & 2) ? box.max.y : box.min.y,
+                      (k & 4) ? box.max.z : box.min.z);
+    const glm::vec4 c = clip_from_world * glm::vec4(p, 1.0f);
+    if (!(c.w > 0.0f)) return std::numeric_limits<float>::infinity();
+    worst = std::max({worst, std::abs(c.x / c.w), std::abs(c.y / c.w)});
+  }
+  return worst;
+}
+
+}  // namespace
+
+void CameraPlan::KeepInFrame(const deform::Bounds& box, render::Camera& camera) const {
+  if (box.empty() || ProjectedExtent(box, camera) <= kFollowFrameLimit) return;
+  // Slide target and eye together toward the box's centre: the least pull s
+  // in [0, 1] that brings the box inside the limit (bisection; s = 1 centres it).
+  const glm::vec3 offset = camera.eye - camera.target;
+  const glm::vec3 lagging = camera.target;
+  const glm::vec3 centre = box.center();
+  const auto at = [&](float s) {
+    render::Camera c = camera;
+    c.target = lagging + s * (centre - lagging);
+    c.eye = c.target + offset;
+    return c;
+  };
+  float lo = 0.0f, hi = 1.0f;
+  for (int i = 0; i < 20; ++i) {
+    const float mid = 0.5f * (lo + hi);
+    (ProjectedExtent(box, at(mid)) <= kFollowFrameLimit ? hi : lo) = mid;
+  }
+  camera = at(hi);
+}
+
 render::Camera CameraPlan::At(const OutputFrame& frame) const {
   if (mode_ == "turntable") return turntable_[static_cast<std::size_t>(frame.camera)];
   if (mode_ == "fixed") return fixed_;
@@ -184,9 +236,11 @@ render::Camera CameraPlan::At(const OutputFrame& frame) const {
   const int cached_end = centre_base_ + static_cast<int>(centres_.size());
   if (first < centre_base_ || first > cached_end) {
     centres_.clear();
+    boxes_.clear();
     centre_base_ = first;
   } else if (first > centre_base_) {
     centres_.erase(centres_.begin(), centres_.begin() + (first - centre_base_));
+    boxes_.erase(boxes_.begin(), boxes_.begin() + (first - centre_base_));
     centre_base_ = first;
   }
   for (int g = centre_base_ + static_cast<int>(centres_.size()); g <= f; ++g) {
@@ -195,8 +249,11 @@ render::Camera CameraPlan::At(const OutputFrame& frame) const {
     const mocap::Status s = tracker_->Evaluate(g * frame_time_s_, scratch_);
     PATCHSKIN_CHECK(s.ok());
     centres_.push_back(scratch_.bounds.center());
+    boxes_.push_back(scratch_.bounds);
   }
-  return follow_.At(centres_, f - centre_base_);
+  render::Camera camera = follow_.At(centres_, f - centre_base_);
+  KeepInFrame(boxes_[static_cast<std::size_t>(f - centre_base_)], camera);
+  return camera;
 }
 
 }  // namespace app

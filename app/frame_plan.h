@@ -5,6 +5,7 @@
 // makes an exported frame and its camera JSON match the rendered image.
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -13,6 +14,7 @@
 #include "app/pipeline.h"
 #include "mocap/error.h"
 #include "mocap/motion.h"
+#include "mocap/skeleton.h"
 #include "render/camera.h"
 
 namespace app {
@@ -28,6 +30,9 @@ mocap::Error ArgError(const std::string& option, const std::string& message);
 // "WxH" with both sides in 16..16384.
 mocap::Result<glm::ivec2> ParseSize(const std::string& text);
 
+// --up: "y" or "z" (either case) -> that axis; "" -> empty (detect it).
+mocap::Result<std::optional<mocap::UpAxis>> ParseUpAxis(const std::string& text);
+
 // Output frames first..last (inclusive) every step.
 struct FrameRange {
   int first = 0;
@@ -41,7 +46,7 @@ mocap::Result<FrameRange> ParseFrames(const std::string& text, int num_frames);
 
 // Everything about one output frame that a frame loop needs.
 struct OutputFrame {
-  int number = 0;      // output frame number (names the file)
+  int number = 0;      // output frame number (names the file): start_number + frame or view
   double time_s = 0;   // motion time evaluated, seconds from the motion's first frame
   int camera = 0;      // turntable camera index, or the follow-camera frame
 };
@@ -51,6 +56,9 @@ struct FramePlanOptions {
   double fps = 0.0;           // output frame rate; 0 = the motion's own (30 when unknown)
   bool turntable = false;     // frames are turntable views of range.first
   int turntable_frames = 36;  // views of a turntable
+  // --start-number: the number of motion frame 0 (turntable: of the first
+  // view), e.g. 1001 for pipelines that count from there; 0..kMaxStartNumber.
+  int start_number = 0;
   // Fill FramePlan::frames. A render of every frame of an hour-long capture
   // has ~430,000 output frames; commands that walk the plan with count() and
   // At() (render) turn this off so the plan's memory stays constant.
@@ -64,6 +72,7 @@ struct FramePlan {
   FrameRange range;                  // the parsed --frames
   bool turntable = false;            // frames are turntable views of range.first
   int turntable_frames = 0;          // views of the turntable (when turntable)
+  int start_number = 0;              // added to every OutputFrame::number
   // In output order; time_s = number * frame_time_s. Empty when the plan was
   // made with list_frames = false; count() and At() work either way.
   std::vector<OutputFrame> frames;
@@ -74,7 +83,9 @@ struct FramePlan {
   OutputFrame At(std::size_t i) const;
 };
 
-// Errors: kInvalidArgument from ParseFrames.
+inline constexpr int kMaxStartNumber = 100'000'000;
+
+// Errors: kInvalidArgument from ParseFrames, or --start-number outside 0..kMaxStartNumber.
 mocap::Result<FramePlan> PlanFrames(const mocap::Motion& motion, const FramePlanOptions& options);
 
 // The camera of every output frame, as `render` uses it: "follow" (a smoothed
@@ -91,7 +102,12 @@ mocap::Result<FramePlan> PlanFrames(const mocap::Motion& motion, const FramePlan
 // - the follow camera of frame f reads the bounds centres of frames
 //   max(0, f - window) .. f only (render::FollowCamera), evaluated on demand and
 //   kept in a sliding window, so memory is constant and the first frame needs
-//   at most window + 1 evaluations, however long the capture.
+//   at most window + 1 evaluations, however long the capture. The smoothed
+//   target lags a fast body (a running dog); it is pulled toward frame f's
+//   bounds centre just far enough that the corners of frame f's bounding box
+//   project within kFollowFrameLimit of the image centre (normalised device
+//   coordinates), so the body stays in the frame with a margin. Framing puts a
+//   centred body inside that limit, so the pull always succeeds.
 // Bodies are evaluated with a private global-only SSD pipeline of the same
 // character (patches and the elastic layer move the surface by a few
 // percent of the body; the caller's pipeline and its state are never touched).
@@ -99,6 +115,9 @@ class CameraPlan {
  public:
   // Output frames of the whole motion sampled for framing and ground height.
   static constexpr int kFramingSamples = 64;
+  // Follow: the body's bounding box stays within this |x|, |y| (NDC, 1 = the
+  // frame's edge) whenever the camera's framing allows it.
+  static constexpr float kFollowFrameLimit = 0.9f;
 
   // mode: follow | fixed | turntable; elevation in degrees, |e| <= kMaxElevationDeg
   // (else kInvalidArgument naming --elevation); size in pixels.
@@ -117,6 +136,10 @@ class CameraPlan {
   float ground_y() const { return ground_y_; }
 
  private:
+  // Follow: pulls `camera` (target and eye together) toward the centre of
+  // `box` until the box projects within kFollowFrameLimit (see above).
+  void KeepInFrame(const deform::Bounds& box, render::Camera& camera) const;
+
   std::string mode_;
   std::vector<render::Camera> turntable_;
   render::Camera fixed_;
@@ -124,6 +147,7 @@ class CameraPlan {
   double frame_time_s_ = 1.0 / 30.0;           // output frame f is at f * frame_time_s_
   std::unique_ptr<FramePipeline> tracker_;     // global-only SSD body for bounds
   mutable std::vector<glm::vec3> centres_;     // follow: bounds centres of frames centre_base_..
+  mutable std::vector<deform::Bounds> boxes_;  // follow: their bounds
   mutable int centre_base_ = 0;
   mutable DeformedFrame scratch_;
   float ground_y_ = 0.0f;

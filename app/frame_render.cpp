@@ -38,7 +38,9 @@ mocap::Status DrawOne(const Character& ch, const DeformedFrame& f, const render:
   render::Overlays overlays;
   if (o.skeleton) AddSkeleton(f, ch.skeleton, overlays);
   overlays.wireframe = o.wireframe;
-  overlays.text.push_back({.text = "frame " + std::to_string(o.frame_number),
+  std::string frame_label = "frame " + std::to_string(o.frame_number);
+  if (o.view >= 0) frame_label += "  view " + std::to_string(o.view);
+  overlays.text.push_back({.text = frame_label,
                            .origin_px = {10, settings.height - 12}});
   if (!label.empty()) overlays.text.push_back({.text = label, .origin_px = {label_x, 30}});
   const mocap::JobStatus js = r.Render(camera, {&body, 1}, overlays, settings, into);

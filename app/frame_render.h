@@ -16,7 +16,8 @@ namespace app {
 struct FrameDrawOptions {
   bool skeleton = false;     // overlay the skeleton (bones and joints, no depth test)
   bool wireframe = false;    // overlay the mesh edges
-  int frame_number = 0;      // printed at the bottom left
+  int frame_number = 0;      // printed at the bottom left (a turntable's motion frame)
+  int view = -1;             // a turntable's view (0-based), printed after it; -1 none
   std::string left_label;    // split view: method names printed at the top of each half
   std::string right_label;
 };

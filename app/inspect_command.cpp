@@ -7,6 +7,7 @@
 #include <glm/gtc/quaternion.hpp>
 #include <nlohmann/json.hpp>
 
+#include "app/frame_plan.h"
 #include "app/motion_source.h"
 #include "app/pipeline.h"
 #include "deform/global/rig_artifacts.h"
@@ -18,6 +19,15 @@ namespace app {
 namespace {
 
 const char* UpAxisName(mocap::UpAxis up) { return up == mocap::UpAxis::kY ? "Y" : "Z"; }
+
+const char* UpAxisSourceName(mocap::UpAxisSource source) {
+  switch (source) {
+    case mocap::UpAxisSource::kAnimatedPoses: return "animated poses";
+    case mocap::UpAxisSource::kGiven: return "given";
+    case mocap::UpAxisSource::kRestPose: break;
+  }
+  return "rest pose";
+}
 
 std::string ChannelList(const mocap::JointChannels& c) {
   std::string out;
@@ -73,7 +83,8 @@ void PrintText(const MotionSource& src, const InspectOptions& options) {
   std::printf("frames:      %d\n", m.num_frames);
   std::printf("frame time:  %.9g s (%g fps)\n", m.frame_time_s, mocap::NominalFps(m.frame_time_s));
   std::printf("duration:    %.6g s\n", m.duration_s());
-  std::printf("up axis:     %s\n", UpAxisName(s.info.up_axis));
+  std::printf("up axis:     %s (%s)\n", UpAxisName(s.info.up_axis),
+              UpAxisSourceName(s.info.up_axis_source));
   std::printf("units:       %s (rest height %.6g, scale applied %g)\n",
               s.info.detected_units.c_str(), s.info.rest_height, s.info.scale_applied);
   if (src.mesh_vertices > 0) {
@@ -113,6 +124,7 @@ void PrintJson(const MotionSource& src, const InspectOptions& options) {
   doc["fps"] = mocap::NominalFps(m.frame_time_s);
   doc["duration_s"] = m.duration_s();
   doc["up_axis"] = UpAxisName(s.info.up_axis);
+  doc["up_axis_from"] = UpAxisSourceName(s.info.up_axis_source);
   doc["units"] = s.info.detected_units;
   doc["rest_height"] = s.info.rest_height;
   doc["scale_applied"] = s.info.scale_applied;
@@ -219,6 +231,7 @@ CLI::App* AddInspectCommand(CLI::App& parent, InspectOptions& options) {
   cmd->add_option("--scale", options.scale,
                   "Multiply lengths by this factor (0: convert detected units to metres)");
   cmd->add_flag("--y-up", options.y_up, "Rotate a Z-up capture to Y-up");
+  cmd->add_option("--up", options.up, "The BVH's up axis, y or z, when detection picks the wrong one (default: detected)");
   cmd->add_flag("--add-position-to-offset", options.add_position_to_offset,
                 "BVH position channels add to OFFSET (three.js) instead of replacing it");
   cmd->add_flag("--allow-short", options.allow_short,
@@ -230,6 +243,12 @@ int RunInspect(const InspectOptions& options) {
   MotionSourceOptions load;
   load.scale = options.scale;
   load.y_up = options.y_up;
+  const mocap::Result<std::optional<mocap::UpAxis>> up = ParseUpAxis(options.up);
+  if (!up.ok()) {
+    std::fprintf(stderr, "%s\n", up.error().ToString().c_str());
+    return 2;
+  }
+  load.up = *up;
   load.add_position_to_offset = options.add_position_to_offset;
   load.allow_short_motion = options.allow_short;
   mocap::Result<MotionSource> src = LoadMotionSource(options.file, load);

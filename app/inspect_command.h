@@ -21,6 +21,7 @@ struct InspectOptions {
   bool artifacts = false;         // print SSD/DQS/SWD artifact figures instead
   float scale = 1.0f;             // 0 = automatic (detected units to metres)
   bool y_up = false;              // rotate a Z-up file to Y-up
+  std::string up;                 // --up y|z: the file's up axis; empty = detected
   bool add_position_to_offset = false;
   bool allow_short = false;       // load the complete frames of a file with fewer than declared
 };

@@ -1,6 +1,8 @@
 // patchskin: the command line. Parses arguments and dispatches to a subcommand;
-// no algorithm lives here. Exit codes: 0 ok, 1 usage (or, for compare, images
-// that differ), 2 bad input, 3 internal error.
+// no algorithm lives here. Exit codes, one rule for every command (as grep and
+// diff): 0 ok; 1 only for compare's "the images differ"; 2 the command cannot
+// run as given (an unknown option, a missing or bad value, a bad or unreadable
+// input, an unwritable output); 3 internal error; 128 + N stopped by signal N.
 
 #include <cstdio>
 #include <exception>
@@ -16,6 +18,10 @@
 #include "app/inspect_command.h"
 #include "app/render_command.h"
 #include "app/sheet_command.h"
+
+namespace {
+constexpr int kUsageError = 2;  // the same code as a bad value or a bad input file
+}  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"patchskin: motion-capture driven layered skinning and software rendering"};
@@ -46,9 +52,7 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     const int code = app.exit(e);
-    if (code == 0) return 0;
-    // compare follows idiff: 1 means "images differ", so its usage errors are 2.
-    return compare->parsed() ? app::kCompareError : 1;
+    return code == 0 ? 0 : kUsageError;
   }
   try {
     if (inspect->parsed()) return app::RunInspect(inspect_options);

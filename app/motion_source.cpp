@@ -21,6 +21,7 @@ mocap::BvhReadOptions BvhOptions(const MotionSourceOptions& options) {
   mocap::BvhReadOptions bvh;
   bvh.scale = options.scale;
   bvh.convert_to_y_up = options.y_up;
+  bvh.up_axis = options.up;
   bvh.position_mode = options.add_position_to_offset ? mocap::PositionChannelMode::kAddToOffset
                                                      : mocap::PositionChannelMode::kReplaceOffset;
   bvh.allow_short_motion = options.allow_short_motion;

@@ -22,6 +22,7 @@ struct MotionSourceOptions {
   bool allow_short_motion = false;     // BVH: load the frames present when fewer than declared
   int animation = 0;                   // glTF: which animation drives the skeleton
   double frame_time_s = 0.0;           // glTF: sampling step; 0 = detected from the key times
+  std::optional<mocap::UpAxis> up = std::nullopt;  // BVH: the file's up axis (--up); empty = detected
 };
 
 struct MotionSource {

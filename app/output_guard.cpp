@@ -1,6 +1,11 @@
 #include "app/output_guard.h"
 
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
 #include <csignal>
+#include <cstring>
 #include <filesystem>
 #include <system_error>
 
@@ -147,6 +152,37 @@ std::string OutputGuard::StopMessage(int last_done_number, int frames_done,
   m += "; run the same command with --resume to render the other " +
        std::to_string(frames_total - frames_done);
   return m;
+}
+
+const char* OutputGuard::signal_name() const {
+  return signal_number() == 0 ? "no signal" : SignalName(signal_number());
+}
+
+mocap::Status PrepareOutputFolder(const std::filesystem::path& dir) {
+  const std::filesystem::path folder = dir.empty() ? std::filesystem::path(".") : dir;
+  const mocap::FileLoc loc{folder.string(), 0, 0, {}};
+  std::error_code ec;
+  std::filesystem::create_directories(folder, ec);
+  if (ec) {
+    const std::string reason = ec == std::errc::permission_denied ? "permission denied: "
+                               : ec == std::errc::read_only_file_system ? "read-only file system: "
+                                                                        : "";
+    return mocap::MakeError(mocap::ErrorCode::kIo, loc,
+                            reason + "cannot create the output folder: " + ec.message());
+  }
+  const std::string probe = (folder / (".patchskin-probe-" + std::to_string(::getpid()))).string();
+  const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+  if (fd < 0) {
+    const int err = errno;
+    const std::string reason = err == EACCES || err == EPERM ? "permission denied"
+                               : err == EROFS                ? "read-only file system"
+                                                             : std::strerror(err);
+    return mocap::MakeError(mocap::ErrorCode::kIo, loc,
+                            reason + ": cannot write in the output folder");
+  }
+  ::close(fd);
+  ::unlink(probe.c_str());
+  return mocap::Status::Ok();
 }
 
 void OutputGuard::SimulateSignal(int signal) { g_signal = signal; }

@@ -20,6 +20,7 @@
 //   own choice and are not restricted.
 
 #include <cstddef>
+#include <filesystem>
 #include <functional>
 #include <string>
 #include <vector>
@@ -35,6 +36,14 @@ namespace app {
 // found '../x/####.png' (a '..' component)".
 [[nodiscard]] mocap::Status CheckRigOutputPattern(const std::string& pattern,
                                                   const mocap::FileLoc& where);
+
+// Creates `dir` (and its parents) when missing and checks that a file can be
+// created in it, by creating and removing an empty hidden one, so a render or
+// export that cannot write stops before any work with kIo "permission denied:
+// cannot write in the output folder" naming the folder (or "cannot create the
+// output folder: ..." with the system's reason). An empty `dir` is the
+// current folder.
+[[nodiscard]] mocap::Status PrepareOutputFolder(const std::filesystem::path& dir);
 
 struct OutputGuardOptions {
   bool overwrite = false;  // --overwrite: replace existing outputs
@@ -77,6 +86,8 @@ class OutputGuard {
   bool interrupted() const;
   // The signal that interrupted (SIGINT, SIGTERM) or 0.
   int signal_number() const;
+  // "SIGINT", "SIGTERM", or "no signal".
+  const char* signal_name() const;
   // 128 + signal, the shell's convention for a process ended by a signal.
   int exit_code() const { return 128 + signal_number(); }
   // "interrupted by SIGINT after frame 11: 12 of 48 frames are complete; run

@@ -57,6 +57,17 @@ void AddOutputFlags(CLI::App& cmd, RenderOptions& o) {
   cmd.add_flag("--overwrite", o.overwrite, "Replace existing frames, contact sheet and video");
   cmd.add_flag("--resume", o.resume,
                "Keep the frames that exist (an interrupted render), render the missing ones");
+  cmd.add_option("--up", o.up, "The BVH's up axis, y or z, when detection picks the wrong one (default: detected)");
+  cmd.add_option("--start-number", o.start_number,
+                 "File number of motion frame 0 (turntable: of the first view), e.g. 1001")
+      ->capture_default_str();
+}
+
+// Records which options were given: with a rig file they override its settings.
+void RecordGivenOptions(CLI::App* cmd, RenderOptions& o) {
+  for (const CLI::Option* opt : cmd->get_options()) {
+    if (opt->count() > 0) o.given.insert(opt->get_name());
+  }
 }
 
 }  // namespace
@@ -101,12 +112,7 @@ CLI::App* AddRenderCommand(CLI::App& parent, RenderOptions& o) {
   cmd->add_option("--motion", o.motion,
                   "BVH motion driving a glTF INPUT (joints matched by name; docs/retargeting.md)");
   AddOutputFlags(*cmd, o);
-  // Which options were given: with a rig file they override its settings.
-  cmd->callback([&o, cmd] {
-    for (const CLI::Option* opt : cmd->get_options()) {
-      if (opt->count() > 0) o.given.insert(opt->get_name());
-    }
-  });
+  cmd->callback([&o, cmd] { RecordGivenOptions(cmd, o); });
   return cmd;
 }
 
@@ -130,7 +136,13 @@ CLI::App* AddTurntableCommand(CLI::App& parent, RenderOptions& o) {
   cmd->add_flag("--no-video", o.no_video, "Do not write the preview video");
   cmd->add_flag("--quiet", o.quiet, "No progress output");
   AddOutputFlags(*cmd, o);
-  cmd->callback([&o] { o.camera = "turntable"; });
+  // A turntable of a rig keeps the rig's settings except those given here,
+  // and is a turntable whatever camera the rig asks for.
+  cmd->callback([&o, cmd] {
+    RecordGivenOptions(cmd, o);
+    o.camera = "turntable";
+    o.given.insert("--camera");
+  });
   return cmd;
 }
 
@@ -247,14 +259,17 @@ int RunRender(const RenderOptions& options) {
   const std::string name = demo  ? "demo"
                            : rig ? std::filesystem::path(rig->file).stem().string()
                                  : std::filesystem::path(o.input).stem().string();
-  mocap::Result<Character> character = LoadCommandCharacter(o.input, o.motion, o.quiet);
+  const mocap::Result<std::optional<mocap::UpAxis>> up = ParseUpAxis(o.up);
+  if (!up.ok()) return Fail(up.error());
+  mocap::Result<Character> character = LoadCommandCharacter(o.input, o.motion, o.quiet, *up);
   if (!character.ok()) return Fail(character.error());
   const Character& ch = *character;
 
   const bool turntable = o.camera == "turntable";
   mocap::Result<FramePlan> plan = PlanFrames(
       ch.motion, {.frames = o.frames, .fps = o.fps, .turntable = turntable,
-                  .turntable_frames = o.turntable_frames, .list_frames = false});
+                  .turntable_frames = o.turntable_frames, .start_number = o.start_number,
+                  .list_frames = false});
   if (!plan.ok()) {
     if (rig && options.frames.empty() && !rig->render.frames.empty()) {
       // The range came from the rig file: name it and its field, not --frames.
@@ -325,7 +340,8 @@ int RunRender(const RenderOptions& options) {
   DeformedFrame frame, right_frame;
   mocap::Result<FramePlan> framing = plan;
   if (!o.framing.empty() && !turntable) {
-    framing = PlanFrames(ch.motion, {.frames = o.framing, .fps = o.fps, .list_frames = false});
+    framing = PlanFrames(ch.motion, {.frames = o.framing, .fps = o.fps,
+                                     .start_number = o.start_number, .list_frames = false});
     if (!framing.ok()) return Fail(ArgError("--framing", framing.error().message));
     if (plan->range.first < framing->range.first || plan->range.last > framing->range.last) {
       return Fail(ArgError("--framing", "expected a range holding every output frame (" +
@@ -343,13 +359,8 @@ int RunRender(const RenderOptions& options) {
   {
     const mocap::Result<std::string> first = render::ExpandFramePattern(pattern, plan->At(0).number);
     if (!first.ok()) return Fail(first.error());
-    const std::filesystem::path dir = std::filesystem::path(*first).parent_path();
-    std::error_code ec;
-    if (!dir.empty()) std::filesystem::create_directories(dir, ec);
-    if (ec) {
-      return Fail(mocap::MakeError(mocap::ErrorCode::kIo, {dir.string(), 0, 0, {}},
-                                   "cannot create the output folder: " + ec.message()));
-    }
+    const mocap::Status writable = PrepareOutputFolder(std::filesystem::path(*first).parent_path());
+    if (!writable.ok()) return Fail(writable.error());
   }
   const std::filesystem::path out_dir =
       std::filesystem::path(*render::ExpandFramePattern(pattern, 0)).parent_path();
@@ -386,8 +397,13 @@ int RunRender(const RenderOptions& options) {
     const double video_fps = turntable ? 24.0 : 1.0 / (frame_time * plan->range.step);
     auto v = render::VideoWriter::Open((out_dir / "preview.mp4").string(), size->x & ~1,
                                        size->y & ~1, {.fps = video_fps});
-    if (!v.ok()) return Fail(v.error());
-    video = std::move(*v);
+    // The video is a preview: a render never fails over it (a warning, no video).
+    if (v.ok()) {
+      video = std::move(*v);
+    } else {
+      const mocap::Warning w{v.error().loc, v.error().message + "; no preview video"};
+      std::fprintf(stderr, "%s\n", w.ToString().c_str());
+    }
   }
 
   // --- The frame loop -------------------------------------------------------------
@@ -454,7 +470,9 @@ int RunRender(const RenderOptions& options) {
     const render::Camera camera = cameras->At(of);
     const FrameDrawOptions draw{.skeleton = overlay_skeleton,
                                 .wireframe = overlay_wire,
-                                .frame_number = of.number,
+                                .frame_number = turntable ? o.start_number + plan->range.first
+                                                          : of.number,
+                                .view = turntable ? of.camera : -1,
                                 .left_label = right_pipeline ? GlobalMethodName(main_method) : "",
                                 .right_label = right_pipeline ? right_label : ""};
     s = DrawCharacterFrame(ch, frame, right_pipeline ? &right_frame : nullptr, camera, settings,

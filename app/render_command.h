@@ -39,6 +39,8 @@ struct RenderOptions {
   bool stats = false;
   bool overwrite = false;             // replace existing outputs (else refuse before rendering)
   bool resume = false;                // keep existing frames, render the missing ones
+  int start_number = 0;               // file number of motion frame 0 (turntable: of view 0)
+  std::string up;                     // --up y|z: a BVH's up axis; empty = detected
   // "A:B[:STEP]": the frames the camera framing and the ground height are
   // computed from; empty = the output frames. Chunks of one render (farm)
   // pass the whole range so every chunk frames the body the same way.

@@ -12,6 +12,55 @@ namespace mocap {
 
 namespace {
 
+// True when `text` is well-formed UTF-8: no stray continuation byte, overlong
+// form, surrogate or code point past U+10FFFF.
+bool IsUtf8(std::string_view text) {
+  std::size_t i = 0;
+  while (i < text.size()) {
+    const auto b = static_cast<unsigned char>(text[i]);
+    std::size_t more = 0;
+    unsigned lo = 0x80, hi = 0xBF;  // the second byte's range (RFC 3629, section 4)
+    if (b < 0x80) {
+      more = 0;
+    } else if (b >= 0xC2 && b <= 0xDF) {
+      more = 1;
+    } else if (b >= 0xE0 && b <= 0xEF) {
+      more = 2;
+      if (b == 0xE0) lo = 0xA0;
+      if (b == 0xED) hi = 0x9F;
+    } else if (b >= 0xF0 && b <= 0xF4) {
+      more = 3;
+      if (b == 0xF0) lo = 0x90;
+      if (b == 0xF4) hi = 0x8F;
+    } else {
+      return false;
+    }
+    if (i + more >= text.size() && more > 0) return false;
+    for (std::size_t k = 1; k <= more; ++k) {
+      const auto c = static_cast<unsigned char>(text[i + k]);
+      if (c < (k == 1 ? lo : 0x80u) || c > (k == 1 ? hi : 0xBFu)) return false;
+    }
+    i += more + 1;
+  }
+  return true;
+}
+
+// Each byte read as the Latin-1 (ISO 8859-1) character it names, in UTF-8.
+std::string Latin1ToUtf8(std::string_view text) {
+  std::string out;
+  out.reserve(text.size() * 2);
+  for (const char ch : text) {
+    const auto b = static_cast<unsigned char>(ch);
+    if (b < 0x80) {
+      out += ch;
+    } else {
+      out += static_cast<char>(0xC0 | (b >> 6));
+      out += static_cast<char>(0x80 | (b & 0x3F));
+    }
+  }
+  return out;
+}
+
 // Shows a token in a message: quoted text, or "end of file".
 std::string Found(const BvhToken& token) {
   if (token.empty()) return "end of file";
@@ -116,6 +165,12 @@ class HierarchyParser {
       }
     } else {
       *name = std::string(name_loc->text);
+      // Names are UTF-8 everywhere they go (JSON, glTF); older tools wrote Latin-1.
+      if (!IsUtf8(*name)) {
+        *name = Latin1ToUtf8(name_loc->text);
+        doc_.warnings.push_back(Warning{FileLoc{doc_.file_name, name_loc->line, name_loc->column, {}},
+                                        "name '" + *name + "' is not UTF-8; read as Latin-1"});
+      }
     }
     const BvhToken brace = tok_.Next();
     if (brace.text != "{") {

@@ -5,10 +5,12 @@
 #include <cerrno>
 #include <cmath>
 #include <condition_variable>
+#include <cstdint>
 #include <cstring>
 #include <limits>
 #include <mutex>
 #include <thread>
+#include <utility>
 
 #include <fcntl.h>
 #include <sys/mman.h>
@@ -373,6 +375,95 @@ UpAxis DetectBvhUpAxis(const Skeleton& skeleton) {
   return z_votes > y_votes ? UpAxis::kZ : UpAxis::kY;
 }
 
+namespace {
+
+// The limbs that hold the body up, as (hips, knee) joint pairs: the hips are
+// the first joint below the first root with two or more children; each child
+// of it but the one with the most descendants (the spine) starts a limb (legs,
+// a tail), whose knee is the first joint down it (first children) at least
+// 40% of the limb's rest reach from the hips. Rest positions only, so the
+// choice does not depend on any pose.
+std::vector<std::pair<int, int>> HipsToKnees(const Skeleton& skeleton) {
+  const int n = skeleton.num_joints();
+  std::vector<std::vector<int>> children(static_cast<std::size_t>(n));
+  std::vector<int> descendants(static_cast<std::size_t>(n), 0);
+  std::vector<glm::vec3> rest(static_cast<std::size_t>(n));
+  for (int j = 0; j < n; ++j) {
+    const int p = skeleton.parents[static_cast<std::size_t>(j)];
+    rest[static_cast<std::size_t>(j)] = skeleton.rest_translations[static_cast<std::size_t>(j)] +
+                                        (p == kNoParent ? glm::vec3(0.0f) : rest[static_cast<std::size_t>(p)]);
+    if (p != kNoParent) children[static_cast<std::size_t>(p)].push_back(j);
+  }
+  for (int j = n - 1; j >= 0; --j) {  // children come after their parents
+    const int p = skeleton.parents[static_cast<std::size_t>(j)];
+    if (p != kNoParent) descendants[static_cast<std::size_t>(p)] += descendants[static_cast<std::size_t>(j)] + 1;
+  }
+  std::vector<std::pair<int, int>> out;
+  if (n == 0) return out;
+  int hips = 0;
+  while (children[static_cast<std::size_t>(hips)].size() == 1) hips = children[static_cast<std::size_t>(hips)][0];
+  const std::vector<int>& limbs = children[static_cast<std::size_t>(hips)];
+  if (limbs.size() < 2) return out;
+  int spine = limbs[0];
+  for (int c : limbs) {
+    if (descendants[static_cast<std::size_t>(c)] > descendants[static_cast<std::size_t>(spine)]) spine = c;
+  }
+  const glm::vec3 h = rest[static_cast<std::size_t>(hips)];
+  for (int c : limbs) {
+    if (c == spine) continue;
+    float reach = 0.0f;
+    std::vector<int> stack = {c};
+    while (!stack.empty()) {
+      const int j = stack.back();
+      stack.pop_back();
+      reach = std::max(reach, glm::distance(rest[static_cast<std::size_t>(j)], h));
+      for (int g : children[static_cast<std::size_t>(j)]) stack.push_back(g);
+    }
+    int knee = c;
+    while (glm::distance(rest[static_cast<std::size_t>(knee)], h) < 0.4f * reach &&
+           !children[static_cast<std::size_t>(knee)].empty()) {
+      knee = children[static_cast<std::size_t>(knee)][0];
+    }
+    if (reach > 0.0f) out.emplace_back(hips, knee);
+  }
+  return out;
+}
+
+}  // namespace
+
+UpAxis DetectBvhUpAxisFromPoses(const Skeleton& skeleton, const Motion& motion,
+                                UpAxisSource* source) {
+  constexpr int kSampleFrames = 32;
+  const std::vector<std::pair<int, int>> thighs = HipsToKnees(skeleton);
+  const std::size_t n = skeleton.rest_translations.size();
+  std::vector<JointTransform> locals(n);
+  std::vector<glm::mat4> model(n);
+  int y_frames = 0;
+  int z_frames = 0;
+  const int samples = thighs.empty() ? 0 : std::min(motion.num_frames, kSampleFrames);
+  for (int i = 0; i < samples; ++i) {
+    const int f = samples > 1 ? static_cast<int>(std::int64_t{motion.num_frames - 1} * i / (samples - 1)) : 0;
+    if (!LocalPoseJob{&skeleton, motion.frame(f), locals}.Run()) continue;
+    if (!LocalToModelJob{skeleton.parents, locals, glm::mat4(1.0f), model}.Run()) continue;
+    int y_votes = 0;
+    int z_votes = 0;
+    for (const auto& [hips, knee] : thighs) {
+      const glm::vec3 a = glm::abs(glm::vec3(model[static_cast<std::size_t>(knee)][3] -
+                                             model[static_cast<std::size_t>(hips)][3]));
+      if (a.y > a.x && a.y > a.z) ++y_votes;
+      if (a.z > a.x && a.z > a.y) ++z_votes;
+    }
+    if (y_votes > z_votes) ++y_frames;
+    if (z_votes > y_votes) ++z_frames;
+  }
+  if (y_frames == z_frames) {
+    if (source != nullptr) *source = UpAxisSource::kRestPose;
+    return DetectBvhUpAxis(skeleton);
+  }
+  if (source != nullptr) *source = UpAxisSource::kAnimatedPoses;
+  return z_frames > y_frames ? UpAxis::kZ : UpAxis::kY;
+}
+
 float RestHeight(const Skeleton& skeleton, UpAxis up) {
   const int axis = up == UpAxis::kY ? 1 : 2;
   std::vector<glm::vec3> model(skeleton.rest_translations.size());
@@ -502,7 +593,12 @@ Result<BvhFile> ParseBvhText(std::string_view text, const std::string& file_name
     return s.error();
 
   SkeletonInfo& info = file.skeleton.info;
-  info.up_axis = options.up_axis.has_value() ? *options.up_axis : DetectBvhUpAxis(file.skeleton);
+  if (options.up_axis.has_value()) {
+    info.up_axis = *options.up_axis;
+    info.up_axis_source = UpAxisSource::kGiven;
+  } else {
+    info.up_axis = DetectBvhUpAxisFromPoses(file.skeleton, file.motion, &info.up_axis_source);
+  }
   const float raw_height = RestHeight(file.skeleton, info.up_axis);
   // A rest pose need not stand upright (Bandai Namco's bones lie along X), so
   // the units come from the taller of the rest pose and the first frame.

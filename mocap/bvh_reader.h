@@ -25,6 +25,19 @@
 //   also its longest overall. More Z votes than Y votes means Z-up. Legs, spine
 //   and neck are vertical in a rest pose and outnumber the forward-pointing feet;
 //   arms, along X in the usual T-pose, do not vote.
+// - The rule above decides from the rest pose alone, which need not be the pose
+//   the capture is seen in: some files have Z-up OFFSETs and a root rotation in
+//   every frame that stands the body Y-up (or the reverse). So the animated
+//   poses decide first, by the limbs that hold the body up: from the hips (the
+//   first joint below the root with two or more children) to the knee of each
+//   limb but the spine (legs, a tail; the knee is the first joint down the limb
+//   40% of its rest reach from the hips). In up to 32 frames spread evenly over
+//   the motion each such thigh votes for the axis, Y or Z, it mostly lies
+//   along; each frame goes to the axis most thighs vote for, and the axis most
+//   frames go to is the up axis (SkeletonInfo::up_axis_source kAnimatedPoses).
+//   Thighs hang down when walking, running, crawling on hands and knees or on
+//   four legs, where spine and shins can lie flat. Without frames or limbs, or
+//   with as many frames for each axis, the rest rule decides (kRestPose).
 // - Height: extent along the up axis of the rest positions of all joints and end
 //   sites (offsets chained from the roots at the origin), after scale.
 // - Units from h = the larger of that rest height and the same extent in the
@@ -108,6 +121,10 @@ struct BvhFile {
 
 // Detection helpers (rules above), exposed for tests and `inspect`.
 UpAxis DetectBvhUpAxis(const Skeleton& skeleton);
+// The up axis from the animated poses (rule above), the rest rule deciding a
+// tie; `source` (optional) says which decided. Cost: 32 poses of #J joints.
+UpAxis DetectBvhUpAxisFromPoses(const Skeleton& skeleton, const Motion& motion,
+                                UpAxisSource* source = nullptr);
 // Extent along `up` of the rest positions of all joints and end sites.
 float RestHeight(const Skeleton& skeleton, UpAxis up);
 // Extent along `up` of joints and end sites posed by frame 0 (0 without frames).

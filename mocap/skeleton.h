@@ -65,6 +65,13 @@ enum class PositionChannelMode : std::uint8_t {
 
 enum class UpAxis : std::uint8_t { kY, kZ };
 
+// What decided SkeletonInfo::up_axis.
+enum class UpAxisSource : std::uint8_t {
+  kRestPose,       // the rest (OFFSET) pose: no frames, or the frames were split evenly
+  kAnimatedPoses,  // the poses of frames sampled over the motion
+  kGiven,          // the caller (--up)
+};
+
 struct EndSite {
   int parent = kNoParent;   // joint the end site hangs from
   glm::vec3 offset{0.0f};   // in the parent's frame, file units
@@ -75,6 +82,7 @@ struct EndSite {
 struct SkeletonInfo {
   std::string source_file;
   UpAxis up_axis = UpAxis::kY;       // axis of the file (detected or given)
+  UpAxisSource up_axis_source = UpAxisSource::kRestPose;
   float scale_applied = 1.0f;        // factor already applied to offsets and positions
   std::string detected_units;        // "cm", "m", "inch", "unknown"
   float rest_height = 0.0f;          // extent along the up axis of the rest pose, after scale

@@ -200,6 +200,19 @@ mocap::Result<BodyChains> BuildBodyChains(const mocap::Skeleton& skeleton,
     }
   }
   const float size = body.empty() ? 0.0f : std::max({body.size().x, body.size().y, body.size().z});
+  // The joints of the points at or below a spine's start get body parts; the
+  // roots passed over above only position the body.
+  std::vector<std::uint8_t> body_point(pts.size(), 0);
+  for (const Pending& spine : todo) body_point[static_cast<std::size_t>(spine.start)] = 1;
+  for (std::size_t i = 0; i < pts.size(); ++i) {  // parents come before their children
+    const int p = pts[i].parent;
+    if (p >= 0 && body_point[static_cast<std::size_t>(p)] != 0) body_point[i] = 1;
+  }
+  out.body_part_joints.assign(static_cast<std::size_t>(nj), 0);
+  for (int j = 0; j < nj; ++j) {
+    out.body_part_joints[static_cast<std::size_t>(j)] =
+        body_point[static_cast<std::size_t>(point_of[static_cast<std::size_t>(j)])];
+  }
   if (!(size > merge_dist)) {
     return MakeError(ErrorCode::kInvalidArgument, {},
                      "skeleton has no bone of non-zero length; cannot build a mannequin");
@@ -256,6 +269,15 @@ mocap::Result<BodyChains> BuildBodyChains(const mocap::Skeleton& skeleton,
 
   out.size = size;
   return out;
+}
+
+mocap::Result<std::vector<std::uint8_t>> BodyPartJoints(
+    const mocap::Skeleton& skeleton, std::span<const glm::mat4> rest_model_from_joint,
+    float min_branch_extent) {
+  mocap::Result<BodyChains> chains =
+      BuildBodyChains(skeleton, rest_model_from_joint, min_branch_extent);
+  if (!chains.ok()) return std::move(chains).error();
+  return std::move(chains->body_part_joints);
 }
 
 }  // namespace deform

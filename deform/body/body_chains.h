@@ -13,6 +13,7 @@
 //     Side branches reaching less than `min_branch_extent` S are folded into their chain
 //     (fingers, eyes).
 
+#include <cstdint>
 #include <span>
 #include <vector>
 
@@ -50,12 +51,25 @@ struct BodyChains {
   std::vector<BodyPoint> points;  // parents before children
   std::vector<BodyChain> chains;  // spines first, then their branches (parents first)
   float size = 0.0f;              // S: largest extent of the body's points, model units
+  // #J: 1 when the joint gets a part of the body (its point is a spine's start
+  // or below one), 0 when it only positions the body: a root passed over by
+  // rule 2 (Bandai's joint_Root, left on the floor while the hips walk away)
+  // and the joints merged into it. No tube, head or weight may follow such a
+  // joint: a vertex bound to it stays where the body was bound.
+  std::vector<std::uint8_t> body_part_joints;
 };
 
 // Errors: kCountMismatch when the matrix count is not #J, kInvalidArgument for
 // broken parent order or a skeleton without any bone of non-zero length, kNonFinite
 // for non-finite matrices.
 [[nodiscard]] mocap::Result<BodyChains> BuildBodyChains(
+    const mocap::Skeleton& skeleton, std::span<const glm::mat4> rest_model_from_joint,
+    float min_branch_extent);
+
+// Which joints get a part of a generated body (BodyChains::body_part_joints),
+// for bodies built on these chains (the mannequin, others): one decision for
+// all of them. Errors: those of BuildBodyChains.
+[[nodiscard]] mocap::Result<std::vector<std::uint8_t>> BodyPartJoints(
     const mocap::Skeleton& skeleton, std::span<const glm::mat4> rest_model_from_joint,
     float min_branch_extent);
 

@@ -259,9 +259,15 @@ mocap::Result<SkinnedMesh> BuildMannequin(const mocap::Skeleton& skeleton,
       if (i + 1 < n) h = std::min(h, 0.45f * (arc[static_cast<std::size_t>(i + 1)] - arc[static_cast<std::size_t>(i)]));
       return std::max(h, 1e-9f);
     };
-    const int incoming = pts[static_cast<std::size_t>(ch.points[0])].parent >= 0 || ch.parent_chain >= 0
-                             ? pts[static_cast<std::size_t>(ch.points[0])].bone_joint
-                             : -1;
+    // The joint before the chain's first point, blended into its first rings;
+    // never one that only positions the body (it would pin them where the
+    // body was bound: Bandai's 4 m tail to the origin).
+    int incoming = pts[static_cast<std::size_t>(ch.points[0])].parent >= 0 || ch.parent_chain >= 0
+                       ? pts[static_cast<std::size_t>(ch.points[0])].bone_joint
+                       : -1;
+    if (incoming >= 0 && tree->body_part_joints[static_cast<std::size_t>(incoming)] == 0) {
+      incoming = -1;
+    }
     const float length = curve.back().arc;
     const int count = std::max(3, static_cast<int>(std::lround(length / spacing)) + 1);
     std::vector<Ring> rings;

@@ -1,5 +1,6 @@
 #include "render/output/video_writer.h"
 
+#include <algorithm>
 #include <filesystem>
 #include <system_error>
 
@@ -112,18 +113,22 @@ Status VideoWriter::AddFrame(const Image& frame) {
   if (!impl_->writer.isOpened()) {
     return MakeError(ErrorCode::kIo, LocOf(path_), "video is closed");
   }
-  if (frame.width != width_ || frame.height != height_ ||
-      frame.rgba.size() != static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_)) {
+  if (frame.width < 1 || frame.height < 1 ||
+      frame.rgba.size() != static_cast<std::size_t>(frame.width) * static_cast<std::size_t>(frame.height)) {
     return MakeError(ErrorCode::kInvalidArgument, LocOf(path_),
-                     "expected a " + std::to_string(width_) + "x" + std::to_string(height_) +
-                         " frame, found " + std::to_string(frame.width) + "x" +
+                     "expected a frame with pixels, found " + std::to_string(frame.width) + "x" +
                          std::to_string(frame.height));
   }
+  // A frame of another size is cropped (its right and bottom edges) or padded
+  // with black: an odd render size gives an even video one pixel smaller.
   cv::Mat& bgr = impl_->bgr;
   bgr.create(height_, width_, CV_8UC3);
-  for (int y = 0; y < height_; ++y) {
+  bgr.setTo(cv::Scalar(0, 0, 0));
+  const int w = std::min(width_, frame.width);
+  const int h = std::min(height_, frame.height);
+  for (int y = 0; y < h; ++y) {
     auto* row = bgr.ptr<std::uint8_t>(y);
-    for (int x = 0; x < width_; ++x) {
+    for (int x = 0; x < w; ++x) {
       const glm::vec4& p = frame.at(x, y);
       row[3 * x + 0] = LinearToSrgb8(p.b);  // OpenCV stores BGR
       row[3 * x + 1] = LinearToSrgb8(p.g);

@@ -49,7 +49,9 @@ class VideoWriter {
                                                                  const VideoOptions& options = {});
   ~VideoWriter();  // closes without renaming if Close() was not called: the temp file is removed
 
-  // Appends one frame; it must be width x height. Errors: kInvalidArgument (size), kIo.
+  // Appends one frame. A frame of another size is cropped at its right and
+  // bottom edges or padded there with black (an odd render size in an even
+  // video). Errors: kInvalidArgument (an empty frame), kIo.
   [[nodiscard]] Status AddFrame(const Image& frame);
   // Finishes the file and renames it to path(). Errors: kIo.
   [[nodiscard]] Status Close();

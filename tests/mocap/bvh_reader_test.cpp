@@ -148,6 +148,25 @@ TEST(BvhReader, NamesWithSpacesAndOddCharacters) {
   EXPECT_EQ(file.skeleton.FindJoint("Upper Chest (L)"), 1);
 }
 
+// A name in Latin-1 bytes (0xE9 = e acute, 0xFF = y diaeresis) is not UTF-8: it is
+// read as Latin-1 with a warning on its line; UTF-8 names (also 4-byte ones)
+// pass unchanged.
+TEST(BvhReader, Latin1NamesBecomeUtf8) {
+  std::string text = Replace(kSmall, "JOINT Chest", "JOINT \xE9paule\xFF");
+  text = Replace(text, "ROOT Hips", "ROOT H\xC3\xBC" "fte\xF0\x9F\xA6\xB4");
+  const BvhFile file = MustParse(text);
+  EXPECT_EQ(file.skeleton.names[0], "H\xC3\xBC" "fte\xF0\x9F\xA6\xB4");
+  EXPECT_EQ(file.skeleton.names[1], "\xC3\xA9paule\xC3\xBF");
+  ASSERT_EQ(file.warnings.size(), 1u);
+  EXPECT_EQ(file.warnings[0].loc.line, 6);
+  EXPECT_NE(file.warnings[0].message.find("Latin-1"), std::string::npos);
+  // Overlong, surrogate and truncated sequences are not UTF-8 either.
+  for (const std::string bad : {"\xC0\xAF", "\xED\xA0\x80", "A\xE2\x82"}) {
+    const BvhFile f = MustParse(Replace(kSmall, "JOINT Chest", "JOINT " + bad));
+    EXPECT_EQ(f.warnings.size(), 1u) << bad;
+  }
+}
+
 TEST(BvhReader, BraceOnTheNameLine) {
   std::string text = Replace(kSmall, "ROOT Hips\n{", "ROOT Hips {");
   text = Replace(text, "JOINT Chest\n  {", "JOINT Chest{");

@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include "deform/body/body_chains.h"
 #include "deform/global/dqs_job.h"
 #include "deform/global/skinning_job.h"
 #include "support/test_skeletons.h"
@@ -146,6 +147,16 @@ TEST(Mannequin, PositioningRootFarFromTheBodyIsIgnored) {
   const deform::Bounds near = deform::ComputeBounds(Build(centred).bind.positions);
   EXPECT_NEAR(far.size().x, near.size().x, testsupport::kPositionTol * 100.0f);
   EXPECT_NEAR(far.size().y, near.size().y, testsupport::kPositionTol * 100.0f);
+  // joint_Root gets no body part and no weight: a vertex bound to it would stay
+  // where the body was bound while the hips walk on (issue 27's 4 m tail).
+  const int root = b.skeleton.FindJoint("joint_Root");
+  EXPECT_EQ(std::find(m.skin_joints.begin(), m.skin_joints.end(), root), m.skin_joints.end());
+  const mocap::Result<std::vector<std::uint8_t>> parts =
+      deform::BodyPartJoints(b.skeleton, b.model_from_joint, 0.15f);
+  ASSERT_TRUE(parts.ok());
+  for (int j = 0; j < b.skeleton.num_joints(); ++j) {
+    EXPECT_EQ((*parts)[static_cast<std::size_t>(j)], j == root ? 0 : 1) << b.skeleton.names[static_cast<std::size_t>(j)];
+  }
 }
 
 TEST(Mannequin, MixamoLikeWithFingersInMetres) {

@@ -48,7 +48,7 @@ void RoundTrip(const std::vector<VideoCodec>& codecs, VideoCodec expected,
   for (int f = 0; f < kFrames; ++f) {
     ASSERT_TRUE((*video)->AddFrame(Image(kWidth, kHeight, Grey(f))));
   }
-  EXPECT_FALSE((*video)->AddFrame(Image(8, 8)).ok());
+  EXPECT_FALSE((*video)->AddFrame(Image()).ok());  // no pixels
   ASSERT_TRUE((*video)->Close());
   const std::string path = (*video)->path();
   ASSERT_TRUE(fs::exists(path));
@@ -82,6 +82,26 @@ TEST(VideoWriter, WritesMpeg4InMp4) {
 
 TEST(VideoWriter, MjpegFallbackWritesAvi) {
   RoundTrip({VideoCodec::kMjpegAvi}, VideoCodec::kMjpegAvi, ".avi");
+}
+
+// An odd render size (65x49) goes into the even video (64x48) cropped at its
+// right and bottom edges: the white last column and row are not in the video.
+TEST(VideoWriter, CropsAFrameOnePixelLargerThanTheVideo) {
+  const fs::path dir = FreshDir("odd");
+  auto video = VideoWriter::Open((dir / "v.mp4").string(), kWidth, kHeight);
+  ASSERT_TRUE(video.ok()) << video.error().ToString();
+  Image odd(kWidth + 1, kHeight + 1, Grey(2));
+  for (int y = 0; y < odd.height; ++y) odd.at(kWidth, y) = glm::vec4(1.0f);
+  for (int x = 0; x < odd.width; ++x) odd.at(x, kHeight) = glm::vec4(1.0f);
+  for (int f = 0; f < 3; ++f) ASSERT_TRUE((*video)->AddFrame(odd)) << "frame " << f;
+  ASSERT_TRUE((*video)->Close());
+  cv::VideoCapture cap((*video)->path());
+  ASSERT_TRUE(cap.isOpened());
+  EXPECT_EQ(cap.get(cv::CAP_PROP_FRAME_WIDTH), kWidth);
+  EXPECT_EQ(cap.get(cv::CAP_PROP_FRAME_HEIGHT), kHeight);
+  cv::Mat bgr;
+  ASSERT_TRUE(cap.read(bgr));
+  EXPECT_NEAR(cv::mean(bgr)[1], 40 + 15 * 2, testsupport::kVideoFlatTol8);
 }
 
 TEST(VideoWriter, RejectsBadArgumentsAndUnwritablePaths) {
