@@ -10,23 +10,27 @@
 # script; fix the bug and copy the input to fuzz/corpus/<target>/ so the
 # ctest replay keeps it fixed.
 #
-# FUZZ_RUNS (optional, with FUZZ_SEED, default 1) also caps the number of inputs
-# per target: with a fixed seed and a count the run is the same sequence of
-# inputs on every machine, so CI tries exactly what was tried before landing
-# (scripts/ci_extended.sh sets it); without it the run is time-bounded and random.
+# FUZZ_SEED (optional) fixes libFuzzer's seed; CI derives it from the commit, so
+# each commit explores new inputs (the corpora themselves are replayed by the
+# fuzz_replay_* tests) and a failure can be reproduced with the printed seed.
+# FUZZ_RUNS (optional) also caps the number of inputs per target.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds="${1:-60}"
 shift || true
-build=build/fuzz
+build="${FUZZ_BUILD:-build/fuzz}"
 shared_data="${PATCHSKIN_DATA_DIR:-$(pwd)/../shared/data}"
 
 if ! command -v clang++ >/dev/null; then
   echo "fuzz: clang++ not found (apt-get install clang libclang-rt-14-dev)" >&2
   exit 1
 fi
-cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++ \
-  -DPATCHSKIN_BUILD_FUZZ=ON -DPATCHSKIN_BUILD_TESTS=OFF -DPATCHSKIN_BUILD_SAMPLES=OFF >/dev/null
+# FUZZ_BUILD names an already configured fuzz build (CI's build/asan, which
+# holds the sanitizer test suites too); otherwise a fuzz-only build is made.
+if [ ! -f "$build/CMakeCache.txt" ]; then
+  cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++ \
+    -DPATCHSKIN_BUILD_FUZZ=ON -DPATCHSKIN_BUILD_TESTS=OFF -DPATCHSKIN_BUILD_SAMPLES=OFF >/dev/null
+fi
 targets=("$@")
 if [ ${#targets[@]} -eq 0 ]; then
   mapfile -t targets < <(cut -f1 "$build/fuzz_targets.txt")
@@ -43,12 +47,11 @@ for t in "${targets[@]}"; do
   work="$build/corpus/$t"
   artifacts="$build/artifacts/$t/"
   mkdir -p "$work" "$artifacts"
-  echo "fuzz: $t for ${seconds}s (seeds: $seeds)"
+  echo "fuzz: $t for ${seconds}s, seed ${FUZZ_SEED:-random} (corpora: $seeds)"
   # shellcheck disable=SC2086
   runs=()
-  if [ -n "${FUZZ_RUNS:-}" ]; then
-    runs=(-runs="$FUZZ_RUNS" -seed="${FUZZ_SEED:-1}")
-  fi
+  if [ -n "${FUZZ_SEED:-}" ]; then runs+=(-seed="$FUZZ_SEED"); fi
+  if [ -n "${FUZZ_RUNS:-}" ]; then runs+=(-runs="$FUZZ_RUNS"); fi
   if ! "$build/fuzz/fuzz_$t" "${runs[@]}" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
       -malloc_limit_mb=1024 -max_len=1048576 -print_final_stats=1 \
       -artifact_prefix="$artifacts" "$work" $seeds > "$build/fuzz_$t.log" 2>&1; then
