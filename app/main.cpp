@@ -1,10 +1,12 @@
 // patchskin: the command line. Parses arguments and dispatches to a subcommand;
-// no algorithm lives here. Exit codes: 0 ok, 1 usage (or, for compare, images
-// that differ), 2 bad input, 3 internal error.
+// no algorithm lives here. Exit codes: 0 ok, 1 usage, 2 bad input, 3 internal
+// error; `compare` and `check` follow idiff instead (0 pass, 1 warning,
+// 2 failure, 4 error, usage errors included).
 
 #include <cstdio>
 #include <exception>
 #include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
@@ -42,12 +44,17 @@ int main(int argc, char** argv) {
   app::BenchOptions bench_options;
   CLI::App* bench = app::AddBenchCommand(app, bench_options);
 
+  // idiff's single-dash spellings (-fail ...) become CLI11's (--fail).
+  std::vector<std::string> args(argv, argv + argc);
+  app::NormalizeIdiffSpelling(args);
+  std::vector<char*> arg_ptrs;
+  for (std::string& a : args) arg_ptrs.push_back(a.data());
   try {
-    app.parse(argc, argv);
+    app.parse(argc, arg_ptrs.data());
   } catch (const CLI::ParseError& e) {
     const int code = app.exit(e);
     if (code == 0) return 0;
-    // compare follows idiff: 1 means "images differ", so its usage errors are 2.
+    // compare follows idiff: 1 means a warning, so its usage errors are 4.
     return compare->parsed() ? app::kCompareError : 1;
   }
   try {
