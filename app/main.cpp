@@ -11,6 +11,7 @@
 #include <CLI/CLI.hpp>
 
 #include "app/bench_command.h"
+#include "app/check_command.h"
 #include "app/compare_command.h"
 #include "app/export_command.h"
 #include "app/farm_command.h"
@@ -35,6 +36,8 @@ int main(int argc, char** argv) {
   CLI::App* export_cmd = app::AddExportCommand(app, export_options);
   app::CompareCommandOptions compare_options;
   CLI::App* compare = app::AddCompareCommand(app, &compare_options);
+  app::CheckOptions check_options;
+  CLI::App* check = app::AddCheckCommand(app, &check_options);
   app::ElasticOptions elastic_options;
   CLI::App* elastic = app::AddElasticCommand(app, elastic_options);
   app::SheetOptions sheet_options;
@@ -55,13 +58,15 @@ int main(int argc, char** argv) {
     const int code = app.exit(e);
     if (code == 0) return 0;
     // compare follows idiff: 1 means a warning, so its usage errors are 4.
-    return compare->parsed() ? app::kCompareError : 1;
+    if (compare->parsed()) return app::kCompareError;
+    return check->parsed() ? app::kCheckError : 1;
   }
   try {
     if (inspect->parsed()) return app::RunInspect(inspect_options);
     if (render->parsed()) return app::RunRender(render_options);
     if (turntable->parsed()) return app::RunRender(turntable_options);
     if (compare->parsed()) return app::RunCompareCommand(compare_options);
+    if (check->parsed()) return app::RunCheck(check_options);
     if (export_cmd->parsed()) return app::RunExport(export_options);
     if (elastic->parsed()) return app::RunElastic(elastic_options);
     if (sheet->parsed()) return app::RunSheet(sheet_options);
