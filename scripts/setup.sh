@@ -14,6 +14,7 @@ packages=(
   libcli11-dev
   libfast-float-dev
   libassimp-dev
+  libtinyxml2-dev chromium
   slurmctld slurmd slurm-client munge
   "$@"
 )
