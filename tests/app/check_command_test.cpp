@@ -257,6 +257,23 @@ TEST(CheckCommand, WarningsErrorsAndBadManifests) {
   EXPECT_EQ(Check(p, {"--update", "--update-all"}).exit_code, 4);
 }
 
+// The README's sample: the first run writes its references, the second passes.
+TEST(CheckCommand, SampleManifestRunsAsDocumented) {
+  const fs::path dir = Dir();
+  fs::remove_all(dir);
+  const std::vector<std::string> base{"check", Samples("check/manifest.json").string(), "--out",
+                                      (dir / "out").string(), "--references",
+                                      (dir / "reference").string()};
+  std::vector<std::string> update = base;
+  update.push_back("--update-all");
+  ProcessResult r = testsupport::RunPatchskin(update, dir / "log_update");
+  EXPECT_EQ(r.exit_code, 0) << r.out << r.err;
+  EXPECT_TRUE(fs::exists(dir / "reference/elbow_knee_patches/frame_0030.png")) << r.out;
+  r = testsupport::RunPatchskin(base, dir / "log_check");
+  EXPECT_EQ(r.exit_code, 0) << r.out << r.err;
+  EXPECT_NE(r.out.find("check: 3 cases: 3 passed, 0 failed"), std::string::npos) << r.out;
+}
+
 // The HTML report as a browser shows it: headless Chromium's screenshot must show
 // the failing case (its red heading) above the passing ones (green headings).
 TEST(CheckCommand, ReportInChromiumShowsTheFailingCaseFirst) {
