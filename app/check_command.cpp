@@ -148,6 +148,11 @@ void CompareCase(const fs::path& new_dir, const fs::path& ref_dir, CaseCheck& c)
     c.summary = "the render wrote no frame";
     return;
   }
+  // References of frames the case no longer renders are named, not compared.
+  int unrendered = 0;
+  for (const auto& [number, path] : ListFrames(ref_dir)) {
+    unrendered += !fs::exists(new_dir / path.filename());
+  }
   int worst_severity = -1;
   double worst_error = -1.0;
   int missing = 0, failing = 0, warning = 0;
@@ -174,6 +179,7 @@ void CompareCase(const fs::path& new_dir, const fs::path& ref_dir, CaseCheck& c)
   if (missing > 0) s += ", " + std::to_string(missing) + " without a reference";
   if (failing > 0) s += ", " + std::to_string(failing) + " failing";
   if (warning > 0) s += ", " + std::to_string(warning) + " with warnings";
+  if (unrendered > 0) s += " (" + std::to_string(unrendered) + " reference frames not rendered)";
   if (w.result) {
     const render::FileCompareResult& r = *w.result;
     if (r.max_error == 0.0) {

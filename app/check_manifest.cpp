@@ -122,6 +122,8 @@ std::optional<mocap::Error> ParseRenderWords(const Ctx& c, const std::string& pa
   std::reverse(args.begin(), args.end());  // CLI11 takes the vector last word first
   try {
     root.parse(args);
+  } catch (const CLI::CallForHelp&) {
+    return c.Fail(path, "render option --help is not a render setting");
   } catch (const CLI::ParseError& e) {
     return c.Fail(path, std::string("render options: ") + e.what());
   }

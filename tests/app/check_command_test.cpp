@@ -185,6 +185,12 @@ TEST(CheckCommand, ABrokenCaseFailsInTheSummaryExitCodeAndJUnit) {
   EXPECT_EQ(html.find("<link"), std::string::npos);
   EXPECT_EQ(html.find("src=\"data:image/png;base64,"), html.find("src=\""));
   EXPECT_LT(html.find("case-rig_elbows"), html.find("case-walk_ssd"));
+
+  // The same results give the same bytes (no times in either file).
+  const fs::path junit2 = p.dir / "junit2.xml", html2 = p.dir / "report2.html";
+  EXPECT_EQ(Check(p, {"--junit", junit2.string(), "--html", html2.string()}).exit_code, 2);
+  EXPECT_EQ(Slurp(junit2), Slurp(junit));
+  EXPECT_EQ(Slurp(html2), html);
 }
 
 TEST(CheckCommand, UpdateReplacesOnlyTheCasesThatDiffer) {
@@ -206,6 +212,13 @@ TEST(CheckCommand, UpdateReplacesOnlyTheCasesThatDiffer) {
   EXPECT_NE(Slurp(p.references / "rig_elbows/frame_0060.png"), rig_before);
   r = Check(p);
   EXPECT_EQ(r.exit_code, 0) << r.out;
+  // A reference of a frame no longer rendered is named in the case's line.
+  fs::copy_file(p.references / "walk_ssd/frame_0020.png", p.references / "walk_ssd/frame_0099.png");
+  r = Check(p);
+  EXPECT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_NE(r.out.find("walk_ssd    3 frames (1 reference frames not rendered), all identical"),
+            std::string::npos)
+      << r.out;
 }
 
 TEST(CheckCommand, WarningsErrorsAndBadManifests) {
@@ -250,6 +263,9 @@ TEST(CheckCommand, WarningsErrorsAndBadManifests) {
   EXPECT_EQ(r.exit_code, 4);
   EXPECT_NE(r.FirstErrLine().find("cases[0].options: error: render options: "), std::string::npos)
       << r.err;
+  WriteText(p.manifest, R"({"cases": [{"name": "a", "input": "x.bvh", "options": "--help"}]})");
+  EXPECT_EQ(Check(p).FirstErrLine(),
+            p.manifest.string() + ": cases[0].options: error: render option --help is not a render setting");
   WriteText(p.manifest, "{\"cases\": [\n  {\"name\": \"a\",}\n]}");
   r = Check(p);
   EXPECT_EQ(r.exit_code, 4);
