@@ -116,43 +116,8 @@ void WriteDiff(FrameCheck& f, const fs::path& dir) {
   if (render::WriteImage(*diff, path, {}).ok()) f.diff_path = path;
 }
 
-// Compares the rendered frames of a case with its references.
-void CompareCase(const fs::path& new_dir, const fs::path& ref_dir, CaseCheck& c) {
-  for (const auto& [number, path] : ListFrames(new_dir)) {
-    FrameCheck f;
-    f.number = number;
-    f.new_path = path.string();
-    f.ref_path = (ref_dir / path.filename()).string();
-    std::error_code ec;
-    if (!fs::exists(f.ref_path, ec)) {
-      f.missing = true;
-    } else {
-      mocap::Result<render::FileCompareResult> r =
-          render::CompareImageFiles(f.new_path, f.ref_path, c.thresholds);
-      if (!r.ok()) {
-        c.status = CaseStatus::kError;
-        c.error += r.error().ToString() + "\n";
-      } else {
-        f.result = std::move(*r);
-        if (FrameSeverity(f) > 0) WriteDiff(f, new_dir);
-      }
-    }
-    c.frames.push_back(std::move(f));
-  }
-  if (c.status == CaseStatus::kError) {
-    c.summary = "cannot compare: " + c.error.substr(0, c.error.find('\n'));
-    return;
-  }
-  if (c.frames.empty()) {
-    c.status = CaseStatus::kError;
-    c.summary = "the render wrote no frame";
-    return;
-  }
-  // References of frames the case no longer renders are named, not compared.
-  int unrendered = 0;
-  for (const auto& [number, path] : ListFrames(ref_dir)) {
-    unrendered += !fs::exists(new_dir / path.filename());
-  }
+// The case's status, worst frame and one-line summary from its compared frames.
+void Judge(int unrendered, CaseCheck& c) {
   int worst_severity = -1;
   double worst_error = -1.0;
   int missing = 0, failing = 0, warning = 0;
@@ -197,6 +162,46 @@ void CompareCase(const fs::path& new_dir, const fs::path& ref_dir, CaseCheck& c)
     }
   }
   c.summary = s;
+}
+
+// Compares the rendered frames of a case with its references.
+void CompareCase(const fs::path& new_dir, const fs::path& ref_dir, CaseCheck& c) {
+  for (const auto& [number, path] : ListFrames(new_dir)) {
+    FrameCheck f;
+    f.number = number;
+    f.new_path = path.string();
+    f.ref_path = (ref_dir / path.filename()).string();
+    std::error_code ec;
+    if (!fs::exists(f.ref_path, ec)) {
+      f.missing = true;
+    } else {
+      mocap::Result<render::FileCompareResult> r =
+          render::CompareImageFiles(f.new_path, f.ref_path, c.thresholds);
+      if (!r.ok()) {
+        c.status = CaseStatus::kError;
+        c.error += r.error().ToString() + "\n";
+      } else {
+        f.result = std::move(*r);
+        if (FrameSeverity(f) > 0) WriteDiff(f, new_dir);
+      }
+    }
+    c.frames.push_back(std::move(f));
+  }
+  if (c.status == CaseStatus::kError) {
+    c.summary = "cannot compare: " + c.error.substr(0, c.error.find('\n'));
+    return;
+  }
+  if (c.frames.empty()) {
+    c.status = CaseStatus::kError;
+    c.summary = "the render wrote no frame";
+    return;
+  }
+  // References of frames the case no longer renders are named, not compared.
+  int unrendered = 0;
+  for (const auto& [number, path] : ListFrames(ref_dir)) {
+    unrendered += !fs::exists(new_dir / path.filename());
+  }
+  Judge(unrendered, c);
 }
 
 // Copies the case's new frames over its references (each atomically).
