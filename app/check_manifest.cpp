@@ -37,7 +37,7 @@ std::string Resolve(const std::string& manifest, const std::string& path) {
 
 std::optional<mocap::Error> CheckKeys(const Ctx& c, const json& obj, const std::string& path,
                                       std::initializer_list<const char*> allowed) {
-  if (!obj.is_object()) return c.Expected(path, "an object", obj);
+  if (!obj.is_object()) return c.Expected(path.empty() ? "manifest" : path, "an object", obj);
   for (const auto& [key, value] : obj.items()) {
     bool known = false;
     std::string list;
@@ -45,7 +45,7 @@ std::optional<mocap::Error> CheckKeys(const Ctx& c, const json& obj, const std::
       known = known || key == a;
       list += std::string(list.empty() ? "" : ", ") + a;
     }
-    if (!known) return c.Fail(path + "." + key, "unknown field (expected one of: " + list + ")");
+    if (!known) return c.Fail(path.empty() ? key : path + "." + key, "unknown field (expected one of: " + list + ")");
   }
   return std::nullopt;
 }
@@ -193,7 +193,7 @@ mocap::Result<CheckManifest> ParseCheckManifest(const std::string& text, const s
     return JsonError(file, text, e, 0);
   }
   if (!doc.is_object()) return c.Expected("manifest", "an object", doc);
-  if (auto e = CheckKeys(c, doc, "manifest", {"references", "thresholds", "cases"})) return *e;
+  if (auto e = CheckKeys(c, doc, "", {"references", "thresholds", "cases"})) return *e;
   CheckManifest m;
   m.file = file;
   m.references = Resolve(file, "reference");

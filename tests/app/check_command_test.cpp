@@ -263,6 +263,10 @@ TEST(CheckCommand, WarningsErrorsAndBadManifests) {
   EXPECT_EQ(r.exit_code, 4);
   EXPECT_NE(r.FirstErrLine().find("cases[0].options: error: render options: "), std::string::npos)
       << r.err;
+  WriteText(p.manifest, R"({"cases": [{"name": "a", "input": "x.bvh"}], "case": []})");
+  EXPECT_EQ(Check(p).FirstErrLine(),
+            p.manifest.string() +
+                ": case: error: unknown field (expected one of: references, thresholds, cases)");
   WriteText(p.manifest, R"({"cases": [{"name": "a", "input": "x.bvh", "options": "--help"}]})");
   EXPECT_EQ(Check(p).FirstErrLine(),
             p.manifest.string() + ": cases[0].options: error: render option --help is not a render setting");
