@@ -1,18 +1,27 @@
 #pragma once
-// `patchskin compare A B`: numeric comparison of two image files in the manner of
-// OpenImageIO's idiff, with the same thresholds as the golden tests.
+// `patchskin compare A B`: a drop-in for OpenImageIO 2.4's `idiff` (the one
+// scripts/setup.sh installs): the same figures, thresholds, defaults, verdict
+// and exit codes, on every channel of the files (Z and beyond RGBA included);
+// see render/image_file_compare.h for the rule.
 //
 //   patchskin compare A B [--fail T] [--failpercent P] [--hardfail H]
-//                         [--diff D.png] [--scale S]
+//                         [--warn T] [--warnpercent P] [--hardwarn H]
+//                         [--allowfailures N] [--diff D.png] [--scale S]
 //
-// Prints mean, RMS, PSNR, max error (with its pixel and channel) and the share of
-// failing pixels, then PASS or FAIL. 8-bit/16-bit files are compared in their
-// sRGB-encoded values (as idiff does on such files), float files (EXR) in linear
-// values. --diff writes |A - B| amplified by --scale (also written on PASS).
-// Exit codes: 0 pass, 1 fail, 2 error (missing file, unreadable, size mismatch,
-// bad option); on error the first stderr line is the formatted error.
+// idiff's single-dash spellings (-fail, -warn, -failpercent, -warnpercent,
+// -hardfail, -hardwarn, -allowfailures, -scale) are accepted as well
+// (NormalizeIdiffSpelling, called by main before parsing).
+// Prints idiff's lines (mean, RMS, PSNR, max error with its pixel, channel and
+// values, pixels over warn and fail), the largest error of each channel, a note
+// when the sizes differ, then PASS, WARNING or FAILURE.
+// Exit codes: 0 pass, 1 warning, 2 failure, 4 error (unreadable or missing file,
+// bad option; idiff exits 1 on a bad option, which a CI script would take for a
+// warning). On error the first stderr line is the formatted error.
 
+#include <cstdint>
+#include <limits>
 #include <string>
+#include <vector>
 
 namespace CLI {
 class App;
@@ -23,20 +32,30 @@ namespace app {
 struct CompareCommandOptions {
   std::string image_a;
   std::string image_b;
-  float fail = 0.004f;         // per-value threshold for a failing pixel
-  float fail_percent = 0.02f;  // percent of pixels allowed over `fail`
-  float hard_fail = 0.012f;    // no value may differ more
+  // idiff's defaults: any difference over 1e-6 fails.
+  float fail = 1e-6f;
+  float fail_percent = 0.0f;
+  float hard_fail = std::numeric_limits<float>::infinity();
+  float warn = 1e-6f;
+  float warn_percent = 0.0f;
+  float hard_warn = std::numeric_limits<float>::infinity();
+  std::int64_t allow_failures = 0;
   std::string diff_path;       // optional difference image (.png/.exr/...)
   float diff_scale = 10.0f;    // amplification of the difference image
 };
 
 inline constexpr int kComparePass = 0;
-inline constexpr int kCompareFail = 1;
-inline constexpr int kCompareError = 2;
+inline constexpr int kCompareWarning = 1;
+inline constexpr int kCompareFail = 2;
+inline constexpr int kCompareError = 4;
 
 // Adds the `compare` subcommand to `app`, storing its arguments in `*options`
 // (which must outlive parsing). Returns the subcommand.
 CLI::App* AddCompareCommand(CLI::App& app, CompareCommandOptions* options);
+
+// Rewrites idiff's single-dash option names after a "compare" argument into
+// the double-dash ones CLI11 parses ("-fail" -> "--fail"); others are unchanged.
+void NormalizeIdiffSpelling(std::vector<std::string>& args);
 
 // Runs the comparison; prints to stdout (report) and stderr (errors). Returns the
 // exit code.

@@ -1,16 +1,19 @@
 // patchskin: the command line. Parses arguments and dispatches to a subcommand;
-// no algorithm lives here. Exit codes, one rule for every command (as grep and
-// diff): 0 ok; 1 only for compare's "the images differ"; 2 the command cannot
-// run as given (an unknown option, a missing or bad value, a bad or unreadable
-// input, an unwritable output); 3 internal error; 128 + N stopped by signal N.
+// no algorithm lives here. Exit codes, one rule for every command: 0 ok; 2 the
+// command cannot run as given (an unknown option, a missing or bad value, a bad
+// or unreadable input, an unwritable output); 3 internal error; 128 + N stopped
+// by signal N. `compare` and `check` follow idiff instead (0 pass, 1 warning,
+// 2 failure, 4 error, usage errors included).
 
 #include <cstdio>
 #include <exception>
 #include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
 #include "app/bench_command.h"
+#include "app/check_command.h"
 #include "app/compare_command.h"
 #include "app/export_command.h"
 #include "app/farm_command.h"
@@ -39,6 +42,8 @@ int main(int argc, char** argv) {
   CLI::App* export_cmd = app::AddExportCommand(app, export_options);
   app::CompareCommandOptions compare_options;
   CLI::App* compare = app::AddCompareCommand(app, &compare_options);
+  app::CheckOptions check_options;
+  CLI::App* check = app::AddCheckCommand(app, &check_options);
   app::ElasticOptions elastic_options;
   CLI::App* elastic = app::AddElasticCommand(app, elastic_options);
   app::SheetOptions sheet_options;
@@ -48,17 +53,26 @@ int main(int argc, char** argv) {
   app::BenchOptions bench_options;
   CLI::App* bench = app::AddBenchCommand(app, bench_options);
 
+  // idiff's single-dash spellings (-fail ...) become CLI11's (--fail).
+  std::vector<std::string> args(argv, argv + argc);
+  app::NormalizeIdiffSpelling(args);
+  std::vector<char*> arg_ptrs;
+  for (std::string& a : args) arg_ptrs.push_back(a.data());
   try {
-    app.parse(argc, argv);
+    app.parse(argc, arg_ptrs.data());
   } catch (const CLI::ParseError& e) {
     const int code = app.exit(e);
-    return code == 0 ? 0 : kUsageError;
+    if (code == 0) return 0;
+    // compare follows idiff: 1 means a warning, so its usage errors are 4.
+    if (compare->parsed()) return app::kCompareError;
+    return check->parsed() ? app::kCheckError : kUsageError;
   }
   try {
     if (inspect->parsed()) return app::RunInspect(inspect_options);
     if (render->parsed()) return app::RunRender(render_options);
     if (turntable->parsed()) return app::RunRender(turntable_options);
     if (compare->parsed()) return app::RunCompareCommand(compare_options);
+    if (check->parsed()) return app::RunCheck(check_options);
     if (export_cmd->parsed()) return app::RunExport(export_options);
     if (elastic->parsed()) return app::RunElastic(elastic_options);
     if (sheet->parsed()) return app::RunSheet(sheet_options);

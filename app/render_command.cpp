@@ -526,7 +526,7 @@ int RunRender(const RenderOptions& options) {
                    static_cast<long long>(r.counters.non_finite_resets));
     }
   }
-  std::printf("frames:        %s (%zu)\n", pattern.c_str(), num_frames);
+  if (o.print_outputs) std::printf("frames:        %s (%zu)\n", pattern.c_str(), num_frames);
   if (sheet) {
     const std::string sheet_path = (out_dir / "contact_sheet.png").string();
     s = render::WriteImage(sheet->sheet(), sheet_path, {});

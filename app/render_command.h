@@ -49,6 +49,8 @@ struct RenderOptions {
   // Long names ("--size") of the options given on the command line, filled by
   // the parser: with a rig file, these win over the rig's render settings.
   std::set<std::string> given;
+  // false: no summary lines on stdout (`check` renders cases and reports itself).
+  bool print_outputs = true;
 };
 
 CLI::App* AddRenderCommand(CLI::App& parent, RenderOptions& options);

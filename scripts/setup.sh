@@ -14,6 +14,7 @@ packages=(
   libcli11-dev
   libfast-float-dev
   libassimp-dev
+  libtinyxml2-dev chromium  # the check tests read JUnit files and open the HTML report headless
   slurmctld slurmd slurm-client munge
   "$@"
 )

@@ -1,5 +1,6 @@
 #pragma once
-// Runs the built `patchskin` (PATCHSKIN_BINARY) as a child process for the app
+// Runs the built `patchskin` (PATCHSKIN_BINARY), or another program (idiff,
+// chromium: FindProgram looks it up on PATH), as a child process for the app
 // tests: arguments passed as a vector (no shell quoting), stdout and stderr
 // captured into files, exit code returned. StartPatchskin leaves it running so
 // a test can signal it.
@@ -11,6 +12,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -44,14 +47,14 @@ struct RunningProcess {
   std::filesystem::path out, err;
 };
 
-// Starts PATCHSKIN_BINARY with `args`, stdout/stderr to `log_dir`/{stdout,stderr}.txt.
-inline RunningProcess StartPatchskin(const std::vector<std::string>& args,
-                                     const std::filesystem::path& log_dir) {
+// Starts `program` (a path) with `args`, stdout/stderr to `log_dir`/{stdout,stderr}.txt.
+inline RunningProcess StartProgram(const std::string& program, const std::vector<std::string>& args,
+                                   const std::filesystem::path& log_dir) {
   RunningProcess p;
   std::filesystem::create_directories(log_dir);
   p.out = log_dir / "stdout.txt";
   p.err = log_dir / "stderr.txt";
-  std::vector<std::string> all{PATCHSKIN_BINARY};
+  std::vector<std::string> all{program};
   all.insert(all.end(), args.begin(), args.end());
   std::vector<char*> argv;
   for (std::string& a : all) argv.push_back(a.data());
@@ -64,6 +67,27 @@ inline RunningProcess StartPatchskin(const std::vector<std::string>& args,
   if (posix_spawn(&p.pid, argv[0], &actions, nullptr, argv.data(), environ) != 0) p.pid = -1;
   posix_spawn_file_actions_destroy(&actions);
   return p;
+}
+
+// Starts PATCHSKIN_BINARY with `args`, stdout/stderr to `log_dir`/{stdout,stderr}.txt.
+inline RunningProcess StartPatchskin(const std::vector<std::string>& args,
+                                     const std::filesystem::path& log_dir) {
+  return StartProgram(PATCHSKIN_BINARY, args, log_dir);
+}
+
+// The full path of `name` found on PATH, or empty when it is not installed.
+inline std::string FindProgram(const std::string& name) {
+  const char* path = std::getenv("PATH");
+  std::string dirs = path != nullptr ? path : "/usr/bin:/bin";
+  std::size_t start = 0;
+  while (start <= dirs.size()) {
+    const std::size_t end = std::min(dirs.find(':', start), dirs.size());
+    const std::filesystem::path candidate =
+        std::filesystem::path(dirs.substr(start, end - start)) / name;
+    if (end > start && access(candidate.c_str(), X_OK) == 0) return candidate.string();
+    start = end + 1;
+  }
+  return {};
 }
 
 inline ProcessResult WaitFor(const RunningProcess& p) {
@@ -80,6 +104,11 @@ inline ProcessResult WaitFor(const RunningProcess& p) {
   r.out = SlurpFile(p.out);
   r.err = SlurpFile(p.err);
   return r;
+}
+
+inline ProcessResult RunProgram(const std::string& program, const std::vector<std::string>& args,
+                                const std::filesystem::path& log_dir) {
+  return WaitFor(StartProgram(program, args, log_dir));
 }
 
 inline ProcessResult RunPatchskin(const std::vector<std::string>& args,
