@@ -99,7 +99,9 @@ CLI::App* AddRenderCommand(CLI::App& parent, RenderOptions& o) {
                   "A:B[:STEP] frames the camera framing looks at (default: the output frames; "
                   "chunks of one render pass the whole range)");
   cmd->add_option("--motion", o.motion,
-                  "BVH motion driving a glTF INPUT (joints matched by name; see README)");
+                  "BVH motion driving a glTF INPUT (joints matched by body topology; see README)");
+  cmd->add_option("--joint-map", o.joint_map,
+                  "JSON {\"glTF joint\": \"BVH joint\" or null} overriding the matched joints (with --motion)");
   AddOutputFlags(*cmd, o);
   // Which options were given: with a rig file they override its settings.
   cmd->callback([&o, cmd] {
@@ -247,7 +249,7 @@ int RunRender(const RenderOptions& options) {
   const std::string name = demo  ? "demo"
                            : rig ? std::filesystem::path(rig->file).stem().string()
                                  : std::filesystem::path(o.input).stem().string();
-  mocap::Result<Character> character = LoadCommandCharacter(o.input, o.motion, o.quiet);
+  mocap::Result<Character> character = LoadCommandCharacter(o.input, o.motion, o.quiet, o.joint_map);
   if (!character.ok()) return Fail(character.error());
   const Character& ch = *character;
 
