@@ -172,11 +172,8 @@ class Matcher {
   void Anchor(const std::vector<int>& tp, int ti, const std::vector<int>& sp, int si) {
     const BodyPoint& a = t_.chains.points[static_cast<std::size_t>(tp[static_cast<std::size_t>(ti)])];
     const BodyPoint& b = s_.chains.points[static_cast<std::size_t>(sp[static_cast<std::size_t>(si)])];
-    // At a chain's tip the source joint turning the last bone stands for it: a leaf
-    // joint's own rotation (LAFAN's "HeadEnd") moves nothing.
-    const bool tip = si + 1 == static_cast<int>(sp.size());
     const int tj = a.joint;
-    const int sj = b.joint >= 0 && !tip ? b.joint : b.bone_joint;
+    const int sj = b.joint >= 0 ? b.joint : b.bone_joint;
     if (tj < 0 || sj < 0 || match_[static_cast<std::size_t>(tj)].source >= 0) return;
     JointMatch& m = match_[static_cast<std::size_t>(tj)];
     m.source = sj;
@@ -194,9 +191,17 @@ class Matcher {
     for (int k = ta; k < tb; ++k) {
       const int tj = t_.chains.points[static_cast<std::size_t>(tp[static_cast<std::size_t>(k + 1)])].bone_joint;
       if (tj < 0 || match_[static_cast<std::size_t>(tj)].source >= 0) continue;
-      const float u = tu[static_cast<std::size_t>(k - ta)];
+      // The source bone overlapping the target bone's stretch the most (the first
+      // covering its start when it has no length).
+      const float u0 = tu[static_cast<std::size_t>(k - ta)], u1 = tu[static_cast<std::size_t>(k + 1 - ta)];
       int m = sa;
-      while (m + 1 < sb && su[static_cast<std::size_t>(m + 1 - sa)] <= u + 1e-4f) ++m;
+      while (m + 1 < sb && su[static_cast<std::size_t>(m + 1 - sa)] <= u0 + 1e-4f) ++m;
+      float best = 0.0f;
+      for (int i = sa; i < sb; ++i) {
+        const float overlap = std::min(u1, su[static_cast<std::size_t>(i + 1 - sa)]) -
+                              std::max(u0, su[static_cast<std::size_t>(i - sa)]);
+        if (overlap > best + 1e-4f) best = overlap, m = i;
+      }
       JointMatch& jm = match_[static_cast<std::size_t>(tj)];
       jm.source = s_.chains.points[static_cast<std::size_t>(sp[static_cast<std::size_t>(m + 1)])].bone_joint;
       jm.target_dir = Dir(t_, tp, k);

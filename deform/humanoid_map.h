@@ -15,9 +15,9 @@
 //     up; left = up x forward. Left and right come from that geometry; only when
 //     the feet give no direction do the names decide ("Left", "_L", "LHip", ...),
 //     and failing those the pair order (a guess, reported).
-// MatchHumanoids maps chain to chain between landmarks: a target bone starting at
-// a fraction u of its stretch's arc length is driven by the source bone covering u
-// (so a 4-joint spine and a 2-joint one map end to end). The pelvis follows the
+// MatchHumanoids maps chain to chain between landmarks: a target bone covering the
+// fractions [u0, u1] of its stretch's arc length is driven by the source bone that
+// overlaps [u0, u1] the most (so a 4-joint spine and a 2-joint one map end to end). The pelvis follows the
 // pelvis. Rest poses are aligned per bone (RetargetPlan::align): the target's body
 // frame is turned onto the source's (up, forward), then each bone swung by the
 // shortest arc onto its source bone, so a T-pose capture on an A-pose character
