@@ -128,6 +128,10 @@ mocap::Result<Character> LoadCommandCharacter(const std::string& input, const st
     }
   };
   print(src->warnings, 0);
+  if (motion.empty() && !joint_map_file.empty()) {
+    return mocap::MakeError(mocap::ErrorCode::kInvalidArgument, {joint_map_file, 0, 0, {}},
+                            "expected a BVH motion (--motion) for the joint map to apply to, found none");
+  }
   if (motion.empty()) return MakeCharacter(std::move(*src));
   mocap::Result<MotionSource> bvh = LoadMotionSource(motion, load);
   if (!bvh.ok()) return std::move(bvh).error();

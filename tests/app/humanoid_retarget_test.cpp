@@ -12,11 +12,13 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "app/character_motion.h"
 #include "app/motion_source.h"
 #include "mocap/pose.h"
 #include "support/data_paths.h"
+#include "support/run_process.h"
 
 namespace {
 
@@ -136,5 +138,57 @@ INSTANTIATE_TEST_SUITE_P(RealCaptures, CesiumManRetarget, ::testing::ValuesIn(kC
                            }
                            return name;
                          });
+
+// `inspect MODEL --motion X --json` prints the matching; a joint map overrides
+// it; a map naming a joint that does not exist fails with exit 2 naming the map.
+TEST(CesiumManRetargetCli, InspectPrintsTheMatchingAndTheJointMapOverridesIt) {
+  const std::string model = testsupport::SharedDataPath("gltf/CesiumMan.glb").string();
+  const std::string motion = testsupport::SharedDataPath("bvh/bandai_namco/dataset-1_walk_normal_001.bvh").string();
+  PATCHSKIN_REQUIRE_SHARED_FILE(model);
+  PATCHSKIN_REQUIRE_SHARED_FILE(motion);
+  const std::filesystem::path dir = testsupport::TestOutputPath("humanoid_retarget/cli/x").parent_path();
+  const auto joint = [](const nlohmann::json& doc, const std::string& name) {
+    for (const auto& j : doc["joints"]) {
+      if (j["character"] == name) return j["motion"];
+    }
+    return nlohmann::json("missing");
+  };
+
+  auto r = testsupport::RunPatchskin({"inspect", model, "--motion", motion, "--json"}, dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  nlohmann::json doc = nlohmann::json::parse(r.out);
+  EXPECT_EQ(doc["method"], "topology");
+  EXPECT_EQ(doc["motion_reference_pose"], "frame 0");
+  EXPECT_EQ(doc["root"]["motion"], "Hips");  // not the positioning joint_Root
+  EXPECT_EQ(doc["joints"].size(), 21u);
+  EXPECT_EQ(joint(doc, "leg_joint_L_1"), "UpperLeg_L");
+  EXPECT_EQ(joint(doc, "Z_UP"), nlohmann::json());
+
+  const std::filesystem::path map = dir / "map.json";
+  std::ofstream(map) << R"({"leg_joint_L_1": "UpperLeg_R", "Skeleton_arm_joint_L__2_": null})";
+  r = testsupport::RunPatchskin(
+      {"inspect", model, "--motion", motion, "--joint-map", map.string(), "--json"}, dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  doc = nlohmann::json::parse(r.out);
+  EXPECT_EQ(joint(doc, "leg_joint_L_1"), "UpperLeg_R");
+  EXPECT_EQ(joint(doc, "Skeleton_arm_joint_L__2_"), nlohmann::json());
+  EXPECT_EQ(joint(doc, "leg_joint_L_2"), "LowerLeg_L");
+
+  std::ofstream(map) << R"({"leg_joint_L_1": "NoSuchJoint"})";
+  r = testsupport::RunPatchskin({"inspect", model, "--motion", motion, "--joint-map", map.string()}, dir);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.FirstErrLine().find(map.string()), std::string::npos) << r.err;
+  EXPECT_NE(r.FirstErrLine().find("\"NoSuchJoint\""), std::string::npos) << r.err;
+
+  std::ofstream(map) << "{\"leg_joint_L_1\": \n  42}";
+  r = testsupport::RunPatchskin({"inspect", model, "--motion", motion, "--joint-map", map.string()}, dir);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.FirstErrLine().find("found number"), std::string::npos) << r.err;
+
+  std::ofstream(map) << "{\"leg_joint_L_1\": \n  \"x\",}";
+  r = testsupport::RunPatchskin({"inspect", model, "--motion", motion, "--joint-map", map.string()}, dir);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.FirstErrLine().find(map.string() + ":2:"), std::string::npos) << r.err;
+}
 
 }  // namespace
