@@ -363,6 +363,14 @@ mocap::Result<Humanoid> FindHumanoid(const mocap::Skeleton& skeleton,
   h.legs[1] = limb[swap_legs ? 0 : 1];
   h.arms[0] = limb[swap_arms ? 3 : 2];
   h.arms[1] = limb[swap_arms ? 2 : 3];
+  // The feet gave the sides; the hips give the exact axes (a running frame's feet
+  // point anywhere within 90 degrees of forward, the hip line stays across it).
+  const glm::vec3 hips = Across(Pos(c, h.legs[0].points[static_cast<std::size_t>(h.legs[0].root)]) -
+                                    Pos(c, h.legs[1].points[static_cast<std::size_t>(h.legs[1].root)]), h.up);
+  if (glm::length(hips) > 0.0f) {
+    h.left = glm::normalize(hips);
+    h.forward = glm::cross(h.left, h.up);
+  }
   return h;
 }
 

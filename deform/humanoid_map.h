@@ -11,10 +11,11 @@
 //   - landmarks: wrist = where the fingers fold in (else the last joint), ankle =
 //     the end of the leg's two longest consecutive bones (thigh, shin); elbow/knee
 //     one point before, shoulder/hip two points before;
-//   - up = pelvis -> chest; forward = the feet's direction (ankle -> tip) across
-//     up; left = up x forward. Left and right come from that geometry; only when
+//   - up = pelvis -> chest; the feet's direction (ankle -> tip) across up is
+//     forward, and which limb lies towards up x forward is the left one. Only when
 //     the feet give no direction do the names decide ("Left", "_L", "LHip", ...),
-//     and failing those the pair order (a guess, reported).
+//     and failing those the pair order (a guess, reported). The body axes are
+//     then left = right hip -> left hip across up, forward = left x up.
 // MatchHumanoids maps chain to chain between landmarks: a target bone covering the
 // fractions [u0, u1] of its stretch's arc length is driven by the source bone that
 // overlaps [u0, u1] the most (so a 4-joint spine and a 2-joint one map end to end). The pelvis follows the
