@@ -1,14 +1,19 @@
 #pragma once
 // A glTF character driven by a separate BVH motion (`render MODEL.glb --motion
 // X.bvh`, or a rig with a glTF "character" and a "motion"): the BVH's joints
-// are matched to the skin's joints by name and its rotations retargeted onto
-// the glTF rest pose (conventions in mocap/retarget.h; docs/retargeting.md).
+// are matched to the skin's joints by body topology (deform/body/humanoid_map.h),
+// by name when either skeleton is no humanoid, with a user's joint map on top,
+// and its rotations retargeted onto the glTF rest pose (mocap/retarget.h;
+// docs/retargeting.md).
 
 #include <optional>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "app/motion_source.h"
 #include "app/pipeline.h"
+#include "deform/body/humanoid_map.h"
 #include "mocap/error.h"
 
 namespace app {
@@ -19,7 +24,26 @@ namespace app {
 // the glTF's own animation. Errors: kInvalidArgument when the character is not
 // a glTF or the motion not a BVH, and RetargetMotion's (unmapped required
 // joints, named). The retargeting warnings join the character's.
-mocap::Result<Character> MakeRetargetedCharacter(MotionSource&& character, MotionSource&& motion);
+// `joint_map_file` (may be empty): a JSON object {"glTF joint": "BVH joint" or
+// null} read by ReadJointMap, overriding the matched joints. `report`, when
+// given, receives how the skeletons were matched.
+struct RetargetReport {
+  std::string method;       // "topology" or "names"
+  std::string source_pose;  // "rest" or "frame N" (the motion pose aligned to the rest pose)
+  std::string target_sides, source_sides;  // "geometry", "names", "guess" (topology only)
+  float translation_scale = 1.0f;
+  std::string target_root, source_root;
+  std::vector<std::pair<std::string, std::string>> joints;  // every glTF joint -> BVH joint or ""
+};
+mocap::Result<Character> MakeRetargetedCharacter(MotionSource&& character, MotionSource&& motion,
+                                                 const std::string& joint_map_file = {},
+                                                 RetargetReport* report = nullptr);
+
+// Reads a joint map: one JSON object whose keys are joints of the character and
+// whose values are joints of the motion (a string) or null (left at rest).
+// Errors: kIo (missing, unreadable, over 1 MiB), kSyntax with line and column for
+// invalid JSON, kInvalidArgument for a value that is not a string or null.
+mocap::Result<deform::JointMapEntries> ReadJointMap(const std::string& path);
 
 // The character a command evaluates, loaded as `render` and `export` load it:
 // `input` (a BVH, glTF or GLB path; empty = the built-in demo walk) read Y-up,
@@ -28,6 +52,8 @@ mocap::Result<Character> MakeRetargetedCharacter(MotionSource&& character, Motio
 // stderr unless `quiet`. Errors: those of LoadMotionSource and the makers.
 // `up` (--up) gives the BVH's up axis instead of detecting it.
 mocap::Result<Character> LoadCommandCharacter(const std::string& input, const std::string& motion,
-                                              bool quiet, std::optional<mocap::UpAxis> up = {});
+                                              bool quiet, std::optional<mocap::UpAxis> up = {},
+                                              const std::string& joint_map_file = {},
+                                              RetargetReport* report = nullptr);
 
 }  // namespace app

@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/frame_plan.h"
+#include "app/character_motion.h"
 #include "app/motion_source.h"
 #include "app/pipeline.h"
 #include "deform/global/rig_artifacts.h"
@@ -218,6 +219,53 @@ int PrintArtifacts(MotionSource&& src, const std::string& file) {
   return 0;
 }
 
+// `inspect MODEL --motion X.bvh`: how the motion's joints drive the character's.
+int PrintRetarget(const InspectOptions& options) {
+  RetargetReport r;
+  const mocap::Result<std::optional<mocap::UpAxis>> up = ParseUpAxis(options.up);
+  if (!up.ok()) {
+    std::fprintf(stderr, "%s\n", up.error().ToString().c_str());
+    return 2;
+  }
+  mocap::Result<Character> ch = LoadCommandCharacter(options.file, options.motion,
+                                                     /*quiet=*/false, *up, options.joint_map, &r);
+  if (!ch.ok()) {
+    std::fprintf(stderr, "%s\n", ch.error().ToString().c_str());
+    return 2;
+  }
+  if (options.json) {
+    nlohmann::json joints = nlohmann::json::array();
+    for (const auto& [character, motion] : r.joints) {
+      joints.push_back({{"character", character},
+                        {"motion", motion.empty() ? nlohmann::json() : nlohmann::json(motion)}});
+    }
+    const nlohmann::json doc = {
+        {"file", options.file},
+        {"motion", options.motion},
+        {"joint_map", options.joint_map.empty() ? nlohmann::json() : nlohmann::json(options.joint_map)},
+        {"method", r.method},
+        {"motion_reference_pose", r.source_pose},
+        {"sides", {{"character", r.target_sides}, {"motion", r.source_sides}}},
+        {"root", {{"character", r.target_root}, {"motion", r.source_root}}},
+        {"translation_scale", r.translation_scale},
+        {"joints", joints}};
+    std::printf("%s\n", doc.dump(2, ' ', false, nlohmann::json::error_handler_t::replace).c_str());
+    return 0;
+  }
+  std::printf("character:  %s\nmotion:     %s\nmatched by: %s", options.file.c_str(),
+              options.motion.c_str(), r.method.c_str());
+  if (r.method == "topology") {
+    std::printf(" (left/right from: character %s, motion %s; motion pose aligned: %s)",
+                r.target_sides.c_str(), r.source_sides.c_str(), r.source_pose.c_str());
+  }
+  std::printf("\nroot:       %s <- %s, translation x %g\n\njoints (character <- motion):\n",
+              r.target_root.c_str(), r.source_root.c_str(), r.translation_scale);
+  for (const auto& [character, motion] : r.joints) {
+    std::printf("  %-28s <- %s\n", character.c_str(), motion.empty() ? "(rest)" : motion.c_str());
+  }
+  return 0;
+}
+
 }  // namespace
 
 CLI::App* AddInspectCommand(CLI::App& parent, InspectOptions& options) {
@@ -236,10 +284,16 @@ CLI::App* AddInspectCommand(CLI::App& parent, InspectOptions& options) {
                 "BVH position channels add to OFFSET (three.js) instead of replacing it");
   cmd->add_flag("--allow-short", options.allow_short,
                 "BVH with fewer frames than 'Frames:' declares: load those present (with a warning)");
+  cmd->add_option("--motion", options.motion,
+                  "Print how this BVH motion's joints drive the glTF FILE's (as render --motion does)");
+  cmd->add_option("--joint-map", options.joint_map,
+                  "JSON {\"glTF joint\": \"BVH joint\" or null} overriding the matched joints")
+      ->needs("--motion");
   return cmd;
 }
 
 int RunInspect(const InspectOptions& options) {
+  if (!options.motion.empty()) return PrintRetarget(options);
   MotionSourceOptions load;
   load.scale = options.scale;
   load.y_up = options.y_up;

@@ -24,6 +24,8 @@ struct InspectOptions {
   std::string up;                 // --up y|z: the file's up axis; empty = detected
   bool add_position_to_offset = false;
   bool allow_short = false;       // load the complete frames of a file with fewer than declared
+  std::string motion;             // BVH driving the glTF `file`: print the joint matching instead
+  std::string joint_map;          // with `motion`: JSON overrides (as render --joint-map)
 };
 
 // Registers the subcommand and its options; the callback stores into `options`.

@@ -110,7 +110,9 @@ CLI::App* AddRenderCommand(CLI::App& parent, RenderOptions& o) {
                   "A:B[:STEP] frames the camera framing looks at (default: the output frames; "
                   "chunks of one render pass the whole range)");
   cmd->add_option("--motion", o.motion,
-                  "BVH motion driving a glTF INPUT (joints matched by name; docs/retargeting.md)");
+                  "BVH motion driving a glTF INPUT (joints matched by body topology; docs/retargeting.md)");
+  cmd->add_option("--joint-map", o.joint_map,
+                  "JSON {\"glTF joint\": \"BVH joint\" or null} overriding the matched joints (with --motion)");
   AddOutputFlags(*cmd, o);
   cmd->callback([&o, cmd] { RecordGivenOptions(cmd, o); });
   return cmd;
@@ -261,7 +263,8 @@ int RunRender(const RenderOptions& options) {
                                  : std::filesystem::path(o.input).stem().string();
   const mocap::Result<std::optional<mocap::UpAxis>> up = ParseUpAxis(o.up);
   if (!up.ok()) return Fail(up.error());
-  mocap::Result<Character> character = LoadCommandCharacter(o.input, o.motion, o.quiet, *up);
+  mocap::Result<Character> character =
+      LoadCommandCharacter(o.input, o.motion, o.quiet, *up, o.joint_map);
   if (!character.ok()) return Fail(character.error());
   const Character& ch = *character;
 

@@ -45,7 +45,8 @@ struct RenderOptions {
   // computed from; empty = the output frames. Chunks of one render (farm)
   // pass the whole range so every chunk frames the body the same way.
   std::string framing;
-  std::string motion;                 // BVH driving a glTF INPUT (retargeted by joint name); empty = its own
+  std::string motion;                 // BVH driving a glTF INPUT (retargeted by topology); empty = its own
+  std::string joint_map;              // JSON joint map overriding the matched joints; empty = none
   // Long names ("--size") of the options given on the command line, filled by
   // the parser: with a rig file, these win over the rig's render settings.
   std::set<std::string> given;

@@ -88,22 +88,21 @@ float HipHeight(const Skeleton& skeleton, int joint) {
   return model[static_cast<std::size_t>(joint)][3].y - lowest;
 }
 
-Result<RetargetedMotion> RetargetMotion(const Skeleton& target, const Skeleton& source,
-                                        const Motion& source_motion,
-                                        const std::string& target_file,
-                                        const std::string& source_file) {
-  RetargetedMotion out;
-  out.source_of_target = MapJointsByName(target, source);
+Result<RetargetPlan> PlanByName(const Skeleton& target, const Skeleton& source,
+                                const std::string& target_file, const std::string& source_file,
+                                std::vector<Warning>* warnings) {
+  RetargetPlan plan;
+  plan.source_of_target = MapJointsByName(target, source);
   const int nt = target.num_joints();
-  const auto& map = out.source_of_target;
+  const auto& map = plan.source_of_target;
   auto mapped = [&map](int j) { return map[static_cast<std::size_t>(j)] >= 0; };
 
   // The root: the target joint driven by the source's first root joint.
-  for (int j = 0; j < nt && out.root < 0; ++j) {
-    if (map[static_cast<std::size_t>(j)] == 0) out.root = j;
+  for (int j = 0; j < nt && plan.target_root < 0; ++j) {
+    if (map[static_cast<std::size_t>(j)] == 0) plan.target_root = j;
   }
   std::vector<std::string> missing;
-  if (out.root < 0 && source.num_joints() > 0) missing.push_back(source.names[0] + " (the root)");
+  if (plan.target_root < 0 && source.num_joints() > 0) missing.push_back(source.names[0] + " (the root)");
   for (int j = 0; j < nt; ++j) {
     if (mapped(j)) continue;
     bool above = false, below = false;
@@ -131,21 +130,51 @@ Result<RetargetedMotion> RetargetMotion(const Skeleton& target, const Skeleton& 
     if (mapped(j)) continue;
     if (++num_unmapped <= 8) unmapped += (unmapped.empty() ? "" : ", ") + target.names[static_cast<std::size_t>(j)];
   }
-  if (num_unmapped > 0) {
-    out.warnings.push_back(
+  if (num_unmapped > 0 && warnings != nullptr) {
+    warnings->push_back(
         {{source_file, 0, 0, {}},
          std::to_string(num_unmapped) + " joint(s) of " + target_file +
              " have no joint of that name in the motion and keep their rest pose: " + unmapped +
              (num_unmapped > 8 ? ", ..." : "")});
   }
   const float source_hips = HipHeight(source, 0);
-  const float target_hips = HipHeight(target, out.root);
+  const float target_hips = HipHeight(target, plan.target_root);
   if (!(source_hips > 0.0f) || !(target_hips > 0.0f)) {
     return MakeError(ErrorCode::kInvalidArgument, {source_hips > 0.0f ? target_file : source_file, 0, 0, {}},
                      "expected the root joint above the lowest joint in the rest pose (a hip "
                      "height > 0) to scale the root translation");
   }
-  out.translation_scale = target_hips / source_hips;
+  plan.translation_scale = target_hips / source_hips;
+  return plan;
+}
+
+Result<RetargetedMotion> ApplyRetargetPlan(const Skeleton& target, const Skeleton& source,
+                                           const Motion& source_motion, const RetargetPlan& plan,
+                                           const std::string& source_file) {
+  const int nt = target.num_joints();
+  const auto ns = static_cast<std::size_t>(source.num_joints());
+  const auto& map = plan.source_of_target;
+  const bool aligned = !plan.align.empty();
+  if (map.size() != static_cast<std::size_t>(nt) ||
+      (aligned && plan.align.size() != static_cast<std::size_t>(nt)) || plan.target_root < 0 ||
+      plan.target_root >= nt || map[static_cast<std::size_t>(plan.target_root)] < 0 ||
+      plan.source_root < 0 || static_cast<std::size_t>(plan.source_root) >= ns) {
+    return MakeError(ErrorCode::kInvalidArgument, {source_file, 0, 0, {}},
+                     "expected a retargeting plan with one entry per target joint and a mapped "
+                     "root joint");
+  }
+  for (const int b : map) {
+    if (b >= static_cast<int>(ns)) {
+      return MakeError(ErrorCode::kInvalidArgument, {source_file, 0, 0, {}},
+                       "retargeting plan names source joint " + std::to_string(b) +
+                           ", expected one of the motion's " + std::to_string(ns));
+    }
+  }
+  auto mapped = [&map](int j) { return map[static_cast<std::size_t>(j)] >= 0; };
+  RetargetedMotion out;
+  out.source_of_target = map;
+  out.root = plan.target_root;
+  out.translation_scale = plan.translation_scale;
 
   // The channel layout: 4 quaternion channels per mapped joint, 3 position
   // channels first on the root.
@@ -175,16 +204,22 @@ Result<RetargetedMotion> RetargetMotion(const Skeleton& target, const Skeleton& 
   out.motion.values.assign(
       static_cast<std::size_t>(channels) * static_cast<std::size_t>(source_motion.num_frames), 0.0f);
 
-  // Rest state of both skeletons.
-  const auto ns = static_cast<std::size_t>(source.num_joints());
+  // Rest state of both skeletons; the target's rest folded into the alignment:
+  // world_rot_j(f) = world_rot_b(f) * after[j].
   std::vector<JointTransform> target_rest(static_cast<std::size_t>(nt)), source_locals(ns);
   RestPose(target, target_rest);
   RestPose(source, source_locals);
   std::vector<glm::quat> target_rest_world, source_rest_world, source_world;
   WorldRotations(target, target_rest, target_rest_world);
   WorldRotations(source, source_locals, source_rest_world);
-  std::vector<glm::quat> source_rest_inverse(ns);
-  for (std::size_t b = 0; b < ns; ++b) source_rest_inverse[b] = glm::inverse(source_rest_world[b]);
+  std::vector<glm::quat> after(static_cast<std::size_t>(nt), glm::quat(1, 0, 0, 0));
+  for (int j = 0; j < nt; ++j) {
+    const auto ju = static_cast<std::size_t>(j);
+    if (!mapped(j)) continue;
+    const glm::quat a = aligned ? plan.align[ju] : glm::quat(1, 0, 0, 0);
+    after[ju] = glm::inverse(source_rest_world[static_cast<std::size_t>(map[ju])]) * a *
+                target_rest_world[ju];
+  }
   const std::vector<glm::mat4> target_rest_model = RestModel(target);
   const int root_parent = target.parents[static_cast<std::size_t>(out.root)];
   const glm::mat4 parent_from_model =
@@ -194,6 +229,7 @@ Result<RetargetedMotion> RetargetMotion(const Skeleton& target, const Skeleton& 
   std::vector<glm::mat4> source_model(ns);
   std::vector<glm::quat> world(static_cast<std::size_t>(nt));
   std::vector<glm::quat> previous(static_cast<std::size_t>(nt), glm::quat(1, 0, 0, 0));
+  const auto source_root = static_cast<std::size_t>(plan.source_root);
   for (int f = 0; f < source_motion.num_frames; ++f) {
     JobStatus s = LocalPoseJob{&source, source_motion.frame(f), source_locals}.Run();
     if (s) s = LocalToModelJob{.parents = source.parents, .locals = source_locals,
@@ -214,13 +250,13 @@ Result<RetargetedMotion> RetargetMotion(const Skeleton& target, const Skeleton& 
         continue;
       }
       const auto b = static_cast<std::size_t>(map[ju]);
-      world[ju] = source_world[b] * source_rest_inverse[b] * target_rest_world[ju];
+      world[ju] = source_world[b] * after[ju];
       glm::quat local = glm::normalize(glm::inverse(parent_world) * world[ju]);
       if (glm::dot(local, previous[ju]) < 0.0f) local = -local;  // continuous for slerp
       previous[ju] = local;
       float* v = row.data() + out.skeleton.channels[ju].first;
       if (j == out.root) {
-        const glm::vec3 moved = out.translation_scale * glm::vec3(source_model[0][3]);
+        const glm::vec3 moved = out.translation_scale * glm::vec3(source_model[source_root][3]);
         const glm::vec3 t = glm::vec3(parent_from_model * glm::vec4(moved, 1.0f));
         *v++ = t.x;
         *v++ = t.y;
@@ -234,6 +270,18 @@ Result<RetargetedMotion> RetargetMotion(const Skeleton& target, const Skeleton& 
   }
   const Status checked = out.skeleton.Check();
   if (!checked.ok()) return checked.error();
+  return out;
+}
+
+Result<RetargetedMotion> RetargetMotion(const Skeleton& target, const Skeleton& source,
+                                        const Motion& source_motion,
+                                        const std::string& target_file,
+                                        const std::string& source_file) {
+  std::vector<Warning> warnings;
+  Result<RetargetPlan> plan = PlanByName(target, source, target_file, source_file, &warnings);
+  if (!plan.ok()) return std::move(plan).error();
+  Result<RetargetedMotion> out = ApplyRetargetPlan(target, source, source_motion, *plan, source_file);
+  if (out.ok()) out->warnings = std::move(warnings);
   return out;
 }
 

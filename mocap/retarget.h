@@ -70,6 +70,34 @@ struct RetargetedMotion {
   std::vector<Warning> warnings;   // e.g. skin joints left unmapped
 };
 
+// How one skeleton drives another, however it was found (by name here, by body
+// topology in deform/body/humanoid_map.h, or from a user's joint map).
+struct RetargetPlan {
+  std::vector<int> source_of_target;  // #J of target: source joint driving it, or -1
+  // #J of target, or empty for all identity: a world-space rotation placed between
+  // the source's turn and the target's rest, so that rest poses that differ (a
+  // T-pose capture on an A-pose character) line up per bone:
+  //   world_rot_j(f) = [world_rot_b(f) * world_rot_b(rest)^-1] * align[j] * world_rot_j(rest)
+  // Identity reproduces the convention above (source rest = target rest).
+  std::vector<glm::quat> align;
+  int target_root = -1;   // target joint placed at the source root's position
+  int source_root = 0;    // source joint whose model-space position is followed
+  float translation_scale = 1.0f;  // target / source lengths, applied to that position
+};
+
+// The plan of the convention above: MapJointsByName, hip heights, identity
+// alignment. Errors as RetargetMotion's (required joints, zero hip height).
+Result<RetargetPlan> PlanByName(const Skeleton& target, const Skeleton& source,
+                                const std::string& target_file, const std::string& source_file,
+                                std::vector<Warning>* warnings);
+
+// Runs `plan`: kQuatX..W channels on every mapped joint, kX/Y/ZPosition on
+// plan.target_root, which must be mapped (kInvalidArgument otherwise, naming
+// `source_file`). Cost: one pose evaluation of the source per frame.
+Result<RetargetedMotion> ApplyRetargetPlan(const Skeleton& target, const Skeleton& source,
+                                           const Motion& source_motion, const RetargetPlan& plan,
+                                           const std::string& source_file);
+
 // Retargets `source_motion` (on `source`) onto `target` (conventions above).
 // `target_file` and `source_file` name the files in errors:
 // kInvalidArgument "expected joints ... in the motion (matched by name), found
