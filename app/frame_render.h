@@ -17,14 +17,19 @@ struct FrameDrawOptions {
   bool skeleton = false;     // overlay the skeleton (bones and joints, no depth test)
   bool wireframe = false;    // overlay the mesh edges
   int frame_number = 0;      // printed at the bottom left
-  std::string left_label;    // split view: method names printed at the top of each half
+  std::string left_label;    // two bodies: what each shows, printed at the top of each half
   std::string right_label;
+  // Two bodies: true = side by side (each whole body in its own half-width
+  // viewport; `camera` must be made for that half's aspect), false = a wipe
+  // (both rendered full width from `camera`, the right half of `right` copied
+  // over the left one's).
+  bool side_by_side = false;
 };
 
-// Renders `frame` (and, when `right` is set, the right half from `right`, with a
-// divider) into `into` (settings.width x settings.height). `right_renderer` and
-// `scratch` are only used for the split view. Errors: kInternal when the renderer
-// refuses the frame.
+// Renders `frame` into `into` (settings.width x settings.height), or, when
+// `right` is set, `frame` and `right` side by side or as a wipe, with a
+// divider. `right_renderer` and `scratch` are only used for two bodies.
+// Errors: kInternal when the renderer refuses the frame.
 mocap::Status DrawCharacterFrame(const Character& character, const DeformedFrame& frame,
                                  const DeformedFrame* right, const render::Camera& camera,
                                  const render::RenderSettings& settings,

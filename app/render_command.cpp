@@ -53,6 +53,90 @@ std::vector<std::string> SplitList(const std::string& text) {
 }
 
 
+// One body of a comparison: a global method, with or without the rig's patch layer.
+struct BodySpec {
+  GlobalMethod method = GlobalMethod::kSsd;
+  bool patches = false;
+  std::string Label() const {
+    return std::string(GlobalMethodName(method)) + (patches ? " + patches" : "");
+  }
+};
+
+// "ssd", "dqs+patches", "swd + patches": a method and whether the patch layer is on.
+mocap::Result<BodySpec> ParseBodySpec(std::string text, const std::string& option) {
+  std::erase(text, ' ');
+  BodySpec spec;
+  const std::string suffix = "+patches";
+  if (text.size() > suffix.size() && text.ends_with(suffix)) {
+    spec.patches = true;
+    text.resize(text.size() - suffix.size());
+  }
+  mocap::Result<GlobalMethod> method = ParseGlobalMethod(text);
+  if (!method.ok()) {
+    return ArgError(option, "expected ssd, dqs or swd, optionally with +patches, found '" + text + "'");
+  }
+  spec.method = *method;
+  return spec;
+}
+
+enum class View { kOne, kCompare, kWipe };
+
+struct TwoBodies {
+  View view = View::kOne;
+  BodySpec sides[2];
+};
+
+// What a render shows: --compare or --wipe (--split) when given, else a rig's
+// render settings (a rig with patches compares its global method alone with
+// the same method and its patches, side by side, unless it asks for a wipe
+// or "split": false), else one body.
+mocap::Result<TwoBodies> ChooseTwoBodies(const RenderOptions& o, const Rig* rig, GlobalMethod global) {
+  const bool has_layers = rig != nullptr && !rig->patches.empty();
+  TwoBodies two;
+  std::string pair_text, option = "--compare";
+  if (o.compare) {
+    two.view = View::kCompare;
+    pair_text = *o.compare;
+  } else if (o.wipe) {
+    two.view = View::kWipe;
+    pair_text = *o.wipe;
+    option = "--wipe";
+  } else if (has_layers && rig->render.split) {
+    two.view = rig->render.wipe ? View::kWipe : View::kCompare;
+    pair_text = rig->render.compare;
+    option = "render.compare";
+  } else {
+    return two;
+  }
+  std::vector<std::string> pair = SplitList(pair_text);
+  if (pair.empty()) {
+    const std::string g = GlobalMethodName(global);
+    pair = has_layers ? std::vector<std::string>{g, g + "+patches"}
+                      : std::vector<std::string>{"ssd", global == GlobalMethod::kSsd ? "dqs" : g};
+  }
+  // Errors name the option, or the rig file and its field.
+  const auto fail = [&](mocap::Error e) {
+    if (option == "render.compare") e.loc = {rig->file, 0, 0, option};
+    return e;
+  };
+  if (pair.size() != 2) return fail(ArgError(option, "expected A,B such as ssd,ssd+patches"));
+  for (int i = 0; i < 2; ++i) {
+    mocap::Result<BodySpec> side = ParseBodySpec(pair[static_cast<std::size_t>(i)], option);
+    if (!side.ok()) return fail(std::move(side).error());
+    if (side->patches && !has_layers) {
+      return fail(ArgError(option, "'" + pair[static_cast<std::size_t>(i)] +
+                                       "' needs a rig file with patches as the input"));
+    }
+    two.sides[i] = *side;
+  }
+  // A wipe of two methods on a rig with patches (the old --split): the right
+  // half gets the patches.
+  if (two.view == View::kWipe && has_layers && !two.sides[0].patches && !two.sides[1].patches) {
+    two.sides[1].patches = true;
+  }
+  return two;
+}
+
 void AddOutputFlags(CLI::App& cmd, RenderOptions& o) {
   cmd.add_flag("--overwrite", o.overwrite, "Replace existing frames, contact sheet and video");
   cmd.add_flag("--resume", o.resume,
@@ -78,8 +162,13 @@ CLI::App* AddRenderCommand(CLI::App& parent, RenderOptions& o) {
   cmd->add_option("--elevation", o.elevation_deg, "Camera elevation in degrees")
       ->capture_default_str();
   cmd->add_option("--overlay", o.overlay, "Comma list: skeleton, wire");
-  cmd->add_option("--split", o.split,
-                  "Left half one method, right half another (LEFT,RIGHT); default ssd,<global>")
+  cmd->add_option("--compare", o.compare,
+                  "Two whole bodies side by side, A,B such as ssd,ssd+patches (default for rigs "
+                  "with patches: <global>,<global>+patches)")
+      ->expected(0, 1)
+      ->default_str("");
+  cmd->add_option("--wipe,--split", o.wipe,
+                  "One view, left half A, right half B (A,B as for --compare; default ssd,<global>)")
       ->expected(0, 1)
       ->default_str("");
   cmd->add_option("--threads", o.threads, "Worker threads (0 = all cores)")->capture_default_str();
@@ -162,7 +251,6 @@ int RunRender(const RenderOptions& options) {
   // --- A rig file (README "Rig files") sets the inputs and render settings ---
   RenderOptions o = options;
   std::optional<Rig> rig;
-  const bool cli_split = o.split.has_value();
   if (std::filesystem::path(o.input).extension() == ".json") {
     mocap::Result<Rig> loaded = LoadRig(o.input);
     if (!loaded.ok()) return Fail(loaded.error());
@@ -185,8 +273,6 @@ int RunRender(const RenderOptions& options) {
     }
     if (!given("--out") || o.out.empty()) o.out = rig->render.output;
     if (!given("--frames") || o.frames.empty()) o.frames = rig->render.frames;
-    // Without --split the rig's split is global only | global + patches (below).
-    if (!given("--split")) o.split.reset();
   }
 
   // --- Arguments -------------------------------------------------------------
@@ -229,18 +315,8 @@ int RunRender(const RenderOptions& options) {
   }
   const mocap::Result<GlobalMethod> method = ParseGlobalMethod(o.global);
   if (!method.ok()) return Fail(method.error());
-  std::optional<GlobalMethod> split_left, split_right;
-  if (o.split) {
-    std::vector<std::string> pair = SplitList(*o.split);
-    if (pair.empty()) pair = {"ssd", *method == GlobalMethod::kSsd ? "dqs" : o.global};
-    if (pair.size() != 2) return Fail(ArgError("--split", "expected LEFT,RIGHT such as ssd,dqs"));
-    const auto l = ParseGlobalMethod(pair[0]);
-    const auto r = ParseGlobalMethod(pair[1]);
-    if (!l.ok()) return Fail(l.error());
-    if (!r.ok()) return Fail(r.error());
-    split_left = *l;
-    split_right = *r;
-  }
+  mocap::Result<TwoBodies> two = ChooseTwoBodies(o, rig ? &*rig : nullptr, *method);
+  if (!two.ok()) return Fail(two.error());
 
   // --- Input -----------------------------------------------------------------
   const bool demo = o.input.empty();
@@ -292,34 +368,32 @@ int RunRender(const RenderOptions& options) {
   }
 
   // --- Pipelines ---------------------------------------------------------------
-  // --split on the command line turns a rig's split on (global only | patches).
+  // One body (the rig's layers on it when it has patches), or the two bodies
+  // of a comparison, each with the layers when its side asks for them.
   const bool has_layers = rig && !rig->patches.empty();
-  const bool rig_split = has_layers && (rig->render.split || cli_split);
-  if (rig_split && !o.split) split_left = split_right = *method;
-  const GlobalMethod main_method = split_left ? *split_left : *method;
-  mocap::Result<FramePipeline> pipeline = FramePipeline::Create(ch, main_method, o.threads);
+  const BodySpec main_body = two->view != View::kOne ? two->sides[0]
+                                                     : BodySpec{*method, has_layers};
+  mocap::Result<FramePipeline> pipeline = FramePipeline::Create(ch, main_body.method, o.threads);
   if (!pipeline.ok()) return Fail(pipeline.error());
   std::optional<FramePipeline> right_pipeline;
-  if (split_right) {
-    mocap::Result<FramePipeline> p = FramePipeline::Create(ch, *split_right, o.threads);
+  if (two->view != View::kOne) {
+    mocap::Result<FramePipeline> p = FramePipeline::Create(ch, two->sides[1].method, o.threads);
     if (!p.ok()) return Fail(p.error());
     right_pipeline.emplace(std::move(*p));
   }
-  if (has_layers) {
-    // Split: the left half stays global only, the right half gets the layers
-    // (patches, example shapes, elastic), set up as `export` sets them up.
-    FramePipeline& layered = right_pipeline ? *right_pipeline : *pipeline;
+  const std::pair<FramePipeline*, bool> bodies[] = {
+      {&*pipeline, main_body.patches},
+      {right_pipeline ? &*right_pipeline : nullptr, right_pipeline && two->sides[1].patches}};
+  for (const auto& [body, layered] : bodies) {
+    if (body == nullptr || !layered) continue;
+    // The layers (patches, example shapes, elastic), set up as `export` sets them up.
     std::vector<std::string> notes;
-    if (mocap::Status s = ApplyRigLayers(*rig, ch, layered, &notes); !s.ok()) return Fail(s.error());
+    if (mocap::Status s = ApplyRigLayers(*rig, ch, *body, &notes); !s.ok()) return Fail(s.error());
     if (!o.quiet) {
       for (const std::string& note : notes) std::fprintf(stderr, "%s\n", note.c_str());
     }
   }
-  const std::string right_label =
-      !right_pipeline ? ""
-      : right_pipeline->num_patches() > 0
-          ? std::string(GlobalMethodName(right_pipeline->method())) + " + patches"
-          : GlobalMethodName(right_pipeline->method());
+  const bool side_by_side = two->view == View::kCompare;
 
   // --- Framing (app/frame_plan.h) ------------------------------------------------
   DeformedFrame frame, right_frame;
@@ -334,8 +408,10 @@ int RunRender(const RenderOptions& options) {
                                             o.framing + "'"));
     }
   }
+  // Side by side, every body is framed in its own half of the frame.
+  const glm::ivec2 view_size = side_by_side ? glm::ivec2(size->x / 2, size->y) : *size;
   mocap::Result<CameraPlan> cameras = CameraPlan::Create(*pipeline, *framing, o.camera,
-                                                         o.elevation_deg, *size);
+                                                         o.elevation_deg, view_size);
   if (!cameras.ok()) return Fail(cameras.error());
   const float ground_y = cameras->ground_y();
 
@@ -455,8 +531,9 @@ int RunRender(const RenderOptions& options) {
     const FrameDrawOptions draw{.skeleton = overlay_skeleton,
                                 .wireframe = overlay_wire,
                                 .frame_number = of.number,
-                                .left_label = right_pipeline ? GlobalMethodName(main_method) : "",
-                                .right_label = right_pipeline ? right_label : ""};
+                                .left_label = right_pipeline ? two->sides[0].Label() : "",
+                                .right_label = right_pipeline ? two->sides[1].Label() : "",
+                                .side_by_side = side_by_side};
     s = DrawCharacterFrame(ch, frame, right_pipeline ? &right_frame : nullptr, camera, settings,
                            draw, renderer, right_renderer, right_image, image);
     if (!s.ok()) return Fail(s.error());

@@ -24,7 +24,10 @@ struct RenderOptions {
   int turntable_frames = 36;          // images of a turntable
   float elevation_deg = 15.0f;        // camera elevation (turntable and fixed)
   std::string overlay;                // comma list: skeleton, wire
-  std::optional<std::string> split;   // "LEFT,RIGHT" methods; "" = default pair
+  // Two bodies in one frame, "A,B" ("" = the default pair); each side is a
+  // global method, "+patches" for the rig's patch layer (e.g. "ssd,ssd+patches").
+  std::optional<std::string> compare;  // side by side, each body in its own half
+  std::optional<std::string> wipe;     // one view, left half A, right half B (also --split)
   int threads = 0;                    // 0 = hardware concurrency
   int supersample = 2;                // 1, 2 or 4 samples per axis
   std::string resolve = "box";        // box | tent: how the samples of a pixel are filtered

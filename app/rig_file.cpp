@@ -274,7 +274,8 @@ std::optional<mocap::Error> ParsePatch(const Ctx& c, const json& v, const std::s
 
 std::optional<mocap::Error> ParseRender(const Ctx& c, const json& v, RigRender& r) {
   if (auto e = CheckObject(c, v, "render",
-                           {"size", "camera", "overlays", "split", "output", "frames"})) {
+                           {"size", "camera", "overlays", "split", "compare", "wipe", "output",
+                            "frames"})) {
     return e;
   }
   if (v.contains("size")) {
@@ -301,6 +302,13 @@ std::optional<mocap::Error> ParseRender(const Ctx& c, const json& v, RigRender& 
   if (v.contains("split")) {
     if (!v["split"].is_boolean()) return c.Expected("render.split", "true or false", v["split"]);
     r.split = v["split"].get<bool>();
+  }
+  if (v.contains("compare")) {
+    if (auto e = GetString(c, v["compare"], "render.compare", r.compare)) return e;
+  }
+  if (v.contains("wipe")) {
+    if (!v["wipe"].is_boolean()) return c.Expected("render.wipe", "true or false", v["wipe"]);
+    r.wipe = v["wipe"].get<bool>();
   }
   if (v.contains("output")) {
     if (auto e = GetString(c, v["output"], "render.output", r.output)) return e;

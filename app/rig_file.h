@@ -68,7 +68,9 @@ struct RigRender {
   glm::ivec2 size{640, 360};         // pixels, 16..16384
   std::string camera = "follow";     // follow | fixed | turntable
   std::vector<std::string> overlays; // skeleton, wire
-  bool split = true;                 // left global only, right global + patches
+  bool split = true;                 // with patches: two bodies (global only | + patches); false: one
+  std::string compare;               // "A,B" as --compare (e.g. "ssd,dqs+patches"); empty = default
+  bool wipe = false;                 // the two bodies as a wipe, not side by side
   std::string output;                // frame pattern (resolved), empty = out/<rig>/frame_####.png
   std::string frames;                // "A:B[:STEP]", empty = all
 };

@@ -29,7 +29,7 @@ constexpr const char* kGood = R"({
     {"name": "sketch", "region": {"view": "front", "rect": [0.1, 0.2, 0.3, 0.4]}}
   ],
   "render": {"size": [320, 200], "camera": "fixed", "overlays": ["skeleton"], "split": false,
-             "output": "out/x_####.png", "frames": "0:10"}
+             "compare": "ssd,dqs + patches", "wipe": true, "output": "out/x_####.png", "frames": "0:10"}
 })";
 
 TEST(RigFile, ParsesEveryFieldAndResolvesPathsAgainstTheRigFolder) {
@@ -57,6 +57,8 @@ TEST(RigFile, ParsesEveryFieldAndResolvesPathsAgainstTheRigFolder) {
   EXPECT_EQ(rig->render.size, glm::ivec2(320, 200));
   EXPECT_EQ(rig->render.camera, "fixed");
   EXPECT_FALSE(rig->render.split);
+  EXPECT_EQ(rig->render.compare, "ssd,dqs + patches");
+  EXPECT_TRUE(rig->render.wipe);
   EXPECT_EQ(rig->render.output, "samples/data/out/x_####.png");
 }
 
@@ -68,6 +70,8 @@ TEST(RigFile, DefaultsOfAMinimalRig) {
   EXPECT_EQ(rig->global, "ssd");
   EXPECT_TRUE(rig->patches.empty());
   EXPECT_TRUE(rig->render.split);
+  EXPECT_TRUE(rig->render.compare.empty());
+  EXPECT_FALSE(rig->render.wipe);
   EXPECT_EQ(rig->render.size, glm::ivec2(640, 360));
 }
 
@@ -182,6 +186,8 @@ const BadRig kBadRigs[] = {
      "\"bones\""},
     {R"({"character": "mannequin", "motion": {"file": "m.bvh"}, "render": {"split": 1}})",
      "r.json: render.split: error: expected true or false, found 1"},
+    {R"({"character": "mannequin", "motion": {"file": "m.bvh"}, "render": {"wipe": "yes"}})",
+     "r.json: render.wipe: error: expected true or false, found \"yes\""},
     {R"({"character": "mannequin", "motion": {"file": "m.bvh"}, "render": {"output": "../x_####.png"}})",
      "r.json: render.output: error: expected a relative path inside the rig's output folder, "
      "found '../x_####.png' (a '..' component)"},
