@@ -3,9 +3,15 @@
 // `patchskin render` and the golden-image tests so both go through the same
 // FramePipeline -> render::Renderer path.
 
+#include <optional>
+#include <span>
 #include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
 
 #include "app/pipeline.h"
+#include "deform/patch_layer.h"
 #include "mocap/error.h"
 #include "render/camera.h"
 #include "render/image.h"
@@ -16,7 +22,8 @@ namespace app {
 struct FrameDrawOptions {
   bool skeleton = false;     // overlay the skeleton (bones and joints, no depth test)
   bool wireframe = false;    // overlay the mesh edges
-  int frame_number = 0;      // printed at the bottom left
+  int frame_number = 0;      // printed at the bottom left as "frame N" ...
+  std::optional<std::string> frame_text;  // ... unless this is set (empty: no label)
   std::string left_label;    // two bodies: what each shows, printed at the top of each half
   std::string right_label;
   // Two bodies: true = side by side (each whole body in its own half-width
@@ -24,7 +31,33 @@ struct FrameDrawOptions {
   // (both rendered full width from `camera`, the right half of `right` copied
   // over the left one's).
   bool side_by_side = false;
+  // Albedo per vertex of each body (#V; empty: the mesh's own): the patch and
+  // displacement overlays (PatchTint, DisplacementColors).
+  std::span<const glm::vec3> left_colors;
+  std::span<const glm::vec3> right_colors;
+  // > 0: a colour bar of DisplacementColors' ramp from 0 to this (model units)
+  // in the top right corner.
+  float color_bar_scale = 0.0f;
 };
+
+// Albedo of every vertex with each patch's region tinted by its own colour,
+// weighted by the border fade beta of its bound vertices (so the fade shows
+// as a fade of the tint); elsewhere `base` (#V, or empty: the default albedo).
+std::vector<glm::vec3> PatchTint(std::span<const deform::PatchSetup> patches, int num_vertices,
+                                 std::span<const glm::vec3> base);
+
+// The heat ramp of the displacement overlay at t in [0, 1] (blue, cyan,
+// yellow, red), linear RGB.
+glm::vec3 HeatRamp(float t);
+
+// Albedo of every vertex by |layered - global| / scale on HeatRamp (#V each).
+void DisplacementColors(std::span<const glm::vec3> global, std::span<const glm::vec3> layered,
+                        float scale, std::vector<glm::vec3>& out);
+
+// The smallest of 1, 2, 5 x 10^k at or above `value` (> 0), for a scale that
+// does not change with every small change of the largest displacement; 1 for
+// value <= 0.
+float NiceScale(float value);
 
 // Renders `frame` into `into` (settings.width x settings.height), or, when
 // `right` is set, `frame` and `right` side by side or as a wipe, with a

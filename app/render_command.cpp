@@ -137,6 +137,25 @@ mocap::Result<TwoBodies> ChooseTwoBodies(const RenderOptions& o, const Rig* rig,
   return two;
 }
 
+// The label at a frame's bottom left: "frame N", a timecode HH:MM:SS:FF (or
+// HH:MM:SS.mmm when the frame rate is not a whole number), or nothing.
+std::string FrameLabel(const std::string& kind, int number, double frame_time_s) {
+  if (kind == "none") return "";
+  if (kind == "frame") return "frame " + std::to_string(number);
+  const double fps = 1.0 / frame_time_s;
+  const long long whole_fps = std::llround(fps);
+  char text[40];
+  if (whole_fps > 0 && std::abs(fps - static_cast<double>(whole_fps)) < 1e-6) {
+    const long long s = number / whole_fps, f = number % whole_fps;
+    std::snprintf(text, sizeof(text), "%02lld:%02lld:%02lld:%02lld", s / 3600, s / 60 % 60, s % 60, f);
+  } else {
+    const long long ms = std::llround(number * frame_time_s * 1000.0);
+    std::snprintf(text, sizeof(text), "%02lld:%02lld:%02lld.%03lld", ms / 3600000, ms / 60000 % 60,
+                  ms / 1000 % 60, ms % 1000);
+  }
+  return text;
+}
+
 void AddOutputFlags(CLI::App& cmd, RenderOptions& o) {
   cmd.add_flag("--overwrite", o.overwrite, "Replace existing frames, contact sheet and video");
   cmd.add_flag("--resume", o.resume,
@@ -161,7 +180,20 @@ CLI::App* AddRenderCommand(CLI::App& parent, RenderOptions& o) {
       ->capture_default_str();
   cmd->add_option("--elevation", o.elevation_deg, "Camera elevation in degrees")
       ->capture_default_str();
+  cmd->add_option("--azimuth", o.azimuth_deg,
+                  "Camera azimuth in degrees about the vertical from the body's front (90: its "
+                  "left side; default front-left, 24)");
+  cmd->add_option("--distance", o.distance, "Camera distance to what it frames, model units (0: framed)")
+      ->capture_default_str();
+  cmd->add_option("--zoom", o.zoom, "Camera distance divided by this")->capture_default_str();
+  cmd->add_option("--look-at", o.look_at,
+                  "Frame and follow a joint's neighbourhood (JOINT) or a patch region (patch:NAME)");
   cmd->add_option("--overlay", o.overlay, "Comma list: skeleton, wire");
+  cmd->add_option("--label", o.label, "Text at the bottom left: none, frame or timecode")
+      ->capture_default_str();
+  cmd->add_option("--background", o.background,
+                  "gradient, or transparent: alpha 0 off the body and ground (PNG, EXR, TIFF)")
+      ->capture_default_str();
   cmd->add_option("--compare", o.compare,
                   "Two whole bodies side by side, A,B such as ssd,ssd+patches (default for rigs "
                   "with patches: <global>,<global>+patches)")
@@ -267,6 +299,11 @@ int RunRender(const RenderOptions& options) {
       o.size = std::to_string(rig->render.size.x) + "x" + std::to_string(rig->render.size.y);
     }
     if (!given("--camera")) o.camera = rig->render.camera;
+    if (!given("--azimuth") && rig->render.azimuth_deg) o.azimuth_deg = rig->render.azimuth_deg;
+    if (!given("--elevation") && rig->render.elevation_deg) o.elevation_deg = *rig->render.elevation_deg;
+    if (!given("--distance")) o.distance = rig->render.distance;
+    if (!given("--zoom")) o.zoom = rig->render.zoom;
+    if (!given("--look-at")) o.look_at = rig->render.look_at;
     if (!given("--overlay")) {
       o.overlay.clear();
       for (const std::string& item : rig->render.overlays) o.overlay += item + ",";
@@ -307,11 +344,21 @@ int RunRender(const RenderOptions& options) {
   }
   if (o.threads < 0 || o.threads > 256) return Fail(ArgError("--threads", "expected 0..256"));
   if (!(o.fps >= 0.0) || o.fps > 10000.0) return Fail(ArgError("--fps", "expected 0 < fps <= 10000"));
-  bool overlay_skeleton = false, overlay_wire = false;
+  bool overlay_skeleton = false, overlay_wire = false, overlay_patches = false, overlay_delta = false;
   for (const std::string& item : SplitList(o.overlay)) {
     if (item == "skeleton") overlay_skeleton = true;
     else if (item == "wire" || item == "wireframe") overlay_wire = true;
-    else return Fail(ArgError("--overlay", "expected skeleton or wire, found '" + item + "'"));
+    else if (item == "patches") overlay_patches = true;
+    else if (item == "delta") overlay_delta = true;
+    else {
+      return Fail(ArgError("--overlay", "expected skeleton, wire, patches or delta, found '" + item + "'"));
+    }
+  }
+  if (o.label != "none" && o.label != "frame" && o.label != "timecode") {
+    return Fail(ArgError("--label", "expected none, frame or timecode, found '" + o.label + "'"));
+  }
+  if (o.background != "gradient" && o.background != "transparent") {
+    return Fail(ArgError("--background", "expected gradient or transparent, found '" + o.background + "'"));
   }
   const mocap::Result<GlobalMethod> method = ParseGlobalMethod(o.global);
   if (!method.ok()) return Fail(method.error());
@@ -350,6 +397,13 @@ int RunRender(const RenderOptions& options) {
   if (!render::HasFramePlaceholder(pattern)) {
     return Fail(ArgError("--out", "the pattern '" + pattern +
                                       "' needs one frame placeholder such as #### or %04d"));
+  }
+  if (o.background == "transparent") {
+    const mocap::Result<render::ImageFormat> format = render::ImageFormatFromPath(pattern);
+    if (format.ok() && *format == render::ImageFormat::kJpeg) {
+      return Fail(ArgError("--background", "transparent needs frames with alpha (PNG, EXR or TIFF), "
+                                           "found the JPEG pattern '" + pattern + "'"));
+    }
   }
   // Existing outputs are refused (or, with --resume, skipped) before anything renders.
   OutputGuard guard({.overwrite = o.overwrite, .resume = o.resume});
@@ -395,6 +449,34 @@ int RunRender(const RenderOptions& options) {
   }
   const bool side_by_side = two->view == View::kCompare;
 
+  // --- Overlays of the patch layer ----------------------------------------------
+  // patches: every region tinted (both bodies); delta: each body with the
+  // layer coloured by its displacement from the same method alone, evaluated
+  // by a global-only pipeline per such body.
+  if ((overlay_patches || overlay_delta) && (!rig || rig->patches.empty())) {
+    return Fail(ArgError("--overlay", std::string(overlay_delta ? "delta" : "patches") +
+                                          " needs a rig file with patches as the input"));
+  }
+  std::vector<glm::vec3> tint;
+  if (overlay_patches) {
+    mocap::Result<std::vector<deform::PatchSetup>> patches = BuildRigPatches(*rig, ch);
+    if (!patches.ok()) return Fail(patches.error());
+    tint = PatchTint(*patches, ch.mesh.bind.num_vertices(), ch.mesh.bind.colors);
+  }
+  struct DeltaBody {
+    std::optional<FramePipeline> base;  // the same method without the layer
+    DeformedFrame base_frame;
+    std::vector<glm::vec3> colors;
+  };
+  DeltaBody delta[2];
+  for (int side = 0; side < 2 && overlay_delta; ++side) {
+    const FramePipeline* body = side == 0 ? &*pipeline : right_pipeline ? &*right_pipeline : nullptr;
+    if (body == nullptr || body->num_patches() == 0) continue;
+    mocap::Result<FramePipeline> base = FramePipeline::Create(ch, body->method(), o.threads);
+    if (!base.ok()) return Fail(base.error());
+    delta[side].base.emplace(std::move(*base));
+  }
+
   // --- Framing (app/frame_plan.h) ------------------------------------------------
   DeformedFrame frame, right_frame;
   mocap::Result<FramePlan> framing = plan;
@@ -410,8 +492,18 @@ int RunRender(const RenderOptions& options) {
   }
   // Side by side, every body is framed in its own half of the frame.
   const glm::ivec2 view_size = side_by_side ? glm::ivec2(size->x / 2, size->y) : *size;
-  mocap::Result<CameraPlan> cameras = CameraPlan::Create(*pipeline, *framing, o.camera,
-                                                         o.elevation_deg, view_size);
+  CameraSpec camera_spec;
+  camera_spec.mode = o.camera;
+  camera_spec.elevation_deg = o.elevation_deg;
+  camera_spec.azimuth_deg = o.azimuth_deg;
+  camera_spec.distance = o.distance;
+  camera_spec.zoom = o.zoom;
+  if (mocap::Status s = ResolveLookAt(o.look_at, rig ? &*rig : nullptr, ch, camera_spec); !s.ok()) {
+    mocap::Error e = s.error();
+    if (rig && options.given.count("--look-at") == 0) e.loc = {rig->file, 0, 0, "render.camera.look_at"};
+    return Fail(e);
+  }
+  mocap::Result<CameraPlan> cameras = CameraPlan::Create(*pipeline, *framing, camera_spec, view_size);
   if (!cameras.ok()) return Fail(cameras.error());
   const float ground_y = cameras->ground_y();
 
@@ -437,6 +529,7 @@ int RunRender(const RenderOptions& options) {
   settings.threads = o.threads;
   settings.ground_at_scene_min = false;
   settings.ground_y = ground_y;
+  settings.background.transparent = o.background == "transparent";
   // Only EXR frames store depth (their Z channel); the renderer still keeps it
   // internally while it draws depth-tested overlays.
   {
@@ -453,7 +546,8 @@ int RunRender(const RenderOptions& options) {
   const int sheet_count = std::min<int>(kMaxSheetFrames, static_cast<int>(num_frames));
   std::unique_ptr<render::ContactSheetBuilder> sheet;
   if (!o.no_sheet) {
-    auto b = render::ContactSheetBuilder::Create(sheet_count, size->x, size->y);
+    auto b = render::ContactSheetBuilder::Create(
+        sheet_count, size->x, size->y, {.columns = render::ContactSheetColumns(sheet_count)});
     if (!b.ok()) return Fail(b.error());
     sheet = std::move(*b);
   }
@@ -477,7 +571,8 @@ int RunRender(const RenderOptions& options) {
   auto feed_sheet_and_video = [&](std::size_t i, int number, const render::Image& img,
                                   bool read_back) {
     if (sheet && next_sheet < sheet_count &&
-        i == num_frames * static_cast<std::size_t>(next_sheet) / static_cast<std::size_t>(sheet_count)) {
+        static_cast<std::int64_t>(i) ==
+            render::ContactSheetPick(next_sheet, sheet_count, static_cast<std::int64_t>(num_frames))) {
       const render::Image* thumb_source = &img;
       mocap::Result<render::Image> stored = render::Image();
       if (!read_back && frame_format.ok()) {
@@ -528,12 +623,39 @@ int RunRender(const RenderOptions& options) {
       continue;
     }
     const render::Camera camera = cameras->At(of);
+    // Displacement colours on a scale shared by both bodies (1, 2 or 5 x 10^k
+    // above the frame's largest displacement: the frame alone decides it).
+    float delta_scale = 0.0f;
+    for (int b = 0; b < 2; ++b) {
+      if (!delta[b].base) continue;
+      s = delta[b].base->Evaluate(of.time_s, delta[b].base_frame);
+      if (!s.ok()) return Fail(s.error());
+      const DeformedFrame& layered = b == 0 ? frame : right_frame;
+      for (std::size_t v = 0; v < layered.positions.size(); ++v) {
+        delta_scale = std::max(delta_scale,
+                               glm::length(layered.positions[v] - delta[b].base_frame.positions[v]));
+      }
+    }
+    if (overlay_delta) delta_scale = NiceScale(delta_scale);
+    for (int b = 0; b < 2; ++b) {
+      if (!delta[b].base) continue;
+      DisplacementColors(delta[b].base_frame.positions,
+                         (b == 0 ? frame : right_frame).positions, delta_scale, delta[b].colors);
+    }
+    const auto colors = [&](int b) {
+      return delta[b].base ? std::span<const glm::vec3>(delta[b].colors)
+                              : std::span<const glm::vec3>(tint);
+    };
     const FrameDrawOptions draw{.skeleton = overlay_skeleton,
                                 .wireframe = overlay_wire,
                                 .frame_number = of.number,
+                                .frame_text = FrameLabel(o.label, of.number, frame_time),
                                 .left_label = right_pipeline ? two->sides[0].Label() : "",
                                 .right_label = right_pipeline ? two->sides[1].Label() : "",
-                                .side_by_side = side_by_side};
+                                .side_by_side = side_by_side,
+                                .left_colors = colors(0),
+                                .right_colors = colors(1),
+                                .color_bar_scale = overlay_delta ? delta_scale : 0.0f};
     s = DrawCharacterFrame(ch, frame, right_pipeline ? &right_frame : nullptr, camera, settings,
                            draw, renderer, right_renderer, right_image, image);
     if (!s.ok()) return Fail(s.error());

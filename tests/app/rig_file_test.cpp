@@ -62,6 +62,34 @@ TEST(RigFile, ParsesEveryFieldAndResolvesPathsAgainstTheRigFolder) {
   EXPECT_EQ(rig->render.output, "samples/data/out/x_####.png");
 }
 
+TEST(RigFile, CameraIsAModeOrAnObject) {
+  const auto rig = app::ParseRig(R"({"character": "mannequin", "motion": {"file": "/m.bvh"},
+      "render": {"camera": {"mode": "fixed", "azimuth": 150, "elevation": -10, "distance": 80,
+                            "zoom": 1.5, "look_at": "patch:left_elbow"}}})",
+                                 "r.json");
+  ASSERT_TRUE(rig.ok()) << rig.error().ToString();
+  EXPECT_EQ(rig->render.camera, "fixed");
+  ASSERT_TRUE(rig->render.azimuth_deg.has_value());
+  EXPECT_EQ(*rig->render.azimuth_deg, 150.0f);
+  ASSERT_TRUE(rig->render.elevation_deg.has_value());
+  EXPECT_EQ(*rig->render.elevation_deg, -10.0f);
+  EXPECT_EQ(rig->render.distance, 80.0f);
+  EXPECT_EQ(rig->render.zoom, 1.5f);
+  EXPECT_EQ(rig->render.look_at, "patch:left_elbow");
+  const auto bad = app::ParseRig(R"({"character": "mannequin", "motion": {"file": "/m.bvh"},
+      "render": {"camera": {"elevation": 95}}})",
+                                 "r.json");
+  ASSERT_FALSE(bad.ok());
+  EXPECT_EQ(bad.error().ToString(),
+            "r.json: render.camera.elevation: error: expected a number in -89..89, found 95");
+  const auto unknown = app::ParseRig(R"({"character": "mannequin", "motion": {"file": "/m.bvh"},
+      "render": {"camera": {"yaw": 5}}})",
+                                     "r.json");
+  ASSERT_FALSE(unknown.ok());
+  EXPECT_NE(unknown.error().ToString().find("render.camera.yaw"), std::string::npos)
+      << unknown.error().ToString();
+}
+
 TEST(RigFile, DefaultsOfAMinimalRig) {
   const auto rig = app::ParseRig(R"({"character": "mannequin", "motion": {"file": "/m.bvh"}})",
                                  "r.json");
@@ -182,8 +210,8 @@ const BadRig kBadRigs[] = {
      "array [8,8]"},
     {R"({"character": "mannequin", "motion": {"file": "m.bvh"}, "render": {"overlays":
         ["bones"]}})",
-     "r.json: render.overlays[0]: error: expected one of \"skeleton\", \"wire\", found "
-     "\"bones\""},
+     "r.json: render.overlays[0]: error: expected one of \"skeleton\", \"wire\", \"patches\", "
+     "\"delta\", found \"bones\""},
     {R"({"character": "mannequin", "motion": {"file": "m.bvh"}, "render": {"split": 1}})",
      "r.json: render.split: error: expected true or false, found 1"},
     {R"({"character": "mannequin", "motion": {"file": "m.bvh"}, "render": {"wipe": "yes"}})",
@@ -289,8 +317,8 @@ TEST(RigFile, RenderCommandRendersTheSampleRigAsASplitFrame) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto img = render::ReadImage((dir / "f_0045.png").string());
   ASSERT_TRUE(img.ok());
-  EXPECT_EQ(img->width, 960);  // the rig's render.size
-  EXPECT_EQ(img->height, 540);
+  EXPECT_EQ(img->width, 1280);  // the rig's render.size
+  EXPECT_EQ(img->height, 720);
 }
 
 TEST(RigFile, RenderCommandReportsABadJointWithItsFieldPath) {
