@@ -90,7 +90,12 @@ mocap::Status DrawOne(const Character& ch, const DeformedFrame& f, const render:
   if (frame_label && !frame_text.empty()) {
     overlays.text.push_back({.text = frame_text, .origin_px = {10, settings.height - 12}});
   }
-  if (!label.empty()) overlays.text.push_back({.text = label, .origin_px = {label_x, 30}});
+  if (!label.empty()) {
+    // Shrunk when it would run past its view (about 15 px a character at 0.8).
+    const double room = static_cast<double>(settings.width - label_x - 10);
+    const double scale = std::min(0.8, 0.8 * room / (15.0 * static_cast<double>(label.size())));
+    overlays.text.push_back({.text = label, .origin_px = {label_x, 30}, .scale = std::max(scale, 0.3)});
+  }
   const mocap::JobStatus js = r.Render(camera, {&body, 1}, overlays, settings, into);
   if (!js) {
     return mocap::MakeError(mocap::ErrorCode::kInternal, {ch.source, 0, 0, {}},

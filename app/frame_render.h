@@ -23,7 +23,7 @@ struct FrameDrawOptions {
   bool skeleton = false;     // overlay the skeleton (bones and joints, no depth test)
   bool wireframe = false;    // overlay the mesh edges
   int frame_number = 0;      // printed at the bottom left as "frame N" ...
-  std::optional<std::string> frame_text;  // ... unless this is set (empty: no label)
+  std::optional<std::string> frame_text{};  // ... unless this is set (empty: no label)
   std::string left_label;    // two bodies: what each shows, printed at the top of each half
   std::string right_label;
   // Two bodies: true = side by side (each whole body in its own half-width
@@ -33,8 +33,8 @@ struct FrameDrawOptions {
   bool side_by_side = false;
   // Albedo per vertex of each body (#V; empty: the mesh's own): the patch and
   // displacement overlays (PatchTint, DisplacementColors).
-  std::span<const glm::vec3> left_colors;
-  std::span<const glm::vec3> right_colors;
+  std::span<const glm::vec3> left_colors{};
+  std::span<const glm::vec3> right_colors{};
   // > 0: a colour bar of DisplacementColors' ramp from 0 to this (model units)
   // in the top right corner.
   float color_bar_scale = 0.0f;
