@@ -116,6 +116,72 @@ OutputFrame FramePlan::At(std::size_t i) const {
 mocap::Result<CameraPlan> CameraPlan::Create(FramePipeline& pipeline, const FramePlan& plan,
                                              const std::string& mode, float elevation_deg,
                                              glm::ivec2 size) {
+  CameraSpec spec;
+  spec.mode = mode;
+  spec.elevation_deg = elevation_deg;
+  return Create(pipeline, plan, spec, size);
+}
+
+glm::vec3 CameraPlan::LookPoint(const DeformedFrame& f) const {
+  if (look_joint_ >= 0) return f.joint_positions[static_cast<std::size_t>(look_joint_)];
+  if (look_region_.empty()) return f.bounds.center();
+  glm::dvec3 sum(0.0);
+  for (const int v : look_region_) sum += glm::dvec3(f.positions[static_cast<std::size_t>(v)]);
+  return glm::vec3(sum / static_cast<double>(look_region_.size()));
+}
+
+namespace {
+
+// The direction the camera looks along: from the eye at `azimuth_deg` about +Y
+// (0 = the body's front, +Z) and `elevation_deg` above the horizontal.
+glm::vec3 ViewDirection(const CameraSpec& spec) {
+  const float elevation = glm::radians(spec.elevation_deg);
+  if (!spec.azimuth_deg) {
+    // Seen from the character's front-left, slightly above (characters face +Z).
+    return -glm::normalize(glm::vec3(0.45f, 0.0f, 1.0f) * std::cos(elevation) +
+                           glm::vec3(0.0f, std::sin(elevation), 0.0f));
+  }
+  const float azimuth = glm::radians(*spec.azimuth_deg);
+  return -glm::vec3(std::sin(azimuth) * std::cos(elevation), std::sin(elevation),
+                    std::cos(azimuth) * std::cos(elevation));
+}
+
+// Moves the eye of a framed camera to `spec`'s distance and zoom (the target
+// stays), near and far following it. Without either it is left as framed.
+void ApplyDistance(const CameraSpec& spec, float body_extent, render::Camera& c) {
+  if (spec.distance <= 0.0f && spec.zoom == 1.0f) return;
+  const glm::vec3 offset = c.eye - c.target;
+  const float framed = glm::length(offset);
+  const float distance = (spec.distance > 0.0f ? spec.distance : framed) / spec.zoom;
+  c.eye = c.target + offset * (distance / framed);
+  c.near_plane = std::max(distance * 0.02f, 1e-3f);
+  c.far_plane = distance + 4.0f * body_extent;
+}
+
+}  // namespace
+
+mocap::Result<CameraPlan> CameraPlan::Create(FramePipeline& pipeline, const FramePlan& plan,
+                                             const CameraSpec& spec, glm::ivec2 size) {
+  const std::string& mode = spec.mode;
+  const float elevation_deg = spec.elevation_deg;
+  if (spec.azimuth_deg && !(std::abs(*spec.azimuth_deg) <= 3600.0f)) {
+    return ArgError("--azimuth", "expected finite degrees in -3600..3600");
+  }
+  if (!(spec.distance >= 0.0f) || !std::isfinite(spec.distance)) {
+    return ArgError("--distance", "expected a finite distance >= 0 (0: framed)");
+  }
+  if (!(spec.zoom > 0.0f) || !(spec.zoom <= 1000.0f)) {
+    return ArgError("--zoom", "expected a factor in (0, 1000]");
+  }
+  const Character& character = pipeline.character();
+  if (spec.look_joint >= character.skeleton.num_joints()) {
+    return ArgError("--look-at", "joint index out of range");
+  }
+  for (const int v : spec.look_region) {
+    if (v < 0 || v >= character.mesh.bind.num_vertices()) {
+      return ArgError("--look-at", "region vertex out of range");
+    }
+  }
   if (mode != "follow" && mode != "fixed" && mode != "turntable") {
     return ArgError("--camera", "expected follow, fixed or turntable, found '" + mode + "'");
   }
@@ -129,6 +195,9 @@ mocap::Result<CameraPlan> CameraPlan::Create(FramePipeline& pipeline, const Fram
   }
   CameraPlan cp;
   cp.mode_ = mode;
+  cp.look_joint_ = spec.look_joint;
+  cp.look_region_ = spec.look_region;
+  const bool look = spec.look_joint >= 0 || !spec.look_region.empty();
   cp.frame_time_s_ = plan.frame_time_s;
   mocap::Result<FramePipeline> tracker =
       FramePipeline::Create(pipeline.character(), GlobalMethod::kSsd, pipeline.threads());
@@ -140,6 +209,9 @@ mocap::Result<CameraPlan> CameraPlan::Create(FramePipeline& pipeline, const Fram
   deform::Bounds all_bounds;
   glm::vec3 largest_extent(0.0f);
   float ground_y = 1e30f;
+  // Look-at: the followed point of every sample and the region's largest extent.
+  std::vector<glm::vec3> look_points;
+  glm::vec3 region_extent(0.0f);
   const std::int64_t last = std::max(0, plan.motion_frames - 1);
   const std::int64_t samples = std::min<std::int64_t>(kFramingSamples, last + 1);
   for (std::int64_t i = 0; i < samples; ++i) {
@@ -150,31 +222,72 @@ mocap::Result<CameraPlan> CameraPlan::Create(FramePipeline& pipeline, const Fram
     all_bounds.Extend(frame.bounds.max);
     largest_extent = glm::max(largest_extent, frame.bounds.size());
     ground_y = std::min(ground_y, frame.bounds.min.y);
+    if (look) {
+      look_points.push_back(cp.LookPoint(frame));
+      deform::Bounds region;
+      for (const int v : spec.look_region) region.Extend(frame.positions[static_cast<std::size_t>(v)]);
+      if (!region.empty()) region_extent = glm::max(region_extent, region.size());
+    }
   }
+  // The box framed around the followed point: the whole body, or the look-at
+  // neighbourhood (a joint: a third of the body's largest extent; a region:
+  // its own extent and as much again around it).
+  const float body_extent = std::max({largest_extent.x, largest_extent.y, largest_extent.z});
+  const glm::vec3 half_box = !look ? 0.5f * largest_extent
+                             : spec.look_region.empty() ? glm::vec3(body_extent / 6.0f)
+                                                        : region_extent;
   cp.ground_y_ = ground_y;
   const float aspect = static_cast<float>(size.x) / static_cast<float>(size.y);
-  const float elevation = glm::radians(elevation_deg);
-  // Seen from the character's front-left, slightly above (characters face +Z).
-  const glm::vec3 view_dir = -glm::normalize(glm::vec3(0.45f, 0.0f, 1.0f) * std::cos(elevation) +
-                                             glm::vec3(0.0f, std::sin(elevation), 0.0f));
+  const glm::vec3 view_dir = ViewDirection(spec);
   if (mode == "turntable") {
     const mocap::Status s = cp.tracker_->Evaluate(plan.At(0).time_s, frame);
     if (!s.ok()) return s.error();
-    const render::Camera framed = render::FrameBounds(frame.bounds, kFovYDeg, aspect, view_dir);
-    cp.turntable_ = render::TurntablePath(frame.bounds.center(),
-                                          glm::length(framed.eye - framed.target), elevation_deg,
-                                          static_cast<int>(plan.count()));
+    deform::Bounds box = frame.bounds;
+    if (look) {
+      box = deform::Bounds();
+      box.Extend(cp.LookPoint(frame) - half_box);
+      box.Extend(cp.LookPoint(frame) + half_box);
+    }
+    render::Camera framed = render::FrameBounds(box, kFovYDeg, aspect, view_dir);
+    ApplyDistance(spec, body_extent, framed);
+    cp.turntable_ = render::TurntablePath(box.center(), glm::length(framed.eye - framed.target),
+                                          elevation_deg, static_cast<int>(plan.count()));
     for (render::Camera& c : cp.turntable_) {
       c.fov_y_deg = kFovYDeg;
       c.aspect = aspect;
+      if (look || spec.distance > 0.0f || spec.zoom != 1.0f) {
+        c.near_plane = framed.near_plane;
+        c.far_plane = framed.far_plane;
+      }
     }
   } else if (mode == "fixed") {
-    cp.fixed_ = render::FrameBounds(all_bounds, kFovYDeg, aspect, view_dir);
+    deform::Bounds box = all_bounds;
+    if (look) {
+      box = deform::Bounds();
+      for (const glm::vec3& p : look_points) {
+        box.Extend(p - half_box);
+        box.Extend(p + half_box);
+      }
+    }
+    cp.fixed_ = render::FrameBounds(box, kFovYDeg, aspect, view_dir);
+    if (look) {
+      const float d = glm::length(cp.fixed_.eye - cp.fixed_.target);
+      cp.fixed_.near_plane = std::max(d * 0.02f, 1e-3f);
+      cp.fixed_.far_plane = d + 4.0f * body_extent;
+    }
+    ApplyDistance(spec, body_extent, cp.fixed_);
   } else {
     deform::Bounds typical;
-    typical.Extend(-0.5f * largest_extent);
-    typical.Extend(0.5f * largest_extent);
-    const render::Camera framed = render::FrameBounds(typical, kFovYDeg, aspect, view_dir);
+    typical.Extend(-half_box);
+    typical.Extend(half_box);
+    render::Camera framed = render::FrameBounds(typical, kFovYDeg, aspect, view_dir);
+    if (look) {
+      // Close to a part of the body: the rest of it may lie between the eye and
+      // the part's box, so near may not stop at the box.
+      framed.near_plane = std::max(glm::length(framed.eye - framed.target) * 0.02f, 1e-3f);
+      framed.far_plane = glm::length(framed.eye - framed.target) + 4.0f * body_extent;
+    }
+    ApplyDistance(spec, body_extent, framed);
     render::FollowCamera& follow = cp.follow_;
     follow.offset = framed.eye - framed.target;
     follow.fov_y_deg = kFovYDeg;
@@ -248,11 +361,13 @@ render::Camera CameraPlan::At(const OutputFrame& frame) const {
     // the same pipeline.
     const mocap::Status s = tracker_->Evaluate(g * frame_time_s_, scratch_);
     PATCHSKIN_CHECK(s.ok());
-    centres_.push_back(scratch_.bounds.center());
+    centres_.push_back(LookPoint(scratch_));
     boxes_.push_back(scratch_.bounds);
   }
   render::Camera camera = follow_.At(centres_, f - centre_base_);
-  KeepInFrame(boxes_[static_cast<std::size_t>(f - centre_base_)], camera);
+  // A camera aimed at a joint or a region frames that close up on purpose.
+  const bool whole_body = look_joint_ < 0 && look_region_.empty();
+  if (whole_body) KeepInFrame(boxes_[static_cast<std::size_t>(f - centre_base_)], camera);
   return camera;
 }
 

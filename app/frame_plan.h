@@ -88,6 +88,24 @@ inline constexpr int kMaxStartNumber = 100'000'000;
 // Errors: kInvalidArgument from ParseFrames, or --start-number outside 0..kMaxStartNumber.
 mocap::Result<FramePlan> PlanFrames(const mocap::Motion& motion, const FramePlanOptions& options);
 
+// Where the camera looks from and what it frames (render --camera, --azimuth,
+// --elevation, --distance, --zoom, --look-at; a rig's render.camera object).
+struct CameraSpec {
+  std::string mode = "follow";       // follow | fixed | turntable
+  float elevation_deg = 15.0f;       // above the horizontal, |e| <= kMaxElevationDeg
+  // The eye's direction about +Y from the body's front (+Z), towards +X (its
+  // left side at 90). None: front-left, atan(0.45) = 24.2 degrees.
+  std::optional<float> azimuth_deg;
+  float distance = 0.0f;             // > 0: eye-to-target distance, model units; 0: framed
+  float zoom = 1.0f;                 // > 0: that distance divided by it
+  // What is framed and followed: the whole body (look_joint < 0 and no
+  // region), a joint's neighbourhood (a box a third of the body's largest
+  // extent across), or a patch region's vertices (the region's largest extent
+  // over the motion, with as much again around it).
+  int look_joint = -1;
+  std::vector<int> look_region;
+};
+
 // The camera of every output frame, as `render` uses it: "follow" (a smoothed
 // follow camera framing the body's largest extent), "fixed" (one camera
 // framing the bounds of the whole motion) or "turntable" (an orbit of the
@@ -127,6 +145,10 @@ class CameraPlan {
   static mocap::Result<CameraPlan> Create(FramePipeline& pipeline, const FramePlan& plan,
                                           const std::string& mode, float elevation_deg,
                                           glm::ivec2 size);
+  // The same with every camera setting (CameraSpec); kInvalidArgument naming
+  // --azimuth, --distance, --zoom or --look-at for values out of range.
+  static mocap::Result<CameraPlan> Create(FramePipeline& pipeline, const FramePlan& plan,
+                                          const CameraSpec& spec, glm::ivec2 size);
 
   // The camera of `frame` (one of the plan's frames). Follow: evaluates the
   // frames of its window not seen yet, so ascending frames cost one body
@@ -140,6 +162,9 @@ class CameraPlan {
   // `box` until the box projects within kFollowFrameLimit (see above).
   void KeepInFrame(const deform::Bounds& box, render::Camera& camera) const;
 
+  // The point the camera follows in `f`: the look-at joint, the look-at
+  // region's centroid, or the bounds centre.
+  glm::vec3 LookPoint(const DeformedFrame& f) const;
   std::string mode_;
   std::vector<render::Camera> turntable_;
   render::Camera fixed_;
@@ -151,6 +176,8 @@ class CameraPlan {
   mutable int centre_base_ = 0;
   mutable DeformedFrame scratch_;
   float ground_y_ = 0.0f;
+  int look_joint_ = -1;
+  std::vector<int> look_region_;
 };
 
 }  // namespace app

@@ -75,6 +75,36 @@ mocap::Error JobError(const Character& c, const mocap::JobStatus& s, const char*
                           std::string(stage) + " refused to run: " + s.what);
 }
 
+// Unit normals of the global result, as every variant gets them: the skinned
+// normals normalized (or, without bind normals, the mesh's geometric normals).
+void GlobalNormals(std::span<const glm::vec3> positions, std::span<const glm::uvec3> triangles,
+                   bool has_normals, std::span<glm::vec3> normals) {
+  if (!has_normals) {
+    deform::ComputeVertexNormals(positions, triangles, normals);
+    return;
+  }
+  for (glm::vec3& n : normals) {
+    const float len = glm::length(n);
+    n = len > 0.0f ? n / len : glm::vec3(0.0f, 1.0f, 0.0f);
+  }
+}
+
+// Turns the global normals by what the patch layer changed in the surface: n +=
+// geometric(layered) - geometric(global), renormalized. A vertex whose one-ring
+// the layer left alone gets exactly the global normal, so the two sides of a
+// comparison shade alike everywhere outside the patch regions.
+void AddLayerNormals(std::span<const glm::vec3> global_geometric,
+                     std::span<const glm::vec3> layered_geometric, std::span<glm::vec3> normals) {
+  for (std::size_t v = 0; v < normals.size(); ++v) {
+    const glm::vec3 change = layered_geometric[v] - global_geometric[v];
+    if (change == glm::vec3(0.0f)) continue;
+    const glm::vec3 n = normals[v] + change;
+    const float len = glm::length(n);
+    if (len > 0.0f) normals[v] = n / len;
+    else normals[v] = layered_geometric[v];
+  }
+}
+
 }  // namespace
 
 const char* GlobalMethodName(GlobalMethod method) {
@@ -156,7 +186,14 @@ struct FramePipeline::Impl {
   std::vector<deform::PatchSetup> patches;
   std::vector<std::vector<glm::vec3>> carried;          // per patch, #M x #N
   std::vector<std::span<const glm::vec3>> carried_views;
+  // Per patch, the control points as the global layer alone carries them (G):
+  // the layer adds P(Q) - P(G), so without local displacements it is the identity.
+  std::vector<std::vector<glm::vec3>> reference;
+  std::vector<std::span<const glm::vec3>> reference_views;
   deform::PatchLayerScratch patch_scratch;
+  // Normals with patches (#V each): the global positions and the geometric
+  // normals of them and of the layered mesh (LayerNormals).
+  std::vector<glm::vec3> global_positions, global_geometric, layered_geometric;
   std::unique_ptr<ElasticLayer> elastic;                // null: no elastic patches
   std::vector<std::vector<glm::vec3>> displacement;     // per patch, empty or #M x #N (model)
   std::vector<std::span<const glm::vec3>> displacement_views;
@@ -215,10 +252,18 @@ mocap::Status FramePipeline::SetPatches(std::vector<deform::PatchSetup> patches)
   m.swd_control = std::move(swd_control);
   m.patches = std::move(patches);
   m.carried.assign(m.patches.size(), {});
+  m.reference.assign(m.patches.size(), {});
   m.carried_views.clear();
+  m.reference_views.clear();
   for (std::size_t k = 0; k < m.patches.size(); ++k) {
     m.carried[k].resize(m.patches[k].rest_control.size());
+    m.reference[k].resize(m.patches[k].rest_control.size());
     m.carried_views.emplace_back(m.carried[k]);
+    m.reference_views.emplace_back(m.reference[k]);
+  }
+  const auto nv = static_cast<std::size_t>(m.character->mesh.bind.num_vertices());
+  for (auto* v : {&m.global_positions, &m.global_geometric, &m.layered_geometric}) {
+    v->assign(m.patches.empty() ? 0 : nv, glm::vec3(0.0f));
   }
   m.patch_scratch.Prepare(m.patches, m.character->mesh.bind.num_vertices());
   m.elastic.reset();
@@ -416,6 +461,9 @@ mocap::Status FramePipeline::Evaluate(double time_s, DeformedFrame& out) {
                 .Run();
       }
       if (!s) return JobError(c, s, "patch control points (swd)");
+      for (std::size_t p = 0; p < m.patches.size(); ++p) {
+        std::copy(m.carried[p].begin(), m.carried[p].end(), m.reference[p].begin());
+      }
     }
     for (std::size_t p = 0; m.method != GlobalMethod::kSwd && p < m.patches.size(); ++p) {
       const bool dqs = m.method == GlobalMethod::kDqs;
@@ -427,6 +475,7 @@ mocap::Status FramePipeline::Evaluate(double time_s, DeformedFrame& out) {
           .control = m.carried[p]}
               .Run();
       if (!s) return JobError(c, s, "patch control points");
+      std::copy(m.carried[p].begin(), m.carried[p].end(), m.reference[p].begin());
       if (p < m.pose_spaces.size() && m.pose_spaces[p].active()) {
         s = AddExampleShapes(m, p);
         if (!s) return JobError(c, s, "pose space");
@@ -440,17 +489,20 @@ mocap::Status FramePipeline::Evaluate(double time_s, DeformedFrame& out) {
       for (std::size_t p = 0; p < m.patches.size(); ++p) m.displacement_views[p] = m.displacement[p];
       displacements = m.displacement_views;
     }
-    const mocap::Status layered = deform::ApplyPatchLayer(m.patches, m.carried_views, displacements,
-                                                          m.patch_scratch, out.positions);
+    std::copy(out.positions.begin(), out.positions.end(), m.global_positions.begin());
+    const mocap::Status layered =
+        deform::ApplyPatchLayer(m.patches, m.carried_views, displacements, m.patch_scratch,
+                                out.positions, m.reference_views);
     if (!layered.ok()) return layered;
-    deform::ComputeVertexNormals(out.positions, mesh.bind.triangles, out.normals);
-  } else if (has_normals) {
-    for (glm::vec3& n : out.normals) {
-      const float len = glm::length(n);
-      n = len > 0.0f ? n / len : glm::vec3(0.0f, 1.0f, 0.0f);
-    }
-  } else {
-    deform::ComputeVertexNormals(out.positions, mesh.bind.triangles, out.normals);
+  }
+  // Normals (one way for every variant): without bind normals the final
+  // surface's geometric normals; with them the skinned normals, turned by the
+  // layer's change of the geometric normals where the layer moved the surface.
+  GlobalNormals(out.positions, mesh.bind.triangles, has_normals, out.normals);
+  if (!m.patches.empty() && has_normals) {
+    deform::ComputeVertexNormals(m.global_positions, mesh.bind.triangles, m.global_geometric);
+    deform::ComputeVertexNormals(out.positions, mesh.bind.triangles, m.layered_geometric);
+    AddLayerNormals(m.global_geometric, m.layered_geometric, out.normals);
   }
   out.joint_positions.resize(m.model_from_joint.size());
   for (std::size_t j = 0; j < m.model_from_joint.size(); ++j) {

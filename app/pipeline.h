@@ -4,7 +4,7 @@
 //
 //   SampleLocals(t) -> LocalToModel -> GlobalDeform (SSD | DQS | SWD)
 //     -> [patch layer: PoseSpace dS -> MassSpring dE -> PatchRebuild -> BorderBlend]
-//     -> Normals -> (render)
+//     -> Normals (global ones, turned where the layer moved the surface) -> (render)
 //
 // Why this order: every later stage reads the joint matrices; the global
 // deformation must move the skin (and, with patches, the control points)
@@ -97,7 +97,11 @@ class FramePipeline {
 
   // Adds the patch layer (ALGORITHMS.md 0, 3.7, 3.8), applied after the global
   // step: control points carried by the same method (SSD, DQS or SWD), bound
-  // vertices rebuilt and blended, then normals recomputed from the mesh.
+  // vertices rebuilt and blended. The layer adds only what the local layer
+  // changes, P(Q) - P(G) (deform::ApplyPatchLayer with a reference grid), and
+  // normals are the global ones turned by the layer's change of the geometric
+  // normals: patches without examples or elastic layer give the global frame
+  // bit for bit, and outside the patch regions' one-rings nothing differs.
   // Patches must be built on this character's bind mesh. With SWD every control
   // point is bound to the sweeps of its nearest region vertex
   // (deform::BindPointsLikeVertices) and carried by deform::SwdJob.

@@ -53,6 +53,109 @@ std::vector<std::string> SplitList(const std::string& text) {
 }
 
 
+// One body of a comparison: a global method, with or without the rig's patch layer.
+struct BodySpec {
+  GlobalMethod method = GlobalMethod::kSsd;
+  bool patches = false;
+  std::string Label() const {
+    return std::string(GlobalMethodName(method)) + (patches ? " + patches" : "");
+  }
+};
+
+// "ssd", "dqs+patches", "swd + patches": a method and whether the patch layer is on.
+mocap::Result<BodySpec> ParseBodySpec(std::string text, const std::string& option) {
+  std::erase(text, ' ');
+  BodySpec spec;
+  const std::string suffix = "+patches";
+  if (text.size() > suffix.size() && text.ends_with(suffix)) {
+    spec.patches = true;
+    text.resize(text.size() - suffix.size());
+  }
+  mocap::Result<GlobalMethod> method = ParseGlobalMethod(text);
+  if (!method.ok()) {
+    return ArgError(option, "expected ssd, dqs or swd, optionally with +patches, found '" + text + "'");
+  }
+  spec.method = *method;
+  return spec;
+}
+
+enum class View { kOne, kCompare, kWipe };
+
+struct TwoBodies {
+  View view = View::kOne;
+  BodySpec sides[2];
+};
+
+// What a render shows: --compare or --wipe (--split) when given, else a rig's
+// render settings (a rig with patches compares its global method alone with
+// the same method and its patches, side by side, unless it asks for a wipe
+// or "split": false), else one body.
+mocap::Result<TwoBodies> ChooseTwoBodies(const RenderOptions& o, const Rig* rig, GlobalMethod global) {
+  const bool has_layers = rig != nullptr && !rig->patches.empty();
+  TwoBodies two;
+  std::string pair_text, option = "--compare";
+  if (o.compare) {
+    two.view = View::kCompare;
+    pair_text = *o.compare;
+  } else if (o.wipe) {
+    two.view = View::kWipe;
+    pair_text = *o.wipe;
+    option = "--wipe";
+  } else if (has_layers && rig->render.split) {
+    two.view = rig->render.wipe ? View::kWipe : View::kCompare;
+    pair_text = rig->render.compare;
+    option = "render.compare";
+  } else {
+    return two;
+  }
+  std::vector<std::string> pair = SplitList(pair_text);
+  if (pair.empty()) {
+    const std::string g = GlobalMethodName(global);
+    pair = has_layers ? std::vector<std::string>{g, g + "+patches"}
+                      : std::vector<std::string>{"ssd", global == GlobalMethod::kSsd ? "dqs" : g};
+  }
+  // Errors name the option, or the rig file and its field.
+  const auto fail = [&](mocap::Error e) {
+    if (option == "render.compare") e.loc = {rig->file, 0, 0, option};
+    return e;
+  };
+  if (pair.size() != 2) return fail(ArgError(option, "expected A,B such as ssd,ssd+patches"));
+  for (int i = 0; i < 2; ++i) {
+    mocap::Result<BodySpec> side = ParseBodySpec(pair[static_cast<std::size_t>(i)], option);
+    if (!side.ok()) return fail(std::move(side).error());
+    if (side->patches && !has_layers) {
+      return fail(ArgError(option, "'" + pair[static_cast<std::size_t>(i)] +
+                                       "' needs a rig file with patches as the input"));
+    }
+    two.sides[i] = *side;
+  }
+  // A wipe of two methods on a rig with patches (the old --split): the right
+  // half gets the patches.
+  if (two.view == View::kWipe && has_layers && !two.sides[0].patches && !two.sides[1].patches) {
+    two.sides[1].patches = true;
+  }
+  return two;
+}
+
+// The label at a frame's bottom left: "frame N", a timecode HH:MM:SS:FF (or
+// HH:MM:SS.mmm when the frame rate is not a whole number), or nothing.
+std::string FrameLabel(const std::string& kind, int number, double frame_time_s) {
+  if (kind == "none") return "";
+  if (kind == "frame") return "frame " + std::to_string(number);
+  const double fps = 1.0 / frame_time_s;
+  const long long whole_fps = std::llround(fps);
+  char text[40];
+  if (whole_fps > 0 && std::abs(fps - static_cast<double>(whole_fps)) < 1e-6) {
+    const long long s = number / whole_fps, f = number % whole_fps;
+    std::snprintf(text, sizeof(text), "%02lld:%02lld:%02lld:%02lld", s / 3600, s / 60 % 60, s % 60, f);
+  } else {
+    const long long ms = std::llround(number * frame_time_s * 1000.0);
+    std::snprintf(text, sizeof(text), "%02lld:%02lld:%02lld.%03lld", ms / 3600000, ms / 60000 % 60,
+                  ms / 1000 % 60, ms % 1000);
+  }
+  return text;
+}
+
 void AddOutputFlags(CLI::App& cmd, RenderOptions& o) {
   cmd.add_flag("--overwrite", o.overwrite, "Replace existing frames, contact sheet and video");
   cmd.add_flag("--resume", o.resume,
@@ -88,9 +191,27 @@ CLI::App* AddRenderCommand(CLI::App& parent, RenderOptions& o) {
       ->capture_default_str();
   cmd->add_option("--elevation", o.elevation_deg, "Camera elevation in degrees")
       ->capture_default_str();
+  cmd->add_option("--azimuth", o.azimuth_deg,
+                  "Camera azimuth in degrees about the vertical from the body's front (90: its "
+                  "left side; default front-left, 24)");
+  cmd->add_option("--distance", o.distance, "Camera distance to what it frames, model units (0: framed)")
+      ->capture_default_str();
+  cmd->add_option("--zoom", o.zoom, "Camera distance divided by this")->capture_default_str();
+  cmd->add_option("--look-at", o.look_at,
+                  "Frame and follow a joint's neighbourhood (JOINT) or a patch region (patch:NAME)");
   cmd->add_option("--overlay", o.overlay, "Comma list: skeleton, wire");
-  cmd->add_option("--split", o.split,
-                  "Left half one method, right half another (LEFT,RIGHT); default ssd,<global>")
+  cmd->add_option("--label", o.label, "Text at the bottom left: none, frame or timecode")
+      ->capture_default_str();
+  cmd->add_option("--background", o.background,
+                  "gradient, or transparent: alpha 0 off the body and ground (PNG, EXR, TIFF)")
+      ->capture_default_str();
+  cmd->add_option("--compare", o.compare,
+                  "Two whole bodies side by side, A,B such as ssd,ssd+patches (default for rigs "
+                  "with patches: <global>,<global>+patches)")
+      ->expected(0, 1)
+      ->default_str("");
+  cmd->add_option("--wipe,--split", o.wipe,
+                  "One view, left half A, right half B (A,B as for --compare; default ssd,<global>)")
       ->expected(0, 1)
       ->default_str("");
   cmd->add_option("--threads", o.threads, "Worker threads (0 = all cores)")->capture_default_str();
@@ -176,7 +297,6 @@ int RunRender(const RenderOptions& options) {
   // --- A rig file (docs/rig-file.md) sets the inputs and render settings ---
   RenderOptions o = options;
   std::optional<Rig> rig;
-  const bool cli_split = o.split.has_value();
   if (std::filesystem::path(o.input).extension() == ".json") {
     mocap::Result<Rig> loaded = LoadRig(o.input);
     if (!loaded.ok()) return Fail(loaded.error());
@@ -193,14 +313,17 @@ int RunRender(const RenderOptions& options) {
       o.size = std::to_string(rig->render.size.x) + "x" + std::to_string(rig->render.size.y);
     }
     if (!given("--camera")) o.camera = rig->render.camera;
+    if (!given("--azimuth") && rig->render.azimuth_deg) o.azimuth_deg = rig->render.azimuth_deg;
+    if (!given("--elevation") && rig->render.elevation_deg) o.elevation_deg = *rig->render.elevation_deg;
+    if (!given("--distance")) o.distance = rig->render.distance;
+    if (!given("--zoom")) o.zoom = rig->render.zoom;
+    if (!given("--look-at")) o.look_at = rig->render.look_at;
     if (!given("--overlay")) {
       o.overlay.clear();
       for (const std::string& item : rig->render.overlays) o.overlay += item + ",";
     }
     if (!given("--out") || o.out.empty()) o.out = rig->render.output;
     if (!given("--frames") || o.frames.empty()) o.frames = rig->render.frames;
-    // Without --split the rig's split is global only | global + patches (below).
-    if (!given("--split")) o.split.reset();
   }
 
   // --- Arguments -------------------------------------------------------------
@@ -235,26 +358,26 @@ int RunRender(const RenderOptions& options) {
   }
   if (o.threads < 0 || o.threads > 256) return Fail(ArgError("--threads", "expected 0..256"));
   if (!(o.fps >= 0.0) || o.fps > 10000.0) return Fail(ArgError("--fps", "expected 0 < fps <= 10000"));
-  bool overlay_skeleton = false, overlay_wire = false;
+  bool overlay_skeleton = false, overlay_wire = false, overlay_patches = false, overlay_delta = false;
   for (const std::string& item : SplitList(o.overlay)) {
     if (item == "skeleton") overlay_skeleton = true;
     else if (item == "wire" || item == "wireframe") overlay_wire = true;
-    else return Fail(ArgError("--overlay", "expected skeleton or wire, found '" + item + "'"));
+    else if (item == "patches") overlay_patches = true;
+    else if (item == "delta") overlay_delta = true;
+    else {
+      return Fail(ArgError("--overlay", "expected skeleton, wire, patches or delta, found '" + item + "'"));
+    }
+  }
+  if (o.label != "none" && o.label != "frame" && o.label != "timecode") {
+    return Fail(ArgError("--label", "expected none, frame or timecode, found '" + o.label + "'"));
+  }
+  if (o.background != "gradient" && o.background != "transparent") {
+    return Fail(ArgError("--background", "expected gradient or transparent, found '" + o.background + "'"));
   }
   const mocap::Result<GlobalMethod> method = ParseGlobalMethod(o.global);
   if (!method.ok()) return Fail(method.error());
-  std::optional<GlobalMethod> split_left, split_right;
-  if (o.split) {
-    std::vector<std::string> pair = SplitList(*o.split);
-    if (pair.empty()) pair = {"ssd", *method == GlobalMethod::kSsd ? "dqs" : o.global};
-    if (pair.size() != 2) return Fail(ArgError("--split", "expected LEFT,RIGHT such as ssd,dqs"));
-    const auto l = ParseGlobalMethod(pair[0]);
-    const auto r = ParseGlobalMethod(pair[1]);
-    if (!l.ok()) return Fail(l.error());
-    if (!r.ok()) return Fail(r.error());
-    split_left = *l;
-    split_right = *r;
-  }
+  mocap::Result<TwoBodies> two = ChooseTwoBodies(o, rig ? &*rig : nullptr, *method);
+  if (!two.ok()) return Fail(two.error());
 
   // --- Input -----------------------------------------------------------------
   const bool demo = o.input.empty();
@@ -293,6 +416,13 @@ int RunRender(const RenderOptions& options) {
     return Fail(ArgError("--out", "the pattern '" + pattern +
                                       "' needs one frame placeholder such as #### or %04d"));
   }
+  if (o.background == "transparent") {
+    const mocap::Result<render::ImageFormat> format = render::ImageFormatFromPath(pattern);
+    if (format.ok() && *format == render::ImageFormat::kJpeg) {
+      return Fail(ArgError("--background", "transparent needs frames with alpha (PNG, EXR or TIFF), "
+                                           "found the JPEG pattern '" + pattern + "'"));
+    }
+  }
   // Existing outputs are refused (or, with --resume, skipped) before anything renders.
   OutputGuard guard({.overwrite = o.overwrite, .resume = o.resume});
   {
@@ -310,34 +440,60 @@ int RunRender(const RenderOptions& options) {
   }
 
   // --- Pipelines ---------------------------------------------------------------
-  // --split on the command line turns a rig's split on (global only | patches).
+  // One body (the rig's layers on it when it has patches), or the two bodies
+  // of a comparison, each with the layers when its side asks for them.
   const bool has_layers = rig && !rig->patches.empty();
-  const bool rig_split = has_layers && (rig->render.split || cli_split);
-  if (rig_split && !o.split) split_left = split_right = *method;
-  const GlobalMethod main_method = split_left ? *split_left : *method;
-  mocap::Result<FramePipeline> pipeline = FramePipeline::Create(ch, main_method, o.threads);
+  const BodySpec main_body = two->view != View::kOne ? two->sides[0]
+                                                     : BodySpec{*method, has_layers};
+  mocap::Result<FramePipeline> pipeline = FramePipeline::Create(ch, main_body.method, o.threads);
   if (!pipeline.ok()) return Fail(pipeline.error());
   std::optional<FramePipeline> right_pipeline;
-  if (split_right) {
-    mocap::Result<FramePipeline> p = FramePipeline::Create(ch, *split_right, o.threads);
+  if (two->view != View::kOne) {
+    mocap::Result<FramePipeline> p = FramePipeline::Create(ch, two->sides[1].method, o.threads);
     if (!p.ok()) return Fail(p.error());
     right_pipeline.emplace(std::move(*p));
   }
-  if (has_layers) {
-    // Split: the left half stays global only, the right half gets the layers
-    // (patches, example shapes, elastic), set up as `export` sets them up.
-    FramePipeline& layered = right_pipeline ? *right_pipeline : *pipeline;
+  const std::pair<FramePipeline*, bool> bodies[] = {
+      {&*pipeline, main_body.patches},
+      {right_pipeline ? &*right_pipeline : nullptr, right_pipeline && two->sides[1].patches}};
+  for (const auto& [body, layered] : bodies) {
+    if (body == nullptr || !layered) continue;
+    // The layers (patches, example shapes, elastic), set up as `export` sets them up.
     std::vector<std::string> notes;
-    if (mocap::Status s = ApplyRigLayers(*rig, ch, layered, &notes); !s.ok()) return Fail(s.error());
+    if (mocap::Status s = ApplyRigLayers(*rig, ch, *body, &notes); !s.ok()) return Fail(s.error());
     if (!o.quiet) {
       for (const std::string& note : notes) std::fprintf(stderr, "%s\n", note.c_str());
     }
   }
-  const std::string right_label =
-      !right_pipeline ? ""
-      : right_pipeline->num_patches() > 0
-          ? std::string(GlobalMethodName(right_pipeline->method())) + " + patches"
-          : GlobalMethodName(right_pipeline->method());
+  const bool side_by_side = two->view == View::kCompare;
+
+  // --- Overlays of the patch layer ----------------------------------------------
+  // patches: every region tinted (both bodies); delta: each body with the
+  // layer coloured by its displacement from the same method alone, evaluated
+  // by a global-only pipeline per such body.
+  if ((overlay_patches || overlay_delta) && (!rig || rig->patches.empty())) {
+    return Fail(ArgError("--overlay", std::string(overlay_delta ? "delta" : "patches") +
+                                          " needs a rig file with patches as the input"));
+  }
+  std::vector<glm::vec3> tint;
+  if (overlay_patches) {
+    mocap::Result<std::vector<deform::PatchSetup>> patches = BuildRigPatches(*rig, ch);
+    if (!patches.ok()) return Fail(patches.error());
+    tint = PatchTint(*patches, ch.mesh.bind.num_vertices(), ch.mesh.bind.colors);
+  }
+  struct DeltaBody {
+    std::optional<FramePipeline> base;  // the same method without the layer
+    DeformedFrame base_frame;
+    std::vector<glm::vec3> colors;
+  };
+  DeltaBody delta[2];
+  for (int side = 0; side < 2 && overlay_delta; ++side) {
+    const FramePipeline* body = side == 0 ? &*pipeline : right_pipeline ? &*right_pipeline : nullptr;
+    if (body == nullptr || body->num_patches() == 0) continue;
+    mocap::Result<FramePipeline> base = FramePipeline::Create(ch, body->method(), o.threads);
+    if (!base.ok()) return Fail(base.error());
+    delta[side].base.emplace(std::move(*base));
+  }
 
   // --- Framing (app/frame_plan.h) ------------------------------------------------
   DeformedFrame frame, right_frame;
@@ -353,8 +509,20 @@ int RunRender(const RenderOptions& options) {
                                             o.framing + "'"));
     }
   }
-  mocap::Result<CameraPlan> cameras = CameraPlan::Create(*pipeline, *framing, o.camera,
-                                                         o.elevation_deg, *size);
+  // Side by side, every body is framed in its own half of the frame.
+  const glm::ivec2 view_size = side_by_side ? glm::ivec2(size->x / 2, size->y) : *size;
+  CameraSpec camera_spec;
+  camera_spec.mode = o.camera;
+  camera_spec.elevation_deg = o.elevation_deg;
+  camera_spec.azimuth_deg = o.azimuth_deg;
+  camera_spec.distance = o.distance;
+  camera_spec.zoom = o.zoom;
+  if (mocap::Status s = ResolveLookAt(o.look_at, rig ? &*rig : nullptr, ch, camera_spec); !s.ok()) {
+    mocap::Error e = s.error();
+    if (rig && options.given.count("--look-at") == 0) e.loc = {rig->file, 0, 0, "render.camera.look_at"};
+    return Fail(e);
+  }
+  mocap::Result<CameraPlan> cameras = CameraPlan::Create(*pipeline, *framing, camera_spec, view_size);
   if (!cameras.ok()) return Fail(cameras.error());
   const float ground_y = cameras->ground_y();
 
@@ -375,6 +543,7 @@ int RunRender(const RenderOptions& options) {
   settings.threads = o.threads;
   settings.ground_at_scene_min = false;
   settings.ground_y = ground_y;
+  settings.background.transparent = o.background == "transparent";
   // Only EXR frames store depth (their Z channel); the renderer still keeps it
   // internally while it draws depth-tested overlays.
   {
@@ -391,7 +560,8 @@ int RunRender(const RenderOptions& options) {
   const int sheet_count = std::min<int>(kMaxSheetFrames, static_cast<int>(num_frames));
   std::unique_ptr<render::ContactSheetBuilder> sheet;
   if (!o.no_sheet) {
-    auto b = render::ContactSheetBuilder::Create(sheet_count, size->x, size->y);
+    auto b = render::ContactSheetBuilder::Create(
+        sheet_count, size->x, size->y, {.columns = render::ContactSheetColumns(sheet_count)});
     if (!b.ok()) return Fail(b.error());
     sheet = std::move(*b);
   }
@@ -420,7 +590,8 @@ int RunRender(const RenderOptions& options) {
   auto feed_sheet_and_video = [&](std::size_t i, int number, const render::Image& img,
                                   bool read_back) {
     if (sheet && next_sheet < sheet_count &&
-        i == num_frames * static_cast<std::size_t>(next_sheet) / static_cast<std::size_t>(sheet_count)) {
+        static_cast<std::int64_t>(i) ==
+            render::ContactSheetPick(next_sheet, sheet_count, static_cast<std::int64_t>(num_frames))) {
       const render::Image* thumb_source = &img;
       mocap::Result<render::Image> stored = render::Image();
       if (!read_back && frame_format.ok()) {
@@ -471,13 +642,43 @@ int RunRender(const RenderOptions& options) {
       continue;
     }
     const render::Camera camera = cameras->At(of);
+    // Displacement colours on a scale shared by both bodies (1, 2 or 5 x 10^k
+    // above the frame's largest displacement: the frame alone decides it).
+    float delta_scale = 0.0f;
+    for (int b = 0; b < 2; ++b) {
+      if (!delta[b].base) continue;
+      s = delta[b].base->Evaluate(of.time_s, delta[b].base_frame);
+      if (!s.ok()) return Fail(s.error());
+      const DeformedFrame& layered = b == 0 ? frame : right_frame;
+      for (std::size_t v = 0; v < layered.positions.size(); ++v) {
+        delta_scale = std::max(delta_scale,
+                               glm::length(layered.positions[v] - delta[b].base_frame.positions[v]));
+      }
+    }
+    if (overlay_delta) delta_scale = NiceScale(delta_scale);
+    for (int b = 0; b < 2; ++b) {
+      if (!delta[b].base) continue;
+      DisplacementColors(delta[b].base_frame.positions,
+                         (b == 0 ? frame : right_frame).positions, delta_scale, delta[b].colors);
+    }
+    const auto colors = [&](int b) {
+      return delta[b].base ? std::span<const glm::vec3>(delta[b].colors)
+                              : std::span<const glm::vec3>(tint);
+    };
+    // A turntable's frames all show one motion frame: the label names it and the view.
+    const int label_number = turntable ? o.start_number + plan->range.first : of.number;
+    std::string frame_text = FrameLabel(o.label, label_number, frame_time);
+    if (turntable && !frame_text.empty()) frame_text += "  view " + std::to_string(of.camera);
     const FrameDrawOptions draw{.skeleton = overlay_skeleton,
                                 .wireframe = overlay_wire,
-                                .frame_number = turntable ? o.start_number + plan->range.first
-                                                          : of.number,
-                                .view = turntable ? of.camera : -1,
-                                .left_label = right_pipeline ? GlobalMethodName(main_method) : "",
-                                .right_label = right_pipeline ? right_label : ""};
+                                .frame_number = label_number,
+                                .frame_text = frame_text,
+                                .left_label = right_pipeline ? two->sides[0].Label() : "",
+                                .right_label = right_pipeline ? two->sides[1].Label() : "",
+                                .side_by_side = side_by_side,
+                                .left_colors = colors(0),
+                                .right_colors = colors(1),
+                                .color_bar_scale = overlay_delta ? delta_scale : 0.0f};
     s = DrawCharacterFrame(ch, frame, right_pipeline ? &right_frame : nullptr, camera, settings,
                            draw, renderer, right_renderer, right_image, image);
     if (!s.ok()) return Fail(s.error());

@@ -22,9 +22,18 @@ struct RenderOptions {
   std::string global = "ssd";         // ssd | dqs | swd
   std::string camera = "follow";      // follow | fixed | turntable
   int turntable_frames = 36;          // images of a turntable
-  float elevation_deg = 15.0f;        // camera elevation (turntable and fixed)
+  float elevation_deg = 15.0f;        // camera elevation, degrees
+  std::optional<float> azimuth_deg;   // camera azimuth from the body's front; none = front-left
+  float distance = 0.0f;              // eye-to-target distance, model units; 0 = framed
+  float zoom = 1.0f;                  // the distance divided by this
+  std::string look_at;                // joint name or "patch:NAME"; empty = the whole body
   std::string overlay;                // comma list: skeleton, wire
-  std::optional<std::string> split;   // "LEFT,RIGHT" methods; "" = default pair
+  std::string label = "frame";        // none | frame | timecode: the text at the bottom left
+  std::string background = "gradient";  // gradient | transparent (alpha 0 off the body and ground)
+  // Two bodies in one frame, "A,B" ("" = the default pair); each side is a
+  // global method, "+patches" for the rig's patch layer (e.g. "ssd,ssd+patches").
+  std::optional<std::string> compare;  // side by side, each body in its own half
+  std::optional<std::string> wipe;     // one view, left half A, right half B (also --split)
   int threads = 0;                    // 0 = hardware concurrency
   int supersample = 2;                // 1, 2 or 4 samples per axis
   std::string resolve = "box";        // box | tent: how the samples of a pixel are filtered

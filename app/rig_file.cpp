@@ -272,19 +272,49 @@ std::optional<mocap::Error> ParsePatch(const Ctx& c, const json& v, const std::s
   return internal::ParsePatchExamples(c.file, v, path, p);
 }
 
+// render.camera: a mode string, or an object of the mode and the view.
+std::optional<mocap::Error> ParseCamera(const Ctx& c, const json& v, RigRender& r) {
+  const std::initializer_list<const char*> modes = {"follow", "fixed", "turntable"};
+  if (v.is_string()) return GetChoice(c, v, "render.camera", modes, r.camera);
+  if (auto e = CheckObject(c, v, "render.camera",
+                           {"mode", "azimuth", "elevation", "distance", "zoom", "look_at"})) {
+    return e;
+  }
+  if (v.contains("mode")) {
+    if (auto e = GetChoice(c, v["mode"], "render.camera.mode", modes, r.camera)) return e;
+  }
+  float value = 0.0f;
+  if (v.contains("azimuth")) {
+    if (auto e = GetFloat(c, v["azimuth"], "render.camera.azimuth", -3600, 3600, value)) return e;
+    r.azimuth_deg = value;
+  }
+  if (v.contains("elevation")) {
+    if (auto e = GetFloat(c, v["elevation"], "render.camera.elevation", -89, 89, value)) return e;
+    r.elevation_deg = value;
+  }
+  if (v.contains("distance")) {
+    if (auto e = GetFloat(c, v["distance"], "render.camera.distance", 0, 1e9, r.distance)) return e;
+  }
+  if (v.contains("zoom")) {
+    if (auto e = GetFloat(c, v["zoom"], "render.camera.zoom", 1e-3, 1000, r.zoom)) return e;
+  }
+  if (v.contains("look_at")) {
+    if (auto e = GetString(c, v["look_at"], "render.camera.look_at", r.look_at)) return e;
+  }
+  return std::nullopt;
+}
+
 std::optional<mocap::Error> ParseRender(const Ctx& c, const json& v, RigRender& r) {
   if (auto e = CheckObject(c, v, "render",
-                           {"size", "camera", "overlays", "split", "output", "frames"})) {
+                           {"size", "camera", "overlays", "split", "compare", "wipe", "output",
+                            "frames"})) {
     return e;
   }
   if (v.contains("size")) {
     if (auto e = GetIntPair(c, v["size"], "render.size", 16, 16384, r.size)) return e;
   }
   if (v.contains("camera")) {
-    if (auto e = GetChoice(c, v["camera"], "render.camera", {"follow", "fixed", "turntable"},
-                           r.camera)) {
-      return e;
-    }
+    if (auto e = ParseCamera(c, v["camera"], r)) return e;
   }
   if (v.contains("overlays")) {
     const json& list = v["overlays"];
@@ -292,7 +322,7 @@ std::optional<mocap::Error> ParseRender(const Ctx& c, const json& v, RigRender& 
     for (std::size_t i = 0; i < list.size(); ++i) {
       std::string item;
       if (auto e = GetChoice(c, list[i], "render.overlays[" + std::to_string(i) + "]",
-                             {"skeleton", "wire"}, item)) {
+                             {"skeleton", "wire", "patches", "delta"}, item)) {
         return e;
       }
       r.overlays.push_back(item);
@@ -301,6 +331,13 @@ std::optional<mocap::Error> ParseRender(const Ctx& c, const json& v, RigRender& 
   if (v.contains("split")) {
     if (!v["split"].is_boolean()) return c.Expected("render.split", "true or false", v["split"]);
     r.split = v["split"].get<bool>();
+  }
+  if (v.contains("compare")) {
+    if (auto e = GetString(c, v["compare"], "render.compare", r.compare)) return e;
+  }
+  if (v.contains("wipe")) {
+    if (!v["wipe"].is_boolean()) return c.Expected("render.wipe", "true or false", v["wipe"]);
+    r.wipe = v["wipe"].get<bool>();
   }
   if (v.contains("output")) {
     if (auto e = GetString(c, v["output"], "render.output", r.output)) return e;

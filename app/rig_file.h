@@ -66,9 +66,19 @@ struct RigPatch {
 
 struct RigRender {
   glm::ivec2 size{640, 360};         // pixels, 16..16384
+  // "camera": "follow" | "fixed" | "turntable", or an object with "mode" (that
+  // string) and the fields below (as --azimuth, --elevation, --distance,
+  // --zoom, --look-at).
   std::string camera = "follow";     // follow | fixed | turntable
+  std::optional<float> azimuth_deg;  // -3600..3600
+  std::optional<float> elevation_deg;  // -89..89
+  float distance = 0.0f;             // >= 0, model units; 0 = framed
+  float zoom = 1.0f;                 // (0, 1000]
+  std::string look_at;               // joint name or "patch:NAME"; empty = the whole body
   std::vector<std::string> overlays; // skeleton, wire
-  bool split = true;                 // left global only, right global + patches
+  bool split = true;                 // with patches: two bodies (global only | + patches); false: one
+  std::string compare;               // "A,B" as --compare (e.g. "ssd,dqs+patches"); empty = default
+  bool wipe = false;                 // the two bodies as a wipe, not side by side
   std::string output;                // frame pattern (resolved), empty = out/<rig>/frame_####.png
   std::string frames;                // "A:B[:STEP]", empty = all
 };

@@ -43,4 +43,31 @@ mocap::Status ApplyRigLayers(const Rig& rig, const Character& character, FramePi
   return mocap::Status::Ok();
 }
 
+mocap::Status ResolveLookAt(const std::string& text, const Rig* rig, const Character& ch,
+                            CameraSpec& spec) {
+  if (text.empty()) return mocap::Status::Ok();
+  const std::string prefix = "patch:";
+  if (!text.starts_with(prefix)) {
+    spec.look_joint = ch.skeleton.FindJoint(text);
+    if (spec.look_joint >= 0) return mocap::Status::Ok();
+    return ArgError("--look-at",
+                    "expected a joint of " + ch.source + " or patch:NAME, found '" + text + "'");
+  }
+  const std::string name = text.substr(prefix.size());
+  std::string names;
+  for (std::size_t i = 0; rig != nullptr && i < rig->patches.size(); ++i) {
+    if (rig->patches[i].name != name) {
+      names += (names.empty() ? "" : ", ") + rig->patches[i].name;
+      continue;
+    }
+    mocap::Result<std::vector<deform::PatchSetup>> patches = BuildRigPatches(*rig, ch);
+    if (!patches.ok()) return std::move(patches).error();
+    spec.look_region = (*patches)[i].region;
+    return mocap::Status::Ok();
+  }
+  return ArgError("--look-at", "expected the name of one of the rig's patches (" +
+                                   (names.empty() ? std::string("it has none") : names) +
+                                   "), found '" + name + "'");
+}
+
 }  // namespace app

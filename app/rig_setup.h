@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "app/frame_plan.h"
 #include "app/pipeline.h"
 #include "app/rig_file.h"
 #include "mocap/error.h"
@@ -27,5 +28,12 @@ mocap::Result<std::string> RigInputFile(const Rig& rig);
 // numbers of the example fits, their warnings, elastic step notes.
 mocap::Status ApplyRigLayers(const Rig& rig, const Character& character, FramePipeline& pipeline,
                              std::vector<std::string>* notes = nullptr);
+
+// Resolves a camera's look-at text into `spec`: a joint of the character
+// (look_joint) or "patch:NAME", one of the rig's patches (look_region: the
+// vertices of its region, built as BuildRigPatches builds them). Empty text
+// leaves `spec` as it is. kInvalidArgument naming --look-at and what exists.
+mocap::Status ResolveLookAt(const std::string& text, const Rig* rig, const Character& character,
+                            CameraSpec& spec);
 
 }  // namespace app

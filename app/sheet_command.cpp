@@ -113,7 +113,8 @@ int RunSheet(const SheetOptions& o) {
   const int sheet_count = std::min(kMaxSheetFrames, n);
   std::unique_ptr<render::ContactSheetBuilder> sheet;
   if (!o.no_sheet) {
-    auto b = render::ContactSheetBuilder::Create(sheet_count, width, height);
+    auto b = render::ContactSheetBuilder::Create(
+        sheet_count, width, height, {.columns = render::ContactSheetColumns(sheet_count)});
     if (!b.ok()) return Fail(b.error());
     sheet = std::move(*b);
   }
@@ -126,9 +127,9 @@ int RunSheet(const SheetOptions& o) {
   }
   int next_sheet = 0;
   for (int i = 0; i < n && (sheet || video); ++i) {
-    // The same frames as render's sheet: index i == n * k / sheet_count.
+    // The same frames as render's sheet: even steps, first and last included.
     const bool on_sheet = sheet && next_sheet < sheet_count &&
-                          i == static_cast<int>(static_cast<long long>(n) * next_sheet / sheet_count);
+                          i == render::ContactSheetPick(next_sheet, sheet_count, n);
     if (!on_sheet && !video) continue;
     mocap::Result<render::Image> image =
         i == 0 ? std::move(first) : render::ReadImage(frames[static_cast<std::size_t>(i)].second);

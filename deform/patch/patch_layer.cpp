@@ -221,6 +221,7 @@ void PatchLayerScratch::Prepare(std::span<const PatchSetup> patches, int num_ver
   }
   control.resize(max_c);
   rebuilt.resize(max_b);
+  reference_rebuilt.resize(max_b);
   delta_sum.assign(static_cast<std::size_t>(std::max(0, num_vertices)), glm::vec3(0.0f));
   beta_sum.assign(static_cast<std::size_t>(std::max(0, num_vertices)), 0.0f);
 }
@@ -228,9 +229,13 @@ void PatchLayerScratch::Prepare(std::span<const PatchSetup> patches, int num_ver
 mocap::Status ApplyPatchLayer(std::span<const PatchSetup> patches,
                               std::span<const std::span<const glm::vec3>> carried,
                               std::span<const std::span<const glm::vec3>> displacements,
-                              PatchLayerScratch& scratch, std::span<glm::vec3> positions) {
+                              PatchLayerScratch& scratch, std::span<glm::vec3> positions,
+                              std::span<const std::span<const glm::vec3>> reference) {
   if (carried.size() != patches.size()) {
     return Invalid("patch layer: one carried control grid per patch is required");
+  }
+  if (!reference.empty() && reference.size() != patches.size()) {
+    return Invalid("patch layer: reference grids must be empty or one per patch");
   }
   if (!displacements.empty() && displacements.size() != patches.size()) {
     return Invalid("patch layer: displacements must be empty or one per patch");
@@ -246,6 +251,9 @@ mocap::Status ApplyPatchLayer(std::span<const PatchSetup> patches,
         displacements[k].size() != p.rest_control.size()) {
       return Invalid("patch layer: displacement " + std::to_string(k) + " is not #M x #N");
     }
+    if (!reference.empty() && reference[k].size() != p.rest_control.size()) {
+      return Invalid("patch layer: reference grid " + std::to_string(k) + " is not #M x #N");
+    }
     for (const int v : p.bound.binding.vertex) {
       if (v < 0 || static_cast<std::size_t>(v) >= nv) {
         return Invalid("patch layer: patch " + std::to_string(k) + " binds a vertex past #V");
@@ -256,7 +264,8 @@ mocap::Status ApplyPatchLayer(std::span<const PatchSetup> patches,
   for (std::size_t k = 0; k < patches.size(); ++k) {
     const PatchSetup& p = patches[k];
     const std::size_t nc = p.rest_control.size(), nb = p.bound.binding.size();
-    if (scratch.control.size() < nc || scratch.rebuilt.size() < nb) {
+    if (scratch.control.size() < nc || scratch.rebuilt.size() < nb ||
+        scratch.reference_rebuilt.size() < nb) {
       scratch.Prepare(patches, static_cast<int>(nv));
     }
     const std::span<glm::vec3> q(scratch.control.data(), nc);
@@ -268,10 +277,19 @@ mocap::Status ApplyPatchLayer(std::span<const PatchSetup> patches,
         PatchRebuildJob{.control = q, .bindings = p.bound.binding.view(), .positions = rebuilt}
             .Run();
     if (!s) return Invalid(std::string("patch layer: rebuild refused: ") + s.what);
+    // Relative: the rebuild of the reference grid stands in for G, so only what
+    // the displacements change reaches the mesh (the same grid gives exactly 0).
+    const std::span<glm::vec3> base(scratch.reference_rebuilt.data(), reference.empty() ? 0 : nb);
+    if (!reference.empty()) {
+      const mocap::JobStatus r = PatchRebuildJob{
+          .control = reference[k], .bindings = p.bound.binding.view(), .positions = base}
+                                     .Run();
+      if (!r) return Invalid(std::string("patch layer: rebuild refused: ") + r.what);
+    }
     for (std::size_t r = 0; r < nb; ++r) {
       const auto v = static_cast<std::size_t>(p.bound.binding.vertex[r]);
       const float beta = p.border_weight[r];
-      scratch.delta_sum[v] += beta * (rebuilt[r] - positions[v]);
+      scratch.delta_sum[v] += beta * (rebuilt[r] - (base.empty() ? positions[v] : base[r]));
       scratch.beta_sum[v] += beta;
     }
   }

@@ -111,6 +111,7 @@ struct CarryControlPointsJob {
 struct PatchLayerScratch {
   std::vector<glm::vec3> control;     // max #M x #N over the patches
   std::vector<glm::vec3> rebuilt;     // max #B
+  std::vector<glm::vec3> reference_rebuilt;  // max #B, rebuild of the reference grid
   std::vector<glm::vec3> delta_sum;   // #V, sum_k beta_k (P_k - G)
   std::vector<float> beta_sum;        // #V, sum_k beta_k
   void Prepare(std::span<const PatchSetup> patches, int num_vertices);
@@ -121,10 +122,18 @@ struct PatchLayerScratch {
 // the caller's: recompute them from the mesh afterwards). carried[k] holds
 // patch k's carried control points (#M x #N); displacements is empty or has
 // one span per patch, each empty (no displacement) or #M x #N (model space,
-// added to the carried points). Errors: sizes that disagree (kInvalidArgument).
+// added to the carried points).
+// `reference` empty: P_k replaces G as in 3.8. Otherwise one #M x #N grid per
+// patch (the control points as the global layer alone carries them), and the
+// layer adds only what the local layer changes: p = G + sum_k beta_k
+// (P_k(carried + d) - P_k(reference)) / max(1, sum_k beta_k). With nothing to
+// add (carried == reference, no displacement) p is G bit for bit, and the
+// fit's and the carried weights' own error never reaches the mesh.
+// Errors: sizes that disagree (kInvalidArgument).
 mocap::Status ApplyPatchLayer(std::span<const PatchSetup> patches,
                               std::span<const std::span<const glm::vec3>> carried,
                               std::span<const std::span<const glm::vec3>> displacements,
-                              PatchLayerScratch& scratch, std::span<glm::vec3> positions);
+                              PatchLayerScratch& scratch, std::span<glm::vec3> positions,
+                              std::span<const std::span<const glm::vec3>> reference = {});
 
 }  // namespace deform

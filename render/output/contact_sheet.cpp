@@ -126,4 +126,17 @@ Result<Image> MakeContactSheet(std::span<const NumberedFrame> frames,
   return (*builder)->sheet();
 }
 
+std::int64_t ContactSheetPick(int k, int count, std::int64_t num_frames) {
+  if (count <= 1 || num_frames <= 1) return 0;
+  const std::int64_t span = num_frames - 1, steps = count - 1;
+  return (static_cast<std::int64_t>(k) * span + steps / 2) / steps;
+}
+
+int ContactSheetColumns(int num_frames, int max_columns) {
+  max_columns = std::max(max_columns, 1);
+  if (num_frames <= max_columns) return std::max(num_frames, 1);
+  const int rows = (num_frames + max_columns - 1) / max_columns;
+  return (num_frames + rows - 1) / rows;
+}
+
 }  // namespace render

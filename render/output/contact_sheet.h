@@ -13,6 +13,7 @@
 // The builder downsizes each frame as it is added, so a long sequence costs one
 // thumbnail per frame, not one frame.
 
+#include <cstdint>
 #include <memory>
 #include <span>
 
@@ -72,6 +73,16 @@ class ContactSheetBuilder {
   int added_ = 0;
   Image sheet_;
 };
+
+// Which frames a sheet of `count` thumbnails shows out of `num_frames` (in
+// order): the k-th (0 <= k < count) is round(k (num_frames - 1) / (count - 1)),
+// even steps from the first frame to the last, both included. count <=
+// num_frames keeps the picks distinct and increasing.
+std::int64_t ContactSheetPick(int k, int count, std::int64_t num_frames);
+
+// Columns for `num_frames` thumbnails, at most `max_columns`: as few rows as
+// that allows, filled as evenly as possible (10 frames: 2 rows of 5, not 6 + 4).
+int ContactSheetColumns(int num_frames, int max_columns = 6);
 
 // One frame for MakeContactSheet.
 struct NumberedFrame {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <vector>
 
 #include <opencv2/imgproc.hpp>
 
@@ -142,12 +143,33 @@ void DrawPoints(const glm::mat4& clip_from_world, const PointOverlay& points, Im
 void DrawWireframe(const glm::mat4& clip_from_world, std::span<const glm::vec3> positions,
                    std::span<const glm::uvec3> triangles, glm::vec4 color, float width_px,
                    bool depth_test, Image& image) {
+  // Each edge once (a shared edge drawn twice would be twice as dark), in a
+  // fixed order (sorted vertex pairs) so the blend is deterministic.
+  std::vector<std::uint64_t> edges;
+  edges.reserve(triangles.size() * 3);
   for (const glm::uvec3& t : triangles) {
     if (t.x >= positions.size() || t.y >= positions.size() || t.z >= positions.size()) continue;
-    const glm::vec4 c[3] = {clip_from_world * glm::vec4(positions[t.x], 1.0f),
-                            clip_from_world * glm::vec4(positions[t.y], 1.0f),
-                            clip_from_world * glm::vec4(positions[t.z], 1.0f)};
-    for (int i = 0; i < 3; ++i) DrawClipSegment(c[i], c[(i + 1) % 3], color, width_px, depth_test, image);
+    const std::uint32_t v[3] = {t.x, t.y, t.z};
+    for (int i = 0; i < 3; ++i) {
+      const std::uint64_t a = std::min(v[i], v[(i + 1) % 3]), b = std::max(v[i], v[(i + 1) % 3]);
+      edges.push_back(a << 32 | b);
+    }
+  }
+  std::sort(edges.begin(), edges.end());
+  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  for (const std::uint64_t e : edges) {
+    glm::vec4 a = clip_from_world * glm::vec4(positions[e >> 32], 1.0f);
+    glm::vec4 b = clip_from_world * glm::vec4(positions[e & 0xffffffffu], 1.0f);
+    // Edges a few pixels long fade out: on a dense mesh seen small they would
+    // cover the surface (the body turned black); longer ones keep `color`.
+    glm::vec4 faded = color;
+    if (a.w > 0.0f && b.w > 0.0f) {
+      const float length_px = glm::length(Project(a, image).px - Project(b, image).px);
+      faded.a *= std::clamp((length_px - kWireFadeStartPx) / (kWireFullPx - kWireFadeStartPx),
+                            0.0f, 1.0f);
+      if (faded.a <= 0.0f) continue;
+    }
+    DrawClipSegment(a, b, faded, width_px, depth_test, image);
   }
 }
 

@@ -43,7 +43,7 @@ struct Overlays {
   std::vector<LineOverlay> lines;      // skeleton bones, control nets, ...
   std::vector<PointOverlay> points;    // joints, control points, ...
   bool wireframe = false;              // draw every scene triangle's edges
-  glm::vec4 wireframe_color{0.05f, 0.05f, 0.05f, 0.6f};
+  glm::vec4 wireframe_color{0.05f, 0.05f, 0.05f, 0.45f};
   float wireframe_width_px = 1.0f;
   bool wireframe_depth_test = true;
   std::vector<TextOverlay> text;       // frame numbers, labels
@@ -66,7 +66,13 @@ void AppendControlNetLines(std::span<const glm::vec3> control_points, int rows, 
 // Draws `lines` into `image` (depth used when present and requested).
 void DrawLines(const glm::mat4& clip_from_world, const LineOverlay& lines, Image& image);
 void DrawPoints(const glm::mat4& clip_from_world, const PointOverlay& points, Image& image);
-// Edges of `triangles` over `positions` (#V world), each shared edge drawn twice.
+// Wireframe edges shorter than kWireFadeStartPx on screen are not drawn; up
+// to kWireFullPx they fade in (a dense mesh seen small stays readable).
+inline constexpr float kWireFadeStartPx = 3.0f;
+inline constexpr float kWireFullPx = 10.0f;
+
+// Edges of `triangles` over `positions` (#V world), each edge once, faded by
+// its length on screen (kWireFadeStartPx, kWireFullPx); cost O(T log T).
 void DrawWireframe(const glm::mat4& clip_from_world, std::span<const glm::vec3> positions,
                    std::span<const glm::uvec3> triangles, glm::vec4 color, float width_px,
                    bool depth_test, Image& image);

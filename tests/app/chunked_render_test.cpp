@@ -95,4 +95,24 @@ TEST(ChunkedRender, RigWithPatchesMatchesTheWholeRender) {
   ExpectChunksMatchWhole(rig.string());
 }
 
+// The cameras aimed at an effect (issue 24) keep the property: a look-at
+// follow camera smooths over the frames before it only, and a fixed look-at
+// camera frames samples of the whole motion. The example-shape demos at their
+// own cameras, side by side, with patches and examples.
+TEST(ChunkedRender, LookAtTheElbowFromTheSideMatchesTheWholeRender) {
+  ExpectChunksMatchWhole((kSamples / "bend.bvh").string(),
+                         {"--look-at", "LeftForeArm", "--azimuth", "90", "--zoom", "1.5",
+                          "--compare", "ssd,dqs"});
+}
+
+TEST(ChunkedRender, FixedCameraOnAJointMatchesTheWholeRender) {
+  ExpectChunksMatchWhole((kSamples / "bend.bvh").string(),
+                         {"--camera", "fixed", "--look-at", "LeftLeg", "--elevation", "-10",
+                          "--distance", "60"});
+}
+
+TEST(ChunkedRender, DemoRigAtItsOwnCameraMatchesTheWholeRender) {
+  ExpectChunksMatchWhole((kSamples / "elbow.json").string(), {"--threads", "2"});
+}
+
 }  // namespace

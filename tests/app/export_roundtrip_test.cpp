@@ -44,14 +44,17 @@ fs::path Dir() {
 std::string BendBvh() { return fs::absolute(kSamples / "bend.bvh").lexically_normal().string(); }
 
 // A rig with one cylinder patch on the left elbow of the mannequin driven by
-// bend.bvh, unsplit so render draws exactly the layered mesh.
+// bend.bvh, with one example shape (a patch without any adds nothing), unsplit
+// so render draws exactly the layered mesh.
 fs::path WriteElbowRig(const fs::path& dir) {
   const fs::path rig = dir / "elbow.json";
   std::ofstream(rig) << R"({"character": "mannequin", "motion": {"file": ")" << BendBvh() << R"("},
     "global": "ssd",
     "patches": [{"name": "left_elbow",
                  "region": {"joint": "LeftForeArm", "radius": 14, "side": [0, 0, 1], "half_angle_deg": 120},
-                 "parametrization": "cylinder", "sampling": [8, 8], "grid": [6, 6]}],
+                 "parametrization": "cylinder", "sampling": [8, 8], "grid": [6, 6],
+                 "examples": [{"pose": {"frame": 45},
+                               "edits": [{"point": [0.5, 0.5], "move": [0, 0, 1.5]}]}]}],
     "render": {"size": [96, 64], "camera": "fixed", "split": false}})";
   return rig;
 }

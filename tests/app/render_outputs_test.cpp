@@ -88,8 +88,9 @@ TEST(RenderOutputs, SameBytesWithOneTwoAndEightThreads) {
   ExpectSameFrames(d / "threads_1", d / "again");
 }
 
-// A rig with B-spline patches (the split frame: global | global + patches):
-// the patch rebuild runs on the worker threads too.
+// A rig with B-spline patches (two bodies side by side: global | global +
+// patches), the camera following the elbow patch: the patch rebuild runs on
+// the worker threads too.
 TEST(RenderOutputs, RigWithPatchesGivesTheSameBytesWithOneTwoAndEightThreads) {
   const fs::path d = Dir();
   const fs::path bend = (testsupport::TestDataPath("../../samples/data/bend.bvh")).lexically_normal();
@@ -104,7 +105,8 @@ TEST(RenderOutputs, RigWithPatchesGivesTheSameBytesWithOneTwoAndEightThreads) {
     "render": {"size": [192, 108], "camera": "fixed", "split": true, "frames": "40:47"}})";
   for (const char* t : {"1", "2", "8"}) {
     const ProcessResult r =
-        Patchskin({"render", rig.string(), "--threads", t, "--quiet", "--no-video", "--out",
+        Patchskin({"render", rig.string(), "--threads", t, "--quiet", "--no-video", "--look-at",
+                   "patch:left_elbow", "--azimuth", "150", "--zoom", "1.2", "--out",
                    (d / (std::string("threads_") + t) / "f_####.png").string()});
     ASSERT_EQ(r.exit_code, 0) << r.err;
   }

@@ -29,7 +29,7 @@ constexpr const char* kGood = R"({
     {"name": "sketch", "region": {"view": "front", "rect": [0.1, 0.2, 0.3, 0.4]}}
   ],
   "render": {"size": [320, 200], "camera": "fixed", "overlays": ["skeleton"], "split": false,
-             "output": "out/x_####.png", "frames": "0:10"}
+             "compare": "ssd,dqs + patches", "wipe": true, "output": "out/x_####.png", "frames": "0:10"}
 })";
 
 TEST(RigFile, ParsesEveryFieldAndResolvesPathsAgainstTheRigFolder) {
@@ -57,7 +57,37 @@ TEST(RigFile, ParsesEveryFieldAndResolvesPathsAgainstTheRigFolder) {
   EXPECT_EQ(rig->render.size, glm::ivec2(320, 200));
   EXPECT_EQ(rig->render.camera, "fixed");
   EXPECT_FALSE(rig->render.split);
+  EXPECT_EQ(rig->render.compare, "ssd,dqs + patches");
+  EXPECT_TRUE(rig->render.wipe);
   EXPECT_EQ(rig->render.output, "samples/data/out/x_####.png");
+}
+
+TEST(RigFile, CameraIsAModeOrAnObject) {
+  const auto rig = app::ParseRig(R"({"character": "mannequin", "motion": {"file": "/m.bvh"},
+      "render": {"camera": {"mode": "fixed", "azimuth": 150, "elevation": -10, "distance": 80,
+                            "zoom": 1.5, "look_at": "patch:left_elbow"}}})",
+                                 "r.json");
+  ASSERT_TRUE(rig.ok()) << rig.error().ToString();
+  EXPECT_EQ(rig->render.camera, "fixed");
+  ASSERT_TRUE(rig->render.azimuth_deg.has_value());
+  EXPECT_EQ(*rig->render.azimuth_deg, 150.0f);
+  ASSERT_TRUE(rig->render.elevation_deg.has_value());
+  EXPECT_EQ(*rig->render.elevation_deg, -10.0f);
+  EXPECT_EQ(rig->render.distance, 80.0f);
+  EXPECT_EQ(rig->render.zoom, 1.5f);
+  EXPECT_EQ(rig->render.look_at, "patch:left_elbow");
+  const auto bad = app::ParseRig(R"({"character": "mannequin", "motion": {"file": "/m.bvh"},
+      "render": {"camera": {"elevation": 95}}})",
+                                 "r.json");
+  ASSERT_FALSE(bad.ok());
+  EXPECT_EQ(bad.error().ToString(),
+            "r.json: render.camera.elevation: error: expected a number in -89..89, found 95");
+  const auto unknown = app::ParseRig(R"({"character": "mannequin", "motion": {"file": "/m.bvh"},
+      "render": {"camera": {"yaw": 5}}})",
+                                     "r.json");
+  ASSERT_FALSE(unknown.ok());
+  EXPECT_NE(unknown.error().ToString().find("render.camera.yaw"), std::string::npos)
+      << unknown.error().ToString();
 }
 
 TEST(RigFile, DefaultsOfAMinimalRig) {
@@ -68,6 +98,8 @@ TEST(RigFile, DefaultsOfAMinimalRig) {
   EXPECT_EQ(rig->global, "ssd");
   EXPECT_TRUE(rig->patches.empty());
   EXPECT_TRUE(rig->render.split);
+  EXPECT_TRUE(rig->render.compare.empty());
+  EXPECT_FALSE(rig->render.wipe);
   EXPECT_EQ(rig->render.size, glm::ivec2(640, 360));
 }
 
@@ -178,10 +210,12 @@ const BadRig kBadRigs[] = {
      "array [8,8]"},
     {R"({"character": "mannequin", "motion": {"file": "m.bvh"}, "render": {"overlays":
         ["bones"]}})",
-     "r.json: render.overlays[0]: error: expected one of \"skeleton\", \"wire\", found "
-     "\"bones\""},
+     "r.json: render.overlays[0]: error: expected one of \"skeleton\", \"wire\", \"patches\", "
+     "\"delta\", found \"bones\""},
     {R"({"character": "mannequin", "motion": {"file": "m.bvh"}, "render": {"split": 1}})",
      "r.json: render.split: error: expected true or false, found 1"},
+    {R"({"character": "mannequin", "motion": {"file": "m.bvh"}, "render": {"wipe": "yes"}})",
+     "r.json: render.wipe: error: expected true or false, found \"yes\""},
     {R"({"character": "mannequin", "motion": {"file": "m.bvh"}, "render": {"output": "../x_####.png"}})",
      "r.json: render.output: error: expected a relative path inside the rig's output folder, "
      "found '../x_####.png' (a '..' component)"},
@@ -283,8 +317,8 @@ TEST(RigFile, RenderCommandRendersTheSampleRigAsASplitFrame) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto img = render::ReadImage((dir / "f_0045.png").string());
   ASSERT_TRUE(img.ok());
-  EXPECT_EQ(img->width, 960);  // the rig's render.size
-  EXPECT_EQ(img->height, 540);
+  EXPECT_EQ(img->width, 1280);  // the rig's render.size
+  EXPECT_EQ(img->height, 720);
 }
 
 TEST(RigFile, RenderCommandReportsABadJointWithItsFieldPath) {

@@ -133,11 +133,12 @@ TEST(RigOverrides, GlobalWins) {
 }
 
 TEST(RigOverrides, SplitWins) {
-  // The rig's split: left ssd, right ssd + patches. --split ssd,dqs: left ssd,
-  // right dqs + patches. Same left half, a different right half.
+  // --wipe on the rig: left ssd, right ssd + patches, one view. --split (the
+  // old name of --wipe) ssd,dqs: left ssd, right dqs + patches. Same left half,
+  // a different right half.
   const fs::path d = Dir();
   const std::string rig = WriteRig(d, "rig.json", WithElbowPatch(BaseRig("out/f_####.png")));
-  ASSERT_EQ(Render(d, rig, {"--size", "96x48"}).exit_code, 0);
+  ASSERT_EQ(Render(d, rig, {"--size", "96x48", "--wipe"}).exit_code, 0);
   const ProcessResult r =
       Render(d, rig, {"--size", "96x48", "--split", "ssd,dqs", "--out", (d / "cli/f_####.png").string()});
   ASSERT_EQ(r.exit_code, 0) << r.err;
@@ -154,6 +155,43 @@ TEST(RigOverrides, SplitWins) {
   }
   EXPECT_EQ(left_diff, 0) << "the left half is ssd in both";
   EXPECT_GT(right_diff, 0) << "the right half is dqs + patches from the command line";
+}
+
+// A rig with patches compares side by side by default: the same frames as
+// --compare ssd,ssd+patches. --compare ssd,ssd shows the same body twice,
+// framed alike: the two halves agree pixel for pixel below the labels, apart
+// from the frame number (bottom left) and the divider.
+TEST(RigOverrides, RigWithPatchesComparesSideBySide) {
+  const fs::path d = Dir();
+  const std::string rig = WriteRig(d, "rig.json", WithElbowPatch(BaseRig("out/f_####.png")));
+  ASSERT_EQ(Render(d, rig, {"--size", "192x96"}).exit_code, 0);
+  ProcessResult r = Render(d, rig, {"--size", "192x96", "--compare", "ssd,ssd + patches", "--out",
+                                    (d / "cli/f_####.png").string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  r = Render(d, rig, {"--size", "192x96", "--compare", "ssd,ssd", "--out", (d / "same/f_####.png").string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto from_rig = render::ReadImage((d / "out/f_0031.png").string());
+  const auto from_cli = render::ReadImage((d / "cli/f_0031.png").string());
+  const auto same = render::ReadImage((d / "same/f_0031.png").string());
+  ASSERT_TRUE(from_rig.ok() && from_cli.ok() && same.ok());
+  EXPECT_EQ(from_rig->rgba, from_cli->rgba);
+  int differing = 0, compared = 0;
+  for (int y = 34; y < 64; ++y) {  // between the labels
+    for (int x = 2; x < 94; ++x) {
+      differing += same->at(x, y) != same->at(x + 96, y) ? 1 : 0;
+      ++compared;
+    }
+  }
+  EXPECT_EQ(differing, 0) << "of " << compared;
+  // A side asking for patches needs a rig that has them.
+  const ProcessResult bad = testsupport::RunPatchskin(
+      {"render", (testsupport::TestDataPath("../../samples/data/bend.bvh")).lexically_normal().string(),
+       "--compare", "ssd,ssd+patches", "--quiet", "--no-video", "--no-sheet", "--out",
+       (d / "bad/f_####.png").string()},
+      d / "logs_bad");
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_NE(bad.err.find("--compare"), std::string::npos) << bad.err;
+  EXPECT_FALSE(fs::exists(d / "bad"));
 }
 
 TEST(RigOverrides, OutWins) {

@@ -121,8 +121,8 @@ TEST(SwdPatches, RenderCommandRendersTheSwdSampleRig) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto img = render::ReadImage((dir / "f_0045.png").string());
   ASSERT_TRUE(img.ok());
-  EXPECT_EQ(img->width, 960);  // the rig's render.size
-  EXPECT_EQ(img->height, 540);
+  EXPECT_EQ(img->width, 1280);  // the rig's render.size
+  EXPECT_EQ(img->height, 720);
 }
 
 }  // namespace

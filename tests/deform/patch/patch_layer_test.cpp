@@ -143,6 +143,63 @@ TEST(PatchLayer, RestPoseGivesTheBindMesh) {
   }
 }
 
+// With a reference grid the layer adds only P(carried + d) - P(reference):
+// nothing when carried == reference and there is no displacement (bit for bit,
+// in a posed frame where the rebuild of the carried grid differs from G), and
+// beta (P(Q) - P(G)) on a vertex of one patch, computed here by two rebuilds.
+TEST(PatchLayer, ReferenceGridAddsOnlyWhatTheDisplacementChanges) {
+  const LayeredBody& b = Body();
+  const testfixture::LayeredFrame f = testfixture::EvaluateLayered(
+      b, Patches(), testfixture::BendPose(b, 70.0f));
+  ASSERT_NE(f.global, f.layered);  // the rebuild alone moves the skin (replace mode)
+  std::vector<std::vector<glm::vec3>> carried;
+  std::vector<std::span<const glm::vec3>> views;
+  for (const deform::PatchSetup& p : Patches()) carried.push_back(p.rest_control);
+  for (std::size_t k = 0; k < carried.size(); ++k) {
+    // Any grid will do as G; move it off the rest grid so P(G) != G.
+    for (glm::vec3& q : carried[k]) q += glm::vec3(0.3f, -0.2f, 0.1f);
+    views.emplace_back(carried[k]);
+  }
+  deform::PatchLayerScratch scratch;
+  std::vector<glm::vec3> same = f.global;
+  ASSERT_TRUE(deform::ApplyPatchLayer(Patches(), views, {}, scratch, same, views).ok());
+  EXPECT_EQ(same, f.global);
+
+  std::vector<glm::vec3> lift(Patches()[0].rest_control.size(), glm::vec3(0.0f));
+  lift[lift.size() / 2 + 2] = glm::vec3(0.0f, 1.5f, 0.0f);
+  const std::span<const glm::vec3> dq[] = {lift, {}};
+  std::vector<glm::vec3> moved = f.global;
+  ASSERT_TRUE(deform::ApplyPatchLayer(Patches(), views, dq, scratch, moved, views).ok());
+  // Independently: both rebuilds of patch 0, on its vertices no other patch binds.
+  const deform::PatchSetup& p0 = Patches()[0];
+  std::vector<glm::vec3> q = carried[0];
+  for (std::size_t c = 0; c < q.size(); ++c) q[c] += lift[c];
+  std::vector<glm::vec3> with(p0.bound.binding.size()), without(p0.bound.binding.size());
+  const deform::PatchRebuildJob rebuild_with{
+      .control = q, .bindings = p0.bound.binding.view(), .positions = with};
+  const deform::PatchRebuildJob rebuild_without{
+      .control = carried[0], .bindings = p0.bound.binding.view(), .positions = without};
+  ASSERT_TRUE(rebuild_with.Run());
+  ASSERT_TRUE(rebuild_without.Run());
+  const std::set<int> other(Patches()[1].bound.binding.vertex.begin(),
+                            Patches()[1].bound.binding.vertex.end());
+  int checked = 0;
+  for (std::size_t r = 0; r < with.size(); ++r) {
+    const int v = p0.bound.binding.vertex[r];
+    if (other.count(v)) continue;
+    const glm::vec3 expected =
+        f.global[static_cast<std::size_t>(v)] + p0.border_weight[r] * (with[r] - without[r]);
+    EXPECT_LT(glm::length(moved[static_cast<std::size_t>(v)] - expected), 1e-5f) << v;
+    ++checked;
+  }
+  EXPECT_GT(checked, 20);
+  double largest = 0.0;
+  for (std::size_t v = 0; v < moved.size(); ++v) {
+    largest = std::max(largest, static_cast<double>(glm::length(moved[v] - f.global[v])));
+  }
+  EXPECT_GT(largest, 0.1);  // the lift shows
+}
+
 TEST(PatchLayer, ApplyChecksSizes) {
   const LayeredBody& b = Body();
   std::vector<glm::vec3> positions = b.mesh.bind.positions;

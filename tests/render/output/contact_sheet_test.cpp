@@ -2,6 +2,8 @@
 
 #include "render/output/contact_sheet.h"
 
+#include <cmath>
+#include <cstdint>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -33,6 +35,36 @@ TEST(ContactSheetLayout, FollowsTheDocumentedFormula) {
   auto one = ComputeContactSheetLayout(2, 80, 60, o);
   EXPECT_EQ(one->columns, 2) << "no empty columns for short sequences";
   EXPECT_EQ(one->rows, 1);
+}
+
+// Even steps from the first frame to the last, both included: 24 of 100
+// frames are 0, 4.30..., 99 rounded; consecutive picks differ by 4 or 5.
+TEST(ContactSheetPick, EvenStepsFromTheFirstFrameToTheLast) {
+  EXPECT_EQ(render::ContactSheetPick(0, 24, 100), 0);
+  EXPECT_EQ(render::ContactSheetPick(23, 24, 100), 99);
+  for (int k = 0; k < 24; ++k) {
+    const double exact = k * 99.0 / 23.0;
+    EXPECT_LE(std::abs(static_cast<double>(render::ContactSheetPick(k, 24, 100)) - exact), 0.5) << k;
+  }
+  for (int k = 1; k < 24; ++k) {
+    const std::int64_t step = render::ContactSheetPick(k, 24, 100) - render::ContactSheetPick(k - 1, 24, 100);
+    EXPECT_TRUE(step == 4 || step == 5) << k;
+  }
+  // As many picks as frames: every frame; one pick: the first.
+  for (int k = 0; k < 7; ++k) EXPECT_EQ(render::ContactSheetPick(k, 7, 7), k);
+  EXPECT_EQ(render::ContactSheetPick(0, 1, 50), 0);
+  // An hour at 120 fps does not overflow.
+  EXPECT_EQ(render::ContactSheetPick(23, 24, 432000), 431999);
+}
+
+TEST(ContactSheetColumns, AsFewRowsAsAllowedFilledEvenly) {
+  EXPECT_EQ(render::ContactSheetColumns(24), 6);  // 4 rows of 6
+  EXPECT_EQ(render::ContactSheetColumns(10), 5);  // 2 rows of 5, not 6 + 4
+  EXPECT_EQ(render::ContactSheetColumns(7), 4);   // 4 + 3
+  EXPECT_EQ(render::ContactSheetColumns(6), 6);
+  EXPECT_EQ(render::ContactSheetColumns(3), 3);
+  EXPECT_EQ(render::ContactSheetColumns(1), 1);
+  EXPECT_EQ(render::ContactSheetColumns(13), 5);  // 3 rows: 5 + 5 + 3
 }
 
 TEST(ContactSheetLayout, RejectsBadArguments) {
