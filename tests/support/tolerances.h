@@ -247,10 +247,5 @@ namespace testsupport {
 // The polar factor of a blend of rotations by Newton's iteration against the
 // SVD's, in double, per matrix entry (the stopping rule leaves ~1e-13).
 inline constexpr double kPolarFactorTol = 1e-10;
-// The same polar factor by the float lane iteration (blends with det in
-// (1/8, 8]) against the double one, as unit quaternions (Euclidean distance,
-// sign aligned): float round-off (6e-8) magnified by the blend's
-// conditioning (<= 4); a tenth of kRotationTol.
-inline constexpr float kPolarFloatTol = 1e-6f;
 
 }  // namespace testsupport
