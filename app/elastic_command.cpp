@@ -171,7 +171,7 @@ int RunElastic(const ElasticOptions& o) {
     std::filesystem::create_directories(out.parent_path(), ec);
   }
   if (const mocap::Status s = render::WriteImage(*image, o.out); !s) return Fail(s.error(), 2);
-  const deform::MassSpringCounters& c = state.counters;
+  const deform::MassSpringCounters& c = state.counters();
   std::printf("%d frames, h = %.6g s, %lld steps, peak |e| %.3f cm (e_max %.3f cm)\n",
               motion.num_frames, net->time_step_s, static_cast<long long>(c.steps), peak,
               100.0 * net->params.max_displacement / upm);

@@ -297,7 +297,7 @@ mocap::Status ElasticLayer::Advance(double time_s, std::span<const glm::mat4> mo
     // (Re)start: zero state, preroll at the first frame, then t = 0.
     for (Patch& p : patches_) {
       p.state.Reset();
-      p.baseline = p.state.counters;
+      p.baseline = p.state.counters();
     }
     if (mocap::Status s = RunAll(0.0); !s.ok()) return s;
     started_ = true;
@@ -333,7 +333,7 @@ std::vector<ElasticPatchReport> ElasticLayer::Report() const {
     r.time_step_s = p.network.time_step_s;
     r.max_displacement = p.network.params.max_displacement;
     r.displacement = p.displacement;
-    const deform::MassSpringCounters& now = p.state.counters;
+    const deform::MassSpringCounters& now = p.state.counters();
     r.counters.steps = now.steps - p.baseline.steps;
     r.counters.displacement_clamps = now.displacement_clamps - p.baseline.displacement_clamps;
     r.counters.acceleration_clamps = now.acceleration_clamps - p.baseline.acceleration_clamps;

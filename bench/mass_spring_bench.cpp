@@ -6,14 +6,11 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
-#include <limits>
 #include <utility>
 #include <vector>
 
 #include <benchmark/benchmark.h>
 
-#include "deform/elastic/internal/driving_sampler.h"
-#include "deform/elastic/internal/mass_spring_modal.h"
 #include "deform/elastic/mass_spring.h"
 #include "mocap/kinematics.h"
 #include "mocap/synthetic.h"
@@ -57,7 +54,7 @@ void BM_MassSpringCallback(benchmark::State& bench, int size, deform::MassSpring
   }
   bench.SetItemsProcessed(bench.iterations());
   bench.counters["steps_per_frame"] =
-      static_cast<double>(state.counters.steps) / static_cast<double>(bench.iterations());
+      static_cast<double>(state.counters().steps) / static_cast<double>(bench.iterations());
   bench.counters["paper_updates_per_s"] = size == 5 ? 1122.0 : 400.0;
 }
 
@@ -103,12 +100,12 @@ void BM_MassSpringTable(benchmark::State& bench, int size) {
   bench.counters["paper_updates_per_s"] = size == 5 ? 1122.0 : 400.0;
 }
 
-// Floats of a state (two arrays of n) in the subnormal range, where each
-// float operation on this machine costs a microcode assist.
-int SubnormalFloats(const float* x, const float* v, std::size_t n) {
+// Floats of displacements in the subnormal range, where each float operation
+// on this machine costs a microcode assist.
+int SubnormalFloats(const std::vector<glm::vec3>& e) {
   int count = 0;
-  for (const float* a : {x, v})
-    for (std::size_t i = 0; i < n; ++i) count += std::fpclassify(a[i]) == FP_SUBNORMAL ? 1 : 0;
+  for (const glm::vec3& p : e)
+    for (int c = 0; c < 3; ++c) count += std::fpclassify(p[c]) == FP_SUBNORMAL ? 1 : 0;
   return count;
 }
 
@@ -117,8 +114,8 @@ int SubnormalFloats(const float* x, const float* v, std::size_t n) {
 // to settle, as a patch at rest costs per frame. The modes once ended in the
 // subnormal floats (25 of a 7x7's 150 state floats) and the row measured
 // microcode assists (1347 ns for 5x5 against 873 for a driven table frame);
-// the runner now sets a decayed state to exactly 0 first, and
-// subnormal_floats (the state's at the end) stays 0.
+// the job now sets a decayed state to exactly 0 first, and subnormal_floats
+// (the newest step's displacements at the end) stays 0.
 void BM_MassSpringAtRest(benchmark::State& bench, int size) {
   const deform::MassSpringNetwork net = MakeNetwork(size, deform::MassSpringSolver::kModal);
   deform::MassSpringState state;
@@ -138,9 +135,9 @@ void BM_MassSpringAtRest(benchmark::State& bench, int size) {
     benchmark::DoNotOptimize(disp.data());
   }
   bench.SetItemsProcessed(bench.iterations());
-  bench.counters["subnormal_floats"] =
-      SubnormalFloats(state.ModalField(2 * state.modal_newest),
-                      state.ModalField(2 * state.modal_newest + 1), 3 * state.modal_stride);
+  std::vector<glm::vec3> newest(static_cast<std::size_t>(net.num_free));
+  deform::MassSpringPointDisplacements(net, state, newest);
+  bench.counters["subnormal_floats"] = SubnormalFloats(newest);
 }
 
 // The generated jump at 120 fps and its per-frame kinematics.
@@ -160,8 +157,8 @@ struct JumpClip {
   }
 };
 
-// Where a jump row's driving frames come from: the kinematics sampler at every
-// RK4 stage time, as the runner does with MassSpringStepJob::kinematics; or a
+// Where a jump row's driving frames come from: mocap::SampleJointKinematics at
+// every RK4 stage time, as the job does with MassSpringStepJob::kinematics; or a
 // table of the same samples (mocap::SampleJointKinematics every h/2, made
 // before timing) read through the callback, which takes the sampler's cost out.
 enum class JumpDriving { kSampler, kTable };
@@ -183,12 +180,11 @@ std::vector<deform::DrivingFrame> JumpTable(const JumpClip& clip, double half_st
 }
 
 // Driving frame sampled from the jump's per-frame kinematics (hips, 120 fps) at
-// every RK4 stage time, as mocap::SampleJointKinematics would; loops over the clip.
-// fma: MassSpringStepJob::allow_fma (the AVX2+FMA step; rounded differently, off by default).
+// every RK4 stage time (mocap::SampleJointKinematics); loops over the clip.
 // The parts of a frame's time: `driving` kTable takes the sampler out; with
 // limit false, e_max is 1e6 cm, so the displacement limit never acts (its
 // cheap exits still run) and clamps_per_frame is 0.
-void BM_MassSpringSampled(benchmark::State& bench, int size, bool fma,
+void BM_MassSpringSampled(benchmark::State& bench, int size,
                           JumpDriving driving = JumpDriving::kSampler, bool limit = true) {
   const deform::MassSpringNetwork net =
       MakeNetwork(size, deform::MassSpringSolver::kModal, limit ? 0.0f : 1e6f);
@@ -208,7 +204,7 @@ void BM_MassSpringSampled(benchmark::State& bench, int size, bool fma,
   for (auto _ : bench) {
     deform::MassSpringStepJob job{.network = &net, .state = &state,
                                   .time_s = (frame++ % clip.frames30) / 30.0,
-                                  .displacements = disp, .allow_fma = fma};
+                                  .displacements = disp};
     if (driving == JumpDriving::kTable) {
       job.driving = &from_table;
     } else {
@@ -222,135 +218,12 @@ void BM_MassSpringSampled(benchmark::State& bench, int size, bool fma,
   }
   bench.SetItemsProcessed(bench.iterations());
   bench.counters["paper_updates_per_s"] = size == 5 ? 1122.0 : 400.0;
-  bench.counters["clamps_per_frame"] = static_cast<double>(state.counters.displacement_clamps) /
+  bench.counters["clamps_per_frame"] = static_cast<double>(state.counters().displacement_clamps) /
                                        static_cast<double>(bench.iterations());
-}
-
-// How the driving sampler is called.
-enum class SamplerCall { kSample, kSampleManySse2, kSampleMany };
-
-// The kinematics sampler alone (deform/elastic/internal/driving_sampler.h), one output
-// frame's worth per iteration as ModalRunner::Steps asks for it: a new sampler,
-// then the 16 RK4 stage times of 8 steps at h = 1/240 s. `joint` of the jump
-// at 120 fps: the hips (no turn: the slerp's nearly-equal lerp) or the left
-// leg (turning: the slerp's sines), looping over the clip.
-void BM_DrivingSampler(benchmark::State& bench, const char* joint, SamplerCall call) {
-  const JumpClip clip;
-  const int joint_index = clip.skel.FindJoint(joint);
-  const double h = 1.0 / 240;
-  int frame = 0;
-  double times[16];
-  deform::DrivingFrame out[16];
-  for (auto _ : bench) {
-    double t = (frame++ % clip.frames30) / 30.0;
-    for (int i = 0; i < 8; ++i, t = t + h) {
-      times[2 * i] = t + 0.5 * h;
-      times[2 * i + 1] = t + h;
-    }
-    deform::internal::KinematicsDrivingSampler sampler(clip.kin, clip.skel.num_joints(),
-                                                       joint_index, clip.frame_time_s);
-    if (call == SamplerCall::kSample) {
-      for (int i = 0; i < 16; ++i) out[i] = sampler.Sample(times[i]);
-    } else {
-      sampler.SampleMany(times, out, call == SamplerCall::kSampleMany);
-    }
-    benchmark::DoNotOptimize(out);
-  }
-  bench.SetItemsProcessed(16 * bench.iterations());
-}
-
-// The modal RK4 kernel alone (no sampling, limits or conversions): 8 steps per
-// iteration, i.e. one 30 fps frame's worth, with fixed stage coefficients
-// (no symmetry between their entries) whose sign flips every frame (a 15 Hz
-// square wave on every term). Before, under a constant drive from a state that
-// excited every mode, the undriven mode and the settled
-// velocities decayed into the subnormal floats and the row measured microcode
-// assists rather than the kernel (~1100 against ~800 ns for 5x5); the
-// subnormal_floats counter says how many state floats ended subnormal.
-// The 8 steps go to the several-step kernel in one call, as the runner makes
-// it when no step needs the limits (ModalStepsFn); with one_step, 8 calls of
-// the one-step kernel (ModalStepFn) instead.
-void BM_MassSpringKernel(benchmark::State& bench, int size, deform::internal::ModalKernel kernel,
-                         bool one_step = false) {
-  deform::MassSpringNetwork net = MakeNetwork(size, deform::MassSpringSolver::kModal);
-  net.params.max_displacement = std::numeric_limits<float>::infinity();  // no limit stop
-  const auto step = deform::internal::SelectModalStep(kernel);
-  const auto steps = deform::internal::SelectModalSteps(kernel);
-  const std::size_t n = 3 * static_cast<std::size_t>(net.mode_stride);
-  alignas(32) float buffers[4][3 * deform::internal::kMaxModeStride] = {};
-  // From rest, as a run starts: a mode no drive reaches (on this flat square
-  // grid, mode 3 has sum_a U[a, 3] = 0 and no rest term) then stays exactly 0.
-  float *x = buffers[0], *v = buffers[1], *x1 = buffers[2], *v1 = buffers[3];
-  deform::internal::StageCoefficients c[2];
-  for (int r = 0; r < 3; ++r) {
-    for (int k = 0; k < 3; ++k) {
-      c[0].Mx(r, k) = 0.1f * static_cast<float>(r - k) + 0.013f * static_cast<float>(1 + 3 * r + k);
-      c[1].Mx(r, k) = -c[0].Mx(r, k);
-      if (r == k) continue;  // mv is skew: no diagonal
-      c[0].Mv(r, k) = 0.2f * static_cast<float>(k - r);
-      c[1].Mv(r, k) = -c[0].Mv(r, k);
-    }
-    c[0].common[r] = 10.0f * static_cast<float>(r + 1);
-    c[1].common[r] = -c[0].common[r];
-  }
-  const float h = static_cast<float>(net.time_step_s);
-  int frame = 0;
-  // The same 17 stage coefficients for the several-step kernel.
-  std::vector<deform::internal::StageCoefficients> same[2] = {
-      std::vector<deform::internal::StageCoefficients>(17, c[0]),
-      std::vector<deform::internal::StageCoefficients>(17, c[1])};
-  for (auto _ : bench) {
-    const int parity = frame++ & 1;
-    if (one_step) {
-      const deform::internal::StageCoefficients& s = c[parity];
-      for (int i = 0; i < 8; ++i) {
-        benchmark::DoNotOptimize(step(net, s, s, s, h, x, v, x1, v1));
-        std::swap(x, x1);
-        std::swap(v, v1);
-      }
-    } else {
-      deform::internal::ModalBuffers b{x, v, x1, v1};
-      deform::internal::ModalStepSums sums;
-      for (int i = 0; i < 8;) i += steps(net, same[parity].data() + 2 * i, 8 - i, h, b, sums);
-      benchmark::DoNotOptimize(sums);
-      x = b.x, v = b.v, x1 = b.prev_x, v1 = b.prev_v;
-    }
-    benchmark::ClobberMemory();
-  }
-  bench.SetItemsProcessed(bench.iterations());
-  bench.counters["subnormal_floats"] = SubnormalFloats(x, v, n);
-}
-
-// The same 8 steps, each from the same input (no step waits for the one before):
-// the kernel's throughput rather than its latency.
-void BM_MassSpringKernelIndependent(benchmark::State& bench, int size,
-                                    deform::internal::ModalKernel kernel) {
-  const deform::MassSpringNetwork net = MakeNetwork(size, deform::MassSpringSolver::kModal);
-  const auto step = deform::internal::SelectModalStep(kernel);
-  alignas(32) float buffers[4][3 * deform::internal::kMaxModeStride] = {};
-  deform::internal::StageCoefficients c;
-  for (int r = 0; r < 3; ++r) c.common[r] = 10.0f * static_cast<float>(r);
-  const float h = static_cast<float>(net.time_step_s);
-  for (auto _ : bench) {
-    for (int i = 0; i < 8; ++i) {
-      benchmark::DoNotOptimize(step(net, c, c, c, h, buffers[0], buffers[1], buffers[2 + (i & 1)],
-                                    buffers[3 - (i & 1)]));
-    }
-    benchmark::ClobberMemory();
-  }
-  bench.SetItemsProcessed(bench.iterations());
 }
 
 }  // namespace
 
-BENCHMARK_CAPTURE(BM_MassSpringKernel, exact_5x5, 5, deform::internal::ModalKernel::kExactAvx);
-BENCHMARK_CAPTURE(BM_MassSpringKernel, exact_7x7, 7, deform::internal::ModalKernel::kExactAvx);
-BENCHMARK_CAPTURE(BM_MassSpringKernel, fma_5x5, 5, deform::internal::ModalKernel::kFastest);
-BENCHMARK_CAPTURE(BM_MassSpringKernel, fma_7x7, 7, deform::internal::ModalKernel::kFastest);
-BENCHMARK_CAPTURE(BM_MassSpringKernel, exact_5x5_one_step, 5, deform::internal::ModalKernel::kExactAvx, true);
-BENCHMARK_CAPTURE(BM_MassSpringKernel, exact_7x7_one_step, 7, deform::internal::ModalKernel::kExactAvx, true);
-BENCHMARK_CAPTURE(BM_MassSpringKernelIndependent, exact_5x5, 5, deform::internal::ModalKernel::kExactAvx);
-BENCHMARK_CAPTURE(BM_MassSpringKernelIndependent, exact_7x7, 7, deform::internal::ModalKernel::kExactAvx);
 BENCHMARK_CAPTURE(BM_MassSpringCallback, modal_5x5, 5, deform::MassSpringSolver::kModal);
 BENCHMARK_CAPTURE(BM_MassSpringCallback, modal_7x7, 7, deform::MassSpringSolver::kModal);
 BENCHMARK_CAPTURE(BM_MassSpringCallback, point_5x5, 5, deform::MassSpringSolver::kPointSpace);
@@ -359,23 +232,15 @@ BENCHMARK_CAPTURE(BM_MassSpringTable, modal_5x5, 5);
 BENCHMARK_CAPTURE(BM_MassSpringTable, modal_7x7, 7);
 BENCHMARK_CAPTURE(BM_MassSpringAtRest, modal_5x5, 5);
 BENCHMARK_CAPTURE(BM_MassSpringAtRest, modal_7x7, 7);
-BENCHMARK_CAPTURE(BM_MassSpringSampled, modal_5x5, 5, false);
-BENCHMARK_CAPTURE(BM_MassSpringSampled, modal_7x7, 7, false);
-BENCHMARK_CAPTURE(BM_MassSpringSampled, modal_5x5_fma, 5, true);
-BENCHMARK_CAPTURE(BM_MassSpringSampled, modal_7x7_fma, 7, true);
-BENCHMARK_CAPTURE(BM_MassSpringSampled, modal_5x5_from_table, 5, false, JumpDriving::kTable);
-BENCHMARK_CAPTURE(BM_MassSpringSampled, modal_7x7_from_table, 7, false, JumpDriving::kTable);
-BENCHMARK_CAPTURE(BM_MassSpringSampled, modal_5x5_no_limit, 5, false, JumpDriving::kSampler, false);
-BENCHMARK_CAPTURE(BM_MassSpringSampled, modal_7x7_no_limit, 7, false, JumpDriving::kSampler, false);
-BENCHMARK_CAPTURE(BM_MassSpringSampled, modal_5x5_from_table_no_limit, 5, false,
-                  JumpDriving::kTable, false);
-BENCHMARK_CAPTURE(BM_MassSpringSampled, modal_7x7_from_table_no_limit, 7, false,
-                  JumpDriving::kTable, false);
-BENCHMARK_CAPTURE(BM_DrivingSampler, hips_sample, "Hips", SamplerCall::kSample);
-BENCHMARK_CAPTURE(BM_DrivingSampler, hips_many_sse2, "Hips", SamplerCall::kSampleManySse2);
-BENCHMARK_CAPTURE(BM_DrivingSampler, hips_many, "Hips", SamplerCall::kSampleMany);
-BENCHMARK_CAPTURE(BM_DrivingSampler, leg_sample, "LeftUpLeg", SamplerCall::kSample);
-BENCHMARK_CAPTURE(BM_DrivingSampler, leg_many_sse2, "LeftUpLeg", SamplerCall::kSampleManySse2);
-BENCHMARK_CAPTURE(BM_DrivingSampler, leg_many, "LeftUpLeg", SamplerCall::kSampleMany);
+BENCHMARK_CAPTURE(BM_MassSpringSampled, modal_5x5, 5);
+BENCHMARK_CAPTURE(BM_MassSpringSampled, modal_7x7, 7);
+BENCHMARK_CAPTURE(BM_MassSpringSampled, modal_5x5_from_table, 5, JumpDriving::kTable);
+BENCHMARK_CAPTURE(BM_MassSpringSampled, modal_7x7_from_table, 7, JumpDriving::kTable);
+BENCHMARK_CAPTURE(BM_MassSpringSampled, modal_5x5_no_limit, 5, JumpDriving::kSampler, false);
+BENCHMARK_CAPTURE(BM_MassSpringSampled, modal_7x7_no_limit, 7, JumpDriving::kSampler, false);
+BENCHMARK_CAPTURE(BM_MassSpringSampled, modal_5x5_from_table_no_limit, 5, JumpDriving::kTable,
+                  false);
+BENCHMARK_CAPTURE(BM_MassSpringSampled, modal_7x7_from_table_no_limit, 7, JumpDriving::kTable,
+                  false);
 
 BENCHMARK_MAIN();

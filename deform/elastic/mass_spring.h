@@ -132,14 +132,6 @@ struct MassSpringNetwork {
   std::vector<float> mode_sum;             // #free: sum_a U[a, k]
   std::vector<glm::vec3> mode_rest;        // #free: sum_a U[a, k] k_a
   std::vector<float> mode_max_abs;         // #free: max_a |U[a, k]| (cheap limit check)
-  std::vector<float> mode_rest_soa;        // 3 x #free: mode_rest as x..., y..., z... (SoA)
-  // The same per-mode data padded for the SIMD step (internal/mass_spring_modal.h):
-  // #free rounded up to a whole number of 8-float lanes; padding lanes hold 0.
-  int mode_stride = 0;                     // #free rounded up to a multiple of 8
-  std::vector<float> mode_lanes;           // 7 x mode_stride, rows: mode_omega2, mode_damping,
-                                           // mode_sum, mode_rest x, y, z, mode_max_abs
-  std::vector<float> modes_by_mode;        // #free x mode_stride: U[a, k] at [k * stride + a]
-  std::vector<float> modes_by_point;       // #free x mode_stride: U[a, k] at [a * stride + k]
   std::vector<std::string> messages;       // step-rule notes ("time step halved to ...")
 };
 
@@ -180,66 +172,43 @@ struct MassSpringCounters {
   }
 };
 
-// Caller-owned state carried between frames (compare ozz's SamplingJob::Context).
-// Sized by Resize(network); a run with a state of another size fails validation.
-struct MassSpringState {
-  bool started = false;       // false: the next run resets (first frame)
-  double step_time_s = 0.0;   // time of the newest step
-  double output_time_s = 0.0; // time of the last run's output
-  // Point space, #free each (kPointSpace, kLength); empty with the modal solver.
-  std::vector<glm::vec3> position, velocity;  // newest step
-  // The step before's displacement: the output is interpolated between it and
-  // the newest (its velocity is never needed, so not kept).
-  std::vector<glm::vec3> prev_position;
-  // Workspace for the RK4 stages (4 x #free each) and point-space outputs.
-  std::vector<glm::vec3> work;
-  // The modal solver's state (kModal with the linear force model), in its SIMD
-  // step's layout (internal/mass_spring_modal.h): four fields of 3 rows of
-  // modal_stride floats (x, y, z rows, padding lanes 0), kept in it between runs
-  // instead of being converted each run. Fields 2 i and 2 i + 1 are a step's
-  // displacement and velocity; pair modal_newest is the newest step, the other
-  // the step before (whose velocity is only scratch). Empty for the other solvers.
-  std::vector<float> modal;
-  std::size_t modal_stride = 0;
-  int modal_newest = 0;
-  float* ModalField(int field) { return modal.data() + static_cast<std::size_t>(field) * 3 * modal_stride; }
-  const float* ModalField(int field) const {
-    return modal.data() + static_cast<std::size_t>(field) * 3 * modal_stride;
-  }
-  // Mode k of the newest step's displacement and velocity (modal solver).
-  glm::vec3 ModalDisplacement(std::size_t k) const { return ModeOf(2 * modal_newest, k); }
-  glm::vec3 ModalVelocity(std::size_t k) const { return ModeOf(2 * modal_newest + 1, k); }
-  glm::vec3 ModeOf(int field, std::size_t k) const {
-    const float* f = ModalField(field);
-    return glm::vec3(f[k], f[modal_stride + k], f[2 * modal_stride + k]);
-  }
-  MassSpringCounters counters;
-
-  // The newest step's end stage time, as the modal solver last sampled it. A run's
-  // last stage time is the next run's first, so the next run starts from this
-  // instead of asking the driving source again, when `valid` and it is the same
-  // source, network, time (bit for bit) and push; the counts it adds are the ones
-  // the sample added, so counters read as if it were sampled again. Reset() and
-  // Resize() clear it. Only the modal solver writes or reads it. The source is
-  // known by address only: a caller that changes what the same callback or
-  // kinematics buffer returns for a time already sampled sets `valid = false`.
-  struct LastStage {
-    bool valid = false;
-    double time_s = 0.0;                   // the stage time (== step_time_s when written)
-    const void* network = nullptr;         // identity of the network and the source:
-    const void* source = nullptr;          //   the callback or kinematics.data()
-    std::size_t source_size = 0;           //   kinematics.size() (0 for a callback)
-    int num_joints = 0, joint = 0;         //   kinematics arguments
-    double frame_time_s = 0.0;
-    DrivingFrame frame;                    // checked (non-finite replaced, |a| clamped)
-    bool non_finite = false;               // the sample was non-finite (counted)
-    bool clamped = false;                  // |a| was clamped (counted)
-    glm::vec3 user_acceleration{0.0f};     // the push `coefficients` include
-    float coefficients[24] = {};           // internal::StageCoefficients (common, mx, mv)
-  } last_stage;
-
+// Caller-owned state carried between frames (compare ozz's SamplingJob::Context):
+// the newest step's displacement and velocity (per mode with the modal solver,
+// per free point otherwise), the step before's displacement, and scratch.
+// Sized by Resize(network); a run with a state of another size or solver
+// fails validation.
+class MassSpringState {
+ public:
   void Resize(const MassSpringNetwork& network);
-  void Reset();  // zero state, started = false; keeps the counters
+  void Reset();  // zero state, started() false; keeps the counters
+
+  // Places the newest step at the free points' displacement `e` (#free, point
+  // space, model units) with zero velocity, e.g. to let a patch ring from a
+  // pose. The clock is kept; a run that resets (first run, time jump) zeroes it.
+  // Returns false (and changes nothing) when e.size() is not #free or the state
+  // is not sized for `network`.
+  bool SetDisplacement(const MassSpringNetwork& network, std::span<const glm::vec3> e);
+
+  bool started() const { return started_; }             // false: the next run resets
+  double step_time_s() const { return step_time_s_; }   // time of the newest step
+  double output_time_s() const { return output_time_s_; }
+  const MassSpringCounters& counters() const { return counters_; }
+
+ private:
+  friend struct MassSpringStepJob;
+  friend void MassSpringPointDisplacements(const MassSpringNetwork&, const MassSpringState&,
+                                           std::span<glm::vec3>);
+  friend double MassSpringEnergy(const MassSpringNetwork&, const MassSpringState&);
+
+  bool started_ = false;
+  bool modal_ = false;          // sized for the modal solver
+  double step_time_s_ = 0.0;
+  double output_time_s_ = 0.0;
+  std::vector<glm::vec3> x_, v_;   // newest step, #free
+  std::vector<glm::vec3> prev_x_;  // the step before's displacement, #free
+  std::vector<glm::vec3> work_;    // 5 x #free: RK4 stages, limit scratch
+  std::vector<unsigned char> clamped_;  // #free: points the modal limit clamped
+  MassSpringCounters counters_;
 };
 
 // Advances a state to `time_s` and writes the displacement there.
@@ -250,14 +219,17 @@ struct MassSpringState {
 //    mocap::SampleJointKinematics at every RK4 stage time;
 //  - `driving`: a callback giving the frame at any time (tests, procedural input).
 // Resets (zero state, then preroll_s of simulation) on the first run, when time
-// goes back, or when it jumps ahead by more than max_time_gap_s. The modal
-// solver samples each stage time once: a run starts from the previous run's last
-// stage (MassSpringState::last_stage) and takes its other stage times in batches
-// of up to 8 steps before stepping (internal/modal_run.h). Both solvers set a
-// state that has decayed to nothing (the squares of its displacements and of
-// its velocities each summing below 1e-24: after each step in point space,
-// after each batch of steps for the modes) to exactly 0, rather than let it
-// decay on into the subnormal floats.
+// goes back, or when it jumps ahead by more than max_time_gap_s. Every driving
+// sample is checked (ALGORITHMS.md 6): a sample with a NaN/Inf field or a zero
+// rotation is taken as the bind frame at rest, |a| above the clamp is scaled
+// back to it; both are counted. A state that has decayed to nothing (the
+// squares of its displacements and of its velocities each summing below 1e-24)
+// is set to exactly 0 after the step, rather than left to decay on into the
+// subnormal floats (where every operation is slow).
+// Cost per RK4 step: O(#free) with the modal solver (plus O(#free^2) in a step
+// whose displacement may exceed e_max), O(#springs) in point space; the output
+// O(#free^2) (modal) or O(#free). Deterministic: the same inputs give the same
+// bits on any x86-64 CPU (no contraction, no run-time instruction choice).
 struct MassSpringStepJob {
   const MassSpringNetwork* network = nullptr;     // required
   MassSpringState* state = nullptr;               // required, Resize()d for network
@@ -270,12 +242,6 @@ struct MassSpringStepJob {
   glm::vec3 user_acceleration{0.0f};  // a push (model units/s^2, driving frame) during this run
   std::span<glm::vec3> displacements = {};  // output, M*N: e at time_s in the driving frame
                                       // (boundary entries 0); may be empty
-  bool allow_avx = true;   // modal solver: the AVX step if the CPU has it, else SSE2; both
-                           // give the scalar order's bits (internal/mass_spring_modal.h)
-  bool allow_fma = false;  // with allow_avx: the AVX2+FMA step where the CPU has it, about
-                           // 10% fewer instructions but rounded differently, so frames would then
-                           // differ between CPUs with and without FMA (a render farm's chunks
-                           // must match); off by default
 
   // kMissingInput: no network, state or driving source; kSizeMismatch: state not
   // sized for the network, displacements not M*N; kOutOfRange: kinematics

@@ -159,25 +159,6 @@ Result<MassSpringNetwork> BuildMassSpringNetwork(const MassSpringSetup& setup,
   for (std::size_t a = 0; a < ns; ++a)
     for (std::size_t k = 0; k < ns; ++k)
       net.mode_max_abs[k] = std::max(net.mode_max_abs[k], std::abs(net.modes[a * ns + k]));
-  net.mode_rest_soa.resize(3 * ns);
-  for (std::size_t k = 0; k < ns; ++k)
-    for (std::size_t c = 0; c < 3; ++c) net.mode_rest_soa[c * ns + k] = net.mode_rest[k][static_cast<int>(c)];
-  // Padded copies for the SIMD step: one row of mode_stride floats per field.
-  net.mode_stride = (n + 7) / 8 * 8;
-  const std::size_t stride = static_cast<std::size_t>(net.mode_stride);
-  net.mode_lanes.assign(7 * stride, 0.0f);
-  net.modes_by_mode.assign(ns * stride, 0.0f);
-  net.modes_by_point.assign(ns * stride, 0.0f);
-  for (std::size_t k = 0; k < ns; ++k) {
-    const float fields[7] = {net.mode_omega2[k], net.mode_damping[k], net.mode_sum[k],
-                             net.mode_rest[k].x, net.mode_rest[k].y,  net.mode_rest[k].z,
-                             net.mode_max_abs[k]};
-    for (std::size_t f = 0; f < 7; ++f) net.mode_lanes[f * stride + k] = fields[f];
-    for (std::size_t a = 0; a < ns; ++a) {
-      net.modes_by_mode[k * stride + a] = net.modes[a * ns + k];
-      net.modes_by_point[a * stride + k] = net.modes[a * ns + k];
-    }
-  }
 
   // Gershgorin bound on the eigenvalues of the linear system (ALGORITHMS.md 6).
   std::vector<double> row_k(ns, s), row_c(ns, net.anchor_damping);

@@ -9,9 +9,4 @@ inline bool CpuHasAvx() {
   return has;
 }
 
-inline bool CpuHasAvx2Fma() {
-  static const bool has = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
-  return has;
-}
-
 }  // namespace deform::internal

@@ -8,11 +8,8 @@
 // kind, 1, 2 or 3+ bones, without a branch per point or slot. Bones are
 // converted on first use (once per call). One and two bones take closed
 // forms. The blends of three or more bones are summed in slot order in
-// double (two entries at a time in SSE2, the same operations as glm's
-// dmat3 sum) and written rounded to float straight into the rows the float
-// Newton lanes load (PolarRotationsNewtonFloatRows; within kPolarFloatTol
-// of the double iteration, det in (1/8, 8]); what those refuse goes to the
-// double lanes (the scalar iteration's bits), then the SVD. (A table of the
+// double and take Newton's polar iteration (PolarRotationNewton); what it
+// refuses takes the SVD. (A table of the
 // bones in use, summed per bone for two blends at a time, took fewer
 // instructions but made a blend's last bit depend on which other control
 // points move: dropped.)
@@ -31,7 +28,6 @@
 
 #include "deform/shapes/example_shapes.h"
 #include "deform/shapes/polar_rotation.h"
-#include "deform/shapes/polar_rotation_lanes.h"
 
 namespace deform {
 namespace {
@@ -42,8 +38,6 @@ constexpr std::size_t kMaxFastBones = 256;
 constexpr double kRigidTol = 1e-4;
 // Control points handled at once (stack arrays of this size; even).
 constexpr std::size_t kChunk = 64;
-// Two doubles, the x86-64 baseline's SSE2 register.
-typedef double D2 __attribute__((vector_size(16)));
 
 // Set bits of a 4-bit mask (the x86-64 baseline has no popcnt instruction:
 // __builtin_popcount is a library call there).
@@ -132,13 +126,6 @@ mocap::JobStatus PatchControlRotations(const PatchSetup& patch, const ExamplePos
   // their kinds, 1, 2 or 3+ bones, as three lists.
   std::array<std::uint32_t, kChunk> moving, mask;
   std::array<std::uint32_t, kChunk> one, two, many;  // indices into `moving`
-  // The 3+-bone blends, rounded to float and laid out as the float lanes load
-  // them (PolarRotationsNewtonFloatRows: entry e of blend i at rows[e][i]).
-  alignas(32) std::array<std::array<float, kChunk>, 9> rows;
-  std::array<glm::quat, kChunk> quats;
-  std::array<std::uint8_t, kChunk> converged;
-  std::array<glm::dmat3, kChunk> retry_blends;
-  std::array<std::uint32_t, kChunk> retry_control;
   // sum_b w_b R_b over the weighted slots of moving[j], in double, in slot
   // order from 0 (the order SsdControlRotations and the tests sum in).
   const auto blend_of = [&](std::size_t j) {
@@ -256,63 +243,19 @@ mocap::JobStatus PatchControlRotations(const PatchSetup& patch, const ExamplePos
       many[num_many++] = static_cast<std::uint32_t>(j);
     }
     // Three or more bones (and the two-bone blends above): the polar factor
-    // of sum_b w_b R_b, in slot order from 0 in double (the operations of
-    // blend_of, so the same values, which PolarRotationsNewtonFloat rounded
-    // from a dmat3 before), written rounded to float into the lanes' rows.
+    // of sum_b w_b R_b by Newton's iteration; a blend it refuses (det <=
+    // kPolarNewtonMinDet: nearly singular or reflecting) by PolarRotation,
+    // whose SVD fixes the sign as SsdControlRotations does.
     for (std::size_t i = 0; i < num_many; ++i) {
       const std::size_t j = many[i], base = moving[j] * kk;
-      static_assert(sizeof(glm::dmat3) == 9 * sizeof(double));
-      D2 acc[4] = {};  // entries 0-7 in pairs; entry 8 alone
-      double acc8 = 0.0;
       for (std::uint32_t m = mask[j]; m != 0; m &= m - 1) {
-        const std::size_t slot = base + static_cast<std::size_t>(__builtin_ctz(m));
-        const std::size_t b = joint[slot];
+        const std::size_t b = joint[base + static_cast<std::size_t>(__builtin_ctz(m))];
         if (!have[b] && !convert(b)) return general();
-        const double wt = weight[slot];
-        const double* const entry = &bone_matrix[b][0][0];
-        for (std::size_t e = 0; e < 4; ++e) {
-          D2 pair;
-          std::memcpy(&pair, entry + 2 * e, sizeof(pair));
-          acc[e] += wt * pair;  // blend += w R, entry by entry
-        }
-        acc8 += wt * entry[8];
       }
-      for (std::size_t e = 0; e < 4; ++e) {
-        rows[2 * e][i] = static_cast<float>(acc[e][0]);
-        rows[2 * e + 1][i] = static_cast<float>(acc[e][1]);
-      }
-      rows[8][i] = static_cast<float>(acc8);
-    }
-    // The lanes load whole groups of 8: the columns up to the next multiple
-    // get a (replaced) value instead of an indeterminate one.
-    for (std::size_t i = num_many; i < std::min(kChunk, (num_many + 7) & ~std::size_t{7}); ++i) {
-      for (auto& row : rows) row[i] = 0.0f;
-    }
-    (void)PolarRotationsNewtonFloatRows(std::span(&rows[0][0], 9 * kChunk),
-                                        std::span(quats.data(), num_many),
-                                        std::span(converged.data(), num_many));
-    // A blend that is not well conditioned for float (det outside (1/8, 8])
-    // takes the double lanes, and one they refuse (det <= kPolarNewtonMinDet:
-    // nearly singular or reflecting) PolarRotation, whose SVD fixes the sign
-    // as SsdControlRotations always did.
-    std::size_t num_retry = 0;
-    for (std::size_t i = 0; i < num_many; ++i) {
-      const std::size_t c = moving[many[i]];
-      if (converged[i]) {
-        rotations[c] = quats[i];
-        continue;
-      }
-      retry_blends[num_retry] = blend_of(many[i]);
-      retry_control[num_retry++] = static_cast<std::uint32_t>(c);
-    }
-    if (num_retry == 0) continue;
-    (void)PolarRotationsNewton(std::span(retry_blends.data(), num_retry), {},
-                               std::span(converged.data(), num_retry), PolarLanesPath::kAuto,
-                               std::span(quats.data(), num_retry));
-    for (std::size_t i = 0; i < num_retry; ++i) {
-      rotations[retry_control[i]] =
-          converged[i] ? quats[i]
-                       : glm::normalize(glm::quat(glm::quat_cast(PolarRotation(retry_blends[i]))));
+      const glm::dmat3 blend = blend_of(j);
+      glm::dmat3 r;
+      if (!PolarRotationNewton(blend, r)) r = PolarRotation(blend);
+      rotations[moving[j]] = glm::normalize(glm::quat(glm::quat_cast(r)));
     }
   }
   return mocap::kJobOk;

@@ -7,37 +7,8 @@
 #include <opencv2/core.hpp>
 #include <string>
 
-#include <xmmintrin.h>
-
 namespace deform {
 namespace {
-
-// Four packed vec3 (12 floats at p: a = x0 y0 z0 x1, b = y1 z1 x2 y2,
-// c = z2 x3 y3 z3) as their x, y and z lanes.
-inline void Transpose3(const float* p, __m128& x, __m128& y, __m128& z) {
-  const __m128 a = _mm_loadu_ps(p), b = _mm_loadu_ps(p + 4), c = _mm_loadu_ps(p + 8);
-  const __m128 b2c1 = _mm_shuffle_ps(b, c, _MM_SHUFFLE(1, 1, 2, 2));   // x2 x2 x3 x3
-  x = _mm_shuffle_ps(a, b2c1, _MM_SHUFFLE(2, 0, 3, 0));
-  const __m128 a1b0 = _mm_shuffle_ps(a, b, _MM_SHUFFLE(0, 0, 1, 1));   // y0 y0 y1 y1
-  const __m128 b3c2 = _mm_shuffle_ps(b, c, _MM_SHUFFLE(2, 2, 3, 0));   // y1 y2 y3 y3
-  y = _mm_shuffle_ps(a1b0, b3c2, _MM_SHUFFLE(2, 1, 2, 0));
-  const __m128 a2b1 = _mm_shuffle_ps(a, b, _MM_SHUFFLE(1, 1, 2, 2));   // z0 z0 z1 z1
-  const __m128 c0c3 = _mm_shuffle_ps(c, c, _MM_SHUFFLE(3, 3, 0, 0));   // z2 z2 z3 z3
-  z = _mm_shuffle_ps(a2b1, c0c3, _MM_SHUFFLE(2, 0, 2, 0));
-}
-
-// The inverse: x, y, z lanes stored as four packed vec3 at p.
-inline void Untranspose3(__m128 x, __m128 y, __m128 z, float* p) {
-  const __m128 x0y0 = _mm_shuffle_ps(x, y, _MM_SHUFFLE(0, 0, 0, 0));   // x0 x0 y0 y0
-  const __m128 z0x1 = _mm_shuffle_ps(z, x, _MM_SHUFFLE(1, 1, 0, 0));   // z0 z0 x1 x1
-  const __m128 y1z1 = _mm_shuffle_ps(y, z, _MM_SHUFFLE(1, 1, 1, 1));   // y1 y1 z1 z1
-  const __m128 x2y2 = _mm_shuffle_ps(x, y, _MM_SHUFFLE(2, 2, 2, 2));   // x2 x2 y2 y2
-  const __m128 z2x3 = _mm_shuffle_ps(z, x, _MM_SHUFFLE(3, 3, 2, 2));   // z2 z2 x3 x3
-  const __m128 y3z3 = _mm_shuffle_ps(y, z, _MM_SHUFFLE(3, 3, 3, 3));   // y3 y3 z3 z3
-  _mm_storeu_ps(p, _mm_shuffle_ps(x0y0, z0x1, _MM_SHUFFLE(2, 0, 2, 0)));
-  _mm_storeu_ps(p + 4, _mm_shuffle_ps(y1z1, x2y2, _MM_SHUFFLE(2, 0, 2, 0)));
-  _mm_storeu_ps(p + 8, _mm_shuffle_ps(z2x3, y3z3, _MM_SHUFFLE(2, 0, 2, 0)));
-}
 
 using mocap::ErrorCode;
 using mocap::JobStatus;
@@ -415,39 +386,8 @@ JobStatus PoseSpaceApplyJob::Run() const {
   const JobStatus status = Validate();
   if (!status.ok()) return status;
   // Where dS is exactly zero (control points no example moves) A dS is zero:
-  // Q = G, without the rotation. Four control points at a time in SSE
-  // lanes: glm's q * v (v + ((uv w) + uuv) 2, uv = q.xyz x v, uuv = q.xyz x
-  // uv) with the same operations in the same order, so the same bits, and G
-  // selected without a branch where dS is zero (which points move is data a
-  // branch predictor cannot learn within one call).
-  static_assert(sizeof(glm::vec3) == 12 && sizeof(glm::quat) == 16);
-  static_assert(offsetof(glm::quat, x) == 0 && offsetof(glm::quat, w) == 12);
-  size_t c = 0;
-  for (; c + 4 <= global.size(); c += 4) {
-    __m128 qx = _mm_loadu_ps(&rotations[c].x), qy = _mm_loadu_ps(&rotations[c + 1].x);
-    __m128 qz = _mm_loadu_ps(&rotations[c + 2].x), qw = _mm_loadu_ps(&rotations[c + 3].x);
-    _MM_TRANSPOSE4_PS(qx, qy, qz, qw);
-    __m128 dx, dy, dz, gx, gy, gz;
-    Transpose3(&displacement[c].x, dx, dy, dz);
-    Transpose3(&global[c].x, gx, gy, gz);
-    const __m128 uvx = _mm_sub_ps(_mm_mul_ps(qy, dz), _mm_mul_ps(dy, qz));  // cross(q.xyz, d)
-    const __m128 uvy = _mm_sub_ps(_mm_mul_ps(qz, dx), _mm_mul_ps(dz, qx));
-    const __m128 uvz = _mm_sub_ps(_mm_mul_ps(qx, dy), _mm_mul_ps(dx, qy));
-    const __m128 uuvx = _mm_sub_ps(_mm_mul_ps(qy, uvz), _mm_mul_ps(uvy, qz));  // cross(q.xyz, uv)
-    const __m128 uuvy = _mm_sub_ps(_mm_mul_ps(qz, uvx), _mm_mul_ps(uvz, qx));
-    const __m128 uuvz = _mm_sub_ps(_mm_mul_ps(qx, uvy), _mm_mul_ps(uvx, qy));
-    const __m128 two = _mm_set1_ps(2.0f), zero = _mm_setzero_ps();
-    const __m128 still = _mm_and_ps(_mm_and_ps(_mm_cmpeq_ps(dx, zero), _mm_cmpeq_ps(dy, zero)),
-                                    _mm_cmpeq_ps(dz, zero));
-    const auto apply = [&](__m128 g, __m128 d, __m128 uv, __m128 uuv) {
-      const __m128 turned = _mm_add_ps(d, _mm_mul_ps(_mm_add_ps(_mm_mul_ps(uv, qw), uuv), two));
-      const __m128 moved = _mm_add_ps(g, turned);
-      return _mm_or_ps(_mm_and_ps(still, g), _mm_andnot_ps(still, moved));
-    };
-    Untranspose3(apply(gx, dx, uvx, uuvx), apply(gy, dy, uvy, uuvy), apply(gz, dz, uvz, uuvz),
-                 &control[c].x);
-  }
-  for (; c < global.size(); ++c) {
+  // Q = G, without the rotation.
+  for (std::size_t c = 0; c < global.size(); ++c) {
     control[c] = displacement[c] == glm::vec3(0.0f) ? global[c]
                                                      : global[c] + rotations[c] * displacement[c];
   }

@@ -88,12 +88,8 @@ mocap::Result<SculptedExample> SculptExample(const PatchSetup& patch, const Skin
 // float) but faster: in closed form for a control point with one or two
 // bones (with R1^T R2 = Rot(a, theta),
 // polar(w1 R1 + w2 R2) = R1 Rot(a, atan2(w2 sin theta, w1 + w2 cos theta))),
-// by Newton's polar iteration for three or more: in float SIMD lanes for
-// blends with det in (1/8, 8] (PolarRotationsNewtonFloatRows on the blend
-// summed in slot order in double, as SsdControlRotations sums it, rounded
-// to float: PolarRotationsNewtonFloat's bits, within 1e-6 of the double
-// iteration, which kRotationTolRad = 1e-5 leaves far apart), else in double
-// lanes (PolarRotationsNewton, PolarRotationNewton's bits).
+// by Newton's polar iteration (PolarRotationNewton) for three or more, on
+// the blend summed in slot order in double, as SsdControlRotations sums it.
 // Blends with det <= kPolarNewtonMinDet (reflecting or nearly singular), and
 // a palette that is not rigid, take PolarRotation / SsdControlRotations.
 // Defined in patch_control_rotations.cpp.

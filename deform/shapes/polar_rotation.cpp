@@ -27,7 +27,6 @@ bool PolarRotationNewton(const glm::dmat3& m, glm::dmat3& rotation, int* iterati
     // Scaling pays only while the iterate is far from orthogonal (it costs two
     // square roots and a division on the critical path of an iteration): a
     // blend of rotations with det in [1/8, 8] converges as fast without it.
-    // polar_rotation_lanes.cpp repeats these operations lane by lane.
     if (det < kPolarNewtonScaleBelowDet || det > kPolarNewtonScaleAboveDet) {
       // |X^-1|_F = |cof|_F / det; g = sqrt(|X^-1|_F / |X|_F).
       g = std::sqrt(std::sqrt(Norm2(cof) / Norm2(x)) * inv_det);

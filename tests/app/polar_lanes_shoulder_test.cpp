@@ -1,14 +1,11 @@
-// Newton's polar iteration in lanes (deform/shapes/polar_rotation_lanes.h) on real
-// blends: every control point of the shoulder demo's patch
-// (samples/data/shoulder.json, 9x6, three bones for most points) at every
-// 3rd frame of shoulder.bvh. The double lanes give the scalar iteration's
-// bits, the float lanes stay within kPolarFloatTol of it, and both agree
-// with the SVD.
+// Newton's polar iteration (deform/shapes/polar_rotation.h) on real blends: every
+// control point of the shoulder demo's patch (samples/data/shoulder.json, 9x6,
+// three bones for most points) at every 3rd frame of shoulder.bvh. The
+// iteration accepts every blend and agrees with the SVD.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cstdio>
-#include <cstring>
 #include <memory>
 #include <vector>
 
@@ -16,7 +13,6 @@
 
 #include "deform/shapes/direct_manipulation.h"
 #include "deform/shapes/polar_rotation.h"
-#include "deform/shapes/polar_rotation_lanes.h"
 #include "deform/global/skinning_job.h"
 #include "mocap/pose.h"
 #include "support/example_demos.h"
@@ -29,7 +25,7 @@ float QuatDistance(const glm::quat& a, const glm::quat& b) {
   return glm::length(glm::vec4(a.x - s.x, a.y - s.y, a.z - s.z, a.w - s.w));
 }
 
-TEST(PolarLanesShoulder, LanesMatchTheScalarIterationAndTheSvdOnTheDemoBlends) {
+TEST(PolarShoulder, NewtonMatchesTheSvdOnTheDemoBlends) {
   const std::unique_ptr<testsupport::Demo> demo = testsupport::LoadDemo("shoulder");
   ASSERT_TRUE(demo->error.empty()) << demo->error;
   const app::Character& ch = demo->character;
@@ -60,32 +56,14 @@ TEST(PolarLanesShoulder, LanesMatchTheScalarIterationAndTheSvdOnTheDemoBlends) {
   }
   const std::size_t n = blends.size();
   ASSERT_GT(n, 30u * 40u);  // 36 control points, 50+ frames
-  std::vector<glm::dmat3> rot(n);
-  std::vector<glm::quat> lanes(n), floats(n);
-  std::vector<std::uint8_t> lanes_ok(n), float_ok(n);
-  ASSERT_TRUE(deform::PolarRotationsNewton(blends, rot, lanes_ok, deform::PolarLanesPath::kAuto, lanes));
-  ASSERT_TRUE(deform::PolarRotationsNewtonFloat(blends, floats, float_ok));
-  int taken_by_float = 0;
-  float worst_float = 0.0f;
   for (std::size_t i = 0; i < n; ++i) {
-    glm::dmat3 scalar;
-    ASSERT_TRUE(deform::PolarRotationNewton(blends[i], scalar)) << i;  // none is degenerate
-    ASSERT_EQ(lanes_ok[i], 1) << i;
-    EXPECT_EQ(std::memcmp(&rot[i], &scalar, sizeof(scalar)), 0) << i;
-    const glm::quat scalar_q = glm::normalize(glm::quat(glm::quat_cast(scalar)));
-    EXPECT_EQ(std::memcmp(&lanes[i], &scalar_q, sizeof(scalar_q)), 0) << i;
+    glm::dmat3 newton;
+    ASSERT_TRUE(deform::PolarRotationNewton(blends[i], newton)) << i;  // none is degenerate
+    const glm::quat q = glm::normalize(glm::quat(glm::quat_cast(newton)));
     const glm::quat svd(glm::quat_cast(deform::PolarRotationSvd(blends[i])));
-    EXPECT_LT(QuatDistance(lanes[i], svd), testsupport::kRotationTol) << i;
-    if (!float_ok[i]) continue;
-    ++taken_by_float;
-    worst_float = std::max(worst_float, QuatDistance(floats[i], scalar_q));
-    EXPECT_LT(QuatDistance(floats[i], svd), testsupport::kRotationTol) << i;
+    EXPECT_LT(QuatDistance(q, svd), testsupport::kRotationTol) << i;
   }
-  EXPECT_LT(worst_float, testsupport::kPolarFloatTol);
-  // The demo's blends are well conditioned: the float lanes take them all.
-  EXPECT_EQ(taken_by_float, static_cast<int>(n));
-  std::printf("%zu shoulder blends, %d by the float lanes, worst %.3g from the double iteration\n",
-              n, taken_by_float, static_cast<double>(worst_float));
+  std::printf("%zu shoulder blends, all by the Newton iteration\n", n);
 }
 
 }  // namespace

@@ -247,16 +247,5 @@ namespace testsupport {
 // The polar factor of a blend of rotations by Newton's iteration against the
 // SVD's, in double, per matrix entry (the stopping rule leaves ~1e-13).
 inline constexpr double kPolarFactorTol = 1e-10;
-// The same polar factor by the float lane iteration (blends with det in
-// (1/8, 8]) against the double one, as unit quaternions (Euclidean distance,
-// sign aligned): float round-off (6e-8) magnified by the blend's
-// conditioning (<= 4); a tenth of kRotationTol.
-inline constexpr float kPolarFloatTol = 1e-6f;
-// The elastic layer's AVX2 + FMA modal kernel against the exact (scalar-order)
-// kernels: FMA rounds a * b + c once instead of twice; in the damped linear
-// system the difference stays at float round-off, measured below 1e-6 of the
-// peak displacement over 100 s (mass_spring_simd_test); 10x headroom.
-inline constexpr float kFusedKernelRelTol = 1e-5f;
-inline constexpr float kFusedKernelAbsTol = 1e-6f;  // model units, near zero crossings
 
 }  // namespace testsupport

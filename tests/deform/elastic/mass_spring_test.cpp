@@ -1,13 +1,16 @@
 // The elastic layer (ALGORITHMS.md 6): topology, the scaled slowest mode and its
 // damping, energy decay, static response, RK4 order, frame-rate independence,
-// limits under glitches, real captures, resets and preroll.
+// limits under glitches (input checks, the displacement limit in both solvers),
+// decay to exactly 0, real captures, resets and preroll.
 
 #include "deform/elastic/mass_spring.h"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <functional>
+#include <limits>
 #include <numbers>
 #include <vector>
 
@@ -176,7 +179,9 @@ FreeResponse SlowestModeResponse(float z0, double duration_s) {
   const DriveFn drive = Still;
   RunCentre(net, state, drive, 0.0, 0.0, 1);  // start the clock at 0
   const std::size_t n = static_cast<std::size_t>(net.num_free);
-  for (std::size_t a = 0; a < n; ++a) state.position[a] = glm::vec3(net.modes[a * n], 0, 0);
+  std::vector<glm::vec3> mode(n);
+  for (std::size_t a = 0; a < n; ++a) mode[a] = glm::vec3(net.modes[a * n], 0, 0);
+  EXPECT_TRUE(state.SetDisplacement(net, mode));
   const double dt = net.time_step_s;
   const int count = static_cast<int>(duration_s / dt);
   FreeResponse r;
@@ -259,7 +264,7 @@ TEST(MassSpringStepJob, EnergyDecaysAfterTheMotionStops) {
   // 4 s after the stop, exp(-2 z0 w0 t) = exp(-22.6): rest up to round-off.
   EXPECT_LT(previous, at_stop * kRestEnergyFraction);
   for (const glm::vec3& e : disp) EXPECT_LT(glm::length(e), kRestDisplacementCm);
-  EXPECT_EQ(state.counters.any_limit(), 0);
+  EXPECT_EQ(state.counters().any_limit(), 0);
 }
 
 TEST(MassSpringStepJob, SustainedAccelerationGivesStaticDisplacement) {
@@ -406,7 +411,7 @@ std::vector<glm::vec3> JumpResponse(double fps) {
     EXPECT_TRUE(job.Run());
     if (f % per_output == 0) out.push_back(disp[12]);
   }
-  EXPECT_EQ(state.counters.any_limit(), 0);
+  EXPECT_EQ(state.counters().any_limit(), 0);
   return out;
 }
 
@@ -456,9 +461,9 @@ TEST(MassSpringStepJob, SpikesAndNanStayBounded) {
         ASSERT_LE(glm::length(e), net.params.max_displacement * (1.0f + kFloatTol));
       }
     }
-    EXPECT_GT(state.counters.acceleration_clamps, 0);
-    EXPECT_GT(state.counters.non_finite_inputs, 0);
-    EXPECT_GT(state.counters.displacement_clamps, 0);
+    EXPECT_GT(state.counters().acceleration_clamps, 0);
+    EXPECT_GT(state.counters().non_finite_inputs, 0);
+    EXPECT_GT(state.counters().displacement_clamps, 0);
   }
 }
 
@@ -468,17 +473,17 @@ TEST(MassSpringStepJob, ResetsWhenTimeJumps) {
   state.Resize(net);
   const DriveFn drive = Shake(100.0);
   const std::vector<glm::vec3> a = RunCentre(net, state, drive, 0.0, 1.0 / 30, 30);
-  EXPECT_EQ(state.counters.time_resets, 1);
+  EXPECT_EQ(state.counters().time_resets, 1);
   EXPECT_GT(glm::length(a.back()), 0.0f);
   // Forward jump beyond max_time_gap_s, then backwards: each starts from rest.
   for (double t : {10.0, 2.0}) {
     const std::vector<glm::vec3> b = RunCentre(net, state, drive, t, 1.0 / 30, 1);
     EXPECT_EQ(glm::length(b[0]), 0.0f);
   }
-  EXPECT_EQ(state.counters.time_resets, 3);
+  EXPECT_EQ(state.counters().time_resets, 3);
   // The same frame twice is no jump.
   RunCentre(net, state, drive, 2.0, 0.0, 2);
-  EXPECT_EQ(state.counters.time_resets, 3);
+  EXPECT_EQ(state.counters().time_resets, 3);
 }
 
 TEST(MassSpringStepJob, PrerollStartsSettled) {
@@ -544,12 +549,212 @@ TEST(MassSpringStepJob, RealCapturesStayFinite) {
         ASSERT_LE(glm::length(e), net->params.max_displacement * (1.0f + kFloatTol));
       }
     }
-    limits += state.counters.any_limit();
+    limits += state.counters().any_limit();
     std::printf("pass %d: %lld acceleration clamps, %lld displacement clamps\n", pass,
-                static_cast<long long>(state.counters.acceleration_clamps),
-                static_cast<long long>(state.counters.displacement_clamps));
+                static_cast<long long>(state.counters().acceleration_clamps),
+                static_cast<long long>(state.counters().displacement_clamps));
   }
   std::printf("10000 real frames: %lld limit events\n", static_cast<long long>(limits));
+}
+
+// Runs `drive` on a fresh state of `net` at 30 fps for `frames` frames; all
+// displacements, frame after frame.
+std::vector<glm::vec3> RunAll(const MassSpringNetwork& net, const DriveFn& drive, int frames,
+                              MassSpringState& state) {
+  state.Resize(net);
+  const std::size_t points = static_cast<std::size_t>(net.rows * net.cols);
+  std::vector<glm::vec3> all(points * static_cast<std::size_t>(frames));
+  for (int f = 0; f < frames; ++f) {
+    const MassSpringStepJob job{
+        .network = &net, .state = &state, .time_s = f / 30.0, .driving = &drive,
+        .displacements = std::span(all).subspan(static_cast<std::size_t>(f) * points, points)};
+    EXPECT_TRUE(job.Run()) << job.Run().what;
+  }
+  return all;
+}
+
+bool SameBits(const std::vector<glm::vec3>& a, const std::vector<glm::vec3>& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(glm::vec3)) == 0;
+}
+
+// A sample with a NaN or Inf in any of its 13 floats, or a zero rotation, is
+// the bind frame at rest (the same bits as a source that gives it), counted
+// once per sample; |a| above the clamp is scaled back to it (the same bits
+// as a source that gives the clamped vector), counted; large finite values
+// of everything else pass unchanged.
+TEST(MassSpringStepJob, InputChecksReplaceGlitchesAndClampTheAcceleration) {
+  MassSpringParams p;  // gravity on: the bind frame is not the identity below
+  p.max_displacement = 100.0f;
+  const glm::quat bind = glm::angleAxis(0.4f, glm::vec3(1, 0, 0));
+  const std::vector<glm::vec3> pts = FlatGrid(5, 5);
+  const MassSpringNetwork net = *BuildMassSpringNetwork(
+      {.rows = 5, .cols = 5, .rest_points = pts, .bind_rotation = bind, .max_angular_speed_rad_s = 1},
+      p);
+  const auto sway = [](double t) {
+    const float s = static_cast<float>(std::sin(3.0 * t));
+    return DrivingFrame{glm::angleAxis(0.3f * s, glm::vec3(0, 0, 1)), glm::vec3(200.0f * s, 0, 50.0f),
+                        glm::vec3(0, 0.8f * s, 0), glm::vec3(0.5f * s, 0, 0)};
+  };
+  // Glitches in field `field` (0..12) at every sample in [0.5, 0.6) s.
+  const auto glitchy = [&](int field, float bad) {
+    return DriveFn([=](double t) {
+      DrivingFrame d = sway(t);
+      if (t >= 0.5 && t < 0.6) (&d.rotation.x)[field] = bad;
+      return d;
+    });
+  };
+  const DriveFn at_rest = [&](double t) {
+    return t >= 0.5 && t < 0.6 ? DrivingFrame{bind} : sway(t);
+  };
+  MassSpringState reference_state;
+  const std::vector<glm::vec3> reference = RunAll(net, at_rest, 30, reference_state);
+  EXPECT_EQ(reference_state.counters().non_finite_inputs, 0);
+  // Stage times h/2 apart in [0.5, 0.6): 48; the run boundaries 0.5, 0.533 and
+  // 0.567 are sampled twice (one run's last stage, the next run's first).
+  const int samples = 48 + 3;
+  for (int field = 0; field < 13; ++field) {
+    for (float bad : {std::nanf(""), std::numeric_limits<float>::infinity()}) {
+      SCOPED_TRACE(testing::Message() << "field " << field << " value " << bad);
+      MassSpringState state;
+      EXPECT_TRUE(SameBits(RunAll(net, glitchy(field, bad), 30, state), reference));
+      EXPECT_EQ(state.counters().non_finite_inputs, samples);
+    }
+  }
+  const DriveFn zero_rotation = [&](double t) {
+    DrivingFrame d = sway(t);
+    if (t >= 0.5 && t < 0.6) d.rotation = glm::quat(0, 0, 0, 0);
+    return d;
+  };
+  MassSpringState zero_state;
+  EXPECT_TRUE(SameBits(RunAll(net, zero_rotation, 30, zero_state), reference));
+  EXPECT_GT(zero_state.counters().non_finite_inputs, 0);
+
+  // |a| = 10x the clamp along (3, 4, 0) against a source giving the clamp itself.
+  const float clamp = p.max_acceleration_mps2 * p.units_per_metre;
+  const auto pushed = [&](float length) {
+    return DriveFn([=](double t) {
+      DrivingFrame d = sway(t);
+      d.angular_velocity.y += 5.0f;  // large, finite: passes unchanged
+      if (t >= 0.5 && t < 0.6) d.linear_acceleration = glm::vec3(0.6f, 0.8f, 0.0f) * length;
+      return d;
+    });
+  };
+  MassSpringState clamped, exact;
+  const std::vector<glm::vec3> a = RunAll(net, pushed(10.0f * clamp), 30, clamped);
+  const std::vector<glm::vec3> b = RunAll(net, pushed(clamp * (1.0f - 1e-6f)), 30, exact);
+  EXPECT_GT(clamped.counters().acceleration_clamps, 0);
+  EXPECT_EQ(exact.counters().acceleration_clamps, 0);
+  EXPECT_EQ(clamped.counters().non_finite_inputs, 0);
+  float worst = 0.0f, largest = 0.0f;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    worst = std::max(worst, glm::length(a[i] - b[i]));
+    largest = std::max(largest, glm::length(b[i]));
+  }
+  ASSERT_GT(largest, 0.1f);
+  EXPECT_LT(worst, 1e-4f * largest);  // the clamp's 1e-6 of |a|, integrated
+}
+
+// The displacement limit in the modal solver (points found from the modes,
+// their clamps taken back to the modes) against the point-space solver's
+// clamp per point: under a drive that keeps pushing the patch past e_max,
+// both clamp, stay within e_max and follow the same trajectory (float
+// round-off apart: the clamp is continuous).
+TEST(MassSpringStepJob, ModalLimitFollowsThePointSpaceLimit) {
+  const DriveFn shove = [](double t) {
+    DrivingFrame d;
+    const float s = static_cast<float>(std::sin(2 * std::numbers::pi * 2.0 * t));
+    d.linear_acceleration = glm::vec3(3000.0f * s, 1500.0f, 800.0f * s);
+    d.angular_velocity = glm::vec3(0, 2.0f * s, 0);
+    return d;
+  };
+  std::vector<glm::vec3> runs[2];
+  std::int64_t clamps[2] = {};
+  for (int solver = 0; solver < 2; ++solver) {
+    MassSpringParams p = QuietParams();
+    p.solver = solver == 0 ? deform::MassSpringSolver::kModal : deform::MassSpringSolver::kPointSpace;
+    const MassSpringNetwork net = Build(7, 7, p, 2.0f);
+    MassSpringState state;
+    runs[solver] = RunAll(net, shove, 60, state);
+    clamps[solver] = state.counters().displacement_clamps;
+    for (const glm::vec3& e : runs[solver]) {
+      ASSERT_LE(glm::length(e), net.params.max_displacement * (1.0f + kFloatTol));
+    }
+  }
+  EXPECT_GT(clamps[0], 100);
+  EXPECT_NEAR(static_cast<double>(clamps[0]), static_cast<double>(clamps[1]),
+              0.02 * static_cast<double>(clamps[1]));
+  float worst = 0.0f;
+  for (std::size_t i = 0; i < runs[0].size(); ++i) {
+    worst = std::max(worst, glm::length(runs[0][i] - runs[1][i]));
+  }
+  EXPECT_LT(worst, 1e-3f);  // cm, against e_max = 1 cm
+}
+
+// A patch pushed and then left alone in the bind pose decays to rest: once
+// its displacements' and velocities' squares each sum below 1e-24 it is set
+// to exactly 0 (before any float of it reaches the subnormal range, where
+// every operation is slow), and stays 0; until then the decay is left alone.
+// Both solvers, both force models.
+TEST(MassSpringStepJob, AStateThatHasDecayedIsSetToExactlyZero) {
+  struct Case {
+    deform::MassSpringSolver solver;
+    deform::SpringForceModel model;
+  };
+  for (const Case c : {Case{deform::MassSpringSolver::kModal, deform::SpringForceModel::kLinear},
+                       Case{deform::MassSpringSolver::kPointSpace, deform::SpringForceModel::kLinear},
+                       Case{deform::MassSpringSolver::kPointSpace, deform::SpringForceModel::kLength}}) {
+    SCOPED_TRACE(testing::Message() << "solver " << static_cast<int>(c.solver) << " model "
+                                    << static_cast<int>(c.model));
+    MassSpringParams p;
+    p.solver = c.solver;
+    p.force_model = c.model;
+    const MassSpringNetwork net = Build(5, 5, p);
+    const DriveFn still = [](double) { return DrivingFrame{glm::quat(1, 0, 0, 0)}; };
+    MassSpringState state;
+    state.Resize(net);
+    std::vector<glm::vec3> disp(25), newest(9);
+    bool seen_small = false;  // a frame whose state was small but not yet at rest
+    int zero_from = -1;
+    for (int frame = 0; frame < 30 * 60; ++frame) {
+      const MassSpringStepJob job{
+          .network = &net, .state = &state, .time_s = frame / 30.0, .driving = &still,
+          .user_acceleration = frame >= 1 && frame <= 3 ? glm::vec3(0, 50.0f, 0) : glm::vec3(0.0f),
+          .displacements = disp};
+      ASSERT_TRUE(job.Run());
+      deform::MassSpringPointDisplacements(net, state, newest);
+      double x2 = 0.0;
+      for (const glm::vec3& e : newest) {
+        for (int k = 0; k < 3; ++k) {
+          ASSERT_NE(std::fpclassify(e[k]), FP_SUBNORMAL) << "frame " << frame;
+          x2 += double(e[k]) * double(e[k]);
+        }
+      }
+      if (frame <= 3) continue;  // at rest before the push
+      if (deform::MassSpringEnergy(net, state) == 0.0) {
+        if (zero_from < 0) zero_from = frame;
+        for (const glm::vec3& d : disp) ASSERT_EQ(d, glm::vec3(0.0f)) << "frame " << frame;
+      } else {
+        ASSERT_LT(zero_from, 0) << "the state left 0 at frame " << frame;
+        seen_small = seen_small || (x2 < 1e-20 && x2 > 1e-24);
+      }
+    }
+    EXPECT_GT(zero_from, 3);
+    EXPECT_TRUE(seen_small);
+    EXPECT_EQ(state.counters().any_limit(), 0);
+  }
+}
+
+TEST(MassSpringState, SetDisplacementChecksItsSizes) {
+  const MassSpringNetwork net = Build(5, 5, {});
+  MassSpringState state;
+  const std::vector<glm::vec3> e(9, glm::vec3(0.1f, 0, 0));
+  EXPECT_FALSE(state.SetDisplacement(net, e));  // not sized
+  state.Resize(net);
+  EXPECT_FALSE(state.SetDisplacement(net, std::span(e).first(8)));
+  ASSERT_TRUE(state.SetDisplacement(net, e));
+  std::vector<glm::vec3> back(9);
+  deform::MassSpringPointDisplacements(net, state, back);  // through the modes and back
+  for (const glm::vec3& b : back) EXPECT_NEAR(b.x, 0.1f, 1e-6f);
 }
 
 }  // namespace

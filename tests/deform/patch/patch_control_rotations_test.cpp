@@ -1,7 +1,6 @@
 // PatchControlRotations' SSD fast path (deform/patch/patch_control_rotations.cpp):
-// the 3+-bone blends summed straight into the float lanes' rows give the
-// float iteration's bits on the dmat3 blend, and stay within the scalar
-// definition (the double Newton iteration, the SVD); the slot masks for 4
+// the 3+-bone blends give the Newton iteration's bits on the dmat3 blend
+// summed in slot order, and stay within the definition (the SVD); the slot masks for 4
 // and for 8 influences, the moving control points found four at a time,
 // joints beyond the palette, and the patches it hands to the general path.
 #include <gtest/gtest.h>
@@ -17,7 +16,6 @@
 #include "deform/shapes/direct_manipulation.h"
 #include "deform/shapes/example_shapes.h"
 #include "deform/shapes/polar_rotation.h"
-#include "deform/shapes/polar_rotation_lanes.h"
 #include "support/random_blends.h"
 #include "support/tolerances.h"
 
@@ -86,9 +84,9 @@ bool SameBits(std::span<const glm::quat> a, std::span<const glm::quat> b) {
   return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size_bytes()) == 0;
 }
 
-// Every 3+-bone rotation within kPolarFloatTol of the double iteration on its
-// blend (or, where that refuses, of the SVD within kRotationTol), and every
-// rotation within kRotationTol of the SVD polar factor (the definition, 4.3).
+// Every 3+-bone rotation the bits of the Newton iteration on its blend (where
+// that accepts the blend), and every rotation within kRotationTol of the SVD
+// polar factor (the definition, 4.3).
 void ExpectTheDefinition(const deform::PatchSetup& p, std::span<const glm::mat4> palette,
                          std::span<const glm::quat> fast, int* three_plus) {
   for (std::size_t c = 0; c < fast.size(); ++c) {
@@ -98,19 +96,10 @@ void ExpectTheDefinition(const deform::PatchSetup& p, std::span<const glm::mat4>
     EXPECT_LT(QuatDistance(fast[c], svd), testsupport::kRotationTol) << c;
     if (bones < 3) continue;
     ++*three_plus;
-    glm::quat newton, lanes;
-    std::uint8_t ok = 0, lanes_ok = 0;
-    ASSERT_TRUE(deform::PolarRotationsNewton(std::span(&blend, 1), {}, std::span(&ok, 1),
-                                             deform::PolarLanesPath::kScalar, std::span(&newton, 1)));
-    if (ok) {
-      EXPECT_LT(QuatDistance(fast[c], newton), testsupport::kPolarFloatTol) << c;
-    }
-    // The float lanes on the dmat3 blend (what PatchControlRotations gave
-    // them before it built their rows itself): the same bits.
-    ASSERT_TRUE(deform::PolarRotationsNewtonFloat(std::span(&blend, 1), std::span(&lanes, 1),
-                                                  std::span(&lanes_ok, 1)));
-    if (lanes_ok) {
-      EXPECT_TRUE(SameBits(std::span(&fast[c], 1), std::span(&lanes, 1))) << c;
+    glm::dmat3 r;
+    if (deform::PolarRotationNewton(blend, r)) {
+      const glm::quat newton = glm::normalize(glm::quat(glm::quat_cast(r)));
+      EXPECT_TRUE(SameBits(std::span(&fast[c], 1), std::span(&newton, 1))) << c;
     }
   }
 }
