@@ -28,7 +28,7 @@
 
 #include "app/render_command.h"
 #include "mocap/error.h"
-#include "render/image_file_compare.h"
+#include "render/output/image_file_compare.h"
 
 namespace app {
 

@@ -20,7 +20,7 @@
 #include <vector>
 
 #include "mocap/error.h"
-#include "render/image_file_compare.h"
+#include "render/output/image_file_compare.h"
 
 namespace app {
 
