@@ -115,4 +115,12 @@ TEST(ChunkedRender, DemoRigAtItsOwnCameraMatchesTheWholeRender) {
   ExpectChunksMatchWhole((kSamples / "elbow.json").string(), {"--threads", "2"});
 }
 
+// The overlays of the layer (the delta's scale is the frame's own), the
+// timecode and a transparent background, on an elastic demo (state carried).
+TEST(ChunkedRender, OverlaysLabelsAndTransparencyMatchTheWholeRender) {
+  ExpectChunksMatchWhole((kSamples / "jowl.json").string(),
+                         {"--overlay", "delta,patches,wire", "--label", "timecode", "--background",
+                          "transparent", "--threads", "3"});
+}
+
 }  // namespace
