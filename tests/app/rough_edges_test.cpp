@@ -131,7 +131,6 @@ TEST(RoughEdges, UsageErrorsAndBadValuesExitTwoInEveryCommand) {
       {"export", "--scale", "-1"},
       {"inspect"},
       {"inspect", "x.bvh", "--frame", "abc"},
-      {"compare", "--bogus"},
       {"elastic", "--bogus"},
       {"sheet", "--bogus"},
       {"farm", "--bogus"},
@@ -144,6 +143,11 @@ TEST(RoughEdges, UsageErrorsAndBadValuesExitTwoInEveryCommand) {
     for (const std::string& a : args) line += a + " ";
     const ProcessResult r = Patchskin(args);
     EXPECT_EQ(r.exit_code, 2) << line << "\n" << r.err;
+  }
+  // compare and check exit as idiff does: 4 for anything but a verdict.
+  for (const char* command : {"compare", "check"}) {
+    const ProcessResult r = Patchskin({command, "--bogus"});
+    EXPECT_EQ(r.exit_code, 4) << command << "\n" << r.err;
   }
 }
 
