@@ -270,7 +270,7 @@ CLI::App* AddCheckCommand(CLI::App& app, CheckOptions* o) {
       "check",
       "Render a manifest's cases and compare them with reference frames: exit 0 pass, 1 warnings, "
       "2 failure, 4 error");
-  cmd->add_option("manifest", o->manifest, "JSON manifest of cases (see README)")->required();
+  cmd->add_option("manifest", o->manifest, "JSON manifest of cases (see docs/command-line.md#check)")->required();
   cmd->add_option("--out", o->out, "Folder of the new frames (default out/check/<manifest name>)");
   cmd->add_option("--references", o->references,
                   "Folder of the reference frames (default: the manifest's, next to it)");
