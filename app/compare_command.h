@@ -2,7 +2,7 @@
 // `patchskin compare A B`: a drop-in for OpenImageIO 2.4's `idiff` (the one
 // scripts/setup.sh installs): the same figures, thresholds, defaults, verdict
 // and exit codes, on every channel of the files (Z and beyond RGBA included);
-// see render/image_file_compare.h for the rule.
+// see render/output/image_file_compare.h for the rule.
 //
 //   patchskin compare A B [--fail T] [--failpercent P] [--hardfail H]
 //                         [--warn T] [--warnpercent P] [--hardwarn H]
