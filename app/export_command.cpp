@@ -96,6 +96,10 @@ CLI::App* AddExportCommand(CLI::App& parent, ExportOptions& o) {
   cmd->add_option("--size", o.size, "Image size for --with-camera, WxH")->capture_default_str();
   cmd->add_option("--elevation", o.elevation_deg, "Camera elevation in degrees")
       ->capture_default_str();
+  cmd->add_option("--motion", o.motion,
+                  "BVH motion driving a glTF INPUT (joints matched by body topology), as for render");
+  cmd->add_option("--joint-map", o.joint_map,
+                  "JSON {\"glTF joint\": \"BVH joint\" or null} overriding the matched joints (with --motion)");
   cmd->add_option("--scale", o.scale,
                   "Multiply positions (and the camera JSON's lengths) by this, e.g. 0.01 for a "
                   "capture in centimetres to metres; 0: the detected units to metres, as inspect")
@@ -117,9 +121,11 @@ int RunExport(const ExportOptions& options) {
     mocap::Result<Rig> loaded = LoadRig(o.input);
     if (!loaded.ok()) return Fail(loaded.error());
     rig = std::move(*loaded);
-    mocap::Result<std::string> input = RigInputFile(*rig);
-    if (!input.ok()) return Fail(input.error());
-    o.input = *input;
+    o.input = RigInputFile(*rig);
+    if (rig->character != "mannequin" && o.motion.empty()) {
+      o.motion = rig->motion;
+      if (o.joint_map.empty()) o.joint_map = rig->joint_map;
+    }
     o.global = rig->global;
     o.fps = rig->fps;
     o.size = std::to_string(rig->render.size.x) + "x" + std::to_string(rig->render.size.y);
@@ -151,7 +157,8 @@ int RunExport(const ExportOptions& options) {
                                  : std::filesystem::path(o.input).stem().string();
   const mocap::Result<std::optional<mocap::UpAxis>> up = ParseUpAxis(o.up);
   if (!up.ok()) return Fail(up.error());
-  mocap::Result<Character> character = LoadCommandCharacter(o.input, {}, o.quiet, *up);
+  mocap::Result<Character> character =
+      LoadCommandCharacter(o.input, o.motion, o.quiet, *up, o.joint_map);
   if (!character.ok()) return Fail(character.error());
   const Character& ch = *character;
   if (o.scale == 0.0f) {  // as inspect --scale 0: the detected units to metres
