@@ -21,6 +21,7 @@
 #include "deform/io/file_output.h"
 #include "deform/io/gltf_export.h"
 #include "deform/io/obj_writer.h"
+#include "mocap/bvh_reader.h"
 #include "render/output/image_io.h"
 
 namespace app {
@@ -95,9 +96,13 @@ CLI::App* AddExportCommand(CLI::App& parent, ExportOptions& o) {
   cmd->add_option("--size", o.size, "Image size for --with-camera, WxH")->capture_default_str();
   cmd->add_option("--elevation", o.elevation_deg, "Camera elevation in degrees")
       ->capture_default_str();
+  cmd->add_option("--motion", o.motion,
+                  "BVH motion driving a glTF INPUT (joints matched by body topology), as for render");
+  cmd->add_option("--joint-map", o.joint_map,
+                  "JSON {\"glTF joint\": \"BVH joint\" or null} overriding the matched joints (with --motion)");
   cmd->add_option("--scale", o.scale,
                   "Multiply positions (and the camera JSON's lengths) by this, e.g. 0.01 for a "
-                  "capture in centimetres to metres")
+                  "capture in centimetres to metres; 0: the detected units to metres, as inspect")
       ->capture_default_str();
   cmd->add_option("--threads", o.threads, "Worker threads (0 = all cores)")->capture_default_str();
   cmd->add_option("--up", o.up, "The BVH's up axis, y or z, when detection picks the wrong one (default: detected)");
@@ -116,9 +121,11 @@ int RunExport(const ExportOptions& options) {
     mocap::Result<Rig> loaded = LoadRig(o.input);
     if (!loaded.ok()) return Fail(loaded.error());
     rig = std::move(*loaded);
-    mocap::Result<std::string> input = RigInputFile(*rig);
-    if (!input.ok()) return Fail(input.error());
-    o.input = *input;
+    o.input = RigInputFile(*rig);
+    if (rig->character != "mannequin" && o.motion.empty()) {
+      o.motion = rig->motion;
+      if (o.joint_map.empty()) o.joint_map = rig->joint_map;
+    }
     o.global = rig->global;
     o.fps = rig->fps;
     o.size = std::to_string(rig->render.size.x) + "x" + std::to_string(rig->render.size.y);
@@ -134,8 +141,9 @@ int RunExport(const ExportOptions& options) {
   }
   if (o.threads < 0 || o.threads > 256) return Fail(ArgError("--threads", "expected 0..256"));
   if (!(o.fps >= 0.0) || o.fps > 10000.0) return Fail(ArgError("--fps", "expected 0 < fps <= 10000"));
-  if (!(o.scale >= 1e-6f && o.scale <= 1e6f)) {
-    return Fail(ArgError("--scale", "expected a factor in 1e-6..1e6, found " + std::to_string(o.scale)));
+  if (!(o.scale == 0.0f || (o.scale >= 1e-6f && o.scale <= 1e6f))) {
+    return Fail(ArgError("--scale", "expected 0 (detected units to metres) or a factor in 1e-6..1e6, found " +
+                                        std::to_string(o.scale)));
   }
   const mocap::Result<GlobalMethod> method = ParseGlobalMethod(o.global);
   if (!method.ok()) return Fail(method.error());
@@ -149,9 +157,18 @@ int RunExport(const ExportOptions& options) {
                                  : std::filesystem::path(o.input).stem().string();
   const mocap::Result<std::optional<mocap::UpAxis>> up = ParseUpAxis(o.up);
   if (!up.ok()) return Fail(up.error());
-  mocap::Result<Character> character = LoadCommandCharacter(o.input, {}, o.quiet, *up);
+  mocap::Result<Character> character =
+      LoadCommandCharacter(o.input, o.motion, o.quiet, *up, o.joint_map);
   if (!character.ok()) return Fail(character.error());
   const Character& ch = *character;
+  if (o.scale == 0.0f) {  // as inspect --scale 0: the detected units to metres
+    const float metres = mocap::MetresPerUnit(ch.skeleton.info.detected_units);
+    if (!(metres > 0.0f) && !o.quiet) {
+      std::fprintf(stderr, "%s: warning: units not recognised; --scale 0 left lengths as they are\n",
+                   ch.source.c_str());
+    }
+    o.scale = metres > 0.0f ? metres : 1.0f;
+  }
   mocap::Result<FramePlan> plan = PlanFrames(
       ch.motion,
       {.frames = o.frames, .fps = o.fps, .start_number = o.start_number, .list_frames = false});

@@ -26,6 +26,8 @@ namespace app {
 
 struct ExportOptions {
   std::string input;              // BVH, glTF/GLB or rig .json; empty = built-in demo
+  std::string motion;             // BVH driving a glTF input (as render --motion); empty = its own
+  std::string joint_map;          // JSON joint map overriding the matched joints; empty = none
   std::string frames;             // "A:B[:STEP]", inclusive, in output frames; empty = all
   double fps = 0.0;               // output frame rate; 0 = the capture's own
   std::string out;                // .obj pattern with ####, or a .glb path;

@@ -306,6 +306,7 @@ int RunRender(const RenderOptions& options) {
     o.input = rig->character == "mannequin" ? rig->motion : rig->character;
     if (rig->character != "mannequin" && !rig->motion.empty() && !given("--motion")) {
       o.motion = rig->motion;
+      if (!given("--joint-map")) o.joint_map = rig->joint_map;
     }
     if (!given("--global")) o.global = rig->global;
     if (!given("--fps")) o.fps = rig->fps;

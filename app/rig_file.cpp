@@ -408,10 +408,14 @@ mocap::Result<Rig> ParseRig(const std::string& text, const std::string& file) {
   if (rig.character != "mannequin") rig.character = Resolve(file, rig.character);
   if (doc.contains("motion")) {
     const json& m = doc["motion"];
-    if (auto e = CheckObject(c, m, "motion", {"file", "fps"})) return *e;
+    if (auto e = CheckObject(c, m, "motion", {"file", "fps", "joint_map"})) return *e;
     if (!m.contains("file")) return c.Fail("motion.file", "missing (a BVH file)");
     if (auto e = GetString(c, m["file"], "motion.file", rig.motion)) return *e;
     rig.motion = Resolve(file, rig.motion);
+    if (m.contains("joint_map")) {
+      if (auto e = GetString(c, m["joint_map"], "motion.joint_map", rig.joint_map)) return *e;
+      rig.joint_map = Resolve(file, rig.joint_map);
+    }
     if (m.contains("fps")) {
       if (auto e = GetNumber(c, m["fps"], "motion.fps", 0, 10000, rig.fps)) return *e;
     }

@@ -4,7 +4,7 @@
 //
 //   {
 //     "character": "mannequin" | "body.glb",
-//     "motion":    {"file": "bend.bvh", "fps": 0},
+//     "motion":    {"file": "bend.bvh", "fps": 0, "joint_map": "map.json"},
 //     "global":    "ssd" | "dqs" | "swd",
 //     "patches":   [{"name": "left_elbow",
 //                    "region": {"joint": "LeftForeArm", "radius": 14, ...},
@@ -87,6 +87,7 @@ struct Rig {
   std::string file;                  // the rig file as given
   std::string character;             // "mannequin" or a resolved glTF/GLB path
   std::string motion;                // resolved BVH path; empty = the glTF's animation
+  std::string joint_map;             // resolved joint map (JSON) for a glTF character; empty = none
   double fps = 0.0;                  // output frame rate, 0 = the motion's own
   std::string global = "ssd";        // ssd | dqs | swd
   std::vector<RigPatch> patches;

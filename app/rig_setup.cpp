@@ -6,12 +6,7 @@
 
 namespace app {
 
-mocap::Result<std::string> RigInputFile(const Rig& rig) {
-  if (rig.character != "mannequin" && !rig.motion.empty()) {
-    return mocap::MakeError(mocap::ErrorCode::kUnsupported, {rig.file, 0, 0, "motion"},
-                            "a glTF character with a separate motion is not supported "
-                            "yet; leave out \"motion\" to use the glTF's animation");
-  }
+std::string RigInputFile(const Rig& rig) {
   return rig.character == "mannequin" ? rig.motion : rig.character;
 }
 

@@ -17,9 +17,8 @@
 namespace app {
 
 // The file to load for a rig: its BVH motion for the mannequin, else its glTF
-// character (whose own animation is the motion). kUnsupported for a glTF
-// character with a separate motion (field "motion").
-mocap::Result<std::string> RigInputFile(const Rig& rig);
+// character (driven by rig.motion when that is set, else by its own animation).
+std::string RigInputFile(const Rig& rig);
 
 // Builds the rig's layers on `character` (BuildRigPatches, BuildRigPoseSpaces
 // for pipeline.method(), ResolveRigElastic) and installs them on `pipeline`,

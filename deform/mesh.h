@@ -18,6 +18,9 @@ namespace deform {
 
 // Maximum influences per vertex the skinning jobs support (4 or 8 are used).
 inline constexpr int kMaxInfluences = 8;
+// Albedo of a vertex whose file gives no colour while others of its mesh have one
+// (the renderer's grey for a mesh without colours, render::SceneMesh::base_color).
+inline constexpr glm::vec3 kDefaultAlbedo{0.75f, 0.72f, 0.68f};
 
 struct Mesh {
   std::vector<glm::vec3> positions;   // #V, model space

@@ -506,6 +506,10 @@ float FirstFrameHeight(const Skeleton& skeleton, const Motion& motion, UpAxis up
   return hi >= lo ? hi - lo : 0.0f;
 }
 
+float MetresPerUnit(std::string_view units) {
+  return units == "m" ? 1.0f : units == "cm" ? 0.01f : units == "inch" ? 0.0254f : 0.0f;
+}
+
 const char* DetectUnits(float h) {
   if (h >= 0.5f && h <= 3.0f) return "m";
   if (h >= 40.0f && h < 100.0f) return "inch";
@@ -606,10 +610,7 @@ Result<BvhFile> ParseBvhText(std::string_view text, const std::string& file_name
       DetectUnits(std::max(raw_height, FirstFrameHeight(file.skeleton, file.motion, info.up_axis)));
   float scale = options.scale;
   if (scale == 0.0f) {
-    scale = info.detected_units == std::string("m")      ? 1.0f
-            : info.detected_units == std::string("cm")   ? 0.01f
-            : info.detected_units == std::string("inch") ? 0.0254f
-                                                         : 1.0f;
+    scale = MetresPerUnit(info.detected_units) > 0.0f ? MetresPerUnit(info.detected_units) : 1.0f;
     if (info.detected_units == std::string("unknown")) {
       file.warnings.push_back(
           Warning{FileLoc{file_name, 0, 0, {}}, "units not recognised from a rest height of " +

@@ -131,6 +131,8 @@ float RestHeight(const Skeleton& skeleton, UpAxis up);
 float FirstFrameHeight(const Skeleton& skeleton, const Motion& motion, UpAxis up);
 // "m", "inch", "cm" or "unknown" for a figure's height.
 const char* DetectUnits(float rest_height);
+// Metres per unit of DetectUnits's names (m 1, cm 0.01, inch 0.0254); 0 for "unknown".
+float MetresPerUnit(std::string_view units);
 
 // Multiplies offsets, end sites and position channels of `motion` by `factor`.
 void ScaleSkeletonAndMotion(float factor, Skeleton* skeleton, Motion* motion);

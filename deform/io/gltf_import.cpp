@@ -158,8 +158,12 @@ class Converter {
     int influences = 4;
     int mesh = -1;                      // the glTF mesh it came from
     internal::PrimitiveTargets targets;
+    std::vector<glm::vec3> colors;      // #V linear albedo, or empty: the file gives none
   };
   std::vector<Part> parts_;
+  template <typename VertexView>
+  mocap::Status ReadColors(const tinygltf::Primitive& p, int color_index, const VertexView& vertex_view,
+                           Part& part);
   std::vector<int> mesh_first_target_;  // glTF mesh -> its first row in out_.morph, or -1
   std::vector<int> mesh_num_targets_;   // glTF mesh -> its target count, -1 when not imported
 };
@@ -440,7 +444,51 @@ mocap::Status Converter::ReadPrimitive(int mesh, int prim, int skin, int rigid_s
     ComputeVertexNormals(part.positions, part.triangles, part.normals);
     computed_normals = true;
   }
+  if (auto st = ReadColors(p, attribute("COLOR_0"), vertex_view, part); !st) return st;
   parts_.push_back(std::move(part));
+  return mocap::Status::Ok();
+}
+
+// The primitive's albedo: COLOR_0 (linear RGB, alpha dropped) times the material's
+// baseColorFactor. A factor of all ones without COLOR_0 leaves the part without
+// colours, so the renderer's grey stands in (tinygltf cannot tell an omitted factor
+// from an explicit white one).
+template <typename VertexView>
+mocap::Status Converter::ReadColors(const tinygltf::Primitive& p, int color_index,
+                                    const VertexView& vertex_view, Part& part) {
+  glm::vec3 factor(1.0f);
+  if (p.material >= 0 && p.material < static_cast<int>(m_.materials.size())) {
+    const std::vector<double>& f =
+        m_.materials[static_cast<std::size_t>(p.material)].pbrMetallicRoughness.baseColorFactor;
+    if (f.size() >= 3) factor = glm::vec3(static_cast<float>(f[0]), static_cast<float>(f[1]), static_cast<float>(f[2]));
+    if (!std::isfinite(factor.x) || !std::isfinite(factor.y) || !std::isfinite(factor.z)) {
+      return Fail(ErrorCode::kNonFinite, Indexed("materials", p.material) + ".pbrMetallicRoughness.baseColorFactor",
+                  "expected finite numbers");
+    }
+    factor = glm::clamp(factor, 0.0f, 1.0f);
+  }
+  const std::size_t n = part.positions.size();
+  if (color_index < 0) {
+    if (factor != glm::vec3(1.0f)) part.colors.assign(n, factor);
+    return mocap::Status::Ok();
+  }
+  auto view = vertex_view(color_index, "COLOR_0", TINYGLTF_TYPE_VEC3,
+                          {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE,
+                           TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT});
+  if (!view.ok()) {  // COLOR_0 may also be RGBA
+    view = vertex_view(color_index, "COLOR_0", TINYGLTF_TYPE_VEC4,
+                       {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE,
+                        TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT});
+  }
+  if (!view.ok()) return std::move(view).error();
+  auto values = Floats(*view, true);
+  if (!values.ok()) return std::move(values).error();
+  const auto stride = static_cast<std::size_t>(view->components);
+  part.colors.resize(n);
+  for (std::size_t v = 0; v < n; ++v) {
+    const glm::vec3 c((*values)[v * stride], (*values)[v * stride + 1], (*values)[v * stride + 2]);
+    part.colors[v] = glm::clamp(c, 0.0f, 1.0f) * factor;
+  }
   return mocap::Status::Ok();
 }
 
@@ -510,7 +558,18 @@ mocap::Status Converter::ReadMeshes(int skin) {
   if (auto st = MergeMorphTargets(total_vertices); !st) return st;
   SkinnedMesh& mesh = out_.mesh;
   mesh.weights.influences = influences;
+  // Colours for all vertices when any part has them; the others get the grey
+  // the renderer uses for a mesh without colours.
+  const bool any_colors =
+      std::any_of(parts_.begin(), parts_.end(), [](const Part& part) { return !part.colors.empty(); });
   for (const Part& part : parts_) {
+    if (any_colors) {
+      if (part.colors.empty()) {
+        mesh.bind.colors.insert(mesh.bind.colors.end(), part.positions.size(), kDefaultAlbedo);
+      } else {
+        mesh.bind.colors.insert(mesh.bind.colors.end(), part.colors.begin(), part.colors.end());
+      }
+    }
     const auto base = static_cast<std::uint32_t>(mesh.bind.positions.size());
     if (part.positions.size() > std::numeric_limits<std::uint32_t>::max() - base) {
       return Fail(ErrorCode::kLimitExceeded, "meshes", "more than 2^32 vertices in total");

@@ -310,7 +310,7 @@ TEST(ExportRoundTrip, ScaleMultipliesPositionsAndCameraLengths) {
     EXPECT_NEAR(pa.y / pa.w, pb.y / pb.w, testsupport::kFloatTol * 10.0f) << v;
   }
   const testsupport::ProcessResult bad = testsupport::RunPatchskin(
-      {"export", BendBvh(), "--scale", "0", "--quiet", "--out", (dir / "bad.glb").string()}, dir);
+      {"export", BendBvh(), "--scale", "-1", "--quiet", "--out", (dir / "bad.glb").string()}, dir);
   EXPECT_EQ(bad.exit_code, 2);
   EXPECT_NE(bad.FirstErrLine().find("--scale"), std::string::npos) << bad.err;
   EXPECT_FALSE(fs::exists(dir / "bad.glb"));

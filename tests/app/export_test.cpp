@@ -233,6 +233,23 @@ TEST(ExportCommand, ObjDrawnWithItsCameraJsonIsTheRenderedFrame) {
   EXPECT_EQ(differing, 0);
 }
 
+// --scale 0 converts the detected units (the demo is in centimetres) to metres,
+// as inspect --scale 0 does: the same bytes as --scale 0.01.
+TEST(ExportCommand, ScaleZeroConvertsTheDetectedUnitsToMetres) {
+  const fs::path dir = Dir();
+  for (const char* scale : {"0", "0.01", "1"}) {
+    ASSERT_EQ(Patchskin(std::string("export --frames 12:12 --quiet --scale ") + scale + " --out '" +
+                            (dir / (std::string("s") + scale + "_####.obj")).string() + "'",
+                        dir),
+              0)
+        << Slurp(dir / "stderr.txt");
+  }
+  const std::string automatic = Slurp(dir / "s0_0012.obj"), metres = Slurp(dir / "s0.01_0012.obj");
+  ASSERT_FALSE(automatic.empty());
+  EXPECT_EQ(automatic, metres);
+  EXPECT_NE(automatic, Slurp(dir / "s1_0012.obj"));
+}
+
 TEST(ExportCommand, BadArgumentsAreRefused) {
   const fs::path dir = Dir();
   EXPECT_EQ(Patchskin("export --quiet --out '" + (dir / "mesh.obj").string() + "'", dir), 2);

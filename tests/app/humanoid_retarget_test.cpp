@@ -197,4 +197,56 @@ TEST(CesiumManRetargetCli, InspectPrintsTheMatchingAndTheJointMapOverridesIt) {
   EXPECT_NE(r.FirstErrLine().find(map.string() + ":2:"), std::string::npos) << r.err;
 }
 
+// A rig's motion.joint_map reaches the retargeting: a map naming no joint of the
+// character fails the render, naming the map; a good one renders.
+TEST(CesiumManRetargetCli, RigJointMapIsUsed) {
+  const std::string model = testsupport::SharedDataPath("gltf/CesiumMan.glb").string();
+  const std::string motion = testsupport::SharedDataPath("bvh/cmu_cgspeed/01_01.bvh").string();
+  PATCHSKIN_REQUIRE_SHARED_FILE(model);
+  PATCHSKIN_REQUIRE_SHARED_FILE(motion);
+  const std::filesystem::path dir = testsupport::TestOutputPath("humanoid_retarget/rig/x").parent_path();
+  const nlohmann::json rig = {{"character", model},
+                              {"motion", {{"file", motion}, {"joint_map", "map.json"}}},
+                              {"render", {{"size", {64, 48}}, {"frames", "0:0"}}}};
+  std::ofstream(dir / "rig.json") << rig.dump();
+  std::ofstream(dir / "map.json") << R"({"no_such_joint": "Hips"})";
+  const std::string out = (dir / "frames" / "f_####.png").string();
+  auto r = testsupport::RunPatchskin({"render", (dir / "rig.json").string(), "--quiet", "--no-video",
+                                      "--overwrite", "--out", out}, dir);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.FirstErrLine().find((dir / "map.json").string()), std::string::npos) << r.err;
+  std::ofstream(dir / "map.json") << R"({"leg_joint_L_1": "LeftUpLeg"})";
+  r = testsupport::RunPatchskin({"render", (dir / "rig.json").string(), "--quiet", "--no-video",
+                                 "--overwrite", "--out", out}, dir);
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(std::filesystem::exists(dir / "frames" / "f_0000.png"));
+}
+
+// export MODEL --motion X writes the retargeted mesh, the same bytes as through a
+// rig naming that motion; not CesiumMan's own animation.
+TEST(CesiumManRetargetCli, ExportTakesTheMotionFromTheCommandLineOrTheRig) {
+  const std::string model = testsupport::SharedDataPath("gltf/CesiumMan.glb").string();
+  const std::string motion = testsupport::SharedDataPath("bvh/bandai_namco/dataset-1_walk_normal_001.bvh").string();
+  PATCHSKIN_REQUIRE_SHARED_FILE(model);
+  PATCHSKIN_REQUIRE_SHARED_FILE(motion);
+  const std::filesystem::path dir = testsupport::TestOutputPath("humanoid_retarget/export/x").parent_path();
+  const nlohmann::json rig = {{"character", model}, {"motion", {{"file", motion}}}};
+  std::ofstream(dir / "rig.json") << rig.dump();
+  const auto run = [&](std::vector<std::string> args, const std::string& name) {
+    args.insert(args.end(), {"--frames", "20:20", "--quiet", "--out", (dir / (name + "_####.obj")).string()});
+    const auto r = testsupport::RunPatchskin(args, dir);
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    std::ifstream in(dir / (name + "_0020.obj"));
+    std::string header;  // names the input file, which differs
+    std::getline(in, header);
+    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  };
+  const std::string cli = run({"export", model, "--motion", motion}, "cli");
+  const std::string by_rig = run({"export", (dir / "rig.json").string()}, "rig");
+  const std::string own = run({"export", model, "--fps", "30"}, "own");
+  ASSERT_FALSE(cli.empty());
+  EXPECT_EQ(cli, by_rig);
+  EXPECT_NE(cli, own);
+}
+
 }  // namespace

@@ -103,6 +103,17 @@ TEST(RigFile, DefaultsOfAMinimalRig) {
   EXPECT_EQ(rig->render.size, glm::ivec2(640, 360));
 }
 
+TEST(RigFile, JointMapResolvesAgainstTheRigFolder) {
+  const auto rig = app::ParseRig(
+      R"({"character": "body.glb", "motion": {"file": "walk.bvh", "joint_map": "maps/body.json"}})",
+      "rigs/r.json");
+  ASSERT_TRUE(rig.ok()) << rig.error().ToString();
+  EXPECT_EQ(rig->joint_map, "rigs/maps/body.json");
+  const auto none = app::ParseRig(R"({"character": "body.glb", "motion": {"file": "walk.bvh"}})", "r.json");
+  ASSERT_TRUE(none.ok());
+  EXPECT_TRUE(none->joint_map.empty());
+}
+
 struct BadRig {
   const char* text;
   const char* message;  // the whole formatted error
