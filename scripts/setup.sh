@@ -14,6 +14,7 @@ packages=(
   libcli11-dev
   libfast-float-dev
   libassimp-dev
+  libopenvdb-dev libboost-dev libtbb-dev libeigen3-dev
   slurmctld slurmd slurm-client munge
   "$@"
 )
