@@ -31,7 +31,7 @@ mocap::Result<Character> MakeRetargetedCharacter(MotionSource&& character, Motio
 }
 
 mocap::Result<Character> LoadCommandCharacter(const std::string& input, const std::string& motion,
-                                              bool quiet) {
+                                              bool quiet, BodyKind body) {
   MotionSourceOptions load;
   load.y_up = true;  // frames are rendered Y-up with the ground at the feet
   mocap::Result<MotionSource> src = input.empty()
@@ -45,7 +45,7 @@ mocap::Result<Character> LoadCommandCharacter(const std::string& input, const st
     }
   };
   print(src->warnings, 0);
-  if (motion.empty()) return MakeCharacter(std::move(*src));
+  if (motion.empty()) return MakeCharacter(std::move(*src), {}, body);
   mocap::Result<MotionSource> bvh = LoadMotionSource(motion, load);
   if (!bvh.ok()) return std::move(bvh).error();
   const std::size_t printed = src->warnings.size();  // the glTF's, printed above

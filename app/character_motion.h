@@ -24,8 +24,9 @@ mocap::Result<Character> MakeRetargetedCharacter(MotionSource&& character, Motio
 // `input` (a BVH, glTF or GLB path; empty = the built-in demo walk) read Y-up,
 // driven by the BVH `motion` when that is not empty (MakeRetargetedCharacter),
 // else by its own motion (MakeCharacter). Load and retarget warnings go to
-// stderr unless `quiet`. Errors: those of LoadMotionSource and the makers.
+// stderr unless `quiet`. A BVH gets the body `body` (MakeCharacter). Errors: those of
+// LoadMotionSource and the makers.
 mocap::Result<Character> LoadCommandCharacter(const std::string& input, const std::string& motion,
-                                              bool quiet);
+                                              bool quiet, BodyKind body = BodyKind::kTubes);
 
 }  // namespace app

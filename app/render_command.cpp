@@ -100,6 +100,9 @@ CLI::App* AddRenderCommand(CLI::App& parent, RenderOptions& o) {
                   "chunks of one render pass the whole range)");
   cmd->add_option("--motion", o.motion,
                   "BVH motion driving a glTF INPUT (joints matched by name; see README)");
+  cmd->add_option("--body", o.body,
+                  "Body of a BVH INPUT: generated, tubes, or a glTF/GLB character it drives")
+      ->capture_default_str();
   AddOutputFlags(*cmd, o);
   // Which options were given: with a rig file they override its settings.
   cmd->callback([&o, cmd] {
@@ -242,12 +245,32 @@ int RunRender(const RenderOptions& options) {
     split_right = *r;
   }
 
+  // --- Body: a rig file names vertices of the tube mannequin; a glTF body is the
+  // character and the BVH input its --motion.
+  BodyKind body = BodyKind::kGenerated;
+  const std::string body_ext = std::filesystem::path(o.body).extension().string();
+  if (body_ext == ".glb" || body_ext == ".gltf") {
+    if (rig || !o.motion.empty()) {
+      return Fail(ArgError("--body", "a glTF/GLB body takes a BVH INPUT as its motion; not with a rig file or --motion"));
+    }
+    o.motion = o.input.empty() ? std::string() : o.input;
+    if (o.motion.empty()) return Fail(ArgError("--body", "a glTF/GLB body needs a BVH INPUT to drive it"));
+    o.input = o.body;
+  } else {
+    const mocap::Result<BodyKind> kind = ParseBodyKind(o.body);
+    if (!kind.ok()) return Fail(kind.error());
+    body = rig ? BodyKind::kTubes : *kind;
+    if (rig && o.given.count("--body") > 0 && *kind != BodyKind::kTubes) {
+      return Fail(ArgError("--body", "rig files name vertices of the tube body; expected tubes with a rig"));
+    }
+  }
+
   // --- Input -----------------------------------------------------------------
   const bool demo = o.input.empty();
   const std::string name = demo  ? "demo"
                            : rig ? std::filesystem::path(rig->file).stem().string()
                                  : std::filesystem::path(o.input).stem().string();
-  mocap::Result<Character> character = LoadCommandCharacter(o.input, o.motion, o.quiet);
+  mocap::Result<Character> character = LoadCommandCharacter(o.input, o.motion, o.quiet, body);
   if (!character.ok()) return Fail(character.error());
   const Character& ch = *character;
 

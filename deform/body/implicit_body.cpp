@@ -364,7 +364,7 @@ mocap::Result<ImplicitBody> BuildImplicitBody(const mocap::Skeleton& skeleton,
         if (humanoid && c == 0 && k < lb) continue;  // the humanoid trunk is built from volumes
         if (k >= neck_end) continue;                 // inside the head
         const bool trunk = k < lb;
-        const float r = trunk ? kTorsoRadius * size : (humanoid ? 0.032f : 0.035f) * size;
+        const float r = trunk ? kTorsoRadius * size : (humanoid ? 0.04f : 0.035f) * size;
         prims.Cone(trunk ? 2 * static_cast<int>(c) : 2 * static_cast<int>(c) + 1, p[k], p[k + 1], r, r);
       }
       const glm::vec3 axis = glm::normalize(p[n - 1] - p[n - 2]);
@@ -416,15 +416,15 @@ mocap::Result<ImplicitBody> BuildImplicitBody(const mocap::Skeleton& skeleton,
     for (const Limb& l : leg) {
       const float a = l.upper(), b = l.lower();
       const std::size_t m = static_cast<std::size_t>(l.middle);
-      thigh_r = 0.21f * a;
+      thigh_r = 0.25f * a;
       for (std::size_t k = 0; k + 1 < m; ++k) prims.Cone(2 * l.chain, l.p[k], l.p[k + 1], thigh_r, thigh_r);
-      prims.Cone(2 * l.chain, l.root(), l.mid(), 0.21f * a, 0.125f * a);
-      prims.Cone(2 * l.chain, l.mid(), l.end(), 0.125f * a, 0.075f * b);
+      prims.Cone(2 * l.chain, l.root(), l.mid(), 0.25f * a, 0.14f * a);
+      prims.Cone(2 * l.chain, l.mid(), l.end(), 0.14f * a, 0.085f * b);
       const glm::vec3 shin = glm::normalize(l.end() - l.mid());
       prims.Ellipsoid(l.mid() + 0.33f * b * shin - 0.04f * b * forward, Frame(shin, lateral),
-                      {0.27f * b, 0.09f * b, 0.085f * b});  // calf
+                      {0.28f * b, 0.11f * b, 0.105f * b});  // calf
       prims.Ellipsoid(l.root() + 0.42f * a * glm::normalize(l.mid() - l.root()) + 0.02f * a * forward,
-                      Frame(l.mid() - l.root(), lateral), {0.36f * a, 0.17f * a, 0.18f * a});  // thigh muscles
+                      Frame(l.mid() - l.root(), lateral), {0.38f * a, 0.2f * a, 0.21f * a});  // thigh muscles
       // Foot: the chain's bones after the ankle, a sole and a heel.
       glm::vec3 toe = l.end() + 0.3f * b * forward - 0.2f * b * up;
       for (std::size_t k = m + 1; k + 1 < l.p.size(); ++k) {
@@ -448,17 +448,17 @@ mocap::Result<ImplicitBody> BuildImplicitBody(const mocap::Skeleton& skeleton,
       for (std::size_t k = 0; k + 1 < m; ++k) prims.Cone(2 * l.chain, l.p[k], l.p[k + 1], 0.17f * a, 0.15f * a);
       const glm::vec3 upper = glm::normalize(l.mid() - l.root());
       const glm::vec3 lower = glm::normalize(l.end() - l.mid());
-      prims.Cone(2 * l.chain, l.root(), l.mid(), 0.16f * a, 0.11f * a);
-      prims.Cone(2 * l.chain, l.mid(), l.end(), 0.13f * b, 0.085f * b);
+      prims.Cone(2 * l.chain, l.root(), l.mid(), 0.19f * a, 0.14f * a);
+      prims.Cone(2 * l.chain, l.mid(), l.end(), 0.15f * b, 0.1f * b);
       glm::vec3 out = l.root() - chest;
       out -= glm::dot(out, spine_dir) * spine_dir;
       shoulder_half_width = std::max(shoulder_half_width, glm::length(out));
       out = glm::length(out) > 1e-6f * size ? glm::normalize(out) : lateral;
       prims.Ellipsoid(l.root() + 0.1f * a * upper + 0.03f * a * out, Frame(upper, forward),
-                      {0.3f * a, 0.2f * a, 0.19f * a});  // deltoid
+                      {0.3f * a, 0.22f * a, 0.21f * a});  // deltoid
       prims.Ellipsoid(l.root() + 0.55f * a * upper + 0.03f * a * forward, Frame(upper, forward),
-                      {0.28f * a, 0.12f * a, 0.13f * a});  // biceps and triceps
-      prims.Ellipsoid(l.mid() + 0.3f * b * lower, Frame(lower, forward), {0.3f * b, 0.14f * b, 0.12f * b});
+                      {0.3f * a, 0.15f * a, 0.16f * a});  // biceps and triceps
+      prims.Ellipsoid(l.mid() + 0.3f * b * lower, Frame(lower, forward), {0.3f * b, 0.17f * b, 0.14f * b});
       // Hand: a mitten from the wrist to the chain's end (folded fingers included).
       glm::vec3 tip = l.p.back();
       if (glm::distance(tip, l.end()) < 0.3f * b) tip = l.end() + 0.75f * b * lower;
@@ -473,7 +473,7 @@ mocap::Result<ImplicitBody> BuildImplicitBody(const mocap::Skeleton& skeleton,
     // Trunk: pelvis, buttocks, belly, chest, shoulders, and the spine inside them.
     const glm::vec3 hips_mid = 0.5f * (leg[0].root() + leg[1].root());
     const float hip_half = 0.5f * glm::distance(leg[0].root(), leg[1].root());
-    const float pelvis_lat = hip_half + 0.85f * thigh_r;
+    const float pelvis_lat = hip_half + 1.0f * thigh_r;
     const glm::mat3 torso_frame(lateral, spine_dir, glm::normalize(glm::cross(lateral, spine_dir)));
     const glm::vec3 fwd = glm::dot(torso_frame[2], forward) >= 0.0f ? torso_frame[2] : -torso_frame[2];
     const glm::mat3 trunk(lateral, spine_dir, fwd);

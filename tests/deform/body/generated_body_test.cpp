@@ -13,6 +13,9 @@
 #include "deform/body/body_mesher.h"
 #include "deform/body/bone_heat.h"
 #include "deform/body/implicit_body.h"
+#include "deform/mannequin.h"
+#include "deform/rig_artifacts.h"
+#include "deform/skinning_job.h"
 #include "mocap/bvh_reader.h"
 #include "mocap/pose.h"
 #include "mocap/synthetic.h"
@@ -257,6 +260,61 @@ TEST(GeneratedBody, BadSkeletonsGetABodyOrAnErrorNamingTheJoint) {
       ExpectValidBody(b.skeleton, b.model_from_joint, *m);
     } else {
       EXPECT_FALSE(m.error().message.empty());
+    }
+  }
+}
+
+}  // namespace
+namespace {
+
+// Volume of `mesh` skinned by SSD with the synthetic humanoid posed by `model` (#J).
+double SsdVolume(const deform::SkinnedMesh& mesh, std::span<const glm::mat4> model) {
+  std::vector<glm::mat4> palette(mesh.skin_joints.size());
+  for (std::size_t s = 0; s < palette.size(); ++s) {
+    palette[s] = model[static_cast<std::size_t>(mesh.skin_joints[s])] * mesh.joint_from_bind[s];
+  }
+  std::vector<glm::vec3> out(mesh.bind.positions.size());
+  EXPECT_TRUE((deform::SkinningJob{.model_from_bind = palette, .influences = mesh.weights.influences,
+                                   .joint_indices = mesh.weights.joints, .joint_weights = mesh.weights.weights,
+                                   .rest_positions = mesh.bind.positions, .rest_normals = {}, .positions = out, .normals = {}}
+                   .Run()));
+  return testsupport::EnclosedVolume(out, mesh.bind.triangles);
+}
+
+// SSD's volume loss, the artefact the patch layer exists to fix, on the new body and the
+// tube mannequin (printed; the figures go in the report). The new body must lose volume
+// where SSD is known to collapse it (a 150 degree elbow or knee).
+TEST(GeneratedBody, SsdVolumeLossAgainstTheTubeBody) {
+  const mocap::Skeleton s = mocap::MakeHumanoidSkeleton();
+  const std::vector<glm::mat4> rest = RestMatrices(s);
+  auto generated = deform::BuildGeneratedBody(s, rest);
+  auto tubes = deform::BuildMannequin(s, rest);
+  ASSERT_TRUE(generated.ok() && tubes.ok());
+  struct Pose {
+    const char* name;
+    const char* joint;
+    glm::vec3 axis;  // turn axis (model space; the humanoid faces +Z, left arm along +X)
+    float degrees;
+  };
+  const Pose poses[] = {{"elbow 90", "LeftForeArm", {0, -1, 0}, 90.0f},
+                        {"elbow 150", "LeftForeArm", {0, -1, 0}, 150.0f},
+                        {"knee 90", "LeftLeg", {1, 0, 0}, 90.0f},
+                        {"knee 150", "LeftLeg", {1, 0, 0}, 150.0f},
+                        {"hip extension 40", "LeftUpLeg", {1, 0, 0}, 40.0f},
+                        {"shoulder abduction 90 (T-pose to arm up)", "LeftArm", {0, 0, 1}, 90.0f}};
+  const double v_new = SsdVolume(*generated, rest), v_old = SsdVolume(*tubes, rest);
+  std::printf("SSD volume change (%% of the whole body; litres), new body vs tube body:\n");
+  for (const Pose& p : poses) {
+    const int j = s.FindJoint(p.joint);
+    ASSERT_GE(j, 0) << p.joint;
+    std::vector<glm::mat4> model = rest;
+    deform::TurnSubtree(s, j, glm::angleAxis(glm::radians(p.degrees), p.axis), glm::vec3(rest[static_cast<std::size_t>(j)][3]),
+                        model);
+    const double d_new = SsdVolume(*generated, model) - v_new, d_old = SsdVolume(*tubes, model) - v_old;
+    std::printf("  %-42s new %+6.2f %% (%+.3f l)   tubes %+6.2f %% (%+.3f l)\n", p.name, 100.0 * d_new / v_new,
+                d_new / 1000.0, 100.0 * d_old / v_old, d_old / 1000.0);
+    if (std::string(p.name) == "elbow 150" || std::string(p.name) == "knee 150") {
+      EXPECT_LT(d_new, 0.0) << p.name << ": SSD should lose volume on the new body";
     }
   }
 }
