@@ -94,6 +94,7 @@ CLI::App* AddExportCommand(CLI::App& parent, ExportOptions& o) {
                   "mesh_####.obj (one OBJ per frame, #### = frame number) or FILE.glb "
                   "(default out/<name>_export/mesh_####.obj)");
   cmd->add_option("--global", o.global, "Global skinning: ssd, dqs or swd")->capture_default_str();
+  cmd->add_option("--body", o.body, "Body of a BVH INPUT: generated or tubes (as render)")->capture_default_str();
   cmd->add_option("--layout", o.layout, ".glb: auto (smaller), morph or baked")
       ->capture_default_str();
   cmd->add_flag("--step", o.step, ".glb: hold each frame (STEP) instead of blending (LINEAR)");
@@ -152,7 +153,10 @@ int RunExport(const ExportOptions& options) {
   const std::string name = demo  ? "demo"
                            : rig ? std::filesystem::path(rig->file).stem().string()
                                  : std::filesystem::path(o.input).stem().string();
-  mocap::Result<Character> character = LoadCommandCharacter(o.input, {}, o.quiet);
+  const mocap::Result<BodyKind> body = ParseBodyKind(o.body);
+  if (!body.ok()) return Fail(body.error());
+  // A rig's example edits name vertices of the tube mannequin.
+  mocap::Result<Character> character = LoadCommandCharacter(o.input, {}, o.quiet, rig ? BodyKind::kTubes : *body);
   if (!character.ok()) return Fail(character.error());
   const Character& ch = *character;
   mocap::Result<FramePlan> plan = PlanFrames(ch.motion, {.frames = o.frames, .fps = o.fps, .list_frames = false});
