@@ -21,7 +21,7 @@
 #include "mocap/synthetic.h"
 #include "support/data_paths.h"
 #include "support/test_skeletons.h"
-#include "deform/body/body_checks.h"  // tests/deform/body
+#include "support/body_checks.h"
 
 namespace {
 

@@ -1,5 +1,5 @@
 #pragma once
-// Checks every generated body must pass (tests/deform/body/*_test.cpp): closed, manifold
+// Checks every generated body must pass (tests/deform/body/, tests/app/generated_body_swd_test.cpp): closed, manifold
 // and consistently oriented, no degenerate triangles, one connected piece, and weights
 // that sum to 1, are non-negative and sit on a bone near the vertex.
 
