@@ -115,7 +115,7 @@ mocap::Result<Character> MakeRetargetedCharacter(MotionSource&& character, Motio
 mocap::Result<Character> LoadCommandCharacter(const std::string& input, const std::string& motion,
                                               bool quiet, std::optional<mocap::UpAxis> up,
                                               const std::string& joint_map_file,
-                                              RetargetReport* report) {
+                                              RetargetReport* report, BodyKind body) {
   MotionSourceOptions load;
   load.y_up = true;  // frames are rendered Y-up with the ground at the feet
   load.up = up;
@@ -134,7 +134,7 @@ mocap::Result<Character> LoadCommandCharacter(const std::string& input, const st
     return mocap::MakeError(mocap::ErrorCode::kInvalidArgument, {joint_map_file, 0, 0, {}},
                             "expected a BVH motion (--motion) for the joint map to apply to, found none");
   }
-  if (motion.empty()) return MakeCharacter(std::move(*src));
+  if (motion.empty()) return MakeCharacter(std::move(*src), {}, body);
   mocap::Result<MotionSource> bvh = LoadMotionSource(motion, load);
   if (!bvh.ok()) return std::move(bvh).error();
   const std::size_t printed = src->warnings.size();  // the glTF's, printed above

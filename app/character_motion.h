@@ -49,11 +49,13 @@ mocap::Result<deform::JointMapEntries> ReadJointMap(const std::string& path);
 // `input` (a BVH, glTF or GLB path; empty = the built-in demo walk) read Y-up,
 // driven by the BVH `motion` when that is not empty (MakeRetargetedCharacter),
 // else by its own motion (MakeCharacter). Load and retarget warnings go to
-// stderr unless `quiet`. Errors: those of LoadMotionSource and the makers.
-// `up` (--up) gives the BVH's up axis instead of detecting it.
+// stderr unless `quiet`. A BVH gets the body `body` (MakeCharacter). Errors: those of
+// LoadMotionSource and the makers. `up` (--up) gives the BVH's up axis instead of
+// detecting it.
 mocap::Result<Character> LoadCommandCharacter(const std::string& input, const std::string& motion,
                                               bool quiet, std::optional<mocap::UpAxis> up = {},
                                               const std::string& joint_map_file = {},
-                                              RetargetReport* report = nullptr);
+                                              RetargetReport* report = nullptr,
+                                              BodyKind body = BodyKind::kTubes);
 
 }  // namespace app

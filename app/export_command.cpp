@@ -86,6 +86,7 @@ CLI::App* AddExportCommand(CLI::App& parent, ExportOptions& o) {
                   "mesh_####.obj (one OBJ per frame, #### = frame number) or FILE.glb "
                   "(default out/<name>_export/mesh_####.obj)");
   cmd->add_option("--global", o.global, "Global skinning: ssd, dqs or swd")->capture_default_str();
+  cmd->add_option("--body", o.body, "Body of a BVH INPUT: generated or tubes (as render)")->capture_default_str();
   cmd->add_option("--layout", o.layout, ".glb: auto (smaller), morph or baked")
       ->capture_default_str();
   cmd->add_flag("--step", o.step, ".glb: hold each frame (STEP) instead of blending (LINEAR)");
@@ -157,8 +158,11 @@ int RunExport(const ExportOptions& options) {
                                  : std::filesystem::path(o.input).stem().string();
   const mocap::Result<std::optional<mocap::UpAxis>> up = ParseUpAxis(o.up);
   if (!up.ok()) return Fail(up.error());
-  mocap::Result<Character> character =
-      LoadCommandCharacter(o.input, o.motion, o.quiet, *up, o.joint_map);
+  const mocap::Result<BodyKind> body = ParseBodyKind(o.body);
+  if (!body.ok()) return Fail(body.error());
+  // A rig's example edits name vertices of the tube mannequin.
+  mocap::Result<Character> character = LoadCommandCharacter(
+      o.input, o.motion, o.quiet, *up, o.joint_map, nullptr, rig ? BodyKind::kTubes : *body);
   if (!character.ok()) return Fail(character.error());
   const Character& ch = *character;
   if (o.scale == 0.0f) {  // as inspect --scale 0: the detected units to metres

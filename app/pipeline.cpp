@@ -9,6 +9,7 @@
 
 #include "app/motion_source.h"
 #include "deform/body/bind_pose.h"
+#include "deform/body/generated_body.h"
 #include "deform/global/dqs_job.h"
 #include "deform/global/skinning_job.h"
 #include "deform/global/swd_job.h"
@@ -144,8 +145,15 @@ mocap::Result<std::vector<glm::mat4>> BindModelFromJoint(const Character& c) {
   return model;
 }
 
+mocap::Result<BodyKind> ParseBodyKind(const std::string& name) {
+  if (name == "tubes") return BodyKind::kTubes;
+  if (name == "generated") return BodyKind::kGenerated;
+  return mocap::MakeError(mocap::ErrorCode::kInvalidArgument, {"--body", 0, 0, {}},
+                          "expected generated, tubes or a glTF/GLB file, found '" + name + "'");
+}
+
 mocap::Result<Character> MakeCharacter(MotionSource&& source,
-                                       const deform::MannequinOptions& mannequin) {
+                                       const deform::MannequinOptions& mannequin, BodyKind kind) {
   Character c;
   c.source = source.gltf ? source.gltf->skeleton.info.source_file : source.skeleton.info.source_file;
   c.skeleton = std::move(source.skeleton);
@@ -162,9 +170,20 @@ mocap::Result<Character> MakeCharacter(MotionSource&& source,
   mocap::Result<deform::BindPoseChoice> pose =
       deform::ChooseBindPose(c.skeleton, c.motion, mannequin.min_branch_extent);
   c.bound_at_first_frame = pose.ok() && pose->frame == 0;
+  // One welded skin fuses whatever touches in its bind pose: a rest pose much taller
+  // than the first frame (LAFAN's arms raised beside the head) would fuse arms and head,
+  // so the generated body is bound at frame 0 then.
+  if (kind == BodyKind::kGenerated && !c.bound_at_first_frame && c.motion.num_frames > 0) {
+    const float rest = mocap::RestHeight(c.skeleton, c.skeleton.info.up_axis);
+    const float first = mocap::FirstFrameHeight(c.skeleton, c.motion, c.skeleton.info.up_axis);
+    c.bound_at_first_frame = first > 0.0f && rest > 1.15f * first;
+  }
   mocap::Result<std::vector<glm::mat4>> model = BindModelFromJoint(c);
   if (!model.ok()) return std::move(model).error();
-  mocap::Result<deform::SkinnedMesh> body = deform::BuildMannequin(c.skeleton, *model, mannequin);
+  mocap::Result<deform::SkinnedMesh> body =
+      kind == BodyKind::kGenerated
+          ? deform::BuildGeneratedBodyCached(c.skeleton, *model, {}, deform::BodyCacheFolder())
+          : deform::BuildMannequin(c.skeleton, *model, mannequin);
   if (!body.ok()) {
     mocap::Error e = std::move(body).error();
     if (e.loc.file.empty()) e.loc.file = c.source;

@@ -57,8 +57,16 @@ struct Character {
 // case it is bound at frame 0 (deform::ChooseBindPose: heights of the body's
 // joints, without a root that only positions it). With SWD each mannequin tube is
 // bound to the sweep of the chain it was generated on (body_chain_coords).
+// Which body a BVH skeleton gets: the tube mannequin (deform/body/mannequin.h; rig files name
+// its vertices) or the generated body (deform/body/generated_body.h: one smooth closed
+// skin with bone-heat weights, read from the body cache when it was built before).
+enum class BodyKind { kTubes, kGenerated };
+// "tubes" or "generated"; kInvalidArgument (naming --body) otherwise.
+mocap::Result<BodyKind> ParseBodyKind(const std::string& name);
+
 mocap::Result<Character> MakeCharacter(MotionSource&& source,
-                                       const deform::MannequinOptions& mannequin = {});
+                                       const deform::MannequinOptions& mannequin = {},
+                                       BodyKind body = BodyKind::kTubes);
 
 // The model-space joint matrices (#J) of the pose the character's mesh was made
 // in: the rest pose, or frame 0 when bound_at_first_frame; a skinned mesh's own

@@ -234,6 +234,9 @@ CLI::App* AddRenderCommand(CLI::App& parent, RenderOptions& o) {
                   "BVH motion driving a glTF INPUT (joints matched by body topology; docs/retargeting.md)");
   cmd->add_option("--joint-map", o.joint_map,
                   "JSON {\"glTF joint\": \"BVH joint\" or null} overriding the matched joints (with --motion)");
+  cmd->add_option("--body", o.body,
+                  "Body of a BVH INPUT: generated, tubes, or a glTF/GLB character it drives")
+      ->capture_default_str();
   AddOutputFlags(*cmd, o);
   cmd->callback([&o, cmd] { RecordGivenOptions(cmd, o); });
   return cmd;
@@ -380,6 +383,26 @@ int RunRender(const RenderOptions& options) {
   mocap::Result<TwoBodies> two = ChooseTwoBodies(o, rig ? &*rig : nullptr, *method);
   if (!two.ok()) return Fail(two.error());
 
+  // --- Body: a rig file names vertices of the tube mannequin; a glTF body is the
+  // character and the BVH input its --motion.
+  BodyKind body = BodyKind::kGenerated;
+  const std::string body_ext = std::filesystem::path(o.body).extension().string();
+  if (body_ext == ".glb" || body_ext == ".gltf") {
+    if (rig || !o.motion.empty()) {
+      return Fail(ArgError("--body", "a glTF/GLB body takes a BVH INPUT as its motion; not with a rig file or --motion"));
+    }
+    o.motion = o.input.empty() ? std::string() : o.input;
+    if (o.motion.empty()) return Fail(ArgError("--body", "a glTF/GLB body needs a BVH INPUT to drive it"));
+    o.input = o.body;
+  } else {
+    const mocap::Result<BodyKind> kind = ParseBodyKind(o.body);
+    if (!kind.ok()) return Fail(kind.error());
+    body = rig ? BodyKind::kTubes : *kind;
+    if (rig && o.given.count("--body") > 0 && *kind != BodyKind::kTubes) {
+      return Fail(ArgError("--body", "rig files name vertices of the tube body; expected tubes with a rig"));
+    }
+  }
+
   // --- Input -----------------------------------------------------------------
   const bool demo = o.input.empty();
   const std::string name = demo  ? "demo"
@@ -388,7 +411,7 @@ int RunRender(const RenderOptions& options) {
   const mocap::Result<std::optional<mocap::UpAxis>> up = ParseUpAxis(o.up);
   if (!up.ok()) return Fail(up.error());
   mocap::Result<Character> character =
-      LoadCommandCharacter(o.input, o.motion, o.quiet, *up, o.joint_map);
+      LoadCommandCharacter(o.input, o.motion, o.quiet, *up, o.joint_map, nullptr, body);
   if (!character.ok()) return Fail(character.error());
   const Character& ch = *character;
 

@@ -56,6 +56,10 @@ struct RenderOptions {
   std::string framing;
   std::string motion;                 // BVH driving a glTF INPUT (retargeted by topology); empty = its own
   std::string joint_map;              // JSON joint map overriding the matched joints; empty = none
+  // The body of a BVH INPUT: "generated" (one smooth skin, deform/body/), "tubes" (the
+  // mannequin rig files name vertices of; a rig file always uses it), or a glTF/GLB
+  // character that the BVH then drives as with --motion.
+  std::string body = "generated";
   // Long names ("--size") of the options given on the command line, filled by
   // the parser: with a rig file, these win over the rig's render settings.
   std::set<std::string> given;

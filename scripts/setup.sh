@@ -15,6 +15,7 @@ packages=(
   libfast-float-dev
   libassimp-dev
   libtinyxml2-dev chromium  # the check tests read JUnit files and open the HTML report headless
+  libopenvdb-dev libboost-dev libtbb-dev libeigen3-dev
   slurmctld slurmd slurm-client munge
   "$@"
 )

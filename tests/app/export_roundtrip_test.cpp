@@ -166,7 +166,7 @@ TEST(ExportRoundTrip, BvhBakedGlbShowsOneFramePerKey) {
 
   auto src = app::LoadMotionSource(BendBvh(), {.y_up = true});
   ASSERT_TRUE(src.ok());
-  auto ch = app::MakeCharacter(std::move(*src));
+  auto ch = app::MakeCharacter(std::move(*src), {}, app::BodyKind::kGenerated);  // export's default body
   ASSERT_TRUE(ch.ok());
   auto pipeline = app::FramePipeline::Create(*ch, app::GlobalMethod::kDqs, 1);
   ASSERT_TRUE(pipeline.ok());

@@ -55,7 +55,7 @@ app::Character Demo() {
   load.y_up = true;
   mocap::Result<app::MotionSource> src = app::LoadBvhText(app::DemoBvhText(), "demo_walk.bvh", load);
   EXPECT_TRUE(src.ok());
-  mocap::Result<app::Character> ch = app::MakeCharacter(std::move(*src));
+  mocap::Result<app::Character> ch = app::MakeCharacter(std::move(*src), {}, app::BodyKind::kGenerated);  // export's default body
   EXPECT_TRUE(ch.ok());
   return std::move(*ch);
 }
