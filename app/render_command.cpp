@@ -385,7 +385,7 @@ int RunRender(const RenderOptions& options) {
 
   // --- Body: a rig file names vertices of the tube mannequin; a glTF body is the
   // character and the BVH input its --motion.
-  BodyKind body = BodyKind::kGenerated;
+  BodyKind body_kind = BodyKind::kGenerated;
   const std::string body_ext = std::filesystem::path(o.body).extension().string();
   if (body_ext == ".glb" || body_ext == ".gltf") {
     if (rig || !o.motion.empty()) {
@@ -397,7 +397,7 @@ int RunRender(const RenderOptions& options) {
   } else {
     const mocap::Result<BodyKind> kind = ParseBodyKind(o.body);
     if (!kind.ok()) return Fail(kind.error());
-    body = rig ? BodyKind::kTubes : *kind;
+    body_kind = rig ? BodyKind::kTubes : *kind;
     if (rig && o.given.count("--body") > 0 && *kind != BodyKind::kTubes) {
       return Fail(ArgError("--body", "rig files name vertices of the tube body; expected tubes with a rig"));
     }
@@ -411,7 +411,7 @@ int RunRender(const RenderOptions& options) {
   const mocap::Result<std::optional<mocap::UpAxis>> up = ParseUpAxis(o.up);
   if (!up.ok()) return Fail(up.error());
   mocap::Result<Character> character =
-      LoadCommandCharacter(o.input, o.motion, o.quiet, *up, o.joint_map, nullptr, body);
+      LoadCommandCharacter(o.input, o.motion, o.quiet, *up, o.joint_map, nullptr, body_kind);
   if (!character.ok()) return Fail(character.error());
   const Character& ch = *character;
 
