@@ -27,10 +27,7 @@ fs::path Samples(const std::string& name) {
 }
 
 // A fresh folder per test (ctest runs the tests of this file as parallel processes).
-fs::path Dir() {
-  const std::string test = ::testing::UnitTest::GetInstance()->current_test_info()->name();
-  return testsupport::TestOutputPath("check_command/" + test + "/x").parent_path();
-}
+fs::path Dir() { return testsupport::TestDir("check_command"); }
 
 void WriteText(const fs::path& path, const std::string& text) {
   std::ofstream out(path, std::ios::binary | std::ios::trunc);

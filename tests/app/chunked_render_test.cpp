@@ -24,14 +24,7 @@ using testsupport::SlurpFile;
 
 const fs::path kSamples = fs::path(GOLDEN_DIR) / ".." / ".." / "samples" / "data";
 
-fs::path Dir() {
-  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-  const fs::path d =
-      testsupport::TestOutputPath(std::string("chunked_render/") + info->name() + "/x").parent_path();
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
+fs::path Dir() { return testsupport::TestDir("chunked_render"); }
 
 // Renders `input` (empty: the demo) frames `frames` into folder/f_####.png.
 void Render(const std::string& input, const std::string& frames, const fs::path& folder,

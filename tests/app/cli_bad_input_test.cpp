@@ -28,19 +28,7 @@ using testsupport::ProcessResult;
 constexpr int kBadInput = 2;
 
 // A fresh folder per test (ctest runs each test as its own process).
-fs::path Dir() {
-  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-  const fs::path d = testsupport::TestOutputPath(std::string("cli_bad_input/") +
-                                                 info->test_suite_name() + "_" + info->name() + "/x")
-                         .parent_path();
-  static std::string cleaned;
-  if (cleaned != d.string()) {
-    fs::remove_all(d);
-    fs::create_directories(d / "logs");
-    cleaned = d.string();
-  }
-  return d;
-}
+fs::path Dir() { return testsupport::TestDir("cli_bad_input"); }
 
 fs::path OutDir() { return Dir() / "out"; }
 

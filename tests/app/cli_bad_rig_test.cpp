@@ -26,18 +26,7 @@ using testsupport::ProcessResult;
 
 constexpr int kBadInput = 2;
 
-fs::path Dir() {
-  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-  const fs::path d =
-      testsupport::TestOutputPath(std::string("cli_bad_rig/") + info->name() + "/x").parent_path();
-  static std::string cleaned;
-  if (cleaned != d.string()) {
-    fs::remove_all(d);
-    fs::create_directories(d / "logs");
-    cleaned = d.string();
-  }
-  return d;
-}
+fs::path Dir() { return testsupport::TestDir("cli_bad_rig"); }
 
 fs::path OutDir() { return Dir() / "out"; }
 

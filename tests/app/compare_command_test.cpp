@@ -21,17 +21,7 @@ namespace fs = std::filesystem;
 using testsupport::ProcessResult;
 
 // One folder per test: ctest runs the tests of this file as parallel processes.
-fs::path Dir() {
-  const std::string test = ::testing::UnitTest::GetInstance()->current_test_info()->name();
-  const fs::path d = testsupport::TestOutputPath("compare_command/" + test + "/x").parent_path();
-  static std::string cleaned;
-  if (cleaned != test) {
-    fs::remove_all(d);
-    fs::create_directories(d);
-    cleaned = test;
-  }
-  return d;
-}
+fs::path Dir() { return testsupport::TestDir("compare_command"); }
 
 ProcessResult Patchskin(const std::vector<std::string>& args) {
   std::vector<std::string> all{"compare"};

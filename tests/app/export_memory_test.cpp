@@ -97,12 +97,7 @@ Growth Measure(const fs::path& input, const std::string& out_name, const std::ve
   return g;
 }
 
-fs::path Dir() {
-  const std::string test = ::testing::UnitTest::GetInstance()->current_test_info()->name();
-  const fs::path d = testsupport::TestOutputPath("export_memory/" + test + "/x").parent_path();
-  fs::create_directories(d);
-  return d;
-}
+fs::path Dir() { return testsupport::TestDir("export_memory"); }
 
 TEST(ExportMemory, ObjSequenceDoesNotGrowWithTheFrameCount) {
   PATCHSKIN_SKIP_MEMORY_BOUND_UNDER_ASAN();

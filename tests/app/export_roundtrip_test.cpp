@@ -33,13 +33,7 @@ namespace fs = std::filesystem;
 
 const fs::path kSamples = fs::path(GOLDEN_DIR) / ".." / ".." / "samples" / "data";
 
-fs::path Dir() {
-  const std::string test = ::testing::UnitTest::GetInstance()->current_test_info()->name();
-  const fs::path d = testsupport::TestOutputPath("export_roundtrip/" + test + "/x").parent_path();
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
+fs::path Dir() { return testsupport::TestDir("export_roundtrip"); }
 
 std::string BendBvh() { return fs::absolute(kSamples / "bend.bvh").lexically_normal().string(); }
 

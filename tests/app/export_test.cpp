@@ -28,13 +28,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-fs::path Dir() {
-  const std::string test = ::testing::UnitTest::GetInstance()->current_test_info()->name();
-  const fs::path d = testsupport::TestOutputPath("export_command/" + test + "/x").parent_path();
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
+fs::path Dir() { return testsupport::TestDir("export_command"); }
 
 int Patchskin(const std::string& args, const fs::path& dir) {
   const std::string cmd = std::string("'") + PATCHSKIN_BINARY + "' " + args + " >'" +

@@ -115,14 +115,7 @@ std::string WriteMotion(const fs::path& path, const std::string& spine_name = "s
   return path.string();
 }
 
-fs::path Dir() {
-  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-  const fs::path d =
-      testsupport::TestOutputPath(std::string("gltf_bvh_motion/") + info->name() + "/x").parent_path();
-  fs::remove_all(d);
-  fs::create_directories(d / "logs");
-  return d;
-}
+fs::path Dir() { return testsupport::TestDir("gltf_bvh_motion"); }
 
 app::Character Load(const fs::path& d) {
   const std::string model = WriteCharacter(d / "body.gltf");

@@ -25,18 +25,7 @@ namespace fs = std::filesystem;
 using testsupport::ProcessResult;
 using testsupport::SlurpFile;
 
-fs::path Dir() {
-  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-  const fs::path d = testsupport::TestOutputPath(std::string("render_outputs/") + info->name() + "/x")
-                         .parent_path();
-  static std::string cleaned;
-  if (cleaned != d.string()) {
-    fs::remove_all(d);
-    fs::create_directories(d / "logs");
-    cleaned = d.string();
-  }
-  return d;
-}
+fs::path Dir() { return testsupport::TestDir("render_outputs"); }
 
 // Renders the built-in demo into `folder`/f_####.png at 320x180, without the
 // contact sheet unless `extra` holds "--sheet" (taken out here).

@@ -25,14 +25,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-fs::path Dir() {
-  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-  const fs::path d =
-      testsupport::TestOutputPath(std::string("render_overlays/") + info->name() + "/x").parent_path();
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
+fs::path Dir() { return testsupport::TestDir("render_overlays"); }
 
 testsupport::ProcessResult Render(const fs::path& d, std::vector<std::string> args) {
   args.insert(args.begin(), "render");

@@ -23,14 +23,7 @@ using nlohmann::json;
 using testsupport::ProcessResult;
 using testsupport::SlurpFile;
 
-fs::path Dir() {
-  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-  const fs::path d =
-      testsupport::TestOutputPath(std::string("rig_overrides/") + info->name() + "/x").parent_path();
-  fs::remove_all(d);
-  fs::create_directories(d / "logs");
-  return d;
-}
+fs::path Dir() { return testsupport::TestDir("rig_overrides"); }
 
 std::string BendBvh() {
   return (fs::path(TEST_DATA_DIR) / "../../samples/data/bend.bvh").lexically_normal().string();

@@ -27,18 +27,7 @@ namespace {
 namespace fs = std::filesystem;
 using testsupport::ProcessResult;
 
-fs::path Dir() {
-  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-  const fs::path d =
-      testsupport::TestOutputPath(std::string("rough_edges/") + info->name() + "/x").parent_path();
-  static std::string cleaned;
-  if (cleaned != d.string()) {
-    fs::remove_all(d);
-    fs::create_directories(d / "logs");
-    cleaned = d.string();
-  }
-  return d;
-}
+fs::path Dir() { return testsupport::TestDir("rough_edges"); }
 
 ProcessResult Patchskin(const std::vector<std::string>& args) {
   return testsupport::RunPatchskin(args, Dir() / "logs");

@@ -24,6 +24,22 @@ inline std::filesystem::path SampleDataPath(const std::string& name) {
       .lexically_normal();
 }
 
+// This test's own output folder, TEST_OUTPUT_DIR/<folder>/<suite>_<test>/, with
+// an empty logs/ in it: emptied the first time a test asks for it and kept for
+// the rest of that test (a failed test leaves its files to look at).
+inline std::filesystem::path TestDir(const std::string& folder) {
+  const ::testing::TestInfo* info = ::testing::UnitTest::GetInstance()->current_test_info();
+  const std::filesystem::path d = std::filesystem::path(TEST_OUTPUT_DIR) / folder /
+                                  (std::string(info->test_suite_name()) + "_" + info->name());
+  static std::string cleaned;
+  if (cleaned != d.string()) {
+    std::filesystem::remove_all(d);
+    std::filesystem::create_directories(d / "logs");
+    cleaned = d.string();
+  }
+  return d;
+}
+
 inline bool HaveSharedData() { return std::filesystem::is_directory(SHARED_DATA_DIR); }
 
 // A folder under the build tree for files a test writes (created on demand).
