@@ -8,6 +8,8 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include "app/internal/json_describe.h"
+
 namespace app {
 namespace {
 
@@ -23,9 +25,7 @@ struct Ctx {
     return mocap::MakeError(mocap::ErrorCode::kInvalidArgument, {file, 0, 0, path}, message);
   }
   mocap::Error Expected(const std::string& path, const std::string& what, const json& found) const {
-    std::string s = found.is_object() ? "an object" : found.is_array() ? "an array" : found.dump();
-    if (s.size() > 40) s = s.substr(0, 37) + "...";
-    return Fail(path, "expected " + what + ", found " + s);
+    return Fail(path, "expected " + what + ", found " + DescribeJson(found));
   }
 };
 

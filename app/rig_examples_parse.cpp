@@ -8,6 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "app/internal/json_describe.h"
 #include "app/rig_file.h"
 
 namespace app {
@@ -24,20 +25,13 @@ constexpr std::size_t kMaxEdits = 256;
 constexpr double kMaxMove = 1e6;
 constexpr double kMaxAngleDeg = 360.0;
 
-std::string Describe(const json& v) {
-  if (v.is_object()) return "an object";
-  std::string s = v.dump();
-  if (s.size() > 40) s = s.substr(0, 37) + "...";
-  return v.is_array() ? "an array " + s : s;
-}
-
 struct Ctx {
   std::string file;
   mocap::Error Fail(const std::string& path, const std::string& message) const {
     return mocap::MakeError(mocap::ErrorCode::kInvalidArgument, {file, 0, 0, path}, message);
   }
   mocap::Error Expected(const std::string& path, const std::string& what, const json& found) const {
-    return Fail(path, "expected " + what + ", found " + Describe(found));
+    return Fail(path, "expected " + what + ", found " + DescribeJson(found));
   }
   // `obj` must be an object whose keys are all in `allowed`.
   std::optional<mocap::Error> Keys(const json& obj, const std::string& path,

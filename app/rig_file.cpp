@@ -9,6 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "app/internal/json_describe.h"
 #include "app/internal/rig_elastic_parse.h"
 #include "app/internal/rig_examples_parse.h"
 #include "app/output_guard.h"
@@ -18,40 +19,6 @@ namespace {
 
 using nlohmann::json;
 
-// Short description of a JSON value for "found ..." in messages, at most
-// kMaxDescribed characters. Never serializes a whole container: nlohmann's
-// dump() recurses once per nesting level, and a rig of 10^6 '[' would
-// overflow the stack (found by fuzz/rig_fuzzer.cpp).
-constexpr std::size_t kMaxDescribed = 40;
-
-std::string DescribeScalar(const json& v) {
-  std::string s = v.dump();  // a scalar: no recursion
-  if (s.size() > kMaxDescribed) s = s.substr(0, kMaxDescribed - 3) + "...";
-  return s;
-}
-
-std::string Describe(const json& v) {
-  switch (v.type()) {
-    case json::value_t::object: return "an object";
-    case json::value_t::null: return "null";
-    case json::value_t::array: {
-      // "[a,b,c]" for an array of scalars, cut short like the scalars; only
-      // the size of an array that holds containers.
-      std::string s = "[";
-      for (const json& e : v) {
-        if (e.is_array() || e.is_object()) {
-          return "an array (" + std::to_string(v.size()) + (v.size() == 1 ? " item)" : " items)");
-        }
-        if (s.size() > 1) s += ',';
-        s += e.dump();
-        if (s.size() > kMaxDescribed) return "an array " + s.substr(0, kMaxDescribed - 3) + "...";
-      }
-      return "an array " + s + "]";
-    }
-    default: return DescribeScalar(v);
-  }
-}
-
 // Parsing context: the file name and the error to return.
 struct Ctx {
   std::string file;
@@ -60,7 +27,7 @@ struct Ctx {
     return mocap::MakeError(code, {file, 0, 0, path}, message);
   }
   mocap::Error Expected(const std::string& path, const std::string& what, const json& found) const {
-    return Fail(path, "expected " + what + ", found " + Describe(found));
+    return Fail(path, "expected " + what + ", found " + DescribeJson(found));
   }
 };
 

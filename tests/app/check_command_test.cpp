@@ -274,6 +274,13 @@ TEST(CheckCommand, WarningsErrorsAndBadManifests) {
   EXPECT_EQ(r.exit_code, 4);
   EXPECT_EQ(r.FirstErrLine().rfind(p.manifest.string() + ":2:", 0), 0u) << r.err;
   EXPECT_EQ(Check(p, {"--update", "--update-all"}).exit_code, 4);
+  // 10^5 nested arrays where a case belongs: the message describes the value
+  // without serializing it (dump() recurses once per level).
+  WriteText(p.manifest, "{\"cases\": [" + std::string(100000, '[') + std::string(100000, ']') + "]}");
+  r = Check(p);
+  EXPECT_EQ(r.exit_code, 4) << r.err;
+  EXPECT_EQ(r.FirstErrLine(),
+            p.manifest.string() + ": cases[0]: error: expected an object, found an array (1 item)");
 }
 
 // The README's sample: the first run writes its references, the second passes.
