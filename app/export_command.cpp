@@ -123,7 +123,7 @@ int RunExport(const ExportOptions& options) {
     if (!loaded.ok()) return Fail(loaded.error());
     rig = std::move(*loaded);
     o.input = RigInputFile(*rig);
-    if (rig->character != "mannequin" && o.motion.empty()) {
+    if (!IsBuiltInBody(rig->character) && o.motion.empty()) {
       o.motion = rig->motion;
       if (o.joint_map.empty()) o.joint_map = rig->joint_map;
     }
@@ -160,9 +160,9 @@ int RunExport(const ExportOptions& options) {
   if (!up.ok()) return Fail(up.error());
   const mocap::Result<BodyKind> body = ParseBodyKind(o.body);
   if (!body.ok()) return Fail(body.error());
-  // A rig's example edits name vertices of the tube mannequin.
+  // A rig names its own body: its example edits may name that body's vertices.
   mocap::Result<Character> character = LoadCommandCharacter(
-      o.input, o.motion, o.quiet, *up, o.joint_map, nullptr, rig ? BodyKind::kTubes : *body);
+      o.input, o.motion, o.quiet, *up, o.joint_map, nullptr, rig ? RigBodyKind(*rig) : *body);
   if (!character.ok()) return Fail(character.error());
   const Character& ch = *character;
   if (o.scale == 0.0f) {  // as inspect --scale 0: the detected units to metres

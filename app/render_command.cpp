@@ -306,8 +306,8 @@ int RunRender(const RenderOptions& options) {
     rig = std::move(*loaded);
     // The rig sets what the command line leaves out; an option given wins.
     const auto given = [&o](const char* name) { return o.given.count(name) > 0; };
-    o.input = rig->character == "mannequin" ? rig->motion : rig->character;
-    if (rig->character != "mannequin" && !rig->motion.empty() && !given("--motion")) {
+    o.input = RigInputFile(*rig);
+    if (!IsBuiltInBody(rig->character) && !rig->motion.empty() && !given("--motion")) {
       o.motion = rig->motion;
       if (!given("--joint-map")) o.joint_map = rig->joint_map;
     }
@@ -383,7 +383,7 @@ int RunRender(const RenderOptions& options) {
   mocap::Result<TwoBodies> two = ChooseTwoBodies(o, rig ? &*rig : nullptr, *method);
   if (!two.ok()) return Fail(two.error());
 
-  // --- Body: a rig file names vertices of the tube mannequin; a glTF body is the
+  // --- Body: a rig file names its body ("character"); a glTF body is the
   // character and the BVH input its --motion.
   BodyKind body_kind = BodyKind::kGenerated;
   const std::string body_ext = std::filesystem::path(o.body).extension().string();
@@ -397,9 +397,11 @@ int RunRender(const RenderOptions& options) {
   } else {
     const mocap::Result<BodyKind> kind = ParseBodyKind(o.body);
     if (!kind.ok()) return Fail(kind.error());
-    body_kind = rig ? BodyKind::kTubes : *kind;
-    if (rig && o.given.count("--body") > 0 && *kind != BodyKind::kTubes) {
-      return Fail(ArgError("--body", "rig files name vertices of the tube body; expected tubes with a rig"));
+    body_kind = rig ? RigBodyKind(*rig) : *kind;
+    if (rig && o.given.count("--body") > 0 && *kind != body_kind) {
+      return Fail(ArgError("--body", "the rig file names its body (\"character\"); expected " +
+                                         std::string(body_kind == BodyKind::kTubes ? "tubes" : "generated") +
+                                         " or no --body with this rig"));
     }
   }
 

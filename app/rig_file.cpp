@@ -322,6 +322,10 @@ std::optional<mocap::Error> ParseRender(const Ctx& c, const json& v, RigRender& 
 
 }  // namespace
 
+bool IsBuiltInBody(const std::string& character) {
+  return character == "generated" || character == "tubes" || character == "mannequin";
+}
+
 mocap::Result<Rig> ParseRig(const std::string& text, const std::string& file) {
   const Ctx c{file};
   json doc;
@@ -370,9 +374,9 @@ mocap::Result<Rig> ParseRig(const std::string& text, const std::string& file) {
   }
   Rig rig;
   rig.file = file;
-  if (!doc.contains("character")) return c.Fail("character", "missing (\"mannequin\" or a glTF file)");
+  if (!doc.contains("character")) return c.Fail("character", "missing (\"generated\", \"tubes\" or a glTF file)");
   if (auto e = GetString(c, doc["character"], "character", rig.character)) return *e;
-  if (rig.character != "mannequin") rig.character = Resolve(file, rig.character);
+  if (!IsBuiltInBody(rig.character)) rig.character = Resolve(file, rig.character);
   if (doc.contains("motion")) {
     const json& m = doc["motion"];
     if (auto e = CheckObject(c, m, "motion", {"file", "fps", "joint_map"})) return *e;
@@ -386,8 +390,8 @@ mocap::Result<Rig> ParseRig(const std::string& text, const std::string& file) {
     if (m.contains("fps")) {
       if (auto e = GetNumber(c, m["fps"], "motion.fps", 0, 10000, rig.fps)) return *e;
     }
-  } else if (rig.character == "mannequin") {
-    return c.Fail("motion", "missing (the mannequin needs a BVH motion: {\"file\": ...})");
+  } else if (IsBuiltInBody(rig.character)) {
+    return c.Fail("motion", "missing (a generated body needs a BVH motion: {\"file\": ...})");
   }
   if (doc.contains("global")) {
     if (auto e = GetChoice(c, doc["global"], "global", {"ssd", "dqs", "swd"}, rig.global)) return *e;

@@ -3,7 +3,7 @@
 // file"; every field is documented in docs/rig-file.md).
 //
 //   {
-//     "character": "mannequin" | "body.glb",
+//     "character": "generated" | "tubes" | "body.glb",
 //     "motion":    {"file": "bend.bvh", "fps": 0, "joint_map": "map.json"},
 //     "global":    "ssd" | "dqs" | "swd",
 //     "patches":   [{"name": "left_elbow",
@@ -85,7 +85,7 @@ struct RigRender {
 
 struct Rig {
   std::string file;                  // the rig file as given
-  std::string character;             // "mannequin" or a resolved glTF/GLB path
+  std::string character;             // a built-in body (IsBuiltInBody) or a resolved glTF/GLB path
   std::string motion;                // resolved BVH path; empty = the glTF's animation
   std::string joint_map;             // resolved joint map (JSON) for a glTF character; empty = none
   double fps = 0.0;                  // output frame rate, 0 = the motion's own
@@ -93,6 +93,11 @@ struct Rig {
   std::vector<RigPatch> patches;
   RigRender render;
 };
+
+// "generated" (the smooth body built from the motion's skeleton), "tubes" or
+// its older name "mannequin" (the tube body whose vertex indices older rigs
+// name): a body made from the motion rather than a file.
+bool IsBuiltInBody(const std::string& character);
 
 // Largest rig file LoadRig reads (rigs are a few kB; this only bounds memory).
 inline constexpr std::uintmax_t kMaxRigFileBytes = std::uintmax_t{1} << 24;

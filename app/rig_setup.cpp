@@ -7,7 +7,11 @@
 namespace app {
 
 std::string RigInputFile(const Rig& rig) {
-  return rig.character == "mannequin" ? rig.motion : rig.character;
+  return IsBuiltInBody(rig.character) ? rig.motion : rig.character;
+}
+
+BodyKind RigBodyKind(const Rig& rig) {
+  return rig.character == "generated" ? BodyKind::kGenerated : BodyKind::kTubes;
 }
 
 mocap::Status ApplyRigLayers(const Rig& rig, const Character& character, FramePipeline& pipeline,

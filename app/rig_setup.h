@@ -20,6 +20,10 @@ namespace app {
 // character (driven by rig.motion when that is set, else by its own animation).
 std::string RigInputFile(const Rig& rig);
 
+// The built-in body a rig names: "generated", else the tube body ("tubes" or
+// "mannequin"). Meaningless for a glTF character.
+BodyKind RigBodyKind(const Rig& rig);
+
 // Builds the rig's layers on `character` (BuildRigPatches, BuildRigPoseSpaces
 // for pipeline.method(), ResolveRigElastic) and installs them on `pipeline`,
 // which must evaluate that character. Errors name the rig file and the field

@@ -12,6 +12,7 @@
 
 #include "app/motion_source.h"
 #include "app/rig_patches.h"
+#include "app/rig_setup.h"
 #include "render/output/image_io.h"
 #include "support/data_paths.h"
 
@@ -114,6 +115,24 @@ TEST(RigFile, JointMapResolvesAgainstTheRigFolder) {
   EXPECT_TRUE(none->joint_map.empty());
 }
 
+TEST(RigFile, BuiltInBodiesAreNamesNotFiles) {
+  for (const char* body : {"generated", "tubes", "mannequin"}) {
+    const std::string text = std::string(R"({"character": ")") + body + R"(", "motion": {"file": "m.bvh"}})";
+    const auto rig = app::ParseRig(text, "rigs/r.json");
+    ASSERT_TRUE(rig.ok()) << rig.error().ToString();
+    EXPECT_EQ(rig->character, body);  // not resolved against the rig's folder
+    EXPECT_EQ(app::RigBodyKind(*rig),
+              std::string(body) == "generated" ? app::BodyKind::kGenerated : app::BodyKind::kTubes);
+  }
+  const auto file = app::ParseRig(R"({"character": "generated.glb"})", "rigs/r.json");
+  ASSERT_TRUE(file.ok()) << file.error().ToString();
+  EXPECT_EQ(file->character, "rigs/generated.glb");
+  const auto no_motion = app::ParseRig(R"({"character": "generated"})", "r.json");
+  ASSERT_FALSE(no_motion.ok());
+  EXPECT_NE(no_motion.error().ToString().find("generated body needs a BVH motion"), std::string::npos)
+      << no_motion.error().ToString();
+}
+
 struct BadRig {
   const char* text;
   const char* message;  // the whole formatted error
@@ -129,9 +148,9 @@ const BadRig kBadRigs[] = {
      "r.json: colour: error: unknown field (expected one of: character, motion, global, "
      "patches, render)"},
     {R"({"motion": {"file": "m.bvh"}})",
-     "r.json: character: error: missing (\"mannequin\" or a glTF file)"},
+     "r.json: character: error: missing (\"generated\", \"tubes\" or a glTF file)"},
     {R"({"character": "mannequin"})",
-     "r.json: motion: error: missing (the mannequin needs a BVH motion: {\"file\": ...})"},
+     "r.json: motion: error: missing (a generated body needs a BVH motion: {\"file\": ...})"},
     {R"({"character": 3, "motion": {"file": "m.bvh"}})",
      "r.json: character: error: expected a non-empty string, found 3"},
     {R"({"character": "mannequin", "motion": {"file": "m.bvh", "fps": -1}})",
