@@ -117,3 +117,35 @@ TEST(SwdPipeline, GeneratedBodyHasNoCrackOrSeamOnCmuFrames750And1500) {
 }
 
 }  // namespace
+
+namespace {
+
+// Issue 25: the generated body of every capture in the shared data, built as `render`
+// builds it (its bind pose chosen from the rest pose or frame 0), is one closed manifold
+// piece whose skin never passes through itself at the bind pose.
+TEST(GeneratedBodyOfCaptures, ClosedOnePieceAndNoSelfIntersectionAtTheBindPose) {
+  const fs::path root = testsupport::SharedDataPath("bvh");
+  PATCHSKIN_REQUIRE_SHARED_FILE(root);
+  std::vector<fs::path> files;
+  for (const auto& e : fs::recursive_directory_iterator(root)) {
+    if (e.path().extension() == ".bvh") files.push_back(e.path());
+  }
+  std::sort(files.begin(), files.end());
+  ASSERT_FALSE(files.empty());
+  for (const fs::path& path : files) {
+    SCOPED_TRACE(path.string());
+    auto src = app::LoadMotionSource(path.string(), {});
+    ASSERT_TRUE(src.ok()) << src.error().ToString();
+    auto c = app::MakeCharacter(std::move(*src), {}, app::BodyKind::kGenerated);
+    ASSERT_TRUE(c.ok()) << c.error().ToString();
+    const deform::Mesh& mesh = c->mesh.bind;
+    const int crossing = testsupport::SelfIntersectingPairs(mesh);
+    std::printf("%s: %d triangles, bound at %s, %d self-intersecting pairs\n", path.filename().c_str(),
+                mesh.num_triangles(), c->bound_at_first_frame ? "frame 0" : "the rest pose", crossing);
+    EXPECT_EQ(testsupport::BadEdges(mesh), 0);
+    EXPECT_EQ(testsupport::ConnectedPieces(mesh), 1);
+    EXPECT_EQ(crossing, 0);
+  }
+}
+
+}  // namespace

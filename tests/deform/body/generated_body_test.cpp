@@ -56,6 +56,7 @@ void ExpectValidBody(const mocap::Skeleton& s, std::span<const glm::mat4> rest, 
   EXPECT_EQ(testsupport::ConnectedPieces(mesh), 1);
   EXPECT_GT(testsupport::SmallestRelativeArea(mesh), 1e-6) << "degenerate triangle";
   EXPECT_GT(testsupport::EnclosedVolume(mesh.positions, mesh.triangles), 0.0) << "faces turned inward";
+  EXPECT_EQ(testsupport::SelfIntersectingPairs(mesh), 0) << "the skin passes through itself at the bind pose";
   // Weights: non-negative, sum to 1, and the heaviest joint has a bone near the vertex.
   auto body = deform::BuildImplicitBody(s, rest);
   ASSERT_TRUE(body.ok());
@@ -98,6 +99,29 @@ TEST(ImplicitBody, RoundConeDistanceIsExact) {
   // Smooth min: min far apart, below both where they meet.
   EXPECT_EQ(deform::SmoothMin(1.0f, 5.0f, 2.0f), 1.0f);
   EXPECT_NEAR(deform::SmoothMin(1.0f, 1.0f, 2.0f), 0.5f, 1e-6f);
+}
+
+// The self-intersection check itself: two octahedra in one mesh are clean while apart and
+// cross along a curve once they overlap; one triangle's edge through another is one pair.
+TEST(BodyChecks, SelfIntersectionFindsOverlappingParts) {
+  const auto two_octahedra = [](glm::vec3 offset) {
+    deform::Mesh m;
+    m.positions = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+    m.triangles = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4}, {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
+    for (int i = 0; i < 6; ++i) m.positions.push_back(m.positions[static_cast<std::size_t>(i)] + offset);
+    for (int i = 0; i < 8; ++i) m.triangles.push_back(m.triangles[static_cast<std::size_t>(i)] + glm::uvec3(6));
+    return m;
+  };
+  EXPECT_EQ(testsupport::BadEdges(two_octahedra({5, 0, 0})), 0);
+  EXPECT_EQ(testsupport::SelfIntersectingPairs(two_octahedra({5, 0, 0})), 0);
+  EXPECT_GT(testsupport::SelfIntersectingPairs(two_octahedra({0.5f, 0.21f, 0.13f})), 0);
+  // Two triangles far apart in one mesh, then one moved to cross the other.
+  deform::Mesh two;
+  two.positions = {{0, 0, 0}, {2, 0, 0}, {0, 2, 0}, {0.5f, 0.5f, 5}, {0.5f, 0.5f, 6}, {1.5f, 0.5f, 5}};
+  two.triangles = {{0, 1, 2}, {3, 4, 5}};
+  EXPECT_EQ(testsupport::SelfIntersectingPairs(two), 0);
+  two.positions[3].z = -1.0f;  // its edge 3-4 now passes through the first triangle
+  EXPECT_EQ(testsupport::SelfIntersectingPairs(two), 1);
 }
 
 TEST(GeneratedBody, HumanoidIsOneClosedManifoldWithHeatWeights) {
