@@ -91,7 +91,8 @@ CLI::App* AddExportCommand(CLI::App& parent, ExportOptions& o) {
       ->capture_default_str();
   cmd->add_flag("--step", o.step, ".glb: hold each frame (STEP) instead of blending (LINEAR)");
   cmd->add_flag("--with-camera", o.with_camera,
-                "Also write camera_####.json per frame: the camera render would use");
+                "Also write camera_####.json per frame: the camera render would use (a .glb also "
+                "carries it as an animated camera node)");
   cmd->add_option("--camera", o.camera, "Camera for --with-camera: follow or fixed")
       ->capture_default_str();
   cmd->add_option("--size", o.size, "Image size for --with-camera, WxH")->capture_default_str();
@@ -218,6 +219,13 @@ int RunExport(const ExportOptions& options) {
     go.step_interpolation = o.step;
     go.generator = "patchskin export (" + std::string(GlobalMethodName(*method)) + ")";
     go.scratch_dir = out_dir.empty() ? "." : out_dir.string();
+    if (cameras) {  // the lens is the same at every frame; the scale moves the planes with the scene
+      const render::Camera first = cameras->At(plan->At(0));
+      go.camera = deform::GltfCameraLens{.yfov_rad = glm::radians(first.fov_y_deg),
+                                         .aspect = first.aspect,
+                                         .znear = first.near_plane * o.scale,
+                                         .zfar = first.far_plane * o.scale};
+    }
     mocap::Result<deform::GltfSequenceWriter> w = deform::GltfSequenceWriter::Create(
         bind.triangles, bind.colors, bind.num_vertices(), static_cast<int>(plan->count()), go);
     if (!w.ok()) return Fail(w.error());
@@ -274,6 +282,10 @@ int RunExport(const ExportOptions& options) {
       camera.target *= o.scale;
       camera.near_plane *= o.scale;
       camera.far_plane *= o.scale;
+      if (gltf) {  // the camera node: world position and world-from-view rotation
+        const glm::quat rotation = glm::quat_cast(glm::transpose(glm::mat3(camera.ViewFromWorld())));
+        if (s = gltf->AddCameraFrame(camera.eye, rotation); !s.ok()) return Fail(s.error());
+      }
       s = deform::WriteFileAtomic((out_dir / file).string(),
                                   CameraJson(camera, *size, cameras->ground_y() * o.scale,
                                              of.number, of.time_s));

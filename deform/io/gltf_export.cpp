@@ -129,6 +129,8 @@ struct GltfSequenceWriter::Impl {
   std::vector<glm::vec3> base_normals;    // morph: frame 0
   std::vector<glm::vec3> delta;           // morph: scratch, #V
   std::vector<std::map<std::string, int>> frame_attributes;  // per frame: accessors added
+  std::vector<float> camera_translations;  // 3 per AddCameraFrame call
+  std::vector<float> camera_rotations;     // 4 per call: x, y, z, w (glTF's order)
 
   ~Impl() {
     if (scratch != nullptr) std::fclose(scratch);
@@ -220,7 +222,49 @@ struct GltfSequenceWriter::Impl {
 
   void FinishMorph();
   void FinishBaked();
+  void AddCamera(tinygltf::Animation& anim);
 };
+
+// The camera node, keyed at every frame's time: its samplers and channels join the
+// deformation's animation, so viewers play both together.
+void GltfSequenceWriter::Impl::AddCamera(tinygltf::Animation& anim) {
+  if (!options.camera) return;
+  tinygltf::Camera camera;
+  camera.type = "perspective";
+  camera.name = "camera";
+  camera.perspective.yfov = options.camera->yfov_rad;
+  camera.perspective.aspectRatio = options.camera->aspect;
+  camera.perspective.znear = options.camera->znear;
+  camera.perspective.zfar = options.camera->zfar;
+  model.cameras.push_back(std::move(camera));
+  tinygltf::Node node;
+  node.name = "camera";
+  node.camera = static_cast<int>(model.cameras.size()) - 1;
+  node.translation.assign(camera_translations.begin(), camera_translations.begin() + 3);
+  node.rotation.assign(camera_rotations.begin(), camera_rotations.begin() + 4);
+  model.nodes.push_back(std::move(node));
+  const int index = static_cast<int>(model.nodes.size()) - 1;
+  model.scenes[0].nodes.push_back(index);
+
+  const auto f = static_cast<std::size_t>(num_frames);
+  std::vector<float> times(f);
+  for (std::size_t k = 0; k < f; ++k) times[k] = KeyTime(static_cast<int>(k));
+  const int input = AddFloats(times, TINYGLTF_TYPE_SCALAR, f, true);
+  const auto channel = [&](const std::vector<float>& values, int type, const char* path) {
+    tinygltf::AnimationSampler sampler;
+    sampler.input = input;
+    sampler.output = AddFloats(values, type, f, false);
+    sampler.interpolation = "LINEAR";
+    anim.samplers.push_back(std::move(sampler));
+    tinygltf::AnimationChannel c;
+    c.sampler = static_cast<int>(anim.samplers.size()) - 1;
+    c.target_node = index;
+    c.target_path = path;
+    anim.channels.push_back(std::move(c));
+  };
+  channel(camera_translations, TINYGLTF_TYPE_VEC3, "translation");
+  channel(camera_rotations, TINYGLTF_TYPE_VEC4, "rotation");
+}
 
 void GltfSequenceWriter::Impl::FinishMorph() {
   tinygltf::Mesh mesh;
@@ -268,6 +312,7 @@ void GltfSequenceWriter::Impl::FinishMorph() {
   anim.name = "deformation";
   anim.samplers.push_back(std::move(sampler));
   anim.channels.push_back(std::move(channel));
+  AddCamera(anim);
   model.animations.push_back(std::move(anim));
 }
 
@@ -315,6 +360,7 @@ void GltfSequenceWriter::Impl::FinishBaked() {
     anim.channels.push_back(std::move(channel));
   }
   model.scenes[0].nodes = {0};
+  AddCamera(anim);
   model.animations.push_back(std::move(anim));
 }
 
@@ -337,6 +383,12 @@ mocap::Result<GltfSequenceWriter> GltfSequenceWriter::Create(std::span<const glm
   }
   if (!(options.frame_time_s > 0.0) || !std::isfinite(options.frame_time_s)) {
     return Invalid("the frame time must be a positive number of seconds");
+  }
+  if (const std::optional<GltfCameraLens>& lens = options.camera) {
+    const bool ok = lens->yfov_rad > 0.0f && lens->yfov_rad < 3.14159f && lens->aspect > 0.0f &&
+                    std::isfinite(lens->aspect) && lens->znear > 0.0f && lens->zfar > lens->znear &&
+                    std::isfinite(lens->zfar);
+    if (!ok) return Invalid("camera lens: expected 0 < yfov < pi, aspect > 0 and 0 < znear < zfar");
   }
   const auto nv = static_cast<std::size_t>(num_vertices);
   if (!colors.empty() && colors.size() != nv) {
@@ -436,6 +488,23 @@ mocap::Status GltfSequenceWriter::AddFrame(std::span<const glm::vec3> positions,
   return mocap::Status::Ok();
 }
 
+mocap::Status GltfSequenceWriter::AddCameraFrame(const glm::vec3& eye, const glm::quat& world_from_camera) {
+  Impl& m = *impl_;
+  if (m.finished) return Invalid("the file was already written");
+  if (!m.options.camera) return Invalid("a camera pose without a camera lens in the options");
+  const std::size_t poses = m.camera_translations.size() / 3;
+  if (poses >= static_cast<std::size_t>(m.num_frames)) {
+    return Invalid("more camera poses than the " + std::to_string(m.num_frames) + " frames announced");
+  }
+  const glm::quat q = glm::normalize(world_from_camera);
+  const bool finite = AllFinite(std::span<const glm::vec3>(&eye, 1)) && std::isfinite(q.x) && std::isfinite(q.y) &&
+                      std::isfinite(q.z) && std::isfinite(q.w);
+  if (!finite) return Invalid("camera pose " + std::to_string(poses) + ": expected finite values and a non-zero rotation");
+  m.camera_translations.insert(m.camera_translations.end(), {eye.x, eye.y, eye.z});
+  m.camera_rotations.insert(m.camera_rotations.end(), {q.x, q.y, q.z, q.w});
+  return mocap::Status::Ok();
+}
+
 mocap::Status GltfSequenceWriter::Finish(const std::string& path) {
   Impl& m = *impl_;
   if (m.finished) return Invalid("the file was already written");
@@ -443,6 +512,11 @@ mocap::Status GltfSequenceWriter::Finish(const std::string& path) {
     return mocap::MakeError(mocap::ErrorCode::kInvalidArgument, {path, 0, 0, {}},
                             "expected " + std::to_string(m.num_frames) + " frames, " +
                                 std::to_string(m.added) + " were added");
+  }
+  if (m.options.camera && m.camera_translations.size() / 3 != static_cast<std::size_t>(m.num_frames)) {
+    return mocap::MakeError(mocap::ErrorCode::kInvalidArgument, {path, 0, 0, {}},
+                            "expected " + std::to_string(m.num_frames) + " camera poses, " +
+                                std::to_string(m.camera_translations.size() / 3) + " were added");
   }
   m.finished = true;  // the model is consumed below, whatever the outcome
   if (m.layout == GltfExportLayout::kBakedMeshes) {

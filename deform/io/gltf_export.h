@@ -27,6 +27,12 @@
 // difference is small next to the vertex data either way).
 // EstimateGltfExportBytes gives both figures.
 //
+// A camera (AddCameraFrame) is written as a glTF perspective camera on its own
+// node "camera" in the scene, its translation and rotation keyed at every
+// frame's time (LINEAR; rotations are unit quaternions, so viewers slerp):
+// viewers that follow a scene's camera show the exported frames as `render`
+// framed them.
+//
 // Units and axes are the caller's (glTF expects metres, +Y up). Every accessor
 // POSITION carries min/max as the specification requires.
 //
@@ -42,10 +48,12 @@
 
 #include <cstddef>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 
 #include <glm/glm.hpp>
+#include <glm/gtc/quaternion.hpp>
 
 #include "mocap/error.h"
 
@@ -53,6 +61,14 @@ namespace deform {
 
 enum class GltfExportLayout : std::uint8_t { kAuto, kMorphTargets, kBakedMeshes };
 const char* GltfExportLayoutName(GltfExportLayout layout);  // "auto", "morph", "baked"
+
+// The lens of an exported camera (glTF 2.0 "cameras", perspective).
+struct GltfCameraLens {
+  float yfov_rad = 0.6f;     // vertical field of view, 0 < yfov < pi
+  float aspect = 16.0f / 9;  // width / height, > 0
+  float znear = 0.01f;       // > 0
+  float zfar = 1000.0f;      // > znear
+};
 
 struct GltfExportOptions {
   double frame_time_s = 1.0 / 30.0;             // seconds between exported frames, > 0
@@ -63,6 +79,8 @@ struct GltfExportOptions {
   // Folder for the scratch file holding the binary data until Finish; empty =
   // the system's temporary folder. Best: the output's folder (same disk).
   std::string scratch_dir = "";
+  // With a lens, every frame also gets a camera pose (AddCameraFrame).
+  std::optional<GltfCameraLens> camera;
 };
 
 // Estimated file sizes in bytes of both layouts (binary data exact, JSON
@@ -98,9 +116,16 @@ class GltfSequenceWriter {
   // kIo (writing the scratch file failed, e.g. disk full).
   mocap::Status AddFrame(std::span<const glm::vec3> positions, std::span<const glm::vec3> normals);
 
+  // With options.camera: the camera of the next frame, as its world position and
+  // its world-from-camera rotation (the camera looks down its -Z with +Y up, as
+  // an OpenGL view). Call once per frame. Errors: kInvalidArgument (no lens in
+  // the options, non-finite values, more poses than frames announced).
+  mocap::Status AddCameraFrame(const glm::vec3& eye, const glm::quat& world_from_camera);
+
   // Writes the .glb to `path` (folder must exist) after exactly num_frames
-  // AddFrame calls. Call once: after it, AddFrame and Finish are errors.
-  // Errors: kInvalidArgument (frame count, second call), kIo, kLimitExceeded
+  // AddFrame calls (and as many AddCameraFrame calls with a lens). Call once:
+  // after it, AddFrame and Finish are errors.
+  // Errors: kInvalidArgument (frame or camera count, second call), kIo, kLimitExceeded
   // (more than 4 GiB).
   mocap::Status Finish(const std::string& path);
 

@@ -6,10 +6,13 @@
 // JSON, is the frame `render` draws for the rig.
 
 #include <algorithm>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <string>
 
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/quaternion.hpp>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -322,6 +325,96 @@ TEST(ExportRoundTrip, BadRigIsRefusedWithoutOutput) {
   EXPECT_FALSE(fs::exists(dir / "out.glb"));
   for (const auto& e : fs::directory_iterator(dir)) {
     EXPECT_EQ(e.path().filename().string().find(".patchskin-glb"), std::string::npos) << e.path();
+  }
+}
+
+}  // namespace
+
+namespace {
+
+// A .glb's JSON chunk and binary chunk, read by hand (not through tinygltf, which wrote it).
+struct Glb {
+  nlohmann::json json;
+  std::string bin;
+
+  std::vector<float> Floats(int accessor) const {
+    const nlohmann::json& a = json["accessors"][static_cast<std::size_t>(accessor)];
+    const nlohmann::json& view = json["bufferViews"][a["bufferView"].get<std::size_t>()];
+    const std::size_t width = a["type"] == "SCALAR" ? 1 : a["type"] == "VEC3" ? 3 : 4;
+    std::vector<float> out(a["count"].get<std::size_t>() * width);
+    const std::size_t offset = view.value("byteOffset", std::size_t{0}) + a.value("byteOffset", std::size_t{0});
+    EXPECT_LE(offset + out.size() * sizeof(float), bin.size());
+    std::memcpy(out.data(), bin.data() + offset, out.size() * sizeof(float));
+    return out;
+  }
+};
+
+Glb ReadGlb(const fs::path& path) {
+  const std::string bytes = testsupport::SlurpFile(path);
+  Glb g;
+  std::uint32_t json_length = 0, bin_length = 0;
+  EXPECT_GE(bytes.size(), 28u);
+  std::memcpy(&json_length, bytes.data() + 12, 4);
+  g.json = nlohmann::json::parse(bytes.substr(20, json_length));
+  std::memcpy(&bin_length, bytes.data() + 20 + json_length, 4);
+  g.bin = bytes.substr(28 + json_length, bin_length);
+  return g;
+}
+
+// Issue 27: `export --with-camera` to a .glb carries the render's camera as a glTF camera
+// node keyed at every frame, in both layouts: at key k its position is the eye of
+// camera_####.json and its node transform inverted is that file's view matrix.
+TEST(ExportRoundTrip, GlbCarriesTheRenderCameraAsAnAnimatedNode) {
+  const fs::path dir = Dir();
+  for (const std::string layout : {"morph", "baked"}) {
+    SCOPED_TRACE(layout);
+    const fs::path out = dir / ("camera_" + layout) / "bend.glb";
+    const testsupport::ProcessResult run = testsupport::RunPatchskin(
+        {"export", BendBvh(), "--frames", "10:30:10", "--with-camera", "--scale", "0.01", "--layout", layout,
+         "--quiet", "--out", out.string()},
+        dir);
+    ASSERT_EQ(run.exit_code, 0) << run.err;
+    const Glb glb = ReadGlb(out);
+    ASSERT_EQ(glb.json["cameras"].size(), 1u);
+    const nlohmann::json& lens = glb.json["cameras"][0]["perspective"];
+    int node = -1;
+    for (std::size_t n = 0; n < glb.json["nodes"].size(); ++n) {
+      if (glb.json["nodes"][n].contains("camera")) node = static_cast<int>(n);
+    }
+    ASSERT_GE(node, 0);
+    const auto& roots = glb.json["scenes"][0]["nodes"];
+    EXPECT_NE(std::find(roots.begin(), roots.end(), node), roots.end()) << "the camera is not in the scene";
+    std::vector<float> times, translations, rotations;
+    for (const nlohmann::json& anim : glb.json["animations"]) {
+      for (const nlohmann::json& c : anim["channels"]) {
+        if (c["target"]["node"] != node) continue;
+        const nlohmann::json& sampler = anim["samplers"][c["sampler"].get<std::size_t>()];
+        times = glb.Floats(sampler["input"]);
+        (c["target"]["path"] == "translation" ? translations : rotations) = glb.Floats(sampler["output"]);
+      }
+    }
+    ASSERT_EQ(times.size(), 3u);
+    ASSERT_EQ(translations.size(), 9u);
+    ASSERT_EQ(rotations.size(), 12u);
+    for (int k = 0; k < 3; ++k) {
+      const int number = 10 + 10 * k;
+      char name[32];
+      std::snprintf(name, sizeof(name), "camera_%04d.json", number);
+      const nlohmann::json cam = nlohmann::json::parse(testsupport::SlurpFile(out.parent_path() / name));
+      EXPECT_NEAR(times[static_cast<std::size_t>(k)], cam["time_s"].get<float>() - 10.0f / 30.0f, 1e-5f) << k;
+      EXPECT_NEAR(lens["yfov"].get<float>(), glm::radians(cam["fov_y_deg"].get<float>()), 1e-6f);
+      EXPECT_NEAR(lens["znear"].get<float>(), cam["near"].get<float>(), 1e-7f);
+      const glm::vec3 eye(translations[3 * k], translations[3 * k + 1], translations[3 * k + 2]);
+      const glm::quat q(rotations[4 * k + 3], rotations[4 * k], rotations[4 * k + 1], rotations[4 * k + 2]);
+      for (int i = 0; i < 3; ++i) EXPECT_NEAR(eye[i], cam["eye"][static_cast<std::size_t>(i)].get<float>(), 1e-6f);
+      const glm::mat4 view = glm::inverse(glm::translate(glm::mat4(1.0f), eye) * glm::mat4_cast(q));
+      for (int c = 0; c < 4; ++c) {
+        for (int r = 0; r < 4; ++r) {
+          EXPECT_NEAR(view[c][r], cam["view"][static_cast<std::size_t>(4 * c + r)].get<float>(), 1e-4f)
+              << "key " << k << " view[" << c << "][" << r << "]";
+        }
+      }
+    }
   }
 }
 
