@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <limits>
 #include <system_error>
 
 #include <opencv2/core.hpp>
@@ -143,11 +144,21 @@ Status VideoWriter::AddFrame(const Image& frame) {
   const int h = std::min(height_, frame.height);
   for (int y = 0; y < h; ++y) {
     auto* row = bgr.ptr<std::uint8_t>(y);
+    // Runs of equal pixels (background rows) reuse the previous pixel's
+    // bytes; NaN never compares equal, so it is always converted.
+    glm::vec3 last(std::numeric_limits<float>::quiet_NaN());
+    std::uint8_t b = 0, g = 0, r = 0;
     for (int x = 0; x < w; ++x) {
-      const glm::vec4& p = frame.at(x, y);
-      row[3 * x + 0] = LinearToSrgb8(p.b);  // OpenCV stores BGR
-      row[3 * x + 1] = LinearToSrgb8(p.g);
-      row[3 * x + 2] = LinearToSrgb8(p.r);
+      const glm::vec3 p(frame.at(x, y));
+      if (!(p == last)) {
+        b = LinearToSrgb8(p.b);  // OpenCV stores BGR
+        g = LinearToSrgb8(p.g);
+        r = LinearToSrgb8(p.r);
+        last = p;
+      }
+      row[3 * x + 0] = b;
+      row[3 * x + 1] = g;
+      row[3 * x + 2] = r;
     }
   }
   if (impl_->h264 != nullptr) {
