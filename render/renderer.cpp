@@ -313,6 +313,7 @@ class Renderer::SampleShader {
                                           SurfacePoints4* deferred, int i) {
     Entry& t = cache_[id & (kCacheSize - 1)];
     if (t.id != id) Load(id, t);
+    if (t.ground) return Kind::kGround;  // most samples: nothing else to compute
     // Perspective-correct weights up to a common scale: edge function times
     // 1/w, as planes in sample space around the triangle's reference sample.
     // (Exact for integer positions: both terms are below 2^24.)
@@ -322,7 +323,6 @@ class Renderer::SampleShader {
     const float w2 = t.wc[2] + t.wa[2] * fx + t.wb[2] * fy;
     const ShadingContext& ctx = r_.context_;
     const LightingModel model = ctx.model;
-    if (t.ground) return Kind::kGround;
     color = glm::vec3(0.0f);
     if (t.lambert_plane) {
       color = LambertPlane(t, fx, fy);
