@@ -674,8 +674,10 @@ void Renderer::ShadeTile(int tile, const RenderSettings& settings,
   // Supersampled: accumulate each output pixel's samples in row-major sample order.
   const int ox0 = x0 / ss, oy0 = y0 / ss, ox1 = x1 / ss, oy1 = y1 / ss;
   const int out_stride = kTileSize / ss;
-  std::fill(s.accum.begin(), s.accum.end(), glm::vec4(0.0f));
-  std::fill(s.nearest.begin(), s.nearest.end(), 0.0f);
+  // Only the tile's (kTileSize / ss)^2 output pixels are used.
+  const auto used = static_cast<std::ptrdiff_t>(out_stride) * out_stride;
+  std::fill(s.accum.begin(), s.accum.begin() + used, glm::vec4(0.0f));
+  std::fill(s.nearest.begin(), s.nearest.begin() + used, 0.0f);
   const int ss_shift = ss == 4 ? 2 : 1;  // ss is 2 or 4 here
   const std::size_t sample_stride = static_cast<std::size_t>(rasterizer_.width());
   glm::vec4* samples = samples_.empty() ? nullptr : samples_.data() + static_cast<std::size_t>(y0) * sample_stride;
