@@ -42,6 +42,10 @@
 #include "mocap/bvh_writer.h"
 #include "mocap/synthetic.h"
 #include "render/output/async_writer.h"
+#include "render/output/contact_sheet.h"
+#include "render/output/serial_task_queue.h"
+#include "render/output/stored_image.h"
+#include "render/output/video_writer.h"
 #include "render/output/image_io.h"
 
 #ifndef PATCHSKIN_BUILD_TYPE
@@ -397,6 +401,90 @@ int RunBench(const BenchOptions& o) {
     e2e.runs.push_back(e2e_frames / std::max(Now(Clock::kWall) - t0, 1e-9));
     e2e_cpu.runs.push_back(e2e_frames / std::max(Now(Clock::kProcess) - c0, 1e-9));
   }
+  // The default render's outputs (PNG frames, H.264 preview, contact sheet),
+  // wired as the render command wires them: PNGs on the async writer's two
+  // workers, video and sheet in frame order on a side thread. `next(i, img)`
+  // fills frame i: either rendered now, or copied from frames rendered before
+  // (encode only). Returns the wall-clock seconds, or < 0 on a failure.
+  const int out_frames = o.quick ? 4 : 12;
+  const auto run_outputs = [&](const std::function<mocap::Status(int, render::Image&)>& next) {
+    const double t0 = Now(Clock::kWall);
+    render::AsyncImageWriter writer({.num_workers = 2, .max_in_flight = 4});
+    auto sheet = render::ContactSheetBuilder::Create(
+        out_frames, 1280, 720, {.columns = render::ContactSheetColumns(out_frames)});
+    auto video = render::VideoWriter::Open((out_dir / "preview.mp4").string(), 1280, 720, {.fps = 30.0});
+    if (!sheet.ok() || !video.ok()) return -1.0;
+    render::SerialTaskQueue side({.max_queued = 2});
+    render::Image img;
+    for (int i = 0; i < out_frames; ++i) {
+      mocap::Status s = next(i, img);
+      char name[32];
+      std::snprintf(name, sizeof(name), "frame_%04d.png", i);
+      if (s.ok()) s = writer.Submit(img, (out_dir / name).string(), png);
+      if (s.ok()) {
+        auto copy = std::make_shared<const render::Image>(img);
+        s = side.Submit([&, i, copy] {
+          const mocap::Result<render::Image> stored =
+              render::AsStored(*copy, render::ImageFormat::kPng, png);
+          if (!stored.ok()) return mocap::Status(stored.error());
+          if (mocap::Status st = (*sheet)->Add(*stored, i); !st.ok()) return st;
+          return (*video)->AddFrame(*copy);
+        });
+      }
+      if (!s.ok()) return -1.0;
+    }
+    if (!side.Finish().ok() || !writer.Finish().ok() || !(*video)->Close().ok()) return -1.0;
+    if (!render::WriteImage((*sheet)->sheet(), (out_dir / "sheet.png").string(), {}).ok()) return -1.0;
+    return Now(Clock::kWall) - t0;
+  };
+  const auto render_frame = [&](render::AntiAlias aa) {
+    return [&, aa](int i, render::Image& img) {
+      const OutputFrame& of = plan->frames[static_cast<std::size_t>(i % e2e_frames)];
+      mocap::Status s = pipeline->Evaluate(of.time_s, frame);
+      if (!s.ok()) return s;
+      render::RenderSettings settings = e2e_settings;
+      settings.antialias = aa;
+      FrameDrawOptions draw;
+      draw.frame_number = of.number;
+      return DrawCharacterFrame(ch, frame, nullptr, cameras->At(of), settings, draw, renderer,
+                                right_renderer, scratch, img);
+    };
+  };
+  std::vector<render::Image> rendered(static_cast<std::size_t>(out_frames));
+  for (int i = 0; i < out_frames; ++i) {
+    if (mocap::Status s = render_frame(render::AntiAlias::kSupersample)(i, rendered[static_cast<std::size_t>(i)]);
+        !s.ok()) {
+      return Fail(s.error());
+    }
+  }
+  const std::string outputs_note = std::to_string(out_frames) + " demo frames, 1280x720, PNG level 1 + H.264 + sheet, " +
+                                   std::to_string(threads) + " threads";
+  Row ssaa_row{"default_render_fps", "frames/s", Clock::kWall, {}, 0.0, "",
+               outputs_note + ", 2x2 supersampling (the default)"};
+  Row msaa_row{"default_render_msaa_fps", "frames/s", Clock::kWall, {}, 0.0, "2x2 ssaa",
+               "the same with --aa msaa; reference: default_render_fps"};
+  Row encode_row{"encode_only_fps", "frames/s", Clock::kWall, {}, 0.0, "",
+                 "the same outputs of those frames already in memory (no render)"};
+  Row bound_row{"encode_bound_ratio", "ratio", Clock::kWall, {}, 0.0, "",
+                "default render time / encode-only time, each repetition's pair (goal <= 1.3)"};
+  for (int r = 0; r < (o.quick ? 1 : 5); ++r) {
+    const double t_encode = run_outputs([&](int i, render::Image& img) {
+      img = rendered[static_cast<std::size_t>(i)];
+      return mocap::Status::Ok();
+    });
+    const double t_ssaa = run_outputs(render_frame(render::AntiAlias::kSupersample));
+    const double t_msaa = run_outputs(render_frame(render::AntiAlias::kMultisample));
+    if (t_encode <= 0.0 || t_ssaa <= 0.0 || t_msaa <= 0.0) {
+      return Fail(mocap::MakeError(mocap::ErrorCode::kInternal, {"bench", 0, 0, {}},
+                                   "the default-render outputs failed"));
+    }
+    encode_row.runs.push_back(out_frames / t_encode);
+    ssaa_row.runs.push_back(out_frames / t_ssaa);
+    msaa_row.runs.push_back(out_frames / t_msaa);
+    bound_row.runs.push_back(t_ssaa / t_encode);
+  }
+  msaa_row.reference = ssaa_row.Median();
+  rendered.clear();
   const std::string png_path = (out_dir / "encode.png").string();
   Row encode{"png_encode_fps", "frames/s", Clock::kCpu, {}, 0.0, "",
              "one 1280x720 frame, level 1, no filter (encode + write only)"};
@@ -406,6 +494,10 @@ int RunBench(const BenchOptions& o) {
   rows.push_back(std::move(e2e));
   rows.push_back(std::move(e2e_cpu));
   rows.push_back(std::move(encode));
+  rows.push_back(std::move(ssaa_row));
+  rows.push_back(std::move(msaa_row));
+  rows.push_back(std::move(encode_row));
+  rows.push_back(std::move(bound_row));
   bench::AddElasticShareRow({std::min(budget.runs, 5), 0.0}, o.quick ? 8 : 30, rows, &failed);
   rows.push_back({"bytes_per_bound_vertex", "bytes", Clock::kCpu,
                   {static_cast<double>(deform::PatchBinding::kStoredBytesPerVertex)}, 0.0, "",

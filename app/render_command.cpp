@@ -220,6 +220,10 @@ CLI::App* AddRenderCommand(CLI::App& parent, RenderOptions& o) {
   cmd->add_option("--resolve", o.resolve,
                   "Supersample filter: box (the pixel's own samples) or tent (radius one pixel, softer)")
       ->capture_default_str();
+  cmd->add_option("--aa", o.aa,
+                  "How samples are shaded: ssaa (every sample) or msaa (once per pixel inside a "
+                  "triangle; edges and ground per sample)")
+      ->capture_default_str();
   cmd->add_option("--png-compression", o.png_compression, "PNG zlib level 0..9")
       ->capture_default_str();
   cmd->add_flag("--no-sheet", o.no_sheet, "Do not write the contact sheet");
@@ -258,6 +262,7 @@ CLI::App* AddTurntableCommand(CLI::App& parent, RenderOptions& o) {
   cmd->add_option("--threads", o.threads, "Worker threads (0 = all cores)");
   cmd->add_option("--supersample", o.supersample, "Anti-aliasing samples per axis: 1, 2 or 4");
   cmd->add_option("--resolve", o.resolve, "Supersample filter: box or tent");
+  cmd->add_option("--aa", o.aa, "Sample shading: ssaa or msaa");
   cmd->add_flag("--no-sheet", o.no_sheet, "Do not write the contact sheet");
   cmd->add_flag("--no-video", o.no_video, "Do not write the preview video");
   cmd->add_flag("--quiet", o.quiet, "No progress output");
@@ -340,6 +345,9 @@ int RunRender(const RenderOptions& options) {
     return Fail(ArgError("--size", "expected at most " + std::to_string(kMaxFrameSamples) +
                                        " samples per frame (width x height x supersample^2), found " +
                                        o.size + " at supersample " + std::to_string(o.supersample)));
+  }
+  if (o.aa != "ssaa" && o.aa != "msaa") {
+    return Fail(ArgError("--aa", "expected ssaa or msaa, found '" + o.aa + "'"));
   }
   if (o.resolve != "box" && o.resolve != "tent") {
     return Fail(ArgError("--resolve", "expected box or tent, found '" + o.resolve + "'"));
@@ -566,6 +574,8 @@ int RunRender(const RenderOptions& options) {
   settings.height = size->y;
   settings.supersample = o.supersample;
   settings.resolve = o.resolve == "tent" ? render::ResolveFilter::kTent : render::ResolveFilter::kBox;
+  settings.antialias =
+      o.aa == "ssaa" ? render::AntiAlias::kSupersample : render::AntiAlias::kMultisample;
   settings.threads = o.threads;
   settings.ground_at_scene_min = false;
   settings.ground_y = ground_y;

@@ -72,6 +72,17 @@ void WriteDepthRow(const float* inv_w, const std::uint32_t* ids, int n, float* o
   for (; i < n; ++i) StreamStore(out + i, ids[i] != kNoTriangle ? 1.0f / inv_w[i] : kInf);
 }
 
+// Multisampling: whether all ss x ss samples of the pixel starting at column
+// c0 of `ids` (the pixel row's first sample row, stride kTileSize) saw `id`.
+bool PixelAllOf(const std::uint32_t* ids, int c0, int ss, std::uint32_t id) {
+  for (int r = 0; r < ss; ++r) {
+    const std::uint32_t* row = ids + static_cast<std::size_t>(r) * kTileSize + c0;
+    for (int c = 0; c < ss; ++c)
+      if (row[c] != id) return false;
+  }
+  return true;
+}
+
 mocap::JobStatus Fail(mocap::JobStatus::Code code, const char* what) { return {code, what}; }
 
 mocap::JobStatus ValidateInputs(std::span<const SceneMesh> meshes, const RenderSettings& s) {
@@ -289,26 +300,29 @@ class Renderer::SampleShader {
 
   [[gnu::always_inline]] glm::vec3 Shade(std::uint32_t id, int sx, int sy) {
     glm::vec3 color;
-    if (ShadeSample(id, sx, sy, color, nullptr, 0) == Kind::kGround)
+    if (ShadeSample(id, static_cast<float>(sx), static_cast<float>(sy), color, nullptr, 0) ==
+        Kind::kGround)
       return r_.ground_shader_.Shade(sx, sy);
     return color;
   }
 
-  // The colour of sample (sx, sy) of triangle `id`; with `deferred` set,
-  // Blinn-Phong surfaces are left to ShadeSurface4 (four samples at a time).
-  [[gnu::always_inline]] Kind ShadeSample(std::uint32_t id, int sx, int sy, glm::vec3& color,
+  // The colour of triangle `id` at sample position (sx, sy) (integers: sample
+  // centres; multisampling passes a centroid between them); with `deferred`
+  // set, Blinn-Phong surfaces are left to ShadeSurface4 (four at a time).
+  [[gnu::always_inline]] Kind ShadeSample(std::uint32_t id, float sx, float sy, glm::vec3& color,
                                           SurfacePoints4* deferred, int i) {
     Entry& t = cache_[id & (kCacheSize - 1)];
     if (t.id != id) Load(id, t);
+    if (t.ground) return Kind::kGround;  // most samples: nothing else to compute
     // Perspective-correct weights up to a common scale: edge function times
     // 1/w, as planes in sample space around the triangle's reference sample.
-    const auto fx = static_cast<float>(sx - t.ref_x), fy = static_cast<float>(sy - t.ref_y);
+    // (Exact for integer positions: both terms are below 2^24.)
+    const float fx = sx - static_cast<float>(t.ref_x), fy = sy - static_cast<float>(t.ref_y);
     const float w0 = t.wc[0] + t.wa[0] * fx + t.wb[0] * fy;
     const float w1 = t.wc[1] + t.wa[1] * fx + t.wb[1] * fy;
     const float w2 = t.wc[2] + t.wa[2] * fx + t.wb[2] * fy;
     const ShadingContext& ctx = r_.context_;
     const LightingModel model = ctx.model;
-    if (t.ground) return Kind::kGround;
     color = glm::vec3(0.0f);
     if (t.lambert_plane) {
       color = LambertPlane(t, fx, fy);
@@ -386,7 +400,8 @@ class Renderer::SampleShader {
       return Kind::kColor;
     }
     glm::vec3 c;
-    const Kind kind = ShadeSample(id, sx, sy, c, deferred, i);
+    const Kind kind =
+        ShadeSample(id, static_cast<float>(sx), static_cast<float>(sy), c, deferred, i);
     if (kind != Kind::kColor) return kind;
     _mm_store_ps(base, _mm_set_ps(1.0f, c.z, c.y, c.x));
     _mm_store_ps(key, _mm_setzero_ps());
@@ -659,42 +674,79 @@ void Renderer::ShadeTile(int tile, const RenderSettings& settings,
   // Supersampled: accumulate each output pixel's samples in row-major sample order.
   const int ox0 = x0 / ss, oy0 = y0 / ss, ox1 = x1 / ss, oy1 = y1 / ss;
   const int out_stride = kTileSize / ss;
-  std::fill(s.accum.begin(), s.accum.end(), glm::vec4(0.0f));
-  std::fill(s.nearest.begin(), s.nearest.end(), inf);
+  // Only the tile's (kTileSize / ss)^2 output pixels are used.
+  const auto used = static_cast<std::ptrdiff_t>(out_stride) * out_stride;
+  std::fill(s.accum.begin(), s.accum.begin() + used, glm::vec4(0.0f));
+  std::fill(s.nearest.begin(), s.nearest.begin() + used, 0.0f);
+  const int ss_shift = ss == 4 ? 2 : 1;  // ss is 2 or 4 here
   const std::size_t sample_stride = static_cast<std::size_t>(rasterizer_.width());
   glm::vec4* samples = samples_.empty() ? nullptr : samples_.data() + static_cast<std::size_t>(y0) * sample_stride;
+  const bool multisample = settings.antialias == AntiAlias::kMultisample;
+  const auto ground_mesh = static_cast<std::uint32_t>(meshes.size());
+  // The colours of the current pixel row's sample rows (multisampling copies
+  // a colour from an earlier sample of the same pixel).
+  glm::vec3 color_rows[4][kTileSize];
   for (int sy = y0; sy < y1; ++sy) {
     const glm::vec3 bg = background_rows_[static_cast<std::size_t>(sy)];
     const std::size_t row = static_cast<std::size_t>(sy - y0) * kTileSize;
     const std::size_t out_row = static_cast<std::size_t>((sy - y0) / ss) * static_cast<std::size_t>(out_stride);
+    const int j = (sy - y0) % ss;  // sample row within the pixel
+    const std::uint32_t* pixel_row_ids = s.ids.data() + row - static_cast<std::size_t>(j) * kTileSize;
     // The row's colours first, so the ground's samples are shaded four at a time.
-    glm::vec3 color[kTileSize];
+    glm::vec3* color = color_rows[j];
+    int from[kTileSize];  // multisampling: where in color_rows this sample's colour is, or -1
     bool ground[kTileSize + 3] = {}, surface[kTileSize + 3] = {};
     SurfacePoints4 deferred[kTileSize / 4];
     bool any_ground = false, any_surface = false;
+    bool any_copy = false;
     for (int sx = x0; sx < x1; ++sx) {
       const std::uint32_t id = s.ids[row + static_cast<std::size_t>(sx - x0)];
       const int i = sx - x0;
+      from[i] = -1;
       if (id == kNoTriangle) continue;
+      glm::vec2 at(static_cast<float>(sx), static_cast<float>(sy));
+      // A pixel inside one triangle is shaded once, at its centre (where the
+      // mean of its samples' positions is); its other samples copy that
+      // colour. Pixels on an edge are shaded per sample, so edges are exactly
+      // supersampling's. The ground's grid lines are thinner than a pixel far
+      // away: it is shaded per sample everywhere.
+      if (multisample && rasterizer_.triangle(id).mesh != ground_mesh) {
+        const int c0 = i - i % ss;
+        if (PixelAllOf(pixel_row_ids, c0, ss, id)) {
+          if (i != c0 || j != 0) {
+            from[i] = c0;  // the pixel's first sample, row 0 of color_rows
+            any_copy = true;
+            continue;
+          }
+          const float centre = 0.5f * static_cast<float>(ss - 1);
+          at += glm::vec2(centre);
+        }
+      }
       const SampleShader::Kind kind =
-          shader.ShadeSample(id, sx, sy, color[static_cast<std::size_t>(i)], deferred, i);
+          shader.ShadeSample(id, at.x, at.y, color[static_cast<std::size_t>(i)], deferred, i);
       if (kind == SampleShader::Kind::kGround) ground[i] = any_ground = true;
       if (kind == SampleShader::Kind::kDeferred) surface[i] = any_surface = true;
     }
     auto store_color = [&](int i, const glm::vec3& c) { color[static_cast<std::size_t>(i)] = c; };
     if (any_ground) ShadeGroundRow(x0, sy, x1 - x0, ground, store_color);
     if (any_surface) ShadeSurfaceRow(x1 - x0, surface, deferred, store_color);
+    if (any_copy) {
+      for (int i = 0; i < x1 - x0; ++i)
+        if (from[i] >= 0) color[i] = color_rows[from[i] / kTileSize][from[i] % kTileSize];
+    }
     for (int sx = x0; sx < x1; ++sx) {
       const std::size_t at = row + static_cast<std::size_t>(sx - x0);
       const std::uint32_t id = s.ids[at];
-      glm::vec4& acc = s.accum[out_row + static_cast<std::size_t>((sx - x0) / ss)];
+      const std::size_t pixel = out_row + static_cast<std::size_t>((sx - x0) >> ss_shift);
+      glm::vec4& acc = s.accum[pixel];
       glm::vec4 sample(0.0f);
       if (id == kNoTriangle) {
         if (!transparent) sample = glm::vec4(bg, 0.0f);
       } else {
         sample = glm::vec4(color[static_cast<std::size_t>(sx - x0)], 1.0f);
-        float& nearest = s.nearest[out_row + static_cast<std::size_t>((sx - x0) / ss)];
-        nearest = std::min(nearest, 1.0f / s.depth[at]);
+        // The largest 1/w; its reciprocal is the smallest of the samples'
+        // reciprocals (rounded division is monotone), one divide per pixel.
+        s.nearest[pixel] = std::max(s.nearest[pixel], s.depth[at]);
       }
       if (id != kNoTriangle || !transparent) acc += sample;
       if (samples != nullptr) samples[static_cast<std::size_t>(sx)] = sample;
@@ -715,7 +767,7 @@ void Renderer::ShadeTile(int tile, const RenderSettings& settings,
       } else {
         image.rgba[out] = glm::vec4(glm::vec3(acc) * inv_n, 1.0f);
       }
-      if (write_depth) image.depth[out] = s.nearest[local];
+      if (write_depth) image.depth[out] = s.nearest[local] > 0.0f ? 1.0f / s.nearest[local] : inf;
     }
   }
 }

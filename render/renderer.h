@@ -10,7 +10,8 @@
 // and binning, then per 64x64-sample tile: visibility (z-buffer) pass,
 // deferred shading of each visible sample once, box resolve of the
 // supersample x supersample samples of each output pixel (or, for a tent
-// resolve, a second pass over the kept samples); then overlays.
+// resolve, a second pass over the kept samples); then overlays. With
+// multisampling a pixel inside one triangle is shaded once.
 // Output bytes are identical for any thread count.
 
 #include <cstdint>
@@ -57,11 +58,27 @@ enum class ResolveFilter {
   kTent,
 };
 
+// How the supersample x supersample samples of a pixel are shaded.
+enum class AntiAlias {
+  // Every sample is shaded (ss^2 shades a pixel). The default.
+  kSupersample,
+  // Multisampling: depth and coverage per sample as above, but a pixel whose
+  // samples all see the same mesh triangle is shaded once, at its centre, and
+  // that colour goes to all of its samples; pixels on an edge and the ground
+  // (its grid lines get thinner than a pixel) are still shaded per sample, so
+  // edges equal supersampling's. Measured (bench/RESULTS.md) it is not faster
+  // on the demo, where the ground is 80% of the samples, and its interiors are
+  // a little further from a 4x4 reference than supersampling's (one shade
+  // instead of the mean of four): opt-in.
+  kMultisample,
+};
+
 struct RenderSettings {
   int width = 1280;        // output pixels, >= 1; width * supersample <= 16384
   int height = 720;        // output pixels, >= 1; height * supersample <= 16384
   int supersample = 1;     // samples per axis per pixel: 1, 2 or 4
   ResolveFilter resolve = ResolveFilter::kBox;  // with supersample 1 both are the identity
+  AntiAlias antialias = AntiAlias::kSupersample;  // with supersample 1 both are the identity
   int threads = 0;         // worker threads; 0 = hardware concurrency
   bool cull_back_faces = false;
   bool clip_far = false;   // clip at camera.far_plane: nothing beyond it is drawn (see RasterSettings)
@@ -95,7 +112,7 @@ class Renderer {
     std::vector<float> depth;               // kTileSize^2 samples, 1/view depth
     std::vector<std::uint32_t> ids;         // kTileSize^2 samples
     std::vector<glm::vec4> accum;           // output pixels of one tile: rgb sum, covered count
-    std::vector<float> nearest;             // output pixels of one tile: min view depth
+    std::vector<float> nearest;             // output pixels of one tile: max 1/w (0 = empty)
   };
   class SampleShader;
   // Tent resolve only (it also fills samples_); the box resolve writes

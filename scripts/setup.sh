@@ -11,6 +11,7 @@ packages=(
   libtinygltf-dev nlohmann-json3-dev libstb-dev
   libopenimageio-dev openimageio-tools
   libopencv-core-dev libopencv-imgproc-dev libopencv-imgcodecs-dev libopencv-videoio-dev
+  libavcodec-dev libavformat-dev libavutil-dev libswscale-dev  # H.264 preview, x264 preset
   libcli11-dev
   libfast-float-dev
   libassimp-dev

@@ -2,12 +2,14 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <limits>
 #include <system_error>
 
 #include <opencv2/core.hpp>
 #include <opencv2/videoio.hpp>
 
 #include "render/output/image_io.h"
+#include "render/output/internal/h264_encoder.h"
 
 namespace render {
 namespace {
@@ -40,9 +42,14 @@ CodecInfo Info(VideoCodec codec) {
 
 }  // namespace
 
+// x264's preset for the H.264 preview: real time on one core at 1280x720.
+constexpr const char* kX264Preset = "veryfast";
+
 struct VideoWriter::Impl {
-  cv::VideoWriter writer;
+  std::unique_ptr<internal::H264Encoder> h264;  // H.264 through libavcodec, or
+  cv::VideoWriter writer;                       // any codec through OpenCV
   cv::Mat bgr;  // reused conversion buffer, height x width 8-bit BGR
+  bool is_open() const { return h264 != nullptr || writer.isOpened(); }
 };
 
 const char* VideoCodecName(VideoCodec codec) {
@@ -79,7 +86,15 @@ Result<std::unique_ptr<VideoWriter>> VideoWriter::Open(const std::string& path, 
     // OpenCV picks the container from the extension, so the temporary name keeps it.
     const std::filesystem::path temp = TemporaryPathFor(final_path.string(), info.extension);
     bool opened = false;
-    try {
+    std::string libav_error;
+    // H.264 with a real-time preset through libavcodec first (an odd size
+    // cannot be 4:2:0: OpenCV then decides), else through OpenCV.
+    if (codec == VideoCodec::kH264Mp4 && width % 2 == 0 && height % 2 == 0) {
+      w->impl_->h264 = internal::H264Encoder::Open(temp.string(), width, height, options.fps,
+                                                   kX264Preset, &libav_error);
+      opened = w->impl_->h264 != nullptr;
+    }
+    if (!opened) try {
       const int fourcc =
           cv::VideoWriter::fourcc(info.fourcc[0], info.fourcc[1], info.fourcc[2], info.fourcc[3]);
       opened = w->impl_->writer.open(temp.string(), cv::CAP_FFMPEG, fourcc, options.fps,
@@ -102,7 +117,8 @@ Result<std::unique_ptr<VideoWriter>> VideoWriter::Open(const std::string& path, 
 }
 
 VideoWriter::~VideoWriter() {
-  if (impl_ && impl_->writer.isOpened()) {
+  if (impl_ && impl_->is_open()) {
+    impl_->h264.reset();
     impl_->writer.release();
     std::error_code ec;
     std::filesystem::remove(temp_path_, ec);
@@ -110,7 +126,7 @@ VideoWriter::~VideoWriter() {
 }
 
 Status VideoWriter::AddFrame(const Image& frame) {
-  if (!impl_->writer.isOpened()) {
+  if (!impl_->is_open()) {
     return MakeError(ErrorCode::kIo, LocOf(path_), "video is closed");
   }
   if (frame.width < 1 || frame.height < 1 ||
@@ -128,12 +144,29 @@ Status VideoWriter::AddFrame(const Image& frame) {
   const int h = std::min(height_, frame.height);
   for (int y = 0; y < h; ++y) {
     auto* row = bgr.ptr<std::uint8_t>(y);
+    // Runs of equal pixels (background rows) reuse the previous pixel's
+    // bytes; NaN never compares equal, so it is always converted.
+    glm::vec3 last(std::numeric_limits<float>::quiet_NaN());
+    std::uint8_t b = 0, g = 0, r = 0;
     for (int x = 0; x < w; ++x) {
-      const glm::vec4& p = frame.at(x, y);
-      row[3 * x + 0] = LinearToSrgb8(p.b);  // OpenCV stores BGR
-      row[3 * x + 1] = LinearToSrgb8(p.g);
-      row[3 * x + 2] = LinearToSrgb8(p.r);
+      const glm::vec3 p(frame.at(x, y));
+      if (!(p == last)) {
+        b = LinearToSrgb8(p.b);  // OpenCV stores BGR
+        g = LinearToSrgb8(p.g);
+        r = LinearToSrgb8(p.r);
+        last = p;
+      }
+      row[3 * x + 0] = b;
+      row[3 * x + 1] = g;
+      row[3 * x + 2] = r;
     }
+  }
+  if (impl_->h264 != nullptr) {
+    std::string error;
+    if (!impl_->h264->Write(bgr.ptr<std::uint8_t>(0), static_cast<int>(bgr.step[0]), &error))
+      return MakeError(ErrorCode::kIo, LocOf(path_), "FFmpeg: " + error);
+    ++frames_;
+    return Status::Ok();
   }
   try {
     impl_->writer.write(bgr);
@@ -145,8 +178,18 @@ Status VideoWriter::AddFrame(const Image& frame) {
 }
 
 Status VideoWriter::Close() {
-  if (!impl_->writer.isOpened()) {
+  if (!impl_->is_open()) {
     return MakeError(ErrorCode::kIo, LocOf(path_), "video is already closed");
+  }
+  if (impl_->h264 != nullptr) {
+    std::string error;
+    const bool closed = impl_->h264->Close(&error);
+    impl_->h264.reset();
+    if (!closed) {
+      std::error_code ignored;
+      std::filesystem::remove(temp_path_, ignored);
+      return MakeError(ErrorCode::kIo, LocOf(path_), "FFmpeg: " + error);
+    }
   }
   impl_->writer.release();
   std::error_code ec;

@@ -1,9 +1,12 @@
 #pragma once
-// Preview video through OpenCV's VideoWriter (OpenCV stays in video_writer.cpp).
+// Preview video (OpenCV and FFmpeg stay in the .cpp files).
 // Tries, in order, H.264 in MP4 ("avc1"), MPEG-4 Part 2 in MP4 ("mp4v") and Motion
 // JPEG in AVI ("MJPG"), whichever this machine's OpenCV/FFmpeg can encode, and
 // says which one it used. The MJPEG fallback replaces the path's extension by .avi.
-// Debian 12's OpenCV 4.6 with FFmpeg 5.1 writes all three.
+// Debian 12's OpenCV 4.6 with FFmpeg 5.1 writes all three. H.264 at an even size
+// goes through libavcodec directly with x264's "veryfast" preset on one thread
+// (internal/h264_encoder.h): OpenCV cannot set a preset, and its default one made
+// the preview the slowest output of a render. OpenCV's avc1 is its fallback.
 //
 // Like frames, the video is written under a temporary name in the same folder
 // and renamed on Close(), so a half-written video never has the final name.

@@ -205,6 +205,7 @@ TEST(CliBadInput, BadRenderOptions) {
       {{"--threads", "10000"}, "--threads", "expected 0..256"},
       {{"--supersample", "0"}, "--supersample", "expected 1, 2 or 4"},
       {{"--png-compression", "10"}, "--png-compression", "expected 0..9"},
+      {{"--aa", "fxaa"}, "--aa", "expected ssaa or msaa"},
       {{"--turntable-frames", "0"}, "--turntable-frames", "expected 1..100000"},
       {{"--elevation", "nan"}, "--elevation", "expected degrees in -89..89"},
       {{"--elevation", "90"}, "--elevation", "expected degrees in -89..89"},

@@ -143,6 +143,7 @@ TEST(ResolveTest, LambertRowPathMatchesPerSamplePathBitForBit) {
   s.width = w;
   s.height = h;
   s.supersample = 2;
+  s.antialias = render::AntiAlias::kSupersample;  // every sample shaded, as the 1x1 render
   const render::Image coarse = render::Render(cam, meshes, {}, s);
   int lit = 0;
   for (int y = 0; y < h; ++y) {
