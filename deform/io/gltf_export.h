@@ -80,7 +80,7 @@ struct GltfExportOptions {
   // the system's temporary folder. Best: the output's folder (same disk).
   std::string scratch_dir = "";
   // With a lens, every frame also gets a camera pose (AddCameraFrame).
-  std::optional<GltfCameraLens> camera;
+  std::optional<GltfCameraLens> camera = std::nullopt;
 };
 
 // Estimated file sizes in bytes of both layouts (binary data exact, JSON
