@@ -170,7 +170,7 @@ mocap::Result<RigPoseSpaces> BuildRigPoseSpaces(const Rig& rig, const Character&
       std::vector<deform::ExampleEdit> edits;
       for (const RigEdit& e : ex.edits) {
         edits.push_back({.vertex = e.vertex, .uv = e.point, .move = e.move, .world_frame = e.world,
-                         .loc = {rig.file, 0, 0, e.path}});
+                         .radius = e.radius, .loc = {rig.file, 0, 0, e.path}});
       }
       const deform::ExamplePose pose{
           .model_from_bind = palette,

@@ -24,6 +24,9 @@ constexpr std::size_t kMaxEdits = 256;
 // Largest |component| of a move (model units) and of a joint angle (degrees).
 constexpr double kMaxMove = 1e6;
 constexpr double kMaxAngleDeg = 360.0;
+// Range of a brush edit's radius, in the patch's (u, v) units.
+constexpr double kMinBrushRadius = 0.01;
+constexpr double kMaxBrushRadius = 2.0;
 
 struct Ctx {
   std::string file;
@@ -98,7 +101,7 @@ std::optional<mocap::Error> ParsePose(const Ctx& c, const json& v, const std::st
 
 std::optional<mocap::Error> ParseEdit(const Ctx& c, const json& v, const std::string& path,
                                       RigEdit& edit) {
-  if (auto e = c.Keys(v, path, {"vertex", "point", "move", "frame"})) return e;
+  if (auto e = c.Keys(v, path, {"vertex", "point", "move", "frame", "radius"})) return e;
   edit.path = path;
   if (v.contains("vertex") == v.contains("point")) {
     return c.Fail(path, "expected exactly one of \"vertex\" (a mesh vertex index) or \"point\" "
@@ -125,6 +128,13 @@ std::optional<mocap::Error> ParseEdit(const Ctx& c, const json& v, const std::st
       return c.Expected(path + ".frame", "\"bind\" or \"world\"", f);
     }
     edit.world = f.get<std::string>() == "world";
+  }
+  if (v.contains("radius")) {
+    // Parameter units of the patch's (u, v) square: a brush (issue 26).
+    if (!NumberIn(v["radius"], kMinBrushRadius, kMaxBrushRadius)) {
+      return c.Expected(path + ".radius", "a brush radius in 0.01..2 ((u, v) units)", v["radius"]);
+    }
+    edit.radius = v["radius"].get<double>();
   }
   return std::nullopt;
 }

@@ -1,0 +1,46 @@
+#include "deform/patch/fold_measure.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+namespace {
+
+// Two triangles hinged on the edge (0,0,0)-(1,0,0): the first in the plane
+// z = 0, the second turned about the x axis by `angle_deg`; the normals then
+// differ by exactly that angle.
+std::vector<glm::vec3> Hinge(double angle_deg) {
+  const double a = angle_deg * std::numbers::pi / 180.0;
+  return {{0, 0, 0}, {1, 0, 0}, {0.5f, -1, 0},
+          {0.5f, static_cast<float>(std::cos(a)), static_cast<float>(std::sin(a))}};
+}
+const std::vector<glm::uvec3> kHingeTriangles{{0, 2, 1}, {0, 1, 3}};
+
+TEST(FoldMeasure, HingeGivesItsAngle) {
+  for (double angle : {0.0, 10.0, 45.0, 90.0, 150.0}) {
+    const std::vector<glm::vec3> p = Hinge(angle);
+    const std::vector<int> both{0, 1};
+    EXPECT_NEAR(deform::MaxFoldAngleDeg(p, kHingeTriangles, both), angle, 1e-3) << angle;
+  }
+}
+
+TEST(FoldMeasure, OnlyTrianglesOfTheSubsetAndSharedEdgesCount) {
+  const std::vector<glm::vec3> p = Hinge(60.0);
+  const std::vector<int> one{0};
+  EXPECT_EQ(deform::MaxFoldAngleDeg(p, kHingeTriangles, one), 0.0);
+  // A region without vertex 3 holds only the first triangle.
+  const std::vector<int> region{0, 1, 2};
+  EXPECT_EQ(deform::RegionTriangles(kHingeTriangles, region, 4), std::vector<int>{0});
+  const std::vector<int> all{3, 2, 1, 0, 7};
+  EXPECT_EQ(deform::RegionTriangles(kHingeTriangles, all, 4), (std::vector<int>{0, 1}));
+}
+
+TEST(FoldMeasure, SkipsDegenerateTriangles) {
+  std::vector<glm::vec3> p = Hinge(80.0);
+  p[3] = {0.5f, 0.0f, 0.0f};  // on the hinge edge: zero area
+  const std::vector<int> both{0, 1};
+  EXPECT_EQ(deform::MaxFoldAngleDeg(p, kHingeTriangles, both), 0.0);
+}
+
+}  // namespace
