@@ -43,4 +43,26 @@ TEST(FoldMeasure, SkipsDegenerateTriangles) {
   EXPECT_EQ(deform::MaxFoldAngleDeg(p, kHingeTriangles, both), 0.0);
 }
 
+// A prism of n sides (each side two triangles): neighbouring sides' normals
+// differ by 360/n degrees, the two triangles of one side by 0.
+TEST(FoldMeasure, PrismSidesDifferByTheirTurn) {
+  for (int n : {6, 12, 40}) {
+    std::vector<glm::vec3> p;
+    std::vector<glm::uvec3> tris;
+    for (int k = 0; k < n; ++k) {
+      const double a = 2.0 * std::numbers::pi * k / n;
+      p.emplace_back(std::cos(a), std::sin(a), 0.0);
+      p.emplace_back(std::cos(a), std::sin(a), 1.0);
+    }
+    for (unsigned k = 0; k < static_cast<unsigned>(n); ++k) {
+      const unsigned a = 2 * k, b = 2 * ((k + 1) % static_cast<unsigned>(n));
+      tris.push_back({a, b, b + 1});
+      tris.push_back({a, b + 1, a + 1});
+    }
+    std::vector<int> all(tris.size());
+    for (std::size_t t = 0; t < all.size(); ++t) all[t] = static_cast<int>(t);
+    EXPECT_NEAR(deform::MaxFoldAngleDeg(p, tris, all), 360.0 / n, 1e-3) << n;
+  }
+}
+
 }  // namespace
