@@ -56,7 +56,12 @@ struct RigExamplePose {
 
 struct RigExample {
   RigExamplePose pose;
-  std::vector<RigEdit> edits;  // at least one, solved together
+  // "auto": computed correction (deform/shapes/corrective_example.h):
+  // "volume" (region volume back to bind), "rest" (toward the bind shape
+  // carried by the driving bone), or empty (none). Edits then move the
+  // corrected shape further.
+  std::string auto_kind;
+  std::vector<RigEdit> edits;  // solved together; at least one unless auto_kind is set
   std::string path;            // "patches[i].examples[k]"
 };
 

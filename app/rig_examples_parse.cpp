@@ -216,12 +216,31 @@ std::optional<mocap::Error> ParsePatchExamples(const std::string& file, const js
   for (std::size_t k = 0; k < list.size(); ++k) {
     const std::string epath = lpath + "[" + std::to_string(k) + "]";
     const json& ex = list[k];
-    if (auto e = c.Keys(ex, epath, {"pose", "edits"})) return e;
+    if (auto e = c.Keys(ex, epath, {"pose", "edits", "auto"})) return e;
     RigExample example;
     example.path = epath;
     if (!ex.contains("pose")) return c.Fail(epath + ".pose", "missing ({\"frame\": N} or {\"joints\": {...}})");
     if (auto e = ParsePose(c, ex["pose"], epath + ".pose", example.pose)) return e;
-    if (!ex.contains("edits")) return c.Fail(epath + ".edits", "missing (an array of edits)");
+    if (ex.contains("auto")) {
+      const json& a = ex["auto"];
+      if (!a.is_string() || (a.get<std::string>() != "volume" && a.get<std::string>() != "rest")) {
+        return c.Expected(epath + ".auto", "\"volume\" or \"rest\"", a);
+      }
+      example.auto_kind = a.get<std::string>();
+    }
+    if (!ex.contains("edits") && !example.auto_kind.empty()) {
+      for (const RigExample& other : out.examples) {
+        if (SamePose(other.pose, example.pose)) {
+          return c.Fail(epath + ".pose", "duplicates the pose of " + other.path +
+                                             " (one example per pose: merge their edits)");
+        }
+      }
+      out.examples.push_back(std::move(example));
+      continue;
+    }
+    if (!ex.contains("edits")) {
+      return c.Fail(epath + ".edits", "missing (an array of edits, or \"auto\": \"volume\" | \"rest\")");
+    }
     const json& edits = ex["edits"];
     if (!edits.is_array() || edits.empty() || edits.size() > kMaxEdits) {
       return c.Expected(epath + ".edits", "an array of 1.." + std::to_string(kMaxEdits) + " edits",

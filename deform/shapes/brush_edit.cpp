@@ -8,6 +8,8 @@
 #include <Eigen/Sparse>
 #include <Eigen/SparseCholesky>
 
+#include "deform/shapes/internal/control_grid.h"
+
 namespace deform {
 namespace {
 
@@ -74,30 +76,6 @@ void AddRhs(const SparseRow& row, const std::vector<int>& free_index, double wei
   }
 }
 
-// mu * L2^T L2 of the second differences along u and v (fixed points are zero
-// values, so their columns are simply dropped).
-void AddSmoothness(int nu, int nv, const std::vector<int>& free_index, double mu,
-                   std::vector<Triplet>& entries) {
-  auto add_stencil = [&](const std::array<int, 3>& idx) {
-    const std::array<double, 3> c{1.0, -2.0, 1.0};
-    for (int a = 0; a < 3; ++a) {
-      const int fa = free_index[static_cast<std::size_t>(idx[static_cast<std::size_t>(a)])];
-      if (fa < 0) continue;
-      for (int b = 0; b < 3; ++b) {
-        const int fb = free_index[static_cast<std::size_t>(idx[static_cast<std::size_t>(b)])];
-        if (fb < 0) continue;
-        entries.emplace_back(fa, fb, mu * c[static_cast<std::size_t>(a)] * c[static_cast<std::size_t>(b)]);
-      }
-    }
-  };
-  for (int i = 0; i < nu; ++i) {
-    for (int j = 0; j < nv; ++j) {
-      if (i > 0 && i + 1 < nu) add_stencil({(i - 1) * nv + j, i * nv + j, (i + 1) * nv + j});
-      if (j > 0 && j + 1 < nv) add_stencil({i * nv + j - 1, i * nv + j, i * nv + j + 1});
-    }
-  }
-}
-
 }  // namespace
 
 double BrushFalloff(double x) {
@@ -128,17 +106,8 @@ mocap::Result<ManipulationResult> SolveBrushStrokes(const BSplineSurface& surfac
     return Invalid("expected a free mask of " + std::to_string(num_c) + " entries, found " +
                    std::to_string(options.free_mask.size()));
   }
-  std::vector<int> free_index(num_c, -1);
-  int nf = 0;
-  for (int i = 0; i < nu; ++i) {
-    for (int j = 0; j < nv; ++j) {
-      const auto c = static_cast<std::size_t>(i * nv + j);
-      const bool free = options.free_mask.empty()
-                            ? (i > 0 && i + 1 < nu && j > 0 && j + 1 < nv)
-                            : options.free_mask[c] != 0;
-      if (free) free_index[c] = nf++;
-    }
-  }
+  std::vector<int> free_index;
+  const int nf = internal::FreeIndex(nu, nv, options.free_mask, free_index);
   if (nf == 0) return Invalid("expected at least one free control point, found none");
 
   // Field fit over an su x sv grid covering the whole domain, weight 1/S each.
@@ -161,7 +130,7 @@ mocap::Result<ManipulationResult> SolveBrushStrokes(const BSplineSurface& surfac
       AddRhs(row, free_index, w_data, field, rhs);
     }
   }
-  AddSmoothness(nu, nv, free_index, options.smoothness / nf, entries);
+  internal::AddSecondDifferences(nu, nv, free_index, options.smoothness / nf, entries);
   Eigen::SparseMatrix<double> normal(nf, nf);
   normal.setFromTriplets(entries.begin(), entries.end());
   // The centres as heavy rows: 1e6 x the data term's mean diagonal.

@@ -158,7 +158,13 @@ const BadExample kBadExamples[] = {
      "r.json: patches[0].examples[0].pose.joints.A: error: expected an array of 3 numbers in "
      "-360..360, found an array [0,0]"},
     {R"(, "examples": [{"pose": {"frame": 3}}])",
-     "r.json: patches[0].examples[0].edits: error: missing (an array of edits)"},
+     "r.json: patches[0].examples[0].edits: error: missing (an array of edits, or \"auto\": "
+     "\"volume\" | \"rest\")"},
+    {R"(, "examples": [{"pose": {"frame": 3}, "auto": "area"}])",
+     "r.json: patches[0].examples[0].auto: error: expected \"volume\" or \"rest\", found \"area\""},
+    {R"(, "examples": [{"pose": {"frame": 3}, "auto": "rest"}, {"pose": {"frame": 3}, "auto": "volume"}])",
+     "r.json: patches[0].examples[1].pose: error: duplicates the pose of patches[0].examples[0] "
+     "(one example per pose: merge their edits)"},
     {R"(, "examples": [{"pose": {"frame": 3}, "edits": []}])",
      "r.json: patches[0].examples[0].edits: error: expected an array of 1..256 edits, found an "
      "array []"},
