@@ -61,6 +61,20 @@ double RmsToTargets(std::span<const BoundRow> rows, std::span<const glm::dvec3> 
 
 }  // namespace
 
+int DominantSkinJoint(const SkinWeights& weights, int vertex) {
+  const int k = weights.influences;
+  int best = 0;
+  float best_w = -1.0f;
+  for (int i = 0; i < k; ++i) {
+    const auto idx = static_cast<std::size_t>(vertex * k + i);
+    if (weights.weights[idx] > best_w) {
+      best_w = weights.weights[idx];
+      best = weights.joints[idx];
+    }
+  }
+  return best;
+}
+
 int DrivingSkinJoint(const PatchSetup& patch, int num_skin_joints) {
   std::vector<double> total(static_cast<std::size_t>(std::max(num_skin_joints, 0)), 0.0);
   const SkinWeights& w = patch.control_weights;
@@ -199,8 +213,10 @@ mocap::Result<CorrectedExample> CorrectExample(const PatchSetup& patch, const Sk
   if (kind == CorrectiveKind::kRest) {
     std::vector<glm::dvec3> target(rows.size());
     for (std::size_t k = 0; k < rows.size(); ++k) {
-      const glm::dvec3 p(mesh.bind.positions[static_cast<std::size_t>(rows[k].vertex)]);
-      target[k] = glm::dvec3(carry * glm::dvec4(p, 1.0));
+      const int v = rows[k].vertex;
+      const glm::dvec3 p(mesh.bind.positions[static_cast<std::size_t>(v)]);
+      const glm::dmat4 bone(pose.model_from_bind[static_cast<std::size_t>(DominantSkinJoint(mesh.weights, v))]);
+      target[k] = glm::dvec3(bone * glm::dvec4(p, 1.0));
     }
     const double w = 1.0 / static_cast<double>(rows.size());
     for (const BoundRow& r : rows) {

@@ -14,10 +14,11 @@
 // beta_v its border fade. Linearised (the normal's turn ignored):
 //   dx_v = beta_v sum_c a_vc dq_c,   a_vc = N_i(u_v) N_j(v_v).
 //
-// kRest: the region follows the bind shape carried rigidly by the driving
-// bone (the skin joint with the largest total weight on the control points,
-// palette matrix T):
-//   min (1/#B) sum_v |x_v(dQ) - T p_v|^2 + mu/#F |L2 dQ|^2
+// kRest: the region follows its bind shape carried rigidly by the bones:
+// each bound vertex's bind point p_v by the palette matrix T_v of its most
+// weighted skin joint (one driving bone for the whole region would drag the
+// half on the other side of the joint along with it: spikes at a bent elbow):
+//   min (1/#B) sum_v |x_v(dQ) - T_v p_v|^2 + mu/#F |L2 dQ|^2
 // (L2 = second differences of the control-grid change along u and v), solved
 // by Gauss-Newton: the linearised problem `iterations` times, re-evaluating x.
 //
@@ -77,6 +78,9 @@ struct CorrectedExample {
   CorrectiveReport report;
   int driving_skin_joint = -1;  // index into the mesh's skin joints
 };
+
+// The skin joint of `vertex` with the largest weight (first on ties).
+int DominantSkinJoint(const SkinWeights& weights, int vertex);
 
 // The skin joint (index into mesh.skin_joints) with the largest total weight
 // over the patch's control points; -1 when the patch has none.
