@@ -1,0 +1,64 @@
+#pragma once
+// The patch layer without writing a rig (`render CAPTURE --layer auto`,
+// `patchskin rig auto CAPTURE`): a rig (rig_file.h) placed on a character from
+// its skeleton's topology alone, never from joint names.
+//
+// Input: a loaded Character (the generated/tube body of a BVH, or a glTF
+// character driven by a capture) and the file names the rig records.
+// Output: an app::Rig whose patches sit where the paper's demos put them, and
+// the notes worth printing (what was placed, what was skipped and why).
+//
+// Placement (deform::FindHumanoid on the bind pose finds the pelvis, spine,
+// head, arms and legs and the body's up / forward / left axes):
+//   - per side: back of the elbow, biceps, top of the shoulder, front of the
+//     knee, back of the hip (buttock);
+//   - elastic belly (the spine point about 45 % of the way pelvis -> chest, front
+//     side) and elastic jowl (the head joint, front side), driven by the capture;
+//   - region sizes are fractions of the bone lengths (radius of the elbow
+//     patch 0.45 x the forearm, ...), so a child and an adult get the same layout;
+//   - which side of a hinge is its back: the direction the child bone swings to
+//     at the capture's frame of largest bend (in the parent bone's bind frame);
+//     a joint that hardly bends (< 20 degrees) falls back to the body's forward.
+// A skeleton that is no humanoid (a quadruped) gets an elastic belly under the
+// first spine chain (down = from the spine towards the leg tips) and a note of
+// what was skipped; a skeleton without any spine chain gets no patch and a note.
+//
+// Cost: one FindHumanoid (O(#J^2) at worst) and one forward-kinematics pass over
+// at most 2000 sampled frames; no mesh is touched (well under 1 ms per joint).
+
+#include <string>
+#include <vector>
+
+#include "app/pipeline.h"
+#include "app/rig_file.h"
+#include "mocap/error.h"
+
+namespace app {
+
+struct AutoRig {
+  Rig rig;
+  std::vector<std::string> notes;  // placed patches, skipped ones and why
+};
+
+// `character_name`: "generated", "tubes" or the glTF path (Rig::character);
+// `motion_file`: the capture (Rig::motion); `label` names the rig in messages
+// and output folders (Rig::file). Errors: BindModelFromJoint's.
+mocap::Result<AutoRig> BuildAutoRig(const Character& character, const std::string& character_name,
+                                    const std::string& motion_file, const std::string& label);
+
+// Loads the character as `render` does (a BVH on the `body` built-in body, or
+// the glTF `body` driven by the BVH `capture`) and builds its rig. `up`: the
+// BVH's up axis as --up gives it (empty = detected). Errors: the loader's,
+// kInvalidArgument naming --body for an unknown body.
+mocap::Result<AutoRig> MakeAutoRig(const std::string& capture, const std::string& body,
+                                   const std::string& up, bool quiet);
+
+// What `--layer LAYER` on render/turntable/export does with a command's input:
+// "auto" makes the rig (MakeAutoRig; `input` empty = the built-in demo walk,
+// `body` a built-in body or a glTF character driven by `input`) and prints its
+// notes to stderr unless `quiet`. kInvalidArgument naming --layer for any other
+// value or a rig file as the input.
+mocap::Result<Rig> AutoRigForCommand(const std::string& layer, const std::string& input,
+                                     const std::string& body, const std::string& up, bool quiet);
+
+}  // namespace app
