@@ -275,12 +275,31 @@ void PlaceNonHumanoid(const mocap::Skeleton& s, std::span<const glm::mat4> bind,
     return;
   }
   const glm::vec3 mid = c.points[static_cast<std::size_t>(belly)].pos;
-  const glm::vec3 down = UnitOr(tips / static_cast<float>(limbs) - mid, {0, -1, 0});
+  // Across the spine's axis, so a tail among the limbs does not tilt it.
+  const glm::vec3 axis = UnitOr(c.points[static_cast<std::size_t>(spine.back())].pos -
+                                    c.points[static_cast<std::size_t>(spine.front())].pos,
+                                {0, 0, 1});
+  const glm::vec3 down = UnitOr(Perp(tips / static_cast<float>(limbs) - mid, axis), {0, -1, 0});
   RigPatch p = JointPatch("belly", *JointName(s, c, belly), 0.2f * arc.back(), down, 70, {6, 6},
                           {10, 10}, true);
   p.elastic = Elastic(4.0f, 0.15f, 1.0f);
-  out.rig.patches.push_back(std::move(p));
   out.notes.push_back("belly: placed under the spine at joint " + p.region.joint);
+  out.rig.patches.push_back(std::move(p));
+}
+
+// A humanoid's legs hang along its spine (hip -> ankle against pelvis -> chest);
+// four legs under a horizontal spine pass FindHumanoid's pairing as "arms" and
+// "legs" but are no humanoid. Empty when upright, else the reason.
+std::string UprightProblem(const deform::Humanoid& h) {
+  for (const deform::HumanoidLimb& leg : h.legs) {
+    const glm::vec3 hip = h.chains.points[static_cast<std::size_t>(leg.points.front())].pos;
+    const glm::vec3 ankle =
+        h.chains.points[static_cast<std::size_t>(leg.points[static_cast<std::size_t>(leg.extremity)])].pos;
+    if (glm::dot(UnitOr(ankle - hip, h.up), -h.up) < 0.5f) {
+      return "the legs do not hang along the spine: a horizontal spine, four legs?";
+    }
+  }
+  return {};
 }
 
 // Keeps the patches that build on this character's mesh: a region the skin
@@ -325,8 +344,9 @@ mocap::Result<AutoRig> BuildAutoRig(const Character& character, const std::strin
   out.rig.render.size = {1280, 720};
   const mocap::Skeleton& s = character.skeleton;
   mocap::Result<deform::Humanoid> h = deform::FindHumanoid(s, *bind);
-  if (!h.ok()) {
-    PlaceNonHumanoid(s, *bind, h.error().message, out);
+  std::string why = h.ok() ? UprightProblem(*h) : h.error().message;
+  if (!why.empty()) {
+    PlaceNonHumanoid(s, *bind, why, out);
     KeepBuildable(character, out);
     return out;
   }
