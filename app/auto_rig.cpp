@@ -20,9 +20,15 @@ constexpr float kMinBranchExtent = 0.15f;  // as the generated bodies fold finge
 constexpr int kMaxScannedFrames = 2000;    // frames read for the largest bends
 constexpr float kMinBendDeg = 20.0f;       // below this a hinge's side comes from the body axes
 
-// Rounds to 0.01 so the rig file reads as typed and parses back to the same float.
-float Round2(float x) { return std::round(x * 100.0f) / 100.0f + 0.0f; }  // + 0: no "-0"
-glm::vec3 Round2(glm::vec3 v) { return {Round2(v.x), Round2(v.y), Round2(v.z)}; }
+// Rounds to three significant digits (any units: cm or m) so the rig file reads
+// as typed; directions (components <= 1) to 0.01.
+float Round2(float x) {
+  if (x == 0.0f || !std::isfinite(x)) return 0.0f;
+  const float scale = std::pow(10.0f, 2.0f - std::floor(std::log10(std::abs(x))));
+  return std::round(x * scale) / scale + 0.0f;  // + 0: no "-0"
+}
+float RoundUnit(float x) { return std::round(x * 100.0f) / 100.0f + 0.0f; }
+glm::vec3 Round2(glm::vec3 v) { return {RoundUnit(v.x), RoundUnit(v.y), RoundUnit(v.z)}; }
 
 glm::vec3 Perp(glm::vec3 v, glm::vec3 axis) { return v - glm::dot(v, axis) * axis; }
 
@@ -138,7 +144,13 @@ void PlaceLimbs(const mocap::Skeleton& s, const deform::Humanoid& h, int side,
   const std::size_t joints = s.parents.size();
   const auto hinge_side = [&](const char* what, int a, int p, int e, glm::vec3 fallback) {
     Hinge hinge = LargestBend(c, a, p, e, bind, poses, joints);
-    if (hinge.angle_deg < kMinBendDeg) {
+    if (hinge.angle_deg >= kMinBendDeg && glm::dot(hinge.bend, fallback) < 0.0f) {
+      // Against the anatomical way (a retargeted rest pose straightening a
+      // bent bind pose): the body's axes decide.
+      out.notes.push_back(prefix + what + ": its largest change straightens it; its side comes "
+                                          "from the body's front");
+      hinge.bend = fallback;
+    } else if (hinge.angle_deg < kMinBendDeg) {
       out.notes.push_back(prefix + what + ": bends at most " +
                           std::to_string(static_cast<int>(hinge.angle_deg)) +
                           " degrees; its side comes from the body's front");
@@ -318,7 +330,13 @@ void KeepBuildable(const Character& character, AutoRig& out) {
       looser.region.min_bone_weight = 0.25f;
       looser.region.half_angle_deg = std::min(p.region.half_angle_deg, 80.0f);
       one.patches = {looser};
-      if (BuildRigPatches(one, character).ok()) {
+      bool ok = BuildRigPatches(one, character).ok();
+      if (!ok && looser.cylinder) {  // a limb too thin for a partial tube: a flat map
+        looser.cylinder = false;
+        one.patches = {looser};
+        ok = BuildRigPatches(one, character).ok();
+      }
+      if (ok) {
         out.notes.push_back(p.name + ": widened (" + built.error().message + ")");
         p = looser;
       } else {
@@ -378,7 +396,8 @@ mocap::Result<AutoRig> MakeAutoRig(const std::string& capture, const std::string
 }
 
 mocap::Result<Rig> AutoRigForCommand(const std::string& layer, const std::string& input,
-                                     const std::string& body, const std::string& up, bool quiet) {
+                                     const std::string& motion, const std::string& body,
+                                     const std::string& up, bool quiet) {
   if (layer != "auto") {
     return mocap::MakeError(mocap::ErrorCode::kInvalidArgument, {"--layer", 0, 0, {}},
                             "expected auto, found '" + layer + "'");
@@ -388,15 +407,22 @@ mocap::Result<Rig> AutoRigForCommand(const std::string& layer, const std::string
                             "expected a capture (BVH) as the input, found the rig file " + input +
                                 " (a rig names its own patches)");
   }
-  mocap::Result<AutoRig> made = MakeAutoRig(input, body, up, quiet);
+  const std::string ext = std::filesystem::path(input).extension().string();
+  if (motion.empty() && (ext == ".glb" || ext == ".gltf")) {
+    return mocap::MakeError(mocap::ErrorCode::kInvalidArgument, {"--layer", 0, 0, {}},
+                            "expected a BVH capture: give the glTF character's motion with "
+                            "--motion, or the capture as the input with --body " + input);
+  }
+  const std::string& capture = motion.empty() ? input : motion;
+  mocap::Result<AutoRig> made = MakeAutoRig(capture, motion.empty() ? body : input, up, quiet);
   if (!made.ok()) return std::move(made).error();
   if (!quiet) {
-    const std::string name = input.empty() ? "demo" : input;
+    const std::string name = capture.empty() ? "demo" : capture;
     for (const std::string& note : made->notes) {
       std::fprintf(stderr, "%s: --layer auto: note: %s\n", name.c_str(), note.c_str());
     }
   }
-  if (input.empty()) made->rig.file = "demo";
+  if (capture.empty()) made->rig.file = "demo";
   return std::move(made->rig);
 }
 

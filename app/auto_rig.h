@@ -54,11 +54,13 @@ mocap::Result<AutoRig> MakeAutoRig(const std::string& capture, const std::string
                                    const std::string& up, bool quiet);
 
 // What `--layer LAYER` on render/turntable/export does with a command's input:
-// "auto" makes the rig (MakeAutoRig; `input` empty = the built-in demo walk,
-// `body` a built-in body or a glTF character driven by `input`) and prints its
-// notes to stderr unless `quiet`. kInvalidArgument naming --layer for any other
-// value or a rig file as the input.
+// "auto" makes the rig (MakeAutoRig) and prints its notes to stderr unless
+// `quiet`. The capture is `input` (a BVH; empty = the built-in demo walk) on the
+// body `body` (built-in or a glTF character), or, with `motion` set, the BVH
+// `motion` driving the glTF `input`. kInvalidArgument naming --layer for any
+// other value, a rig file as the input, or a glTF input without --motion.
 mocap::Result<Rig> AutoRigForCommand(const std::string& layer, const std::string& input,
-                                     const std::string& body, const std::string& up, bool quiet);
+                                     const std::string& motion, const std::string& body,
+                                     const std::string& up, bool quiet);
 
 }  // namespace app

@@ -307,7 +307,7 @@ int RunRender(const RenderOptions& options) {
   std::optional<Rig> rig;
   if (!o.layer.empty()) {
     // --layer auto: the rig `patchskin rig auto` would write, used as if read.
-    mocap::Result<Rig> made = AutoRigForCommand(o.layer, o.input, o.body, o.up, o.quiet);
+    mocap::Result<Rig> made = AutoRigForCommand(o.layer, o.input, o.motion, o.body, o.up, o.quiet);
     if (!made.ok()) return Fail(made.error());
     rig = std::move(*made);
     o.given.erase("--body");  // the rig names the body now
