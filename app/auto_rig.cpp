@@ -123,12 +123,14 @@ float Dist(const deform::BodyChains& c, int a, int b) {
 
 // The elbow (knee) of a limb: the point between its two longest consecutive
 // bones up to the extremity, upper arm and forearm (thigh and shin), so a hand
-// end site or a collar bone does not shift it. 0 when the limb is too short.
+// end site does not shift it. 0 when the limb is too short.
 int MiddleOfLongestPair(const deform::BodyChains& c, const deform::HumanoidLimb& limb) {
   int best = 0;
   float best_len = 0.0f;
   const int last = std::min(limb.extremity + 1, static_cast<int>(limb.points.size()) - 1);
-  for (int k = 1; k < last; ++k) {
+  // From 2: the first bone leaves the trunk (a collar, a pelvis half) and may
+  // be as long as a forearm (CMU's collar 3.6 against the forearm's 3.5).
+  for (int k = 2; k < last; ++k) {
     const auto at = [&](int i) { return limb.points[static_cast<std::size_t>(i)]; };
     const float len = Dist(c, at(k - 1), at(k)) + Dist(c, at(k), at(k + 1));
     if (len > best_len) best = k, best_len = len;
@@ -174,11 +176,11 @@ void PlaceLimbs(const mocap::Skeleton& s, const deform::Humanoid& h, int side,
     if (elbow_joint != nullptr && shoulder_joint != nullptr) {
       const Hinge e = hinge_side("elbow", shoulder, elbow, wrist, h.forward);
       out.rig.patches.push_back(JointPatch(prefix + "elbow_back", *elbow_joint, 0.45f * fore,
-                                           -e.bend, 110, {7, 7}, {16, 16}, true));
+                                           -e.bend, 80, {7, 7}, {16, 16}, true));
       out.rig.patches.push_back(JointPatch(prefix + "biceps", *elbow_joint, 0.75f * upper, e.bend,
-                                           110, {9, 10}, {18, 20}, true));
-      out.rig.patches.push_back(JointPatch(prefix + "shoulder_top", *shoulder_joint, 0.5f * upper,
-                                           h.up, 80, {9, 6}, {18, 12}, false));
+                                           80, {9, 10}, {18, 20}, true));
+      out.rig.patches.push_back(JointPatch(prefix + "shoulder_top", *shoulder_joint, 0.4f * upper,
+                                           h.up, 60, {9, 6}, {18, 12}, false));
     }
   }
   const deform::HumanoidLimb& leg = h.legs[side];
@@ -193,7 +195,7 @@ void PlaceLimbs(const mocap::Skeleton& s, const deform::Humanoid& h, int side,
       // A knee bends backwards: its front is away from the bend.
       const Hinge bent = hinge_side("knee", hip, knee, ankle, -h.forward);
       out.rig.patches.push_back(JointPatch(prefix + "knee_front", *knee_joint, 0.4f * shin, -bent.bend,
-                                           110, {7, 7}, {16, 16}, true));
+                                           80, {7, 7}, {16, 16}, true));
       out.rig.patches.push_back(JointPatch(prefix + "hip_back", *hip_joint, 0.4f * thigh,
                                            -h.forward, 70, {7, 7}, {16, 16}, false));
     }
@@ -233,17 +235,20 @@ void PlaceTrunk(const mocap::Skeleton& s, const deform::Humanoid& h, AutoRig& ou
   } else {
     out.notes.push_back("belly: skipped (no spine joint between the pelvis and the chest)");
   }
-  // The head: the last spine point with a joint; its size from the head's bone.
+  // The head: the spine point before the tip (its bone is the neck's end), the
+  // one before that when the body gives it no skin; size from the head's bone.
   if (h.spine.size() >= 3) {
     const int tip = h.spine.back();
-    int head = h.spine[h.spine.size() - 2];
-    if (c.points[static_cast<std::size_t>(tip)].joint >= 0) head = tip;
+    const int head = h.spine[h.spine.size() - 2];
     const std::string* head_joint = JointName(s, c, head);
-    const float head_len = head == tip ? Dist(c, h.spine[h.spine.size() - 2], tip) : Dist(c, head, tip);
+    const float head_len = Dist(c, head, tip);
     if (head_joint != nullptr && head_len > 0.0f) {
       RigPatch p = JointPatch("jowl", *head_joint, 0.9f * head_len, h.forward, 75, {5, 5}, {8, 8},
                               true);
       p.elastic = Elastic(5.0f, 0.25f, 1.5f);
+      if (const std::string* neck = JointName(s, c, h.spine[h.spine.size() - 3])) {
+        out.alternate_joints.emplace_back("jowl", *neck);
+      }
       out.rig.patches.push_back(std::move(p));
       return;
     }
@@ -315,9 +320,10 @@ std::string UprightProblem(const deform::Humanoid& h) {
 }
 
 // Keeps the patches that build on this character's mesh: a region the skin
-// weights leave empty, or a cylinder wrapping too far round, is tried once more
-// wider and looser (1.5 x the radius, bone weight 0.25, a narrower side), then
-// dropped with a note; never an error.
+// weights leave empty, or a cylinder wrapping too far round, is tried again
+// wider and looser (1.5 x the radius, bone weight 0.25, a narrower side; then
+// flat), then smaller (0.7 x, flat, 50 degrees: a map that folded), then on an
+// alternate joint, and else dropped with a note; never an error.
 void KeepBuildable(const Character& character, AutoRig& out) {
   std::vector<RigPatch> kept;
   for (RigPatch& p : out.rig.patches) {
@@ -336,8 +342,26 @@ void KeepBuildable(const Character& character, AutoRig& out) {
         one.patches = {looser};
         ok = BuildRigPatches(one, character).ok();
       }
+      if (!ok) {  // folds in the map: a smaller, flatter cap
+        looser = p;
+        looser.region.radius = Round2(0.7f * p.region.radius);
+        looser.region.half_angle_deg = std::min(p.region.half_angle_deg, 50.0f);
+        looser.cylinder = false;
+        one.patches = {looser};
+        ok = BuildRigPatches(one, character).ok();
+      }
+      for (const auto& [name, joint] : out.alternate_joints) {
+        if (ok || name != p.name) continue;
+        looser = p;
+        looser.region.joint = joint;
+        one.patches = {looser};
+        ok = BuildRigPatches(one, character).ok();
+      }
       if (ok) {
-        out.notes.push_back(p.name + ": widened (" + built.error().message + ")");
+        out.notes.push_back(p.name + ": " +
+                            (looser.region.joint != p.region.joint ? "on " + looser.region.joint
+                                                                   : std::string("resized")) +
+                            " (" + built.error().message + ")");
         p = looser;
       } else {
         out.notes.push_back(p.name + ": skipped (" + built.error().message + ")");

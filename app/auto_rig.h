@@ -27,6 +27,7 @@
 // at most 2000 sampled frames; no mesh is touched (well under 1 ms per joint).
 
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "app/pipeline.h"
@@ -38,6 +39,8 @@ namespace app {
 struct AutoRig {
   Rig rig;
   std::vector<std::string> notes;  // placed patches, skipped ones and why
+  // Patch name -> a joint to try when the first choice has no skin there.
+  std::vector<std::pair<std::string, std::string>> alternate_joints;
 };
 
 // `character_name`: "generated", "tubes" or the glTF path (Rig::character);
