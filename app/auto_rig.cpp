@@ -202,11 +202,16 @@ void PlaceLimbs(const mocap::Skeleton& s, const deform::Humanoid& h, int side,
   }
 }
 
-RigElastic Elastic(float frequency_hz, float damping_ratio, float gain) {
+// Gentler than the demo rigs (gain 0.5 on the belly, stiffer bending) and a
+// displacement limit of 8 % of the region's radius: a capture of any violence
+// (Bandai's run) must jiggle the patch, never crease it.
+RigElastic Elastic(float frequency_hz, float damping_ratio, float gain, float radius) {
   RigElastic e;
   e.params.frequency_hz = frequency_hz;
   e.params.damping_ratio = damping_ratio;
   e.params.gain = gain;
+  e.params.bending_ratio = 1.0f;
+  e.params.max_displacement = Round2(0.08f * radius);
   return e;
 }
 
@@ -230,7 +235,13 @@ void PlaceTrunk(const mocap::Skeleton& s, const deform::Humanoid& h, AutoRig& ou
   if (belly >= 0) {
     RigPatch p = JointPatch("belly", *JointName(s, c, belly), 0.4f * trunk, h.forward, 70, {6, 6},
                             {10, 10}, true);
-    p.elastic = Elastic(4.0f, 0.15f, 1.0f);
+    p.elastic = Elastic(4.0f, 0.2f, 0.5f, p.region.radius);
+    for (int k = 1; k <= h.chest; ++k) {  // the other trunk joints, should its skin be elsewhere
+      const int id = h.spine[static_cast<std::size_t>(k)];
+      if (id != belly && JointName(s, c, id) != nullptr) {
+        out.alternate_joints.emplace_back("belly", *JointName(s, c, id));
+      }
+    }
     out.rig.patches.push_back(std::move(p));
   } else {
     out.notes.push_back("belly: skipped (no spine joint between the pelvis and the chest)");
@@ -245,7 +256,7 @@ void PlaceTrunk(const mocap::Skeleton& s, const deform::Humanoid& h, AutoRig& ou
     if (head_joint != nullptr && head_len > 0.0f) {
       RigPatch p = JointPatch("jowl", *head_joint, 0.9f * head_len, h.forward, 75, {5, 5}, {8, 8},
                               true);
-      p.elastic = Elastic(5.0f, 0.25f, 1.5f);
+      p.elastic = Elastic(5.0f, 0.25f, 1.0f, p.region.radius);
       if (const std::string* neck = JointName(s, c, h.spine[h.spine.size() - 3])) {
         out.alternate_joints.emplace_back("jowl", *neck);
       }
@@ -299,7 +310,7 @@ void PlaceNonHumanoid(const mocap::Skeleton& s, std::span<const glm::mat4> bind,
   const glm::vec3 down = UnitOr(Perp(tips / static_cast<float>(limbs) - mid, axis), {0, -1, 0});
   RigPatch p = JointPatch("belly", *JointName(s, c, belly), 0.2f * arc.back(), down, 70, {6, 6},
                           {10, 10}, true);
-  p.elastic = Elastic(4.0f, 0.15f, 1.0f);
+  p.elastic = Elastic(4.0f, 0.2f, 0.5f, p.region.radius);
   out.notes.push_back("belly: placed under the spine at joint " + p.region.joint);
   out.rig.patches.push_back(std::move(p));
 }
@@ -336,13 +347,15 @@ void KeepBuildable(const Character& character, AutoRig& out) {
       looser.region.min_bone_weight = 0.25f;
       looser.region.half_angle_deg = std::min(p.region.half_angle_deg, 80.0f);
       one.patches = {looser};
-      bool ok = BuildRigPatches(one, character).ok();
-      if (!ok && looser.cylinder) {  // a limb too thin for a partial tube: a flat map
+      // An elastic patch keeps its size: widened ones jiggled into ridges on
+      // Bandai's run; it moves to another joint instead.
+      bool ok = !p.elastic && BuildRigPatches(one, character).ok();
+      if (!ok && !p.elastic && looser.cylinder) {  // a limb too thin for a partial tube: a flat map
         looser.cylinder = false;
         one.patches = {looser};
         ok = BuildRigPatches(one, character).ok();
       }
-      if (!ok) {  // folds in the map: a smaller, flatter cap
+      if (!ok && !p.elastic) {  // folds in the map: a smaller, flatter cap
         looser = p;
         looser.region.radius = Round2(0.7f * p.region.radius);
         looser.region.half_angle_deg = std::min(p.region.half_angle_deg, 50.0f);
