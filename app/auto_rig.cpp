@@ -215,6 +215,14 @@ RigElastic Elastic(float frequency_hz, float damping_ratio, float gain, float ra
   return e;
 }
 
+// An elastic patch fades out over a wider border (0.3) than a sculpted one: on
+// the generated body's jagged chest underside a narrow fade left a notch.
+RigPatch ElasticPatch(RigPatch p, RigElastic e) {
+  p.border_width = 0.3f;
+  p.elastic = std::move(e);
+  return p;
+}
+
 // Belly and jowl on a humanoid's spine.
 void PlaceTrunk(const mocap::Skeleton& s, const deform::Humanoid& h, AutoRig& out) {
   const deform::BodyChains& c = h.chains;
@@ -235,7 +243,7 @@ void PlaceTrunk(const mocap::Skeleton& s, const deform::Humanoid& h, AutoRig& ou
   if (belly >= 0) {
     RigPatch p = JointPatch("belly", *JointName(s, c, belly), 0.4f * trunk, h.forward, 70, {6, 6},
                             {10, 10}, true);
-    p.elastic = Elastic(4.0f, 0.2f, 0.5f, p.region.radius);
+    p = ElasticPatch(p, Elastic(4.0f, 0.2f, 0.5f, p.region.radius));
     for (int k = 1; k <= h.chest; ++k) {  // the other trunk joints, should its skin be elsewhere
       const int id = h.spine[static_cast<std::size_t>(k)];
       if (id != belly && JointName(s, c, id) != nullptr) {
@@ -256,7 +264,7 @@ void PlaceTrunk(const mocap::Skeleton& s, const deform::Humanoid& h, AutoRig& ou
     if (head_joint != nullptr && head_len > 0.0f) {
       RigPatch p = JointPatch("jowl", *head_joint, 0.9f * head_len, h.forward, 75, {5, 5}, {8, 8},
                               true);
-      p.elastic = Elastic(5.0f, 0.25f, 1.0f, p.region.radius);
+      p = ElasticPatch(p, Elastic(5.0f, 0.25f, 1.0f, p.region.radius));
       if (const std::string* neck = JointName(s, c, h.spine[h.spine.size() - 3])) {
         out.alternate_joints.emplace_back("jowl", *neck);
       }
@@ -310,7 +318,7 @@ void PlaceNonHumanoid(const mocap::Skeleton& s, std::span<const glm::mat4> bind,
   const glm::vec3 down = UnitOr(Perp(tips / static_cast<float>(limbs) - mid, axis), {0, -1, 0});
   RigPatch p = JointPatch("belly", *JointName(s, c, belly), 0.2f * arc.back(), down, 70, {6, 6},
                           {10, 10}, true);
-  p.elastic = Elastic(4.0f, 0.2f, 0.5f, p.region.radius);
+  p = ElasticPatch(p, Elastic(4.0f, 0.2f, 0.5f, p.region.radius));
   out.notes.push_back("belly: placed under the spine at joint " + p.region.joint);
   out.rig.patches.push_back(std::move(p));
 }
