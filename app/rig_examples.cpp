@@ -6,6 +6,7 @@
 #include "app/pipeline.h"
 #include "app/rig_file.h"
 #include "deform/global/dqs_job.h"
+#include "deform/shapes/corrective_example.h"
 #include "deform/shapes/example_shapes.h"
 #include "deform/global/skinning_job.h"
 #include "mocap/pose.h"
@@ -167,18 +168,42 @@ mocap::Result<RigPoseSpaces> BuildRigPoseSpaces(const Rig& rig, const Character&
       if (js) js = deform::BuildSkinningPalette(model, ch.mesh, palette);
       if (js && method == GlobalMethod::kDqs) js = deform::BuildDualQuatPalette(palette, dq);
       if (!js) return mocap::MakeError(mocap::ErrorCode::kInternal, {rig.file, 0, 0, ex.path}, js.what);
-      std::vector<deform::ExampleEdit> edits;
-      for (const RigEdit& e : ex.edits) {
-        edits.push_back({.vertex = e.vertex, .uv = e.point, .move = e.move, .world_frame = e.world,
-                         .loc = {rig.file, 0, 0, e.path}});
-      }
       const deform::ExamplePose pose{
           .model_from_bind = palette,
           .dq_palette = method == GlobalMethod::kDqs ? std::span<const deform::DualQuat>(dq)
                                                      : std::span<const deform::DualQuat>()};
-      mocap::Result<deform::SculptedExample> sculpted = deform::SculptExample(patch, ch.mesh, pose, edits);
-      if (!sculpted.ok()) return At(rig.file, ex.path + ".edits", std::move(sculpted).error());
-      for (mocap::Warning& w : sculpted->warnings) out.warnings.push_back(std::move(w));
+      mocap::Result<deform::SculptedExample> sculpted = deform::SculptedExample{};
+      if (!ex.auto_kind.empty()) {
+        // Computed at load, once (deform/shapes/corrective_example.h).
+        const bool volume = ex.auto_kind == "volume";
+        mocap::Result<deform::CorrectedExample> corrected = deform::CorrectExample(
+            patch, ch.mesh, pose, volume ? deform::CorrectiveKind::kVolume : deform::CorrectiveKind::kRest);
+        if (!corrected.ok()) return At(rig.file, ex.path + ".auto", std::move(corrected).error());
+        std::ostringstream note;
+        note << ex.path << " auto " << ex.auto_kind << ": "
+             << (volume ? "region volume bind " : "rms distance to the rigid rest shape ");
+        if (volume) note << corrected->report.bind_value << ", ";
+        note << "before " << corrected->report.before << ", after " << corrected->report.after;
+        out.notes.push_back(note.str());
+        sculpted = std::move(corrected->shape);
+      }
+      if (!ex.edits.empty()) {
+        std::vector<deform::ExampleEdit> edits;
+        for (const RigEdit& e : ex.edits) {
+          edits.push_back({.vertex = e.vertex, .uv = e.point, .move = e.move, .world_frame = e.world,
+                           .radius = e.radius, .loc = {rig.file, 0, 0, e.path}});
+        }
+        mocap::Result<deform::SculptedExample> edited = deform::SculptExample(patch, ch.mesh, pose, edits);
+        if (!edited.ok()) return At(rig.file, ex.path + ".edits", std::move(edited).error());
+        if (!ex.auto_kind.empty()) {
+          // Edits move the corrected shape further: the changes add (s is linear in Q).
+          for (std::size_t c = 0; c < edited->displacement.size(); ++c) {
+            edited->displacement[c] += sculpted->displacement[c];
+            edited->world_delta[c] += sculpted->world_delta[c];
+          }
+        }
+        sculpted = std::move(edited);
+      }
       deform::PoseExample pe{.name = ex.path, .loc = {rig.file, 0, 0, ex.path + ".pose"},
                              .features = std::vector<float>(static_cast<std::size_t>(dim)),
                              .displacement = std::move(sculpted->displacement)};

@@ -4,7 +4,8 @@
 //
 //   "examples": [{"pose": {"frame": 45} | {"joints": {"LeftForeArm": [0, -90, 0]}},
 //                 "edits": [{"vertex": 812, "move": [0, 0, 1.5]},
-//                           {"point": [0.5, 0.4], "move": [0, 0.8, 0], "frame": "world"}]}],
+//                           {"point": [0.5, 0.4], "move": [0, 0.8, 0], "frame": "world"},
+//                           {"point": [0.5, 0.5], "move": [0, 0, 2], "radius": 0.3}]}],
 //   "pose_space": {"features": "rotvec", "kernel": "gaussian", "kappa": 1, "width": 0,
 //                  "joints": ["LeftArm", "LeftForeArm"]}
 //
@@ -38,6 +39,7 @@ struct RigEdit {
   glm::dvec2 point{-1.0};      // (u, v) in [0,1]^2 of a surface point, when vertex < 0
   glm::dvec3 move{0.0};        // model units
   bool world = false;          // "frame": "world"; default "bind" (turns with the body)
+  double radius = 0.0;         // "radius": > 0 a brush (deform/shapes/brush_edit.h); 0 none
   std::string path;            // field path, e.g. "patches[0].examples[1].edits[0]"
 };
 
@@ -54,7 +56,12 @@ struct RigExamplePose {
 
 struct RigExample {
   RigExamplePose pose;
-  std::vector<RigEdit> edits;  // at least one, solved together
+  // "auto": computed correction (deform/shapes/corrective_example.h):
+  // "volume" (region volume back to bind), "rest" (toward the bind shape
+  // carried by the driving bone), or empty (none). Edits then move the
+  // corrected shape further.
+  std::string auto_kind;
+  std::vector<RigEdit> edits;  // solved together; at least one unless auto_kind is set
   std::string path;            // "patches[i].examples[k]"
 };
 

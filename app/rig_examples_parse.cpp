@@ -24,6 +24,9 @@ constexpr std::size_t kMaxEdits = 256;
 // Largest |component| of a move (model units) and of a joint angle (degrees).
 constexpr double kMaxMove = 1e6;
 constexpr double kMaxAngleDeg = 360.0;
+// Range of a brush edit's radius, in the patch's (u, v) units.
+constexpr double kMinBrushRadius = 0.01;
+constexpr double kMaxBrushRadius = 2.0;
 
 struct Ctx {
   std::string file;
@@ -98,7 +101,7 @@ std::optional<mocap::Error> ParsePose(const Ctx& c, const json& v, const std::st
 
 std::optional<mocap::Error> ParseEdit(const Ctx& c, const json& v, const std::string& path,
                                       RigEdit& edit) {
-  if (auto e = c.Keys(v, path, {"vertex", "point", "move", "frame"})) return e;
+  if (auto e = c.Keys(v, path, {"vertex", "point", "move", "frame", "radius"})) return e;
   edit.path = path;
   if (v.contains("vertex") == v.contains("point")) {
     return c.Fail(path, "expected exactly one of \"vertex\" (a mesh vertex index) or \"point\" "
@@ -125,6 +128,13 @@ std::optional<mocap::Error> ParseEdit(const Ctx& c, const json& v, const std::st
       return c.Expected(path + ".frame", "\"bind\" or \"world\"", f);
     }
     edit.world = f.get<std::string>() == "world";
+  }
+  if (v.contains("radius")) {
+    // Parameter units of the patch's (u, v) square: a brush (issue 26).
+    if (!NumberIn(v["radius"], kMinBrushRadius, kMaxBrushRadius)) {
+      return c.Expected(path + ".radius", "a brush radius in 0.01..2 ((u, v) units)", v["radius"]);
+    }
+    edit.radius = v["radius"].get<double>();
   }
   return std::nullopt;
 }
@@ -206,12 +216,31 @@ std::optional<mocap::Error> ParsePatchExamples(const std::string& file, const js
   for (std::size_t k = 0; k < list.size(); ++k) {
     const std::string epath = lpath + "[" + std::to_string(k) + "]";
     const json& ex = list[k];
-    if (auto e = c.Keys(ex, epath, {"pose", "edits"})) return e;
+    if (auto e = c.Keys(ex, epath, {"pose", "edits", "auto"})) return e;
     RigExample example;
     example.path = epath;
     if (!ex.contains("pose")) return c.Fail(epath + ".pose", "missing ({\"frame\": N} or {\"joints\": {...}})");
     if (auto e = ParsePose(c, ex["pose"], epath + ".pose", example.pose)) return e;
-    if (!ex.contains("edits")) return c.Fail(epath + ".edits", "missing (an array of edits)");
+    if (ex.contains("auto")) {
+      const json& a = ex["auto"];
+      if (!a.is_string() || (a.get<std::string>() != "volume" && a.get<std::string>() != "rest")) {
+        return c.Expected(epath + ".auto", "\"volume\" or \"rest\"", a);
+      }
+      example.auto_kind = a.get<std::string>();
+    }
+    if (!ex.contains("edits") && !example.auto_kind.empty()) {
+      for (const RigExample& other : out.examples) {
+        if (SamePose(other.pose, example.pose)) {
+          return c.Fail(epath + ".pose", "duplicates the pose of " + other.path +
+                                             " (one example per pose: merge their edits)");
+        }
+      }
+      out.examples.push_back(std::move(example));
+      continue;
+    }
+    if (!ex.contains("edits")) {
+      return c.Fail(epath + ".edits", "missing (an array of edits, or \"auto\": \"volume\" | \"rest\")");
+    }
     const json& edits = ex["edits"];
     if (!edits.is_array() || edits.empty() || edits.size() > kMaxEdits) {
       return c.Expected(epath + ".edits", "an array of 1.." + std::to_string(kMaxEdits) + " edits",

@@ -121,7 +121,22 @@ mocap::Result<SculptedExample> SculptExample(const PatchSetup& patch, const Skin
     targets.push_back(target);
   }
 
-  mocap::Result<ManipulationResult> solved = MoveBoundVertices(surface, targets, options, iterations);
+  bool brush = false;
+  for (const ExampleEdit& e : edits) brush = brush || e.radius > 0.0;
+  mocap::Result<ManipulationResult> solved = ManipulationResult{};
+  if (brush) {
+    std::vector<BrushStroke> strokes;
+    for (std::size_t k = 0; k < edits.size(); ++k) {
+      if (!(edits[k].radius >= 0.0 && std::isfinite(edits[k].radius))) {
+        return EditError(edits[k], "expected a finite radius >= 0");
+      }
+      strokes.push_back({.u = targets[k].u, .v = targets[k].v, .radius = edits[k].radius,
+                         .delta = targets[k].delta});
+    }
+    solved = SolveBrushStrokes(surface, strokes, {.free_mask = options.free_mask});
+  } else {
+    solved = MoveBoundVertices(surface, targets, options, iterations);
+  }
   if (!solved.ok()) {
     mocap::Error err = std::move(solved).error();
     if (err.loc.file.empty()) err.loc = edits.front().loc;

@@ -23,6 +23,7 @@
 
 #include <glm/glm.hpp>
 
+#include "deform/shapes/brush_edit.h"
 #include "deform/shapes/direct_manipulation.h"
 #include "deform/global/dqs_job.h"
 #include "deform/mesh.h"
@@ -43,6 +44,10 @@ struct ExampleEdit {
   // point uses its control points' rotations weighted by N_i(u) N_j(v));
   // true: `move` is a world (model-space) vector at the example pose.
   bool world_frame = false;
+  // > 0: a brush (brush_edit.h): the point moves by `move` and drags the
+  // surface around it with a smooth falloff over this radius (parameter
+  // units). 0: the plain minimum-norm edit (4.2).
+  double radius = 0.0;
   mocap::FileLoc loc{};     // where it was defined (rig file field path), for messages
 };
 
@@ -75,6 +80,10 @@ inline constexpr float kMinEditableBorderWeight = 0.05f;
 // out of range, not bound to the patch or too close to its border (beta <
 // kMinEditableBorderWeight), (u,v) outside [0,1]^2, a non-finite move; palette
 // sizes that disagree with the mesh (kInvalidArgument).
+// When any edit has a radius > 0 the example is solved as brush strokes
+// (SolveBrushStrokes: field fit + smoothness, every edit's surface point
+// s(u,v) moved by its move as a heavy row; a vertex's offset d n is then not
+// re-solved for the turning normal); without one, exactly as before.
 mocap::Result<SculptedExample> SculptExample(const PatchSetup& patch, const SkinnedMesh& mesh,
                                              const ExamplePose& pose,
                                              std::span<const ExampleEdit> edits,

@@ -158,7 +158,13 @@ const BadExample kBadExamples[] = {
      "r.json: patches[0].examples[0].pose.joints.A: error: expected an array of 3 numbers in "
      "-360..360, found an array [0,0]"},
     {R"(, "examples": [{"pose": {"frame": 3}}])",
-     "r.json: patches[0].examples[0].edits: error: missing (an array of edits)"},
+     "r.json: patches[0].examples[0].edits: error: missing (an array of edits, or \"auto\": "
+     "\"volume\" | \"rest\")"},
+    {R"(, "examples": [{"pose": {"frame": 3}, "auto": "area"}])",
+     "r.json: patches[0].examples[0].auto: error: expected \"volume\" or \"rest\", found \"area\""},
+    {R"(, "examples": [{"pose": {"frame": 3}, "auto": "rest"}, {"pose": {"frame": 3}, "auto": "volume"}])",
+     "r.json: patches[0].examples[1].pose: error: duplicates the pose of patches[0].examples[0] "
+     "(one example per pose: merge their edits)"},
     {R"(, "examples": [{"pose": {"frame": 3}, "edits": []}])",
      "r.json: patches[0].examples[0].edits: error: expected an array of 1..256 edits, found an "
      "array []"},
@@ -178,7 +184,15 @@ const BadExample kBadExamples[] = {
     {R"(, "examples": [{"pose": {"frame": 3}, "edits": [{"vertex": 4, "move": [0, 0, 1],
         "scale": 2}]}])",
      "r.json: patches[0].examples[0].edits[0].scale: error: unknown field (expected one of: "
-     "vertex, point, move, frame)"},
+     "vertex, point, move, frame, radius)"},
+    {R"(, "examples": [{"pose": {"frame": 3}, "edits": [{"point": [0.5, 0.5], "move": [0, 0, 1],
+        "radius": 0}]}])",
+     "r.json: patches[0].examples[0].edits[0].radius: error: expected a brush radius in 0.01..2 "
+     "((u, v) units), found 0"},
+    {R"(, "examples": [{"pose": {"frame": 3}, "edits": [{"point": [0.5, 0.5], "move": [0, 0, 1],
+        "radius": "wide"}]}])",
+     "r.json: patches[0].examples[0].edits[0].radius: error: expected a brush radius in 0.01..2 "
+     "((u, v) units), found \"wide\""},
     {R"(, "examples": [{"pose": {"frame": 3}, "edits": [{"vertex": 4, "move": [0, 0, 1]}]},
                        {"pose": {"frame": 3}, "edits": [{"vertex": 5, "move": [0, 0, 1]}]}])",
      "r.json: patches[0].examples[1].pose: error: duplicates the pose of patches[0].examples[0] "
@@ -480,6 +494,73 @@ TEST(RigExamples, ShoulderThreeBoneRotationsMatchTheSvd) {
     }
   }
   EXPECT_LT(worst, testsupport::kRotationTolRad);
+}
+
+}  // namespace
+
+namespace {
+
+// Vertices that moved by more than `frac` x |move| between two frames.
+int CountMoved(const app::DeformedFrame& a, const app::DeformedFrame& b, double threshold) {
+  int n = 0;
+  for (std::size_t i = 0; i < a.positions.size(); ++i) {
+    if (glm::length(b.positions[i] - a.positions[i]) > threshold) ++n;
+  }
+  return n;
+}
+
+// A brush edit (issue 26) makes a shape, not a bump: at its example pose the
+// surface point under the brush moves by the move, and many more skin
+// vertices follow than with the same edit without a radius.
+TEST(RigExamples, BrushEditMovesTheNeighbourhoodSmoothly) {
+  auto f = Load();
+  ASSERT_TRUE(f.has_value());
+  // A 10 x 10 grid: on the fixture's 6 x 6 every basis function already spans
+  // a third of the patch, so a plain edit is as wide as a brush there.
+  auto fine = [](std::string rig) {
+    rig.replace(rig.find(R"("sampling": [8, 8], "grid": [6, 6])"), 34,
+                R"("sampling": [14, 14], "grid": [10, 10])");
+    return rig;
+  };
+  {
+    auto rig = app::ParseRig(fine(ElbowRig("")), "r.json");
+    ASSERT_TRUE(rig.ok()) << rig.error().ToString();
+    auto patches = app::BuildRigPatches(*rig, f->character);
+    ASSERT_TRUE(patches.ok()) << patches.error().ToString();
+    f->patches = std::move(*patches);
+  }
+  const int frame = 45;
+  const glm::dvec3 move(0.0, 0.0, 1.0);
+  auto edit = [&](const std::string& radius) {
+    return fine(ElbowRig(R"(, "examples": [{"pose": {"frame": )" + std::to_string(frame) +
+                    R"(}, "edits": [{"point": [0.5, 0.5], "move": )" + Vec(move) +
+                    R"(, "frame": "world")" + radius + "}]}]"));
+  };
+  const auto plain_rig = app::ParseRig(edit(""), "r.json");
+  const auto brush_rig = app::ParseRig(edit(R"(, "radius": 0.8)"), "r.json");
+  ASSERT_TRUE(plain_rig.ok()) << plain_rig.error().ToString();
+  ASSERT_TRUE(brush_rig.ok()) << brush_rig.error().ToString();
+  EXPECT_EQ(brush_rig->patches[0].examples[0].edits[0].radius, 0.8);
+  auto none = MakePipeline(*f, nullptr);
+  auto plain = MakePipeline(*f, &*plain_rig);
+  auto brush = MakePipeline(*f, &*brush_rig);
+  ASSERT_TRUE(none.ok() && plain.ok() && brush.ok());
+  const double t = frame * f->character.motion.frame_time_s;
+  app::DeformedFrame a, b, c;
+  ASSERT_TRUE(none->Evaluate(t, a).ok());
+  ASSERT_TRUE(plain->Evaluate(t, b).ok());
+  ASSERT_TRUE(brush->Evaluate(t, c).ok());
+  double peak_plain = 0.0, peak_brush = 0.0;
+  for (std::size_t i = 0; i < a.positions.size(); ++i) {
+    peak_plain = std::max(peak_plain, static_cast<double>(glm::length(b.positions[i] - a.positions[i])));
+    peak_brush = std::max(peak_brush, static_cast<double>(glm::length(c.positions[i] - a.positions[i])));
+  }
+  const int moved_plain = CountMoved(a, b, 0.25);
+  const int moved_brush = CountMoved(a, c, 0.25);
+  std::printf("vertices moved > 0.25 of the move: plain %d, brush %d; peak plain %.3f brush %.3f\n",
+              moved_plain, moved_brush, peak_plain, peak_brush);
+  EXPECT_GT(moved_brush, 2 * moved_plain);
+  EXPECT_NEAR(peak_brush, 1.0, 0.1);  // the surface point moves by |move|; vertices near it too
 }
 
 }  // namespace

@@ -1,0 +1,62 @@
+#include "deform/patch/fold_measure.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <numbers>
+#include <tuple>
+
+namespace deform {
+
+std::vector<int> RegionTriangles(std::span<const glm::uvec3> triangles, std::span<const int> region,
+                                 int num_vertices) {
+  std::vector<std::uint8_t> in(static_cast<std::size_t>(std::max(num_vertices, 0)), 0);
+  for (int v : region) {
+    if (v >= 0 && v < num_vertices) in[static_cast<std::size_t>(v)] = 1;
+  }
+  std::vector<int> out;
+  for (std::size_t t = 0; t < triangles.size(); ++t) {
+    const glm::uvec3& tri = triangles[t];
+    bool all = true;
+    for (int k = 0; k < 3; ++k) all = all && tri[k] < in.size() && in[tri[k]] != 0;
+    if (all) out.push_back(static_cast<int>(t));
+  }
+  return out;
+}
+
+double MaxFoldAngleDeg(std::span<const glm::vec3> positions, std::span<const glm::uvec3> triangles,
+                       std::span<const int> subset) {
+  // (edge low vertex, edge high vertex, triangle) for every edge of a usable triangle.
+  std::vector<std::tuple<unsigned, unsigned, int>> edges;
+  std::vector<glm::dvec3> normal(triangles.size(), glm::dvec3(0.0));
+  for (int t : subset) {
+    if (t < 0 || static_cast<std::size_t>(t) >= triangles.size()) continue;
+    const glm::uvec3& tri = triangles[static_cast<std::size_t>(t)];
+    if (tri.x >= positions.size() || tri.y >= positions.size() || tri.z >= positions.size()) continue;
+    const glm::dvec3 p0(positions[tri.x]), p1(positions[tri.y]), p2(positions[tri.z]);
+    const glm::dvec3 n = glm::cross(p1 - p0, p2 - p0);
+    const double len = glm::length(n);
+    if (!(len > 0.0)) continue;                      // degenerate: no normal
+    normal[static_cast<std::size_t>(t)] = n / len;
+    for (int k = 0; k < 3; ++k) {
+      const unsigned a = tri[k], b = tri[(k + 1) % 3];
+      edges.emplace_back(std::min(a, b), std::max(a, b), t);
+    }
+  }
+  std::sort(edges.begin(), edges.end());
+  double worst = 0.0;
+  for (std::size_t e = 0; e + 1 < edges.size(); ++e) {
+    const auto& [a0, b0, t0] = edges[e];
+    // Every pair of triangles on the same edge (a non-manifold edge has more than two).
+    for (std::size_t f = e + 1; f < edges.size(); ++f) {
+      const auto& [a1, b1, t1] = edges[f];
+      if (a1 != a0 || b1 != b0) break;
+      if (t1 == t0) continue;
+      const double c = glm::dot(normal[static_cast<std::size_t>(t0)], normal[static_cast<std::size_t>(t1)]);
+      worst = std::max(worst, std::acos(std::clamp(c, -1.0, 1.0)) * 180.0 / std::numbers::pi);
+    }
+  }
+  return worst;
+}
+
+}  // namespace deform
