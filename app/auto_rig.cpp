@@ -121,6 +121,17 @@ float Dist(const deform::BodyChains& c, int a, int b) {
   return glm::distance(c.points[static_cast<std::size_t>(a)].pos, c.points[static_cast<std::size_t>(b)].pos);
 }
 
+// A computed corrective example (`"auto": "volume"`, deform/shapes/
+// corrective_example.h) at the capture's frame of the joint's largest bend;
+// none when the joint hardly bends.
+void AddVolumeExample(RigPatch& p, const Hinge& hinge) {
+  if (hinge.frame < 0 || hinge.angle_deg < kMinBendDeg) return;
+  RigExample e;
+  e.pose.frame = hinge.frame;
+  e.auto_kind = "volume";
+  p.examples.push_back(std::move(e));
+}
+
 // The elbow (knee) of a limb: the point between its two longest consecutive
 // bones up to the extremity, upper arm and forearm (thigh and shin), so a hand
 // end site does not shift it. 0 when the limb is too short.
@@ -175,12 +186,18 @@ void PlaceLimbs(const mocap::Skeleton& s, const deform::Humanoid& h, int side,
     const float upper = Dist(c, shoulder, elbow), fore = Dist(c, elbow, wrist);
     if (elbow_joint != nullptr && shoulder_joint != nullptr) {
       const Hinge e = hinge_side("elbow", shoulder, elbow, wrist, h.forward);
-      out.rig.patches.push_back(JointPatch(prefix + "elbow_back", *elbow_joint, 0.45f * fore,
-                                           -e.bend, 80, {7, 7}, {16, 16}, true));
-      out.rig.patches.push_back(JointPatch(prefix + "biceps", *elbow_joint, 0.75f * upper, e.bend,
-                                           80, {9, 10}, {18, 20}, true));
-      out.rig.patches.push_back(JointPatch(prefix + "shoulder_top", *shoulder_joint, 0.4f * upper,
-                                           h.up, 60, {9, 6}, {18, 12}, false));
+      RigPatch back = JointPatch(prefix + "elbow_back", *elbow_joint, 0.45f * fore, -e.bend, 80,
+                                 {7, 7}, {16, 16}, true);
+      RigPatch biceps = JointPatch(prefix + "biceps", *elbow_joint, 0.75f * upper, e.bend, 80,
+                                   {9, 10}, {18, 20}, true);
+      RigPatch top = JointPatch(prefix + "shoulder_top", *shoulder_joint, 0.4f * upper, h.up, 60,
+                                {9, 6}, {18, 12}, false);
+      // The biceps and shoulder are left without one: restoring their region's
+      // volume swelled the walk's upper arms into lumps (seen at 1280x720).
+      AddVolumeExample(back, e);
+      out.rig.patches.push_back(std::move(back));
+      out.rig.patches.push_back(std::move(biceps));
+      out.rig.patches.push_back(std::move(top));
     }
   }
   const deform::HumanoidLimb& leg = h.legs[side];
@@ -194,10 +211,16 @@ void PlaceLimbs(const mocap::Skeleton& s, const deform::Humanoid& h, int side,
     if (knee_joint != nullptr && hip_joint != nullptr) {
       // A knee bends backwards: its front is away from the bend.
       const Hinge bent = hinge_side("knee", hip, knee, ankle, -h.forward);
-      out.rig.patches.push_back(JointPatch(prefix + "knee_front", *knee_joint, 0.4f * shin, -bent.bend,
-                                           80, {7, 7}, {16, 16}, true));
-      out.rig.patches.push_back(JointPatch(prefix + "hip_back", *hip_joint, 0.4f * thigh,
-                                           -h.forward, 70, {7, 7}, {16, 16}, false));
+      const Hinge flex = LargestBend(c, leg.points[static_cast<std::size_t>(k - 2)], hip, knee, bind,
+                                     poses, joints);
+      RigPatch front = JointPatch(prefix + "knee_front", *knee_joint, 0.4f * shin, -bent.bend, 80,
+                                  {7, 7}, {16, 16}, true);
+      RigPatch buttock = JointPatch(prefix + "hip_back", *hip_joint, 0.4f * thigh, -h.forward, 70,
+                                    {7, 7}, {16, 16}, false);
+      AddVolumeExample(front, bent);
+      AddVolumeExample(buttock, flex);
+      out.rig.patches.push_back(std::move(front));
+      out.rig.patches.push_back(std::move(buttock));
     }
   }
 }
@@ -392,6 +415,13 @@ void KeepBuildable(const Character& character, AutoRig& out) {
     kept.push_back(p);
   }
   out.rig.patches = std::move(kept);
+  // Messages name examples by their place in the rig, as a parsed rig does.
+  for (std::size_t i = 0; i < out.rig.patches.size(); ++i) {
+    std::vector<RigExample>& examples = out.rig.patches[i].examples;
+    for (std::size_t k = 0; k < examples.size(); ++k) {
+      examples[k].path = "patches[" + std::to_string(i) + "].examples[" + std::to_string(k) + "]";
+    }
+  }
 }
 
 }  // namespace

@@ -14,6 +14,9 @@
 //     knee, back of the hip (buttock);
 //   - elastic belly (the spine point about 45 % of the way pelvis -> chest, front
 //     side) and elastic jowl (the head joint, front side), driven by the capture;
+//   - a computed corrective example (`"auto": "volume"`) at the capture's frame
+//     of largest bend on the back of each elbow, the front of each knee and the
+//     back of each hip (the joints whose skin SSD collapses);
 //   - region sizes are fractions of the bone lengths (radius of the elbow
 //     patch 0.45 x the forearm, ...), so a child and an adult get the same layout;
 //   - which side of a hinge is its back: the direction the child bone swings to

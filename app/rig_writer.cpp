@@ -131,10 +131,12 @@ mocap::Result<std::string> WriteRigJson(const Rig& rig, const std::string& folde
   s += "  \"patches\": [";
   for (std::size_t i = 0; i < rig.patches.size(); ++i) {
     const RigPatch& p = rig.patches[i];
-    if (!p.examples.empty()) {
-      return mocap::MakeError(mocap::ErrorCode::kUnsupported,
-                              {rig.file, 0, 0, "patches[" + std::to_string(i) + "].examples"},
-                              "writing example shapes is not supported yet");
+    for (const RigExample& e : p.examples) {
+      if (!e.edits.empty() || e.pose.frame < 0 || e.auto_kind.empty()) {
+        return mocap::MakeError(mocap::ErrorCode::kUnsupported,
+                                {rig.file, 0, 0, "patches[" + std::to_string(i) + "].examples"},
+                                "only computed examples at a frame are written (no edits, no joint angles)");
+      }
     }
     s += std::string(i ? "," : "") + "\n    {\"name\": " + Str(p.name) + ",\n";
     s += "     \"region\": " + Region(p.region) + ",\n";
@@ -142,6 +144,15 @@ mocap::Result<std::string> WriteRigJson(const Rig& rig, const std::string& folde
          ", \"grid\": " + Pair(p.grid) + ", \"sampling\": " + Pair(p.sampling) +
          ", \"border_width\": " + Num(p.border_width);
     if (p.elastic) s += ",\n     \"elastic\": " + Elastic(*p.elastic);
+    if (!p.examples.empty()) {
+      s += ",\n     \"examples\": [";
+      for (std::size_t k = 0; k < p.examples.size(); ++k) {
+        if (k > 0) s += ", ";
+        s += "{\"pose\": {\"frame\": " + std::to_string(p.examples[k].pose.frame) +
+             "}, \"auto\": " + Str(p.examples[k].auto_kind) + "}";
+      }
+      s += "]";
+    }
     s += "}";
   }
   s += rig.patches.empty() ? "],\n" : "\n  ],\n";

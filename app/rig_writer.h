@@ -6,8 +6,9 @@
 // Paths (character, motion, joint map, output) are written relative to
 // `folder`, the folder the file will live in, so the file resolves them as the
 // in-memory rig did. Numbers are written in their shortest form that reads back
-// to the same float. Example shapes are not written (an auto rig has none):
-// kUnsupported naming the patch when a rig has them.
+// to the same float. Examples are written when they are computed ones at a
+// frame (`{"pose": {"frame": N}, "auto": "volume"}`, what an auto rig has);
+// sculpted edits or joint-angle poses give kUnsupported naming the patch.
 //
 // Cost: linear in the number of patches.
 

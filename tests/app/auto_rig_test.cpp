@@ -65,6 +65,13 @@ TEST(AutoRig, PlacesTheDemosPatchesOnTheWalksJoints) {
   EXPECT_GT(Find(a.rig, "belly")->region.side.z, 0.9f);
   ASSERT_TRUE(Find(a.rig, "belly")->elastic.has_value());
   ASSERT_TRUE(Find(a.rig, "jowl")->elastic.has_value());
+  // A computed volume example at the walk's deepest knee bend (61 degrees at
+  // frame 24 for the left knee, frame 39 for the right: the gait's half cycle).
+  const app::RigPatch* knee = Find(a.rig, "left_knee_front");
+  ASSERT_EQ(knee->examples.size(), 1u);
+  EXPECT_EQ(knee->examples[0].auto_kind, "volume");
+  EXPECT_EQ(knee->examples[0].pose.frame, 24);
+  EXPECT_EQ(Find(a.rig, "right_knee_front")->examples.at(0).pose.frame, 39);
   // Sizes follow the bones: the biceps patch reaches further than the elbow's.
   EXPECT_GT(Find(a.rig, "left_biceps")->region.radius, Find(a.rig, "left_elbow_back")->region.radius);
 }
@@ -113,6 +120,11 @@ TEST(AutoRig, WrittenRigReadsBackToTheSameRig) {
     EXPECT_EQ(q.grid, p.grid);
     EXPECT_EQ(q.sampling, p.sampling);
     EXPECT_EQ(q.border_width, p.border_width);
+    ASSERT_EQ(q.examples.size(), p.examples.size());
+    for (std::size_t k = 0; k < p.examples.size(); ++k) {
+      EXPECT_EQ(q.examples[k].pose.frame, p.examples[k].pose.frame);
+      EXPECT_EQ(q.examples[k].auto_kind, p.examples[k].auto_kind);
+    }
     ASSERT_EQ(q.elastic.has_value(), p.elastic.has_value());
     if (p.elastic) {
       EXPECT_EQ(q.elastic->params.frequency_hz, p.elastic->params.frequency_hz);
