@@ -27,6 +27,7 @@
 #include <assimp/scene.h>
 #endif
 
+#include "app/bench_auto_layer.h"
 #include "app/bench_elastic_share.h"
 #include "app/bench_long_capture.h"
 #include "app/bench_table1.h"
@@ -499,6 +500,7 @@ int RunBench(const BenchOptions& o) {
   rows.push_back(std::move(encode_row));
   rows.push_back(std::move(bound_row));
   bench::AddElasticShareRow({std::min(budget.runs, 5), 0.0}, o.quick ? 8 : 30, rows, &failed);
+  bench::AddAutoLayerRows({std::min(budget.runs, 5), 0.0}, o.quick ? 8 : 30, rows, &failed);
   rows.push_back({"bytes_per_bound_vertex", "bytes", Clock::kCpu,
                   {static_cast<double>(deform::PatchBinding::kStoredBytesPerVertex)}, 0.0, "",
                   "stored; the rebuild reads " +

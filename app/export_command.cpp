@@ -16,6 +16,7 @@
 #include "app/output_guard.h"
 #include "app/pipeline.h"
 #include "app/progress.h"
+#include "app/auto_rig.h"
 #include "app/rig_file.h"
 #include "app/rig_setup.h"
 #include "deform/io/file_output.h"
@@ -112,6 +113,8 @@ CLI::App* AddExportCommand(CLI::App& parent, ExportOptions& o) {
                   "File number of motion frame 0 (OBJ meshes, camera JSON), e.g. 1001")
       ->capture_default_str();
   cmd->add_flag("--quiet", o.quiet, "No progress output");
+  cmd->add_option("--layer", o.layer,
+                  "auto: the patch layer placed from the skeleton (as render --layer auto)");
   return cmd;
 }
 
@@ -119,7 +122,14 @@ int RunExport(const ExportOptions& options) {
   // --- A rig file sets the inputs, the method and the layers, as for render ---
   ExportOptions o = options;
   std::optional<Rig> rig;
-  if (Lower(std::filesystem::path(o.input).extension().string()) == ".json") {
+  if (!o.layer.empty()) {
+    // --layer auto: the rig `patchskin rig auto` writes; the options given here stay.
+    mocap::Result<Rig> made = AutoRigForCommand(o.layer, o.input, o.motion, o.body, o.up, o.quiet);
+    if (!made.ok()) return Fail(made.error());
+    rig = std::move(*made);
+    o.input = RigInputFile(*rig);
+    if (!IsBuiltInBody(rig->character)) o.motion = rig->motion;
+  } else if (Lower(std::filesystem::path(o.input).extension().string()) == ".json") {
     mocap::Result<Rig> loaded = LoadRig(o.input);
     if (!loaded.ok()) return Fail(loaded.error());
     rig = std::move(*loaded);

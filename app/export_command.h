@@ -34,6 +34,7 @@ struct ExportOptions {
                                   // empty = out/<name>_export/mesh_####.obj
   std::string global = "ssd";     // ssd | dqs | swd
   std::string body = "generated"; // body of a BVH input: generated | tubes (as render; a rig: tubes)
+  std::string layer;              // "auto": the patch layer placed from the skeleton; empty = none
   std::string layout = "auto";    // .glb: auto | morph | baked
   bool step = false;              // .glb morph weights: STEP instead of LINEAR
   bool with_camera = false;       // also write camera_####.json per frame

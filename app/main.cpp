@@ -20,6 +20,7 @@
 #include "app/elastic_command.h"
 #include "app/inspect_command.h"
 #include "app/render_command.h"
+#include "app/rig_command.h"
 #include "app/sheet_command.h"
 
 namespace {
@@ -50,6 +51,8 @@ int main(int argc, char** argv) {
   CLI::App* sheet = app::AddSheetCommand(app, sheet_options);
   app::FarmOptions farm_options;
   CLI::App* farm = app::AddFarmCommand(app, farm_options);
+  app::RigCommandOptions rig_options;
+  CLI::App* rig_auto = app::AddRigCommand(app, rig_options);
   app::BenchOptions bench_options;
   CLI::App* bench = app::AddBenchCommand(app, bench_options);
 
@@ -78,6 +81,7 @@ int main(int argc, char** argv) {
     if (sheet->parsed()) return app::RunSheet(sheet_options);
     if (farm->parsed()) return app::RunFarm(farm_options);
     if (bench->parsed()) return app::RunBench(bench_options);
+    if (rig_auto->parsed()) return app::RunRigAuto(rig_options);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "patchskin: internal error: %s\n", e.what());
     return 3;

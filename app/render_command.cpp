@@ -10,6 +10,7 @@
 #include <sstream>
 #include <vector>
 
+#include "app/auto_rig.h"
 #include "app/character_motion.h"
 #include "app/demo_data.h"
 #include "app/frame_plan.h"
@@ -241,6 +242,9 @@ CLI::App* AddRenderCommand(CLI::App& parent, RenderOptions& o) {
   cmd->add_option("--body", o.body,
                   "Body of a BVH INPUT: generated, tubes, or a glTF/GLB character it drives")
       ->capture_default_str();
+  cmd->add_option("--layer", o.layer,
+                  "auto: place the paper's patches (elbows, knees, shoulders, hips, elastic belly "
+                  "and jowl) from the skeleton, as `patchskin rig auto` writes them");
   AddOutputFlags(*cmd, o);
   cmd->callback([&o, cmd] { RecordGivenOptions(cmd, o); });
   return cmd;
@@ -266,6 +270,7 @@ CLI::App* AddTurntableCommand(CLI::App& parent, RenderOptions& o) {
   cmd->add_flag("--no-sheet", o.no_sheet, "Do not write the contact sheet");
   cmd->add_flag("--no-video", o.no_video, "Do not write the preview video");
   cmd->add_flag("--quiet", o.quiet, "No progress output");
+  cmd->add_option("--layer", o.layer, "auto: the patch layer placed from the skeleton (as render)");
   AddOutputFlags(*cmd, o);
   // A turntable of a rig keeps the rig's settings except those given here,
   // and is a turntable whatever camera the rig asks for.
@@ -305,10 +310,19 @@ int RunRender(const RenderOptions& options) {
   // --- A rig file (docs/rig-file.md) sets the inputs and render settings ---
   RenderOptions o = options;
   std::optional<Rig> rig;
-  if (std::filesystem::path(o.input).extension() == ".json") {
+  if (!o.layer.empty()) {
+    // --layer auto: the rig `patchskin rig auto` would write, used as if read.
+    mocap::Result<Rig> made = AutoRigForCommand(o.layer, o.input, o.motion, o.body, o.up, o.quiet);
+    if (!made.ok()) return Fail(made.error());
+    rig = std::move(*made);
+    o.given.erase("--body");  // the rig names the body now
+    o.body = "generated";
+  } else if (std::filesystem::path(o.input).extension() == ".json") {
     mocap::Result<Rig> loaded = LoadRig(o.input);
     if (!loaded.ok()) return Fail(loaded.error());
     rig = std::move(*loaded);
+  }
+  if (rig) {
     // The rig sets what the command line leaves out; an option given wins.
     const auto given = [&o](const char* name) { return o.given.count(name) > 0; };
     o.input = RigInputFile(*rig);

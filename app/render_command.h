@@ -61,6 +61,7 @@ struct RenderOptions {
   // mannequin rig files name vertices of; a rig file always uses it), or a glTF/GLB
   // character that the BVH then drives as with --motion.
   std::string body = "generated";
+  std::string layer;                  // "auto": the patch layer placed from the skeleton; empty = none
   // Long names ("--size") of the options given on the command line, filled by
   // the parser: with a rig file, these win over the rig's render settings.
   std::set<std::string> given;

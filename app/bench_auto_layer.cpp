@@ -1,0 +1,116 @@
+#include "app/bench_auto_layer.h"
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <string>
+
+#include "app/auto_rig.h"
+#include "app/demo_data.h"
+#include "app/frame_render.h"
+#include "app/motion_source.h"
+#include "app/pipeline.h"
+#include "app/rig_setup.h"
+#include "render/camera.h"
+#include "render/output/image_io.h"
+
+namespace app::bench {
+namespace {
+
+bool Report(const mocap::Error& e, bool* failed) {
+  std::fprintf(stderr, "bench: auto layer: %s\n", e.ToString().c_str());
+  *failed = true;
+  return false;
+}
+
+}  // namespace
+
+void AddAutoLayerRows(const Budget& b, int frames, std::vector<Row>& rows, bool* failed) {
+  mocap::Result<MotionSource> src = LoadBvhText(DemoBvhText(), "demo_walk.bvh", {.y_up = true});
+  if (!src.ok()) return void(Report(src.error(), failed));
+  mocap::Result<Character> character = MakeCharacter(std::move(*src), {}, BodyKind::kGenerated);
+  if (!character.ok()) return void(Report(character.error(), failed));
+  const Character& ch = *character;
+  mocap::Result<FramePipeline> global = FramePipeline::Create(ch, GlobalMethod::kSsd, 1);
+  if (!global.ok()) return void(Report(global.error(), failed));
+
+  Row setup{"auto_layer_setup_s", "s", Clock::kCpu, {}, 1.0, "limit",
+            "BuildAutoRig + ApplyRigLayers, demo walk (" + std::to_string(ch.skeleton.num_joints()) +
+                " joints), generated body"};
+  std::optional<FramePipeline> layered;
+  std::size_t patches = 0;
+  for (int r = 0; r < b.runs; ++r) {
+    const double t0 = Now(Clock::kCpu);
+    mocap::Result<AutoRig> made = BuildAutoRig(ch, "generated", "demo_walk.bvh", "demo");
+    if (!made.ok()) return void(Report(made.error(), failed));
+    mocap::Result<FramePipeline> p = FramePipeline::Create(ch, GlobalMethod::kSsd, 1);
+    if (!p.ok()) return void(Report(p.error(), failed));
+    if (mocap::Status s = ApplyRigLayers(made->rig, ch, *p); !s.ok()) {
+      return void(Report(s.error(), failed));
+    }
+    setup.runs.push_back(Now(Clock::kCpu) - t0);
+    patches = made->rig.patches.size();
+    layered.emplace(std::move(*p));
+  }
+  if (!layered) return;
+  setup.note += ", " + std::to_string(patches) + " patches";
+
+  DeformedFrame frame;
+  if (mocap::Status s = global->Evaluate(0.0, frame); !s.ok()) return void(Report(s.error(), failed));
+  render::RenderSettings settings;
+  settings.width = 1280;
+  settings.height = 720;
+  settings.supersample = 2;
+  settings.threads = 1;
+  const render::Camera camera =
+      render::FrameBounds(frame.bounds, 35.0f, 1280.0f / 720.0f, glm::vec3(0.0f, 0.0f, -1.0f));
+  render::Renderer renderer, unused;
+  render::Image image, scratch;
+  render::WriteOptions png;
+  png.png_compression = 1;
+  const std::string png_path = (std::filesystem::temp_directory_path() /
+                                ("patchskin_bench_auto_" + std::to_string(getpid()) + ".png"))
+                                   .string();
+  // CPU seconds of `frames` end-to-end frames of `pipeline`, from the start of the clip.
+  const auto time_frames = [&](FramePipeline& pipeline) {
+    const double t0 = Now(Clock::kCpu);
+    for (int f = 0; f < frames && !*failed; ++f) {
+      const double time_s = f / 30.0;
+      mocap::Status s = pipeline.Evaluate(time_s, frame);
+      if (s.ok()) {
+        FrameDrawOptions draw;
+        draw.frame_number = f;
+        s = DrawCharacterFrame(ch, frame, nullptr, camera, settings, draw, renderer, unused,
+                               scratch, image);
+      }
+      if (s.ok()) s = render::WriteImage(image, png_path, png);
+      if (!s.ok()) Report(s.error(), failed);
+    }
+    return Now(Clock::kCpu) - t0;
+  };
+  Row overhead{"auto_layer_overhead", "%", Clock::kCpu, {}, 30.0, "limit",
+               "end-to-end frame with --layer auto's " + std::to_string(patches) +
+                   " patches vs ssd alone, 1280x720 2x2, PNG, 1 thread, " +
+                   std::to_string(frames) + " frames each"};
+  double base_s = 0.0, layer_s = 0.0;
+  for (int r = 0; r < b.runs && !*failed; ++r) {
+    const double base = time_frames(*global);
+    const double with = time_frames(*layered);
+    base_s += base;
+    layer_s += with;
+    overhead.runs.push_back(100.0 * (with / base - 1.0));
+  }
+  if (base_s > 0.0 && layer_s > 0.0) {
+    char note[96];
+    std::snprintf(note, sizeof(note), "; %.2f vs %.2f frames/s", frames * b.runs / base_s,
+                  frames * b.runs / layer_s);
+    overhead.note += note;
+  }
+  std::error_code ec;
+  std::filesystem::remove(png_path, ec);
+  rows.push_back(std::move(setup));
+  rows.push_back(std::move(overhead));
+}
+
+}  // namespace app::bench

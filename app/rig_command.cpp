@@ -1,0 +1,71 @@
+#include "app/rig_command.h"
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include "app/auto_rig.h"
+#include "app/rig_writer.h"
+
+namespace app {
+
+CLI::App* AddRigCommand(CLI::App& parent, RigCommandOptions& o) {
+  CLI::App* rig = parent.add_subcommand("rig", "Make rig files");
+  rig->require_subcommand(1, 1);
+  CLI::App* cmd = rig->add_subcommand(
+      "auto", "The rig of --layer auto for a capture, as an editable rig file (stdout or --out)");
+  cmd->add_option("capture", o.capture, "BVH capture")->required();
+  cmd->add_option("--body", o.body, "generated, tubes, or a glTF/GLB character the capture drives")
+      ->capture_default_str();
+  cmd->add_option("--up", o.up, "The BVH's up axis, y or z (default: detected)");
+  cmd->add_option("--out", o.out, "Rig file to write (default: stdout)");
+  cmd->add_flag("--quiet", o.quiet, "No notes on stderr");
+  return cmd;
+}
+
+int RunRigAuto(const RigCommandOptions& o) {
+  mocap::Result<AutoRig> made = MakeAutoRig(o.capture, o.body, o.up, o.quiet);
+  if (!made.ok()) {
+    std::fprintf(stderr, "%s\n", made.error().ToString().c_str());
+    return made.error().code == mocap::ErrorCode::kInternal ? 3 : 2;
+  }
+  const std::string folder =
+      o.out.empty() ? std::string(".") : std::filesystem::path(o.out).parent_path().string();
+  mocap::Result<std::string> text = WriteRigJson(made->rig, folder);
+  if (!text.ok()) {
+    std::fprintf(stderr, "%s\n", text.error().ToString().c_str());
+    return 3;
+  }
+  if (!o.quiet) {
+    for (const std::string& note : made->notes) {
+      std::fprintf(stderr, "%s: note: %s\n", o.capture.c_str(), note.c_str());
+    }
+    std::fprintf(stderr, "%s: %zu patches\n", o.capture.c_str(), made->rig.patches.size());
+  }
+  if (o.out.empty()) {
+    std::fwrite(text->data(), 1, text->size(), stdout);
+    return std::fflush(stdout) == 0 ? 0 : 2;
+  }
+  // Written beside the target and renamed, so a failed write leaves no partial file.
+  const std::string tmp = o.out + ".partial";
+  {
+    std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
+    f.write(text->data(), static_cast<std::streamsize>(text->size()));
+    if (!f.flush()) {
+      std::error_code ec;
+      std::filesystem::remove(tmp, ec);
+      std::fprintf(stderr, "%s: error: cannot write the rig file\n", o.out.c_str());
+      return 2;
+    }
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, o.out, ec);
+  if (ec) {
+    std::filesystem::remove(tmp, ec);
+    std::fprintf(stderr, "%s: error: cannot write the rig file\n", o.out.c_str());
+    return 2;
+  }
+  return 0;
+}
+
+}  // namespace app

@@ -1,0 +1,25 @@
+#pragma once
+// `patchskin rig auto CAPTURE [--body B] [--out rig.json]`: the rig that
+// `render CAPTURE --layer auto` uses (app/auto_rig.h), written as an editable
+// rig file (app/rig_writer.h) to stdout or --out; the placement notes go to
+// stderr. Exit codes as every command (app/main.cpp).
+
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+namespace app {
+
+struct RigCommandOptions {
+  std::string capture;             // BVH capture
+  std::string body = "generated";  // generated | tubes | a glTF/GLB character the capture drives
+  std::string up;                  // --up y|z; empty = detected
+  std::string out;                 // rig file; empty = stdout
+  bool quiet = false;
+};
+
+// Adds `rig` with its `auto` subcommand; returns the `auto` one.
+CLI::App* AddRigCommand(CLI::App& parent, RigCommandOptions& o);
+int RunRigAuto(const RigCommandOptions& o);
+
+}  // namespace app
