@@ -55,7 +55,7 @@ Measured Measure(const std::string& demo) {
   auto source = app::LoadMotionSource(rig->motion, {.y_up = true});
   EXPECT_TRUE(source.ok());
   if (!source.ok()) return m;
-  auto ch = app::MakeCharacter(std::move(*source));
+  auto ch = app::MakeCharacter(std::move(*source), {}, app::RigBodyKind(*rig));
   EXPECT_TRUE(ch.ok());
   if (!ch.ok()) return m;
   const auto method = app::ParseGlobalMethod(rig->global);

@@ -6,9 +6,10 @@
 //   elbow     ulna protruding at a bend: tip protrusion along the outer bisector
 //   biceps    the biceps bulging as the elbow bends: radial extent of the upper arm
 //   knee      rounder at a bend: curvature of the outer profile at the kneecap
-//   shoulder  five example poses, each reproduced: the edited vertex's move
+//   shoulder  five example poses, each reproduced: the brush stroke's move
 //   hip       no crush when the leg stretches back: enclosed body volume
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -72,8 +73,8 @@ TEST(ExampleDemos, ElbowUlnaProtrudesAtTheBend) {
 TEST(ExampleDemos, BicepsBulgesAsTheElbowBends) {
   auto d = Load("biceps");
   ASSERT_TRUE(d->error.empty());
-  // The 9x10 patch of the paper with 5 examples (30..150 degrees, 0.6 cm more
-  // bulge each). The figure: the largest distance from the upper-arm bone of
+  // The 9x10 patch of the paper over the front of the upper arm with 5
+  // examples (30..150 degrees, a brush stroke 0.6 cm higher each). The figure: the largest distance from the upper-arm bone of
   // the region vertices on its middle (bind projection 0.3..0.7).
   const glm::dvec3 shoulder_bind(17.0, 140.0, 0.0), elbow_bind(45.0, 140.0, 0.0);
   std::vector<int> upper;
@@ -104,13 +105,25 @@ TEST(ExampleDemos, BicepsBulgesAsTheElbowBends) {
   EXPECT_GT(previous_gain, 2.0);  // 3 cm asked at 150 degrees, on the front of an oval arm
 }
 
+// Half-width of the slab around the bend plane that the knee's profile is
+// taken from: about one edge of the generated body's mesh.
+constexpr double kProfileSlab = 2.0;
+
 TEST(ExampleDemos, KneeIsRounderAtTheBend) {
   auto d = Load("knee");
   ASSERT_TRUE(d->error.empty());
   // A round knee keeps the curvature of the leg at rest around the joint,
-  // 1 / (kneecap distance from the knee joint in the bind pose).
-  const glm::dvec3 knee_bind(9.0, 50.0, 0.0);
-  const double round = 1.0 / glm::length(glm::dvec3(d->character.mesh.bind.positions[4527]) - knee_bind);
+  // 1 / (kneecap distance from the knee joint in the bind pose): the kneecap is
+  // the region's most forward vertex at rest (frame 0 is the rest pose).
+  const Frames rest = Evaluate(*d, 0);
+  const glm::dvec3 knee_rest = testsupport::JointAt(*d, rest.global, "LeftLeg");
+  double kneecap = 0.0;
+  for (int v : d->patches[0].region) {
+    const glm::dvec3 p(rest.global.positions[static_cast<std::size_t>(v)]);
+    if (p.z - knee_rest.z > kneecap) kneecap = p.z - knee_rest.z;
+  }
+  ASSERT_GT(kneecap, 1.0);
+  const double round = 1.0 / kneecap;
   for (const auto& [frame, max_ratio] : {std::pair{30, 0.8}, std::pair{60, 0.5}}) {
     const Frames f = Evaluate(*d, frame);
     const glm::dvec3 a = testsupport::JointAt(*d, f.global, "LeftUpLeg"),
@@ -118,7 +131,7 @@ TEST(ExampleDemos, KneeIsRounderAtTheBend) {
                      c = testsupport::JointAt(*d, f.global, "LeftFoot");
     const glm::dvec3 in = glm::normalize(b - a), out = glm::normalize(c - b);
     const auto curvature = [&](const std::vector<glm::vec3>& p) {
-      return testsupport::BendCurvature(p, d->patches[0].region, b, in, out, 1.5);
+      return testsupport::BendCurvature(p, d->patches[0].region, b, in, out, kProfileSlab);
     };
     const double global = curvature(f.global.positions), layered = curvature(f.layered.positions);
     std::printf("knee frame %d (%.0f deg): outer curvature global %.4f /cm, with examples %.4f /cm "
@@ -138,17 +151,22 @@ TEST(ExampleDemos, ShoulderReproducesItsFiveExamplePoses) {
   auto plain = app::FramePipeline::Create(d->character, app::GlobalMethod::kSsd, 1);
   ASSERT_TRUE(plain.ok());
   ASSERT_TRUE(plain->SetPatches(d->patches).ok());
-  const double tol = 1e-4 * d->patches[0].bound.report.patch_diagonal;
+  // Each example is a brush stroke at a surface point (u, v): at its pose the
+  // skin there moves by the asked length (the point is held; the vertices
+  // nearest it move almost as far), and no vertex moves much further.
   for (const app::RigExample& ex : rp.examples) {
     const Frames f = Evaluate(*d, ex.pose.frame);
     app::DeformedFrame p;
     ASSERT_TRUE(plain->Evaluate(ex.pose.frame * d->character.motion.frame_time_s, p).ok());
-    const auto v = static_cast<std::size_t>(ex.edits[0].vertex);
-    const double moved = glm::length(glm::dvec3(f.layered.positions[v]) - glm::dvec3(p.positions[v]));
+    double moved = 0.0;
+    for (std::size_t v = 0; v < p.positions.size(); ++v) {
+      moved = std::max(moved, glm::length(glm::dvec3(f.layered.positions[v]) - glm::dvec3(p.positions[v])));
+    }
     const double want = glm::length(ex.edits[0].move);  // a bind-frame move only turns
-    std::printf("shoulder frame %d: vertex %zu moved %.4f cm (asked %.4f)\n", ex.pose.frame, v,
-                moved, want);
-    EXPECT_NEAR(moved, want, tol) << ex.path;
+    std::printf("shoulder frame %d: the skin moved up to %.3f cm (asked %.3f)\n", ex.pose.frame, moved,
+                want);
+    EXPECT_GT(moved, 0.85 * want) << ex.path;
+    EXPECT_LT(moved, 1.1 * want) << ex.path;
   }
   // The arm down at the side: SSD flattens the top of the shoulder.
   const Frames f = Evaluate(*d, 15);

@@ -1,5 +1,5 @@
 // Golden frames of the example-shape demos shipped in samples/data (issue 6):
-// each demo rig on the mannequin at an example pose and at a pose between
+// each demo rig on the generated body at an example pose and at a pose between
 // examples, split: the global method alone (left) | global + patch with its
 // example shapes (right), close up on the patch. The figures these frames show
 // are measured in tests/app/example_demos_test.cpp.

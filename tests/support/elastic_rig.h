@@ -16,6 +16,7 @@
 #include "app/pipeline.h"
 #include "app/rig_file.h"
 #include "app/rig_patches.h"
+#include "app/rig_setup.h"
 #include "support/data_paths.h"
 
 namespace testsupport {
@@ -41,7 +42,7 @@ inline RigPipeline LoadRigPipeline(const app::Rig& rig, int threads = 1,
     return l;
   }
   if (edit) edit(*source);
-  auto character = app::MakeCharacter(std::move(*source));
+  auto character = app::MakeCharacter(std::move(*source), {}, app::RigBodyKind(rig));  // the body the rig names
   if (!character.ok()) {
     ADD_FAILURE() << character.error().ToString();
     return l;

@@ -20,6 +20,7 @@
 #include "app/rig_examples.h"
 #include "app/rig_file.h"
 #include "app/rig_patches.h"
+#include "app/rig_setup.h"
 #include "support/data_paths.h"
 
 namespace testsupport {
@@ -46,7 +47,7 @@ inline std::unique_ptr<Demo> LoadDemo(const std::string& name) {
   demo->rig = std::move(*rig);
   auto source = app::LoadMotionSource(demo->rig.motion, {.y_up = true});
   if (!source.ok()) return fail(source.error());
-  auto character = app::MakeCharacter(std::move(*source));
+  auto character = app::MakeCharacter(std::move(*source), {}, app::RigBodyKind(demo->rig));
   if (!character.ok()) return fail(character.error());
   demo->character = std::move(*character);
   auto patches = app::BuildRigPatches(demo->rig, demo->character);
