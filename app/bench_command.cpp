@@ -363,6 +363,48 @@ int RunBench(const BenchOptions& o) {
                     0.0, "", "demo body, " + triangles + ", 1 thread, no supersampling"});
   }
 
+  // The key light's shadow map: the default render (1280x720, 2x2 samples,
+  // all threads) of the same posed frames with shadows off (the baseline) and
+  // on, alternating, per CPU second of all threads (insensitive to load).
+  {
+    const int n = o.quick ? 2 : 8;
+    std::vector<DeformedFrame> posed(static_cast<std::size_t>(n));
+    for (int i = 0; i < n; ++i) {
+      const double t = plan->frames[static_cast<std::size_t>(i % e2e_frames)].time_s;
+      if (mocap::Status s = pipeline->Evaluate(t, posed[static_cast<std::size_t>(i)]); !s.ok())
+        return Fail(s.error());
+    }
+    const auto render_all = [&](bool shadows) {
+      render::RenderSettings s = draw_settings(1280, 720, 2, threads);
+      s.shadows = shadows;
+      const double c0 = Now(Clock::kProcess);
+      for (int i = 0; i < n; ++i) {
+        const OutputFrame& of = plan->frames[static_cast<std::size_t>(i % e2e_frames)];
+        failed |= !DrawCharacterFrame(ch, posed[static_cast<std::size_t>(i)], nullptr, cameras->At(of), s,
+                                      {}, renderer, right_renderer, scratch, image)
+                       .ok();
+      }
+      return std::max(Now(Clock::kProcess) - c0, 1e-9);
+    };
+    const std::string note = std::to_string(n) + " demo frames, 1280x720, 2x2 samples, " +
+                             std::to_string(threads) + " threads, render only";
+    Row off{"render_shadows_off_fps", "frames/s", Clock::kProcess, {}, 0.0, "", note + ", --shadows off"};
+    Row on{"render_shadows_on_fps", "frames/s", Clock::kProcess, {}, 0.0, "shadows off",
+           "the same with the key light's shadow map (the default)"};
+    Row share{"shadow_frame_share", "%", Clock::kProcess, {}, 0.0, "",
+              "(on - off) / on time, each repetition's pair (goal <= 15)"};
+    for (int r = 0; r < (o.quick ? 1 : 5); ++r) {
+      const double t_off = render_all(false), t_on = render_all(true);
+      off.runs.push_back(n / t_off);
+      on.runs.push_back(n / t_on);
+      share.runs.push_back(100.0 * (t_on - t_off) / t_on);
+    }
+    on.reference = off.Median();
+    rows.push_back(std::move(off));
+    rows.push_back(std::move(on));
+    rows.push_back(std::move(share));
+  }
+
   // End to end: pipeline, follow camera, render at the command's defaults
   // (1280x720, 2x2 supersampling), PNG level 1 through the async writer.
   const std::filesystem::path out_dir =

@@ -225,6 +225,9 @@ CLI::App* AddRenderCommand(CLI::App& parent, RenderOptions& o) {
                   "How samples are shaded: ssaa (every sample) or msaa (once per pixel inside a "
                   "triangle; edges and ground per sample)")
       ->capture_default_str();
+  cmd->add_option("--shadows", o.shadows,
+                  "The key light's cast shadow on the ground: on or off (only the soft contact blob)")
+      ->capture_default_str();
   cmd->add_option("--png-compression", o.png_compression, "PNG zlib level 0..9")
       ->capture_default_str();
   cmd->add_flag("--no-sheet", o.no_sheet, "Do not write the contact sheet");
@@ -267,6 +270,7 @@ CLI::App* AddTurntableCommand(CLI::App& parent, RenderOptions& o) {
   cmd->add_option("--supersample", o.supersample, "Anti-aliasing samples per axis: 1, 2 or 4");
   cmd->add_option("--resolve", o.resolve, "Supersample filter: box or tent");
   cmd->add_option("--aa", o.aa, "Sample shading: ssaa or msaa");
+  cmd->add_option("--shadows", o.shadows, "Cast shadow on the ground: on or off");
   cmd->add_flag("--no-sheet", o.no_sheet, "Do not write the contact sheet");
   cmd->add_flag("--no-video", o.no_video, "Do not write the preview video");
   cmd->add_flag("--quiet", o.quiet, "No progress output");
@@ -362,6 +366,9 @@ int RunRender(const RenderOptions& options) {
   }
   if (o.aa != "ssaa" && o.aa != "msaa") {
     return Fail(ArgError("--aa", "expected ssaa or msaa, found '" + o.aa + "'"));
+  }
+  if (o.shadows != "on" && o.shadows != "off") {
+    return Fail(ArgError("--shadows", "expected on or off, found '" + o.shadows + "'"));
   }
   if (o.resolve != "box" && o.resolve != "tent") {
     return Fail(ArgError("--resolve", "expected box or tent, found '" + o.resolve + "'"));
@@ -590,6 +597,7 @@ int RunRender(const RenderOptions& options) {
   settings.resolve = o.resolve == "tent" ? render::ResolveFilter::kTent : render::ResolveFilter::kBox;
   settings.antialias =
       o.aa == "ssaa" ? render::AntiAlias::kSupersample : render::AntiAlias::kMultisample;
+  settings.shadows = o.shadows == "on";
   settings.threads = o.threads;
   settings.ground_at_scene_min = false;
   settings.ground_y = ground_y;

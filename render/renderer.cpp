@@ -184,6 +184,13 @@ mocap::JobStatus Renderer::Render(const Camera& camera, std::span<const SceneMes
                                 ? glm::vec3(1.0f)
                                 : ctx.ambient + ctx.key_radiance * std::max(ctx.key_dir.y, 0.0f) +
                                       ctx.fill_radiance * std::max(ctx.fill_dir.y, 0.0f);
+    // The key light's cast shadow takes its diffuse term away where occluded.
+    const bool cast = settings.shadows && ctx.model != LightingModel::kUnlit && ctx.key_dir.y > 0.0f;
+    if (cast) {
+      casters_.clear();
+      for (const SceneMesh& mesh : meshes) casters_.push_back({mesh.positions, mesh.triangles});
+      shadow_map_.Build(ctx.key_dir, casters_, settings.shadow_map);
+    }
     ground_shader_ = GroundShader::Create({.clip_from_world = clip_from_world,
                                            .eye = ctx.eye,
                                            .raster_width = raster.width,
@@ -192,7 +199,9 @@ mocap::JobStatus Renderer::Render(const Camera& camera, std::span<const SceneMes
                                            .grid_spacing = grid_spacing_,
                                            .style = settings.ground_style,
                                            .shadows = shadows_,
-                                           .light = light});
+                                           .light = light,
+                                           .shadow_map = cast ? &shadow_map_ : nullptr,
+                                           .key_light = ctx.key_radiance * std::max(ctx.key_dir.y, 0.0f)});
   }
 
   background_rows_.resize(static_cast<std::size_t>(raster.height));

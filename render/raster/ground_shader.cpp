@@ -39,6 +39,7 @@ GroundShader GroundShader::Create(const GroundShaderParams& params) {
   g.ray_c_ = glm::vec3(d0 + dx * (1.0 / w - 1.0) + dy * (1.0 - 1.0 / h));
   g.eye_ = params.eye;
   g.height_ = params.ground_y - params.eye.y;
+  g.ground_y_ = params.ground_y;
   const GroundStyle& style = params.style;
   g.grid_ = params.grid_spacing > 0.0f;
   g.inv_spacing_ = g.grid_ ? 1.0f / params.grid_spacing : 1.0f;
@@ -49,6 +50,9 @@ GroundShader GroundShader::Create(const GroundShaderParams& params) {
   g.color_ = style.color;
   g.line_delta_ = style.line_color - style.color;
   g.light_ = params.light;
+  g.shadow_map_ = params.shadow_map != nullptr && !params.shadow_map->empty() ? params.shadow_map
+                                                                                 : nullptr;
+  g.key_light_ = params.key_light;
   g.shadows_.clear();
   for (const ContactShadow& s : params.shadows) {
     if (!(s.strength > 0.0f)) continue;  // a factor of exactly 1
@@ -139,13 +143,23 @@ void GroundShader::Shade4(int sx, int sy, float* r, float* g, float* b) const {
                                           _mm_andnot_ps(inside, _mm_set1_ps(1.0f))));
   }
 
-  auto channel = [&](float base, float delta, float light, float* out) {
+  // 1 - visibility of the key light per lane (exactly 0 where lit).
+  __m128 occluded = _mm_setzero_ps();
+  if (shadow_map_ != nullptr) {
+    alignas(16) float x4[4], z4[4], o4[4];
+    _mm_store_ps(x4, px);
+    _mm_store_ps(z4, pz);
+    for (int k = 0; k < 4; ++k) o4[k] = 1.0f - shadow_map_->Visibility({x4[k], ground_y_, z4[k]});
+    occluded = _mm_load_ps(o4);
+  }
+  auto channel = [&](float base, float delta, float light, float key, float* out) {
     const __m128 albedo = _mm_add_ps(_mm_set1_ps(base), _mm_mul_ps(_mm_set1_ps(delta), line));
-    _mm_storeu_ps(out, _mm_mul_ps(_mm_mul_ps(albedo, _mm_set1_ps(light)), shadow));
+    const __m128 lit = _mm_sub_ps(_mm_set1_ps(light), _mm_mul_ps(_mm_set1_ps(key), occluded));
+    _mm_storeu_ps(out, _mm_mul_ps(_mm_mul_ps(albedo, lit), shadow));
   };
-  channel(color_.x, line_delta_.x, light_.x, r);
-  channel(color_.y, line_delta_.y, light_.y, g);
-  channel(color_.z, line_delta_.z, light_.z, b);
+  channel(color_.x, line_delta_.x, light_.x, key_light_.x, r);
+  channel(color_.y, line_delta_.y, light_.y, key_light_.y, g);
+  channel(color_.z, line_delta_.z, light_.z, key_light_.z, b);
 }
 
 #else  // the same operations, one lane at a time
@@ -193,10 +207,13 @@ void GroundShader::Shade4(int sx, int sy, float* r, float* g, float* b) const {
       const float r2 = ux * ux + uz * uz;
       if (r2 < kShadowCutR2) shadow *= 1.0f - s.strength * ExpNonPositive1(-2.0f * r2);
     }
+    const float occluded =
+        shadow_map_ != nullptr ? 1.0f - shadow_map_->Visibility({px, ground_y_, pz}) : 0.0f;
+    const glm::vec3 lit = light_ - key_light_ * occluded;
     const glm::vec3 albedo = color_ + line_delta_ * line;
-    r[k] = albedo.x * light_.x * shadow;
-    g[k] = albedo.y * light_.y * shadow;
-    b[k] = albedo.z * light_.z * shadow;
+    r[k] = albedo.x * lit.x * shadow;
+    g[k] = albedo.y * lit.y * shadow;
+    b[k] = albedo.z * lit.z * shadow;
   }
 }
 

@@ -14,7 +14,9 @@
 //    hoisted and exp(-2 r^2) from a degree-6 polynomial of 2^f, f in
 //    [-1/2, 1/2] (relative error below 3e-7, about 10^4 times finer than one
 //    8-bit step), evaluated only when a lane is inside a shadow's 3-radius cut;
-//  - the light on the (upward-facing) ground, one colour per frame.
+//  - the light on the (upward-facing) ground, one colour per frame, less the
+//    key light's share where the shadow map (when given) finds an occluder:
+//    light - key_light * (1 - visibility); lit lanes keep `light` exactly.
 // Every lane runs the same IEEE operations, so a sample's colour does not
 // depend on its neighbours, on which lanes are asked for, or on thread count.
 // The colour agrees with GroundAlbedo * ContactShadowFactor * light to about
@@ -26,6 +28,7 @@
 #include <glm/glm.hpp>
 
 #include "render/raster/shading.h"
+#include "render/raster/shadow_map.h"
 
 namespace render {
 
@@ -39,6 +42,10 @@ struct GroundShaderParams {
   GroundStyle style;                // colours, line width, fade distance
   std::span<const ContactShadow> shadows;  // copied by Create; may be empty
   glm::vec3 light{1.0f};            // multiplies albedo * shadow (1 for unlit renders)
+  // The key light's cast shadow: the map (borrowed; must outlive the shader),
+  // or null for none, and the part of `light` it takes away where fully shadowed.
+  const ShadowMap* shadow_map = nullptr;
+  glm::vec3 key_light{0.0f};
 };
 
 class GroundShader {
@@ -64,6 +71,7 @@ class GroundShader {
   glm::vec3 ray_c_{0.0f}, ray_x_{0.0f}, ray_y_{0.0f};
   glm::vec3 eye_{0.0f};
   float height_ = 0.0f;          // ground_y - eye.y
+  float ground_y_ = 0.0f;
   bool grid_ = false;            // grid lines drawn
   float inv_spacing_ = 1.0f;     // 1 / grid spacing
   float half_width_ = 0.0f;      // half the line width, in spacings
@@ -72,6 +80,8 @@ class GroundShader {
   float inv_fade_ = 1.0f;        // 1 / fade start (spacings)
   glm::vec3 color_{0.0f}, line_delta_{0.0f};  // albedo between lines, line - between
   glm::vec3 light_{1.0f};
+  const ShadowMap* shadow_map_ = nullptr;
+  glm::vec3 key_light_{0.0f};
   std::vector<Shadow> shadows_;
 };
 

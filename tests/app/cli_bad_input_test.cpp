@@ -206,6 +206,7 @@ TEST(CliBadInput, BadRenderOptions) {
       {{"--supersample", "0"}, "--supersample", "expected 1, 2 or 4"},
       {{"--png-compression", "10"}, "--png-compression", "expected 0..9"},
       {{"--aa", "fxaa"}, "--aa", "expected ssaa or msaa"},
+      {{"--shadows", "soft"}, "--shadows", "expected on or off"},
       {{"--turntable-frames", "0"}, "--turntable-frames", "expected 1..100000"},
       {{"--elevation", "nan"}, "--elevation", "expected degrees in -89..89"},
       {{"--elevation", "90"}, "--elevation", "expected degrees in -89..89"},

@@ -186,7 +186,7 @@ render::Image TorusWithOverlays() {
 
 // An asymmetric scene, so every orbit position looks different: a torus, a
 // green ball on +X and a red ball on +Z.
-render::Image TurntableFrame(int k) {
+render::Image TurntableFrame(int k, bool shadows = false) {
   static const TestMesh torus = Torus(0.8f, 0.3f, 36, 14, glm::vec3(0.0f, 0.9f, 0.0f));
   static const TestMesh ball_x = Sphere(0.35f, 16, 32, glm::vec3(1.1f, 0.35f, 0.0f));
   static const TestMesh ball_z = Sphere(0.25f, 16, 32, glm::vec3(0.0f, 0.25f, 1.2f));
@@ -195,7 +195,9 @@ render::Image TurntableFrame(int k) {
                                        Scene(ball_z, glm::vec3(0.8f, 0.15f, 0.1f))};
   render::Camera c = render::TurntablePath({0.0f, 0.55f, 0.0f}, 4.5f, 25.0f, 8)[static_cast<std::size_t>(k)];
   c.aspect = 1.0f;
-  return render::Render(c, meshes, {}, SmallSettings(128, 128));
+  render::RenderSettings settings = SmallSettings(128, 128);
+  settings.shadows = shadows;
+  return render::Render(c, meshes, {}, settings);
 }
 
 // The left elbow of the mannequin bent 120 degrees (bend ramp), seen from
@@ -254,6 +256,9 @@ const std::vector<GoldenCase>& Cases() {
       {"turntable_5", [] { return TurntableFrame(5); }, {}},
       {"turntable_6", [] { return TurntableFrame(6); }, {}},
       {"turntable_7", [] { return TurntableFrame(7); }, {}},
+      // With the key light's cast shadow (--shadows on): the torus's shadow
+      // shows its hole, the balls' shadows meet them at the ground.
+      {"turntable_2_shadows", [] { return TurntableFrame(2, true); }, {}},
       {"patch_elbow_split_120", [] { return ElbowSplit(256, 128); }, {}},
   };
   return cases;
