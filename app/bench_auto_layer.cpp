@@ -1,19 +1,14 @@
 #include "app/bench_auto_layer.h"
 
-#include <unistd.h>
-
 #include <cstdio>
-#include <filesystem>
 #include <string>
 
 #include "app/auto_rig.h"
+#include "app/bench_frame.h"
 #include "app/demo_data.h"
-#include "app/frame_render.h"
 #include "app/motion_source.h"
 #include "app/pipeline.h"
 #include "app/rig_setup.h"
-#include "render/camera.h"
-#include "render/output/image_io.h"
 
 namespace app::bench {
 namespace {
@@ -58,33 +53,14 @@ void AddAutoLayerRows(const Budget& b, int frames, std::vector<Row>& rows, bool*
 
   DeformedFrame frame;
   if (mocap::Status s = global->Evaluate(0.0, frame); !s.ok()) return void(Report(s.error(), failed));
-  render::RenderSettings settings;
-  settings.width = 1280;
-  settings.height = 720;
-  settings.supersample = 2;
-  settings.threads = 1;
-  const render::Camera camera =
-      render::FrameBounds(frame.bounds, 35.0f, 1280.0f / 720.0f, glm::vec3(0.0f, 0.0f, -1.0f));
-  render::Renderer renderer, unused;
-  render::Image image, scratch;
-  render::WriteOptions png;
-  png.png_compression = 1;
-  const std::string png_path = (std::filesystem::temp_directory_path() /
-                                ("patchskin_bench_auto_" + std::to_string(getpid()) + ".png"))
-                                   .string();
+  EndToEndFrame end_to_end(ch, frame, "auto");
   // CPU seconds of `frames` end-to-end frames of `pipeline`, from the start of the clip.
   const auto time_frames = [&](FramePipeline& pipeline) {
     const double t0 = Now(Clock::kCpu);
     for (int f = 0; f < frames && !*failed; ++f) {
       const double time_s = f / 30.0;
       mocap::Status s = pipeline.Evaluate(time_s, frame);
-      if (s.ok()) {
-        FrameDrawOptions draw;
-        draw.frame_number = f;
-        s = DrawCharacterFrame(ch, frame, nullptr, camera, settings, draw, renderer, unused,
-                               scratch, image);
-      }
-      if (s.ok()) s = render::WriteImage(image, png_path, png);
+      if (s.ok()) s = end_to_end.Draw(frame, f);
       if (!s.ok()) Report(s.error(), failed);
     }
     return Now(Clock::kCpu) - t0;
@@ -107,8 +83,6 @@ void AddAutoLayerRows(const Budget& b, int frames, std::vector<Row>& rows, bool*
                   frames * b.runs / layer_s);
     overhead.note += note;
   }
-  std::error_code ec;
-  std::filesystem::remove(png_path, ec);
   rows.push_back(std::move(setup));
   rows.push_back(std::move(overhead));
 }

@@ -390,7 +390,7 @@ int RunBench(const BenchOptions& o) {
                              std::to_string(threads) + " threads, render only";
     Row off{"render_shadows_off_fps", "frames/s", Clock::kProcess, {}, 0.0, "", note + ", --shadows off"};
     Row on{"render_shadows_on_fps", "frames/s", Clock::kProcess, {}, 0.0, "shadows off",
-           "the same with the key light's shadow map (the default)"};
+           "the same with the key light's shadow map (--shadows on)"};
     Row share{"shadow_frame_share", "%", Clock::kProcess, {}, 0.0, "",
               "(on - off) / on time, each repetition's pair (goal <= 15)"};
     for (int r = 0; r < (o.quick ? 1 : 5); ++r) {

@@ -1,26 +1,21 @@
 #include "app/bench_elastic_share.h"
 
-#include <unistd.h>
-
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
 #include <memory>
 #include <span>
 #include <string>
 #include <utility>
 
+#include "app/bench_frame.h"
 #include "app/demo_data.h"
 #include "app/elastic_layer.h"
-#include "app/frame_render.h"
 #include "app/motion_source.h"
 #include "app/pipeline.h"
 #include "app/rig_file.h"
 #include "app/rig_patches.h"
 #include "app/rig_setup.h"
 #include "mocap/kinematics.h"
-#include "render/camera.h"
-#include "render/output/image_io.h"
 
 namespace app::bench {
 namespace {
@@ -91,20 +86,7 @@ void AddElasticShareRow(const Budget& b, int frames, std::vector<Row>& rows, boo
 
   DeformedFrame frame;
   if (mocap::Status s = pipeline->Evaluate(0.0, frame); !s.ok()) return void(Report(s.error(), failed));
-  render::RenderSettings settings;  // 1280 x 720
-  settings.width = 1280;
-  settings.height = 720;
-  settings.supersample = 2;
-  settings.threads = 1;
-  const render::Camera camera =
-      render::FrameBounds(frame.bounds, 35.0f, 1280.0f / 720.0f, glm::vec3(0.0f, 0.0f, -1.0f));
-  render::Renderer renderer, unused;
-  render::Image image, scratch;
-  render::WriteOptions png;
-  png.png_compression = 1;
-  const std::string png_path = (std::filesystem::temp_directory_path() /
-                                ("patchskin_bench_share_" + std::to_string(getpid()) + ".png"))
-                                   .string();
+  EndToEndFrame end_to_end(ch, frame, "share");
   std::vector<std::vector<glm::vec3>> displacements(rig->patches.size());
   const double dt = 1.0 / 30.0;
   const double clip_dt = ch.motion.frame_time_s;
@@ -120,13 +102,7 @@ void AddElasticShareRow(const Budget& b, int frames, std::vector<Row>& rows, boo
       const double time_s = f * dt;
       const double t0 = Now(Clock::kCpu);
       mocap::Status s = pipeline->Evaluate(time_s, frame);
-      if (s.ok()) {
-        FrameDrawOptions draw;
-        draw.frame_number = f;
-        s = DrawCharacterFrame(ch, frame, nullptr, camera, settings, draw, renderer, unused,
-                               scratch, image);
-      }
-      if (s.ok()) s = render::WriteImage(image, png_path, png);
+      if (s.ok()) s = end_to_end.Draw(frame, f);
       const double t1 = Now(Clock::kCpu);
       std::size_t clip = static_cast<std::size_t>(std::lround(time_s / clip_dt));
       if (clip >= clip_frames) clip = clip_frames - 1;
@@ -144,8 +120,6 @@ void AddElasticShareRow(const Budget& b, int frames, std::vector<Row>& rows, boo
     }
     row.runs.push_back(100.0 * elastic_s / frame_s);
   }
-  std::error_code ec;
-  std::filesystem::remove(png_path, ec);
   rows.push_back(std::move(row));
 }
 
