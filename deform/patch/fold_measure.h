@@ -31,4 +31,14 @@ std::vector<int> RegionTriangles(std::span<const glm::uvec3> triangles, std::spa
 double MaxFoldAngleDeg(std::span<const glm::vec3> positions, std::span<const glm::uvec3> triangles,
                        std::span<const int> subset);
 
+// The fold a layer adds where it acts: the largest increase, over the shared
+// edges of `subset`, of the angle between the two triangles' normals from
+// `before` (the global result) to `after` (with the layer), in degrees (may be
+// negative when the layer only smooths). Unlike comparing two MaxFoldAngleDeg
+// figures it is local: a new crease beside a region's existing sharpest edge
+// (the inner crease of a bent elbow) counts. Edges with a degenerate triangle
+// in either pose are skipped; 0 when no edge counts.
+double MaxAddedFoldAngleDeg(std::span<const glm::vec3> before, std::span<const glm::vec3> after,
+                            std::span<const glm::uvec3> triangles, std::span<const int> subset);
+
 }  // namespace deform

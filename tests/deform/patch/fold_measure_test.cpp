@@ -66,3 +66,31 @@ TEST(FoldMeasure, PrismSidesDifferByTheirTurn) {
 }
 
 }  // namespace
+
+namespace {
+
+// Two separate hinges in one mesh: the first stays at 90 degrees, the second
+// turns from flat to `second_deg`.
+std::vector<glm::vec3> TwoHinges(double second_deg) {
+  std::vector<glm::vec3> p = Hinge(90.0);
+  for (const glm::vec3& q : Hinge(second_deg)) p.push_back(q + glm::vec3(5, 0, 0));
+  return p;
+}
+const std::vector<glm::uvec3> kTwoHinges{{0, 2, 1}, {0, 1, 3}, {4, 6, 5}, {4, 5, 7}};
+
+// The added fold is local: a new 30-degree crease beside an unchanged 90-degree
+// edge is 30 added, though the region's largest angle stays 90.
+TEST(FoldMeasure, AddedFoldIsPerEdgeNotPerRegion) {
+  const std::vector<int> all{0, 1, 2, 3};
+  const std::vector<glm::vec3> before = TwoHinges(0.0), after = TwoHinges(30.0);
+  EXPECT_NEAR(deform::MaxFoldAngleDeg(before, kTwoHinges, all), 90.0, 1e-3);
+  EXPECT_NEAR(deform::MaxFoldAngleDeg(after, kTwoHinges, all), 90.0, 1e-3);
+  EXPECT_NEAR(deform::MaxAddedFoldAngleDeg(before, after, kTwoHinges, all), 30.0, 1e-3);
+  // Smoothing only: the largest change is negative.
+  EXPECT_NEAR(deform::MaxAddedFoldAngleDeg(after, before, kTwoHinges, all), 0.0, 1e-3);  // the 90 stays
+  const std::vector<int> second{2, 3};
+  EXPECT_NEAR(deform::MaxAddedFoldAngleDeg(after, before, kTwoHinges, second), -30.0, 1e-3);
+  EXPECT_EQ(deform::MaxAddedFoldAngleDeg(after, before, kTwoHinges, std::vector<int>{0}), 0.0);
+}
+
+}  // namespace
