@@ -81,7 +81,8 @@ mocap::Status DrawOne(const Character& ch, const DeformedFrame& f, const render:
   render::SceneMesh body{.positions = f.positions, .normals = f.normals,
                          .triangles = bind.triangles,
                          .vertex_colors = colors.empty() ? std::span<const glm::vec3>(bind.colors)
-                                                         : colors};
+                                                         : colors,
+                         .closed = ch.closed_surface};
   render::Overlays overlays;
   if (o.skeleton) AddSkeleton(f, ch.skeleton, overlays);
   overlays.wireframe = o.wireframe;

@@ -162,6 +162,7 @@ mocap::Result<Character> MakeCharacter(MotionSource&& source,
   if (c.source.empty()) c.source = "<input>";
   if (source.gltf) {
     c.mesh = std::move(source.gltf->mesh);
+    c.closed_surface = deform::IsClosedOutward(c.mesh.bind.positions, c.mesh.bind.triangles);
     return c;
   }
   // A rest pose far lower than the first frame's is not a body pose (limbs
@@ -190,6 +191,7 @@ mocap::Result<Character> MakeCharacter(MotionSource&& source,
     return e;
   }
   c.mesh = std::move(*body);
+  c.closed_surface = deform::IsClosedOutward(c.mesh.bind.positions, c.mesh.bind.triangles);
   return c;
 }
 

@@ -43,6 +43,7 @@ struct SceneMesh {
                                                // empty; wins over vertex_colors
   glm::vec3 base_color{0.75f, 0.72f, 0.68f};   // albedo when both colour spans are empty
   bool casts_contact_shadow = true;            // darken the ground under this mesh
+  bool closed = false;  // closed and outward (deform::IsClosedOutward): a cheaper shadow map
 };
 
 // How the supersample x supersample samples of a pixel become its colour.
@@ -159,6 +160,7 @@ class Renderer {
   ShadingContext context_;
   GroundShader ground_shader_;                          // this frame's ground (when drawn)
   ShadowMap shadow_map_;                                // this frame's key-light map (when used)
+  const ShadowMap* body_shadow_ = nullptr;              // &shadow_map_ when this frame has one
   std::vector<ShadowCaster> casters_;
   float grid_spacing_ = 1.0f;
 };
