@@ -226,7 +226,8 @@ CLI::App* AddRenderCommand(CLI::App& parent, RenderOptions& o) {
                   "triangle; edges and ground per sample)")
       ->capture_default_str();
   cmd->add_option("--shadows", o.shadows,
-                  "The key light's cast shadow on the ground: on or off (only the soft contact blob)")
+                  "The key light's cast shadow on the ground and the body: on or off (only the soft "
+                  "contact blob under the body)")
       ->capture_default_str();
   cmd->add_option("--png-compression", o.png_compression, "PNG zlib level 0..9")
       ->capture_default_str();
@@ -270,7 +271,7 @@ CLI::App* AddTurntableCommand(CLI::App& parent, RenderOptions& o) {
   cmd->add_option("--supersample", o.supersample, "Anti-aliasing samples per axis: 1, 2 or 4");
   cmd->add_option("--resolve", o.resolve, "Supersample filter: box or tent");
   cmd->add_option("--aa", o.aa, "Sample shading: ssaa or msaa");
-  cmd->add_option("--shadows", o.shadows, "Cast shadow on the ground: on or off");
+  cmd->add_option("--shadows", o.shadows, "Cast shadow on the ground and the body: on or off");
   cmd->add_flag("--no-sheet", o.no_sheet, "Do not write the contact sheet");
   cmd->add_flag("--no-video", o.no_video, "Do not write the preview video");
   cmd->add_flag("--quiet", o.quiet, "No progress output");

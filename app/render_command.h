@@ -38,7 +38,7 @@ struct RenderOptions {
   int supersample = 2;                // 1, 2 or 4 samples per axis
   std::string resolve = "box";        // box | tent: how the samples of a pixel are filtered
   std::string aa = "ssaa";            // ssaa | msaa: shade every sample, or once per interior pixel
-  std::string shadows = "off";        // on | off: the key light's cast shadow on the ground
+  std::string shadows = "on";         // on | off: the key light's cast shadow (ground and body)
   int png_compression = 1;            // zlib level for PNG frames
   bool no_sheet = false;
   bool no_video = false;
