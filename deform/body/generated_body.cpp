@@ -20,7 +20,9 @@ namespace {
 using mocap::ErrorCode;
 using mocap::MakeError;
 
-constexpr std::uint32_t kCacheVersion = 1;
+// Part of every cache key: bump it whenever the generated shape, mesh or
+// weights change, so that no cached body from an older build is read back.
+constexpr std::uint32_t kCacheVersion = 2;
 constexpr char kMagic[8] = {'p', 's', 'b', 'o', 'd', 'y', '0', '1'};
 
 // FNV-1a over raw bytes.
