@@ -46,11 +46,13 @@ struct FsContext {
 
 bool ConfinedFileExists(const std::string& path, void* user) {
   auto* ctx = static_cast<FsContext*>(user);
+  std::error_code ec;
   if (!InsideFolder(ctx->folder, path)) {
-    ctx->rejected = path;
+    // tinygltf also tries a missing file's name in other folders (the working
+    // one): only a file that is there is a refusal, a missing one stays missing.
+    if (fs::exists(path, ec)) ctx->rejected = path;
     return false;
   }
-  std::error_code ec;
   return fs::is_regular_file(path, ec);
 }
 
