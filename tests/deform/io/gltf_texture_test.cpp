@@ -7,6 +7,8 @@
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <limits>
 #include <string>
 #include <vector>
@@ -14,8 +16,10 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "deform/io/gltf_export.h"
 #include "deform/io/gltf_import.h"
 #include "deform/io/internal/gltf_material.h"
+#include "deform/io/obj_writer.h"
 #include "support/data_paths.h"
 #include "support/gltf_writer.h"
 #include "support/texture_files.h"
@@ -46,6 +50,7 @@ struct Quad {
   std::vector<int> wrap = {};   // wrapS, wrapT of a sampler, or none
   bool second_primitive = false;      // plus an untextured quad ...
   std::vector<double> second_factor;  // ... with this baseColorFactor (empty: no material)
+  std::vector<double> factor;         // the textured material's baseColorFactor, or none
 };
 
 // A skinned quad (two triangles, four vertices bound to one joint) with the
@@ -91,6 +96,7 @@ std::string Write(const std::string& name, const Quad& q) {
   const std::vector<float> ibm = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
   const int ibm_accessor = w.Accessor(ibm, GltfWriter::kFloat, "MAT4", 1);  // before the image's view
   nlohmann::json textured = {{"name", "skin"}, {"pbrMetallicRoughness", nlohmann::json::object()}};
+  if (!q.factor.empty()) textured["pbrMetallicRoughness"]["baseColorFactor"] = q.factor;
   if (q.texture >= 0) {
     textured["pbrMetallicRoughness"]["baseColorTexture"] = {{"index", q.texture}, {"texCoord", q.tex_coord}};
   }
@@ -286,6 +292,131 @@ TEST(GltfTexture, JpegAndGreyAlphaImagesDecode) {
     EXPECT_NEAR(g->rgb[static_cast<std::size_t>(c)], Linear(64), 1e-6);
     EXPECT_NEAR(g->rgb[static_cast<std::size_t>(3 + c)], Linear(192), 1e-6) << "alpha 0 keeps its colour";
   }
+}
+
+// Exports `mesh` (its bind pose as two frames) to a .glb and reads it back
+// (no skin in an export: each mesh node is rigid).
+mocap::Result<deform::GltfModel> ExportAndReimport(const deform::SkinnedMesh& mesh, const std::string& name,
+                                                  deform::GltfExportLayout layout) {
+  deform::GltfExportOptions options;
+  options.layout = layout;
+  options.scratch_dir = Folder().string();
+  const deform::Mesh& bind = mesh.bind;
+  std::vector<glm::vec3> normals(bind.positions.size(), glm::vec3(0, 0, 1));
+  auto w = deform::GltfSequenceWriter::Create(bind.triangles, bind.colors, bind.num_vertices(), 2, options,
+                                              {.uvs = bind.uvs, .materials = &mesh.materials});
+  if (!w.ok()) return std::move(w).error();
+  for (int f = 0; f < 2; ++f) {
+    if (auto s = w->AddFrame(bind.positions, normals); !s) return s.error();
+  }
+  const std::string path = (Folder() / name).string();
+  if (auto s = w->Finish(path); !s) return s.error();
+  deform::GltfReadOptions read;
+  read.require_skin = false;
+  return deform::ReadGltf(path, read);
+}
+
+TEST(GltfTextureExport, GlbRoundTripKeepsUvsMaterialAndTexturePixels) {
+  Quad q;
+  q.wrap = {33648, 33071};
+  q.factor = {0.5, 0.25, 1.0, 1.0};  // folded into the imported colours
+  auto original = deform::ReadGltf(Write("export_src.glb", q));
+  ASSERT_TRUE(original.ok()) << original.error().ToString();
+  for (const auto layout : {deform::GltfExportLayout::kMorphTargets, deform::GltfExportLayout::kBakedMeshes}) {
+    auto back = ExportAndReimport(original->mesh, "export_back.glb", layout);
+    ASSERT_TRUE(back.ok()) << back.error().ToString();
+    const deform::Mesh& a = original->mesh.bind;
+    const deform::Mesh& b = back->mesh.bind;
+    // Baked: one mesh per frame, which the importer merges; frame 0 comes first.
+    const int copies = layout == deform::GltfExportLayout::kBakedMeshes ? 2 : 1;
+    ASSERT_EQ(b.num_vertices(), copies * a.num_vertices());
+    const auto first = [&](const auto& v, std::size_t n) { return std::vector(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(n)); };
+    EXPECT_EQ(first(b.uvs, a.uvs.size()), a.uvs);
+    EXPECT_EQ(first(b.colors, a.colors.size()), a.colors) << "colour / factor written, times factor read";
+    EXPECT_EQ(first(b.triangles, a.triangles.size()), a.triangles);
+    const deform::MeshMaterials& ma = original->mesh.materials;
+    const deform::MeshMaterials& mb = back->mesh.materials;
+    ASSERT_EQ(mb.materials.size(), 1u);  // shared by the frames' primitives
+    EXPECT_EQ(mb.materials[0].base_color_factor, glm::vec3(0.5f, 0.25f, 1.0f));
+    EXPECT_EQ(mb.materials[0].wrap_s, deform::TextureWrap::kMirroredRepeat);
+    EXPECT_EQ(mb.materials[0].wrap_t, deform::TextureWrap::kClampToEdge);
+    ASSERT_EQ(mb.images.size(), 1u);
+    EXPECT_EQ(mb.images[0]->encoded, ma.images[0]->encoded) << "the image is embedded unchanged";
+    EXPECT_EQ(mb.images[0]->rgb, ma.images[0]->rgb);
+  }
+}
+
+TEST(GltfTextureExport, GlbOnePrimitivePerMaterial) {
+  Quad q;
+  q.second_primitive = true;
+  q.second_factor = {0.5, 0.25, 1.0, 1.0};
+  auto original = deform::ReadGltf(Write("export_two.glb", q));
+  ASSERT_TRUE(original.ok()) << original.error().ToString();
+  auto back = ExportAndReimport(original->mesh, "export_two_back.glb", deform::GltfExportLayout::kMorphTargets);
+  ASSERT_TRUE(back.ok()) << back.error().ToString();
+  const deform::MeshMaterials& m = back->mesh.materials;
+  ASSERT_EQ(m.materials.size(), 2u);
+  EXPECT_EQ(m.materials[0].texture, 0);
+  EXPECT_EQ(m.materials[1].texture, -1);
+  EXPECT_EQ(m.materials[1].base_color_factor, glm::vec3(0.5f, 0.25f, 1.0f));
+  // The primitives share the vertex attributes, so the importer reads them once per primitive.
+  ASSERT_EQ(back->mesh.bind.num_vertices(), 2 * original->mesh.bind.num_vertices());
+  EXPECT_EQ(m.triangle_material, (std::vector<std::int32_t>{0, 0, 1, 1}));
+  // The second primitive's triangles (in the second copy of the vertices) keep
+  // their albedo: the factor, as in the original.
+  const glm::uvec3 t = back->mesh.bind.triangles[2];
+  EXPECT_EQ(back->mesh.bind.colors[t.x], original->mesh.bind.colors[original->mesh.bind.triangles[2].x]);
+}
+
+TEST(GltfTextureExport, ObjKeepsUvsAndMaterials) {
+  Quad q;
+  q.second_primitive = true;
+  q.second_factor = {0.5, 0.25, 1.0, 1.0};
+  auto model = deform::ReadGltf(Write("obj_src.glb", q));
+  ASSERT_TRUE(model.ok()) << model.error().ToString();
+  const deform::Mesh& bind = model->mesh.bind;
+  const std::vector<std::string> names = {"skin", "plain"};
+  std::string text;
+  ASSERT_TRUE(deform::AppendObj({.positions = bind.positions, .triangles = bind.triangles, .uvs = bind.uvs,
+                                 .material_library = "m.mtl", .material_names = names,
+                                 .triangle_material = model->mesh.materials.triangle_material},
+                                text)
+                  .ok());
+  std::istringstream lines(text);
+  std::string line;
+  std::vector<glm::vec2> uvs;
+  std::vector<std::string> faces, usemtl;
+  bool mtllib = false;
+  while (std::getline(lines, line)) {
+    std::istringstream in(line);
+    std::string tag;
+    in >> tag;
+    if (tag == "vt") {
+      glm::vec2 uv;
+      in >> uv.x >> uv.y;
+      uvs.emplace_back(uv.x, 1.0f - uv.y);  // OBJ's v runs up the image
+    }
+    if (tag == "f") faces.push_back(line);
+    if (tag == "usemtl") usemtl.push_back(line);
+    mtllib = mtllib || line == "mtllib m.mtl";
+  }
+  EXPECT_TRUE(mtllib);
+  ASSERT_EQ(uvs.size(), bind.uvs.size());
+  for (std::size_t v = 0; v < uvs.size(); ++v) {
+    EXPECT_NEAR(uvs[v].x, bind.uvs[v].x, 0.0f) << v;
+    EXPECT_NEAR(uvs[v].y, bind.uvs[v].y, 1e-7f) << v;  // 1 - (1 - v): one rounding
+  }
+  ASSERT_EQ(faces.size(), 4u);
+  EXPECT_EQ(faces[0], "f 1/1 2/2 3/3");
+  EXPECT_EQ(usemtl, (std::vector<std::string>{"usemtl skin", "usemtl plain"}));
+  const fs::path mtl = Folder() / "m.mtl";
+  const std::vector<glm::vec3> kd = {glm::vec3(1.0f), glm::vec3(0.5f, 0.25f, 1.0f)};
+  const std::vector<std::string> files = {"skin.png", ""};
+  ASSERT_TRUE(deform::WriteObjMaterials(mtl.string(), names, kd, files).ok());
+  std::ifstream in(mtl);
+  const std::string content{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  EXPECT_NE(content.find("newmtl skin\nKd 1 1 1\nmap_Kd skin.png\n"), std::string::npos) << content;
+  EXPECT_NE(content.find("newmtl plain\nKd 0.5 0.25 1\n"), std::string::npos) << content;
 }
 
 }  // namespace
