@@ -45,7 +45,8 @@ class Texture {
   glm::vec3 Sample(glm::vec2 uv, float lod) const;
   // The level of detail of a footprint given by the screen derivatives of uv
   // (per sample step in x and in y): log2 of the longer one in level-0 texels
-  // (as OpenGL's scale factor rho), -inf for a zero footprint.
+  // (as OpenGL's scale factor rho, its log2 approximated within 0.008); -1 for
+  // any footprint under one texel (magnified: level 0 either way).
   float Lod(glm::vec2 duv_dx, glm::vec2 duv_dy) const;
 
  private:

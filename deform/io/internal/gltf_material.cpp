@@ -17,7 +17,7 @@ namespace {
 
 using mocap::ErrorCode;
 
-constexpr int kMaxTextureSide = 16384;
+constexpr int kMaxTextureSide = 8192;  // 8192^2 texels: 768 MiB of linear floats
 
 mocap::Error Fail(ErrorCode code, const std::string& file, const std::string& field, std::string message) {
   return mocap::MakeError(code, {file, 0, 0, field}, std::move(message));
@@ -75,7 +75,7 @@ mocap::Result<TextureImage> DecodeTextureImage(std::span<const unsigned char> by
       spec.nchannels < 1 || spec.nchannels > 4) {
     return Fail(ErrorCode::kLimitExceeded, file, field,
                 "image of " + std::to_string(spec.width) + " x " + std::to_string(spec.height) + " x " +
-                    std::to_string(spec.nchannels) + " is outside 1..16384 texels a side, 1..4 channels");
+                    std::to_string(spec.nchannels) + " is outside 1..8192 texels a side, 1..4 channels");
   }
   const auto texels = static_cast<std::size_t>(spec.width) * static_cast<std::size_t>(spec.height);
   const auto channels = static_cast<std::size_t>(spec.nchannels);

@@ -27,7 +27,7 @@ float SrgbToLinear(float encoded);
 // are read (alpha dropped); 8- and 16-bit values are taken as sRGB (glTF's
 // base colour texture is sRGB) and converted to linear. `encoded` and
 // `mime_type` are kept in the result. Errors name `file` and `field`
-// (kSyntax: not a decodable image; kLimitExceeded: over 16384 texels a side).
+// (kSyntax: not a decodable image; kLimitExceeded: over 8192 texels a side).
 mocap::Result<TextureImage> DecodeTextureImage(std::span<const unsigned char> bytes,
                                                const std::string& mime_type, const std::string& file,
                                                const std::string& field);

@@ -294,6 +294,16 @@ TEST(GltfTexture, JpegAndGreyAlphaImagesDecode) {
   }
 }
 
+TEST(GltfTexture, ImagesWiderThanTheLimitAreRefused) {
+  const auto wide = testsupport::EncodeImage(Folder() / "wide.png", 8193, 1, 3,
+                                             std::vector<std::uint8_t>(8193 * 3, 7));
+  ASSERT_FALSE(wide.empty());
+  auto image = deform::internal::DecodeTextureImage(wide, "image/png", "w.glb", "images[0]");
+  ASSERT_FALSE(image.ok());
+  EXPECT_EQ(image.error().code, mocap::ErrorCode::kLimitExceeded);
+  EXPECT_NE(image.error().ToString().find("8193 x 1 x 3"), std::string::npos) << image.error().ToString();
+}
+
 // Exports `mesh` (its bind pose as two frames) to a .glb and reads it back
 // (no skin in an export: each mesh node is rigid).
 mocap::Result<deform::GltfModel> ExportAndReimport(const deform::SkinnedMesh& mesh, const std::string& name,
