@@ -81,7 +81,8 @@ mocap::Status DrawOne(const Character& ch, const DeformedFrame& f, const render:
   render::SceneMesh body{.positions = f.positions, .normals = f.normals,
                          .triangles = bind.triangles,
                          .vertex_colors = colors.empty() ? std::span<const glm::vec3>(bind.colors)
-                                                         : colors};
+                                                         : colors,
+                         .closed = ch.closed_surface};
   if (o.textures && ch.textures && bind.uvs.size() == bind.positions.size() &&
       ch.textures->triangle_textures.size() == bind.triangles.size()) {
     body.uvs = bind.uvs;

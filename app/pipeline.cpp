@@ -164,6 +164,7 @@ mocap::Result<Character> MakeCharacter(MotionSource&& source,
   if (source.gltf) {
     c.mesh = std::move(source.gltf->mesh);
     c.textures = BuildCharacterTextures(c.mesh);
+    c.closed_surface = deform::IsClosedOutward(c.mesh.bind.positions, c.mesh.bind.triangles);
     return c;
   }
   // A rest pose far lower than the first frame's is not a body pose (limbs
@@ -192,6 +193,7 @@ mocap::Result<Character> MakeCharacter(MotionSource&& source,
     return e;
   }
   c.mesh = std::move(*body);
+  c.closed_surface = deform::IsClosedOutward(c.mesh.bind.positions, c.mesh.bind.triangles);
   return c;
 }
 

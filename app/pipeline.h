@@ -47,6 +47,7 @@ struct Character {
   deform::SkinnedMesh mesh;
   glm::mat4 world_from_model{1.0f};    // glTF: node transform of the skinned mesh is ignored
                                        // (glTF rule), so identity; kept for other sources
+  bool closed_surface = false;         // the bind mesh is closed and outward (deform::IsClosedOutward)
   bool bound_at_first_frame = false;   // BVH: the rest pose was not a body pose, so the
                                        // mannequin was built and bound at frame 0
   std::vector<mocap::Warning> warnings;

@@ -1,7 +1,10 @@
 #include "deform/mesh.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <string>
+#include <vector>
 
 namespace deform {
 
@@ -60,6 +63,31 @@ void ComputeVertexNormals(std::span<const glm::vec3> positions,
     const float len = glm::length(n);
     n = len > 0.0f ? n / len : glm::vec3(0.0f, 0.0f, 1.0f);
   }
+}
+
+bool IsClosedOutward(std::span<const glm::vec3> positions, std::span<const glm::uvec3> triangles) {
+  if (triangles.empty()) return false;
+  // Directed edges as sorted keys: each must occur once, and its reverse once.
+  std::vector<std::uint64_t> edges;
+  edges.reserve(3 * triangles.size());
+  for (const glm::uvec3& t : triangles) {
+    if (t.x >= positions.size() || t.y >= positions.size() || t.z >= positions.size()) return false;
+    for (int k = 0; k < 3; ++k)
+      edges.push_back(static_cast<std::uint64_t>(t[k]) << 32 | t[(k + 1) % 3]);
+  }
+  std::sort(edges.begin(), edges.end());
+  if (std::adjacent_find(edges.begin(), edges.end()) != edges.end()) return false;
+  for (const std::uint64_t e : edges) {
+    const std::uint64_t reverse = (e << 32) | (e >> 32);
+    if (!std::binary_search(edges.begin(), edges.end(), reverse)) return false;
+  }
+  // Consistent winding could still face inwards: the enclosed volume says which.
+  double volume = 0.0;
+  for (const glm::uvec3& t : triangles) {
+    const glm::dvec3 a(positions[t.x]), b(positions[t.y]), c(positions[t.z]);
+    volume += glm::dot(a, glm::cross(b, c));
+  }
+  return volume > 0.0;
 }
 
 Bounds ComputeBounds(std::span<const glm::vec3> points) {

@@ -119,6 +119,12 @@ struct SkinnedMesh {
 void ComputeVertexNormals(std::span<const glm::vec3> positions,
                           std::span<const glm::uvec3> triangles, std::span<glm::vec3> normals);
 
+// True when `triangles` close every surface they bound (each directed edge once,
+// its reverse once) with outward winding (counter-clockwise seen from outside,
+// positive enclosed volume); false for an open or inconsistent mesh.
+// Cost: O(#T log #T), allocates 3 #T edges.
+bool IsClosedOutward(std::span<const glm::vec3> positions, std::span<const glm::uvec3> triangles);
+
 // Axis-aligned bounds of a point set; min > max when empty.
 struct Bounds {
   glm::vec3 min{1e30f};

@@ -181,6 +181,17 @@ mocap::JobStatus Renderer::Render(const Camera& camera, std::span<const SceneMes
   if (!rasterizer_.Setup(clip_meshes, raster))
     return Fail(mocap::JobStatus::kOutOfRange, "raster size out of range");
 
+  // The key light's shadow map, for the meshes and the ground.
+  body_shadow_ = nullptr;
+  if (settings.shadows && context_.model != LightingModel::kUnlit) {
+    casters_.clear();
+    for (const SceneMesh& mesh : meshes) casters_.push_back({mesh.positions, mesh.triangles, mesh.closed});
+    ShadowMapSettings map_settings = settings.shadow_map;
+    map_settings.threads = threads;
+    shadow_map_.Build(context_.key_dir, casters_, map_settings);
+    if (!shadow_map_.empty()) body_shadow_ = &shadow_map_;
+  }
+
   if (settings.ground) {
     // The ground faces up: ambient plus the key and fill lights' diffuse terms.
     const ShadingContext& ctx = context_;
@@ -189,12 +200,7 @@ mocap::JobStatus Renderer::Render(const Camera& camera, std::span<const SceneMes
                                 : ctx.ambient + ctx.key_radiance * std::max(ctx.key_dir.y, 0.0f) +
                                       ctx.fill_radiance * std::max(ctx.fill_dir.y, 0.0f);
     // The key light's cast shadow takes its diffuse term away where occluded.
-    const bool cast = settings.shadows && ctx.model != LightingModel::kUnlit && ctx.key_dir.y > 0.0f;
-    if (cast) {
-      casters_.clear();
-      for (const SceneMesh& mesh : meshes) casters_.push_back({mesh.positions, mesh.triangles});
-      shadow_map_.Build(ctx.key_dir, casters_, settings.shadow_map);
-    }
+    const bool cast = body_shadow_ != nullptr && ctx.key_dir.y > 0.0f;
     ground_shader_ = GroundShader::Create({.clip_from_world = clip_from_world,
                                            .eye = ctx.eye,
                                            .raster_width = raster.width,
@@ -370,7 +376,12 @@ class Renderer::SampleShader {
     }
     n = len2 > 0.0f ? n * (1.0f / std::sqrt(len2)) : t.face_normal;
     const glm::vec3 p = l0 * t.p[0] + l1 * t.p[1] + l2 * t.p[2];
-    if (deferred != nullptr) {
+    // Only samples the key light reaches can lose it to a shadow; the map is
+    // read off the surface's outer side (a back face's normal was turned).
+    const float side = r_.body_shadow_ != nullptr && glm::dot(n, ctx.key_dir) > 0.0f
+                           ? (t.back_facing ? -1.0f : 1.0f)
+                           : 0.0f;
+    if (deferred != nullptr) {  // ShadeSurfaceRow reads the map four lanes at a time
       SurfacePoints4& d = deferred[i >> 2];
       const int lane = i & 3;
       for (int c = 0; c < 3; ++c) {
@@ -378,9 +389,11 @@ class Renderer::SampleShader {
         d.normal[c][lane] = n[c];
         d.position[c][lane] = p[c];
       }
+      d.shadow_side[lane] = side;
       return Kind::kDeferred;
     }
-    color = ShadeSurface(ctx, albedo, n, p);
+    const float key = side != 0.0f ? r_.body_shadow_->SurfaceVisibility(p, side * n) : 1.0f;
+    color = ShadeSurface(ctx, albedo, n, p, key);
     return Kind::kColor;
   }
 
@@ -429,7 +442,7 @@ class Renderer::SampleShader {
   static constexpr std::uint32_t kCacheSize = 64;
   struct Entry {
     std::uint32_t id = kNoTriangle;
-    bool ground = false, smooth = false, interpolate_color = false;
+    bool ground = false, smooth = false, interpolate_color = false, back_facing = false;
     // Lambert with one albedo per triangle: the unnormalized normal N and
     // D = N . key_dir are linear in the sample position, so they are stored
     // as planes and a sample costs two plane evaluations, |N| and one divide:
@@ -518,6 +531,7 @@ class Renderer::SampleShader {
     const SceneMesh& mesh = meshes_[tri.mesh];
     const glm::uvec3 v = mesh.triangles[tri.triangle];
     t.smooth = settings_.shading == ShadingMode::kSmooth && !mesh.normals.empty();
+    t.back_facing = tri.back_facing;
     const bool need_positions = r_.context_.model == LightingModel::kBlinnPhong;
     if (!t.smooth || need_positions) {
       for (int k = 0; k < 3; ++k) corner[k] = mesh.positions[v[k]];
@@ -633,6 +647,18 @@ void Renderer::ShadeSurfaceRow(int n, const bool* surface, SurfacePoints4* defer
         group.normal[c][k] = c == 1 ? 1.0f : 0.0f;
         group.position[c][k] = context_.eye[c] + (c == 1 ? 1.0f : 0.0f);
       }
+      group.shadow_side[k] = 0.0f;
+    }
+    int shadowed = 0;  // lanes that read the shadow map
+    alignas(16) float outward[3][4];
+    for (int k = 0; k < 4; ++k) {
+      shadowed |= group.shadow_side[k] != 0.0f ? 1 << k : 0;
+      for (int c = 0; c < 3; ++c) outward[c][k] = group.shadow_side[k] * group.normal[c][k];
+    }
+    if (shadowed != 0) {
+      body_shadow_->SurfaceVisibility4(group.position, outward, shadowed, group.key_visibility);
+    } else {
+      for (float& v : group.key_visibility) v = 1.0f;
     }
     float out[3][4];
     ShadeSurface4(context_, group, out);

@@ -53,6 +53,7 @@ struct SceneMesh {
   std::span<const std::int32_t> triangle_textures{};  // #T index into textures (-1 or out of
                                                      // range: untextured), or empty: textures[0]
   bool casts_contact_shadow = true;            // darken the ground under this mesh
+  bool closed = false;  // closed and outward (deform::IsClosedOutward): a cheaper shadow map
 };
 
 // How the supersample x supersample samples of a pixel become its colour.
@@ -169,6 +170,7 @@ class Renderer {
   ShadingContext context_;
   GroundShader ground_shader_;                          // this frame's ground (when drawn)
   ShadowMap shadow_map_;                                // this frame's key-light map (when used)
+  const ShadowMap* body_shadow_ = nullptr;              // &shadow_map_ when this frame has one
   std::vector<ShadowCaster> casters_;
   float grid_spacing_ = 1.0f;
 };

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <limits>
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -22,6 +23,30 @@ constexpr float kIntegerFloat = 8388608.0f;  // 2^23: floats this large are inte
 constexpr float kShadowCutR2 = 9.0f;        // ContactShadowFactor's cut (3 radii)
 
 }  // namespace
+
+// The sample-space bounding box of the ground the shadow map can darken: its
+// corners on the ground, projected. The whole raster when a corner is behind
+// the eye (its projection says nothing) or the map does not reach the ground.
+glm::ivec4 ShadowedSampleBox(const ShadowMap& map, const GroundShaderParams& params) {
+  const glm::ivec4 all(0, 0, params.raster_width - 1, params.raster_height - 1);
+  glm::vec3 corners[4];
+  if (!map.CornersOnPlane(params.ground_y, corners)) return all;
+  glm::vec2 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+  for (const glm::vec3& c : corners) {
+    const glm::vec4 clip = params.clip_from_world * glm::vec4(c, 1.0f);
+    if (!(clip.w > 1e-6f)) return all;
+    const glm::vec2 ndc = glm::vec2(clip) / clip.w;
+    const glm::vec2 s((ndc.x + 1.0f) * 0.5f * static_cast<float>(params.raster_width),
+                      (1.0f - ndc.y) * 0.5f * static_cast<float>(params.raster_height));
+    lo = glm::min(lo, s);
+    hi = glm::max(hi, s);
+  }
+  // A sample of margin for rounding; clamped to the raster (also when outside it).
+  const glm::vec2 max_xy(static_cast<float>(params.raster_width), static_cast<float>(params.raster_height));
+  lo = glm::clamp(lo - 1.0f, glm::vec2(-1.0f), max_xy);
+  hi = glm::clamp(hi + 1.0f, glm::vec2(-1.0f), max_xy);
+  return {static_cast<int>(lo.x), static_cast<int>(lo.y), static_cast<int>(hi.x), static_cast<int>(hi.y)};
+}
 
 GroundShader GroundShader::Create(const GroundShaderParams& params) {
   GroundShader g;
@@ -53,6 +78,7 @@ GroundShader GroundShader::Create(const GroundShaderParams& params) {
   g.shadow_map_ = params.shadow_map != nullptr && !params.shadow_map->empty() ? params.shadow_map
                                                                                  : nullptr;
   g.key_light_ = params.key_light;
+  if (g.shadow_map_ != nullptr) g.map_box_ = ShadowedSampleBox(*g.shadow_map_, params);
   g.shadows_.clear();
   for (const ContactShadow& s : params.shadows) {
     if (!(s.strength > 0.0f)) continue;  // a factor of exactly 1
@@ -145,12 +171,13 @@ void GroundShader::Shade4(int sx, int sy, float* r, float* g, float* b) const {
 
   // 1 - visibility of the key light per lane (exactly 0 where lit).
   __m128 occluded = _mm_setzero_ps();
-  if (shadow_map_ != nullptr) {
-    alignas(16) float x4[4], z4[4], o4[4];
+  if (shadow_map_ != nullptr && sy >= map_box_.y && sy <= map_box_.w && sx + 3 >= map_box_.x &&
+      sx <= map_box_.z) {
+    alignas(16) float x4[4], z4[4], v4[4];
     _mm_store_ps(x4, px);
     _mm_store_ps(z4, pz);
-    for (int k = 0; k < 4; ++k) o4[k] = 1.0f - shadow_map_->Visibility({x4[k], ground_y_, z4[k]});
-    occluded = _mm_load_ps(o4);
+    shadow_map_->Visibility4(x4, ground_y_, z4, v4);
+    occluded = _mm_sub_ps(_mm_set1_ps(1.0f), _mm_load_ps(v4));
   }
   auto channel = [&](float base, float delta, float light, float key, float* out) {
     const __m128 albedo = _mm_add_ps(_mm_set1_ps(base), _mm_mul_ps(_mm_set1_ps(delta), line));

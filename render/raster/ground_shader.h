@@ -81,6 +81,7 @@ class GroundShader {
   glm::vec3 color_{0.0f}, line_delta_{0.0f};  // albedo between lines, line - between
   glm::vec3 light_{1.0f};
   const ShadowMap* shadow_map_ = nullptr;
+  glm::ivec4 map_box_{0};  // samples (x0, y0, x1, y1), inclusive, the map can darken
   glm::vec3 key_light_{0.0f};
   std::vector<Shadow> shadows_;
 };

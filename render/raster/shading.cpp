@@ -51,13 +51,13 @@ float PowInteger(float x, unsigned n) {
 }  // namespace
 
 glm::vec3 ShadeSurface(const ShadingContext& ctx, const glm::vec3& albedo,
-                       const glm::vec3& normal, const glm::vec3& position) {
+                       const glm::vec3& normal, const glm::vec3& position, float key_visibility) {
   switch (ctx.model) {
     case LightingModel::kUnlit:
       return albedo;
     case LightingModel::kLambert: {
       const float n_dot_l = std::max(glm::dot(normal, ctx.key_dir), 0.0f);
-      return albedo * (ctx.ambient + ctx.key_radiance * n_dot_l);
+      return albedo * (ctx.ambient + ctx.key_radiance * key_visibility * n_dot_l);
     }
     case LightingModel::kBlinnPhong:
       break;
@@ -74,13 +74,14 @@ glm::vec3 ShadeSurface(const ShadingContext& ctx, const glm::vec3& albedo,
   for (int i = 0; i < 3; ++i) {
     const float n_dot_l = glm::dot(normal, *dirs[i]);
     if (n_dot_l <= 0.0f) continue;
-    diffuse += *radiance[i] * n_dot_l;
+    const glm::vec3 rad = i == 0 ? *radiance[i] * key_visibility : *radiance[i];
+    diffuse += rad * n_dot_l;
     if (ctx.specular > 0.0f) {
       const glm::vec3 half = glm::normalize(*dirs[i] + view);
       const float n_dot_h = glm::dot(normal, half);
       if (n_dot_h > 0.0f) {
         const float lobe = whole ? PowInteger(n_dot_h, exponent) : std::pow(n_dot_h, ctx.shininess);
-        spec += *radiance[i] * (ctx.specular * lobe);
+        spec += rad * (ctx.specular * lobe);
       }
     }
   }

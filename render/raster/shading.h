@@ -80,9 +80,11 @@ ShadingContext MakeShadingContext(const LightRig& rig, LightingModel model,
                                   const glm::mat4& view_from_world);
 
 // Lit colour of a surface point. `normal` must be unit length and face the
-// viewer side the caller wants lit; `position` is only used for specular.
+// viewer side the caller wants lit; `position` is only used for specular;
+// `key_visibility` scales the key light (its shadow map's verdict, 1 = lit).
 glm::vec3 ShadeSurface(const ShadingContext& ctx, const glm::vec3& albedo,
-                       const glm::vec3& normal, const glm::vec3& position);
+                       const glm::vec3& normal, const glm::vec3& position,
+                       float key_visibility = 1.0f);
 
 // Ground albedo at world point `position` (grid lines blended in), before
 // lighting. Lines fade out between style.fade_start and 2 * style.fade_start

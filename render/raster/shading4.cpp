@@ -40,7 +40,7 @@ void ShadeSurface4(const ShadingContext& ctx, const SurfacePoints4& in, float (&
       const glm::vec3 c = ShadeSurface(
           ctx, {in.albedo[0][k], in.albedo[1][k], in.albedo[2][k]},
           {in.normal[0][k], in.normal[1][k], in.normal[2][k]},
-          {in.position[0][k], in.position[1][k], in.position[2][k]});
+          {in.position[0][k], in.position[1][k], in.position[2][k]}, in.key_visibility[k]);
       for (int ch = 0; ch < 3; ++ch) out[ch][k] = c[ch];
     }
     return;
@@ -61,7 +61,11 @@ void ShadeSurface4(const ShadingContext& ctx, const SurfacePoints4& in, float (&
     const __m128 n_dot_l = Dot(n, l);
     const __m128 lit = _mm_cmpgt_ps(n_dot_l, zero);
     if (_mm_movemask_ps(lit) == 0) continue;
-    const Vec4x3 rad = Splat(*radiance[i]);
+    Vec4x3 rad = Splat(*radiance[i]);
+    if (i == 0) {  // the key light, less its shadowed share
+      const __m128 v = _mm_load_ps(in.key_visibility);
+      rad = {_mm_mul_ps(rad.x, v), _mm_mul_ps(rad.y, v), _mm_mul_ps(rad.z, v)};
+    }
     // Unlit lanes add +0, which leaves their (non-negative) sums unchanged.
     diffuse.x = _mm_add_ps(diffuse.x, _mm_and_ps(lit, _mm_mul_ps(rad.x, n_dot_l)));
     diffuse.y = _mm_add_ps(diffuse.y, _mm_and_ps(lit, _mm_mul_ps(rad.y, n_dot_l)));
@@ -104,7 +108,8 @@ void ShadeSurface4(const ShadingContext& ctx, const SurfacePoints4& in, float (&
   for (int k = 0; k < 4; ++k) {
     const glm::vec3 c = ShadeSurface(ctx, {in.albedo[0][k], in.albedo[1][k], in.albedo[2][k]},
                                      {in.normal[0][k], in.normal[1][k], in.normal[2][k]},
-                                     {in.position[0][k], in.position[1][k], in.position[2][k]});
+                                     {in.position[0][k], in.position[1][k], in.position[2][k]},
+                                     in.key_visibility[k]);
     for (int ch = 0; ch < 3; ++ch) out[ch][k] = c[ch];
   }
 }

@@ -198,7 +198,7 @@ TEST(ShadingTest, EmptyTilesMatchBackgroundOfShadedTiles) {
 }
 
 // ShadeSurface4 (four lanes) gives ShadeSurface's bits in every lane: whole and
-// fractional exponents, no specular, lights behind the surface.
+// fractional exponents, no specular, lights behind the surface, a shadowed key.
 TEST(ShadingTest, ShadeSurface4IsShadeSurfaceBitForBit) {
   std::uint32_t seed = 99u;
   auto next = [&seed] {  // deterministic LCG in [-1, 1)
@@ -218,7 +218,11 @@ TEST(ShadingTest, ShadeSurface4IsShadeSurfaceBitForBit) {
       for (int trial = 0; trial < 500; ++trial) {
         render::SurfacePoints4 in;
         glm::vec3 albedo[4], normal[4], position[4];
+        float key[4];
         for (int k = 0; k < 4; ++k) {
+          // Half the trials in partial shadow (the key light scaled), half lit.
+          key[k] = trial % 2 == 0 ? 1.0f : 0.5f + 0.5f * next();
+          in.key_visibility[k] = key[k];
           albedo[k] = glm::abs(glm::vec3(next(), next(), next()));
           normal[k] = glm::normalize(glm::vec3(next(), next(), next()) + glm::vec3(0.0f, 0.0f, 0.3f));
           position[k] = glm::vec3(next(), next() + 1.0f, next());
@@ -231,7 +235,7 @@ TEST(ShadingTest, ShadeSurface4IsShadeSurfaceBitForBit) {
         float out[3][4];
         render::ShadeSurface4(ctx, in, out);
         for (int k = 0; k < 4; ++k) {
-          const glm::vec3 expected = render::ShadeSurface(ctx, albedo[k], normal[k], position[k]);
+          const glm::vec3 expected = render::ShadeSurface(ctx, albedo[k], normal[k], position[k], key[k]);
           ASSERT_EQ(glm::vec3(out[0][k], out[1][k], out[2][k]), expected) << trial << " lane " << k;
           lit += expected != albedo[k] * ctx.ambient ? 1 : 0;
         }
