@@ -28,6 +28,40 @@
 namespace app {
 namespace {
 
+// The OBJ sequence's material library, written once next to the frames.
+struct ObjMaterials {
+  std::string library;             // file name of the .mtl in the output folder, or empty
+  std::vector<std::string> names;  // per material
+};
+
+// materials.mtl and each texture's image as read (texture_K.png / .jpg) in
+// `folder`: map_Kd names the image, Kd the base colour factor.
+mocap::Result<ObjMaterials> WriteObjMaterialFiles(const deform::MeshMaterials& materials,
+                                                  const std::filesystem::path& folder) {
+  ObjMaterials out;
+  out.library = "materials.mtl";
+  std::vector<glm::vec3> diffuse;
+  std::vector<std::string> files;
+  for (std::size_t k = 0; k < materials.materials.size(); ++k) {
+    const deform::Material& m = materials.materials[k];
+    out.names.push_back("material_" + std::to_string(k));
+    diffuse.push_back(m.base_color_factor);
+    std::string file;
+    if (m.texture >= 0 && static_cast<std::size_t>(m.texture) < materials.images.size() &&
+        !materials.images[static_cast<std::size_t>(m.texture)]->encoded.empty()) {
+      const deform::TextureImage& image = *materials.images[static_cast<std::size_t>(m.texture)];
+      file = "texture_" + std::to_string(m.texture) + (image.mime_type == "image/jpeg" ? ".jpg" : ".png");
+      const std::string_view bytes(reinterpret_cast<const char*>(image.encoded.data()), image.encoded.size());
+      if (mocap::Status s = deform::WriteFileAtomic((folder / file).string(), bytes); !s) return s.error();
+    }
+    files.push_back(file);
+  }
+  if (mocap::Status s = deform::WriteObjMaterials((folder / out.library).string(), out.names, diffuse, files); !s) {
+    return s.error();
+  }
+  return out;
+}
+
 int Fail(const mocap::Error& e) {
   std::fprintf(stderr, "%s\n", e.ToString().c_str());
   return e.code == mocap::ErrorCode::kInternal ? 3 : 2;
@@ -236,8 +270,12 @@ int RunExport(const ExportOptions& options) {
                                          .znear = first.near_plane * o.scale,
                                          .zfar = first.far_plane * o.scale};
     }
+    const deform::MeshMaterials& materials = ch.mesh.materials;
+    const deform::GltfExportSurface surface{
+        .uvs = bind.uvs, .materials = materials.materials.empty() ? nullptr : &materials};
     mocap::Result<deform::GltfSequenceWriter> w = deform::GltfSequenceWriter::Create(
-        bind.triangles, bind.colors, bind.num_vertices(), static_cast<int>(plan->count()), go);
+        bind.triangles, bind.colors, bind.num_vertices(), static_cast<int>(plan->count()), go,
+        surface);
     if (!w.ok()) return Fail(w.error());
     gltf.emplace(std::move(*w));
   }
@@ -250,6 +288,12 @@ int RunExport(const ExportOptions& options) {
   DeformedFrame frame;
   std::vector<glm::vec3> scaled;  // --scale: the positions written (#V, reused)
   deform::ObjSequenceWriter obj;
+  ObjMaterials obj_materials;
+  if (!glb && !ch.mesh.materials.materials.empty()) {
+    mocap::Result<ObjMaterials> written = WriteObjMaterialFiles(ch.mesh.materials, out_dir);
+    if (!written.ok()) return Fail(written.error());
+    obj_materials = std::move(*written);
+  }
   const std::string source = demo ? "demo_walk.bvh (built in)" : rig ? rig->file : o.input;
   // Frames are computed one at a time (plan->At): an export of every frame of
   // an hour-long capture holds no per-frame list (issue 8).
@@ -279,7 +323,13 @@ int RunExport(const ExportOptions& options) {
                     of.time_s, GlobalMethodName(*method));
       s = obj.Write({.positions = positions, .normals = frame.normals,
                      .triangles = bind.triangles,
-                     .comment = "patchskin export of " + source + "\n" + comment},
+                     .comment = "patchskin export of " + source + "\n" + comment,
+                     .uvs = bind.uvs,
+                     .material_library = obj_materials.library,
+                     .material_names = obj_materials.names,
+                     .triangle_material = obj_materials.names.empty()
+                                              ? std::span<const std::int32_t>()
+                                              : std::span<const std::int32_t>(ch.mesh.materials.triangle_material)},
                     *path);
     }
     if (!s.ok()) return Fail(s.error());

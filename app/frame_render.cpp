@@ -83,6 +83,12 @@ mocap::Status DrawOne(const Character& ch, const DeformedFrame& f, const render:
                          .vertex_colors = colors.empty() ? std::span<const glm::vec3>(bind.colors)
                                                          : colors,
                          .closed = ch.closed_surface};
+  if (o.textures && ch.textures && bind.uvs.size() == bind.positions.size() &&
+      ch.textures->triangle_textures.size() == bind.triangles.size()) {
+    body.uvs = bind.uvs;
+    body.textures = ch.textures->textures;
+    body.triangle_textures = ch.textures->triangle_textures;
+  }
   render::Overlays overlays;
   if (o.skeleton) AddSkeleton(f, ch.skeleton, overlays);
   overlays.wireframe = o.wireframe;
@@ -150,6 +156,28 @@ mocap::Status DrawCharacterFrame(const Character& character, const DeformedFrame
   ComposeSplit(scratch, into);
   if (options.color_bar_scale > 0.0f) DrawColorBar(options.color_bar_scale, into);
   return mocap::Status::Ok();
+}
+
+std::shared_ptr<const CharacterTextures> BuildCharacterTextures(const deform::SkinnedMesh& mesh) {
+  const deform::MeshMaterials& m = mesh.materials;
+  if (!m.textured() || mesh.bind.uvs.size() != mesh.bind.positions.size() ||
+      m.triangle_material.size() != mesh.bind.triangles.size()) {
+    return nullptr;
+  }
+  auto out = std::make_shared<CharacterTextures>();
+  std::vector<std::int32_t> of_material(m.materials.size(), -1);
+  for (std::size_t k = 0; k < m.materials.size(); ++k) {
+    const deform::Material& mat = m.materials[k];
+    if (mat.texture < 0 || static_cast<std::size_t>(mat.texture) >= m.images.size()) continue;
+    of_material[k] = static_cast<std::int32_t>(out->textures.size());
+    out->textures.emplace_back(*m.images[static_cast<std::size_t>(mat.texture)], mat.wrap_s, mat.wrap_t);
+  }
+  out->triangle_textures.resize(m.triangle_material.size());
+  for (std::size_t t = 0; t < m.triangle_material.size(); ++t) {
+    const std::int32_t k = m.triangle_material[t];
+    out->triangle_textures[t] = k >= 0 && static_cast<std::size_t>(k) < of_material.size() ? of_material[static_cast<std::size_t>(k)] : -1;
+  }
+  return out;
 }
 
 std::vector<glm::vec3> PatchTint(std::span<const deform::PatchSetup> patches, int num_vertices,

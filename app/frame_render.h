@@ -3,6 +3,8 @@
 // `patchskin render` and the golden-image tests so both go through the same
 // FramePipeline -> render::Renderer path.
 
+#include <cstdint>
+#include <memory>
 #include <optional>
 #include <span>
 #include <string>
@@ -39,6 +41,7 @@ struct FrameDrawOptions {
   // > 0: a colour bar of DisplacementColors' ramp from 0 to this (model units)
   // in the top right corner.
   float color_bar_scale = 0.0f;
+  bool textures = true;  // draw the character's textures (false: its colours alone, as untextured)
 };
 
 // Albedo of every vertex with each patch's region tinted by its own colour,
@@ -50,6 +53,17 @@ std::vector<glm::vec3> PatchTint(std::span<const deform::PatchSetup> patches, in
 // The heat ramp of the displacement overlay at t in [0, 1] (blue, cyan,
 // yellow, red), linear RGB.
 glm::vec3 HeatRamp(float t);
+
+// The textures of a character's mesh as the renderer samples them: one mip
+// pyramid per material with a texture (its image and wrap modes), and the
+// texture of each bind triangle (-1: untextured).
+struct CharacterTextures {
+  std::vector<render::Texture> textures;
+  std::vector<std::int32_t> triangle_textures;  // #T
+};
+// Null when no material of `mesh` has a texture (or the mesh has no uvs).
+// Costs one pass over each image's texels.
+std::shared_ptr<const CharacterTextures> BuildCharacterTextures(const deform::SkinnedMesh& mesh);
 
 // Albedo of every vertex by |layered - global| / scale on HeatRamp (#V each).
 void DisplacementColors(std::span<const glm::vec3> global, std::span<const glm::vec3> layered,

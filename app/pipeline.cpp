@@ -7,6 +7,7 @@
 #include <string>
 #include <thread>
 
+#include "app/frame_render.h"
 #include "app/motion_source.h"
 #include "deform/body/bind_pose.h"
 #include "deform/body/generated_body.h"
@@ -162,6 +163,7 @@ mocap::Result<Character> MakeCharacter(MotionSource&& source,
   if (c.source.empty()) c.source = "<input>";
   if (source.gltf) {
     c.mesh = std::move(source.gltf->mesh);
+    c.textures = BuildCharacterTextures(c.mesh);
     c.closed_surface = deform::IsClosedOutward(c.mesh.bind.positions, c.mesh.bind.triangles);
     return c;
   }

@@ -31,6 +31,7 @@
 namespace app {
 
 struct MotionSource;
+struct CharacterTextures;  // app/frame_render.h
 
 enum class GlobalMethod { kSsd, kDqs, kSwd };
 const char* GlobalMethodName(GlobalMethod method);
@@ -50,6 +51,8 @@ struct Character {
   bool bound_at_first_frame = false;   // BVH: the rest pose was not a body pose, so the
                                        // mannequin was built and bound at frame 0
   std::vector<mocap::Warning> warnings;
+  // The renderer's mip pyramids of mesh.materials' textures, built once (null: untextured).
+  std::shared_ptr<const CharacterTextures> textures;
 };
 
 // Builds a Character from a loaded source: glTF keeps its mesh; BVH gets a

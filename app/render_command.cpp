@@ -229,6 +229,9 @@ CLI::App* AddRenderCommand(CLI::App& parent, RenderOptions& o) {
                   "The key light's cast shadow on the ground and the body: on or off (only the soft "
                   "contact blob under the body)")
       ->capture_default_str();
+  cmd->add_option("--textures", o.textures,
+                  "A glTF character's base colour textures: on or off (its colours alone)")
+      ->capture_default_str();
   cmd->add_option("--png-compression", o.png_compression, "PNG zlib level 0..9")
       ->capture_default_str();
   cmd->add_flag("--no-sheet", o.no_sheet, "Do not write the contact sheet");
@@ -370,6 +373,9 @@ int RunRender(const RenderOptions& options) {
   }
   if (o.shadows != "on" && o.shadows != "off") {
     return Fail(ArgError("--shadows", "expected on or off, found '" + o.shadows + "'"));
+  }
+  if (o.textures != "on" && o.textures != "off") {
+    return Fail(ArgError("--textures", "expected on or off, found '" + o.textures + "'"));
   }
   if (o.resolve != "box" && o.resolve != "tent") {
     return Fail(ArgError("--resolve", "expected box or tent, found '" + o.resolve + "'"));
@@ -737,7 +743,8 @@ int RunRender(const RenderOptions& options) {
                                 .side_by_side = side_by_side,
                                 .left_colors = colors(0),
                                 .right_colors = colors(1),
-                                .color_bar_scale = overlay_delta ? delta_scale : 0.0f};
+                                .color_bar_scale = overlay_delta ? delta_scale : 0.0f,
+                                .textures = o.textures == "on"};
     s = DrawCharacterFrame(ch, frame, right_pipeline ? &right_frame : nullptr, camera, settings,
                            draw, renderer, right_renderer, right_image, image);
     if (!s.ok()) return Fail(s.error());

@@ -39,6 +39,7 @@ struct RenderOptions {
   std::string resolve = "box";        // box | tent: how the samples of a pixel are filtered
   std::string aa = "ssaa";            // ssaa | msaa: shade every sample, or once per interior pixel
   std::string shadows = "on";         // on | off: the key light's cast shadow (ground and body)
+  std::string textures = "on";        // on | off: a glTF character's base colour textures
   int png_compression = 1;            // zlib level for PNG frames
   bool no_sheet = false;
   bool no_video = false;

@@ -21,6 +21,16 @@ mocap::Status Mesh::Check() const {
                             "mesh has " + std::to_string(n) + " positions but " +
                                 std::to_string(colors.size()) + " colors");
   }
+  if (!uvs.empty() && uvs.size() != n) {
+    return mocap::MakeError(ErrorCode::kCountMismatch, {},
+                            "mesh has " + std::to_string(n) + " positions but " +
+                                std::to_string(uvs.size()) + " texture coordinates");
+  }
+  for (const glm::vec2& uv : uvs) {
+    if (!std::isfinite(uv.x) || !std::isfinite(uv.y)) {
+      return mocap::MakeError(ErrorCode::kNonFinite, {}, "mesh has a non-finite texture coordinate");
+    }
+  }
   for (std::size_t t = 0; t < triangles.size(); ++t) {
     const glm::uvec3& tri = triangles[t];
     if (tri.x >= n || tri.y >= n || tri.z >= n) {

@@ -7,7 +7,9 @@
 // drives them.
 
 #include <cstdint>
+#include <memory>
 #include <span>
+#include <string>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -27,11 +29,52 @@ struct Mesh {
   std::vector<glm::vec3> normals;     // #V unit normals, or empty (then computed on demand)
   std::vector<glm::uvec3> triangles;  // #T, counter-clockwise seen from outside
   std::vector<glm::vec3> colors;      // #V linear RGB in [0,1], or empty (default material)
+  std::vector<glm::vec2> uvs;         // #V texture coordinates (glTF TEXCOORD_0), or empty
 
   int num_vertices() const { return static_cast<int>(positions.size()); }
   int num_triangles() const { return static_cast<int>(triangles.size()); }
   // Sizes agree, indices in range, values finite.
   mocap::Status Check() const;
+};
+
+// How a texture coordinate outside [0, 1] is mapped back (glTF 2.0 sampler wrap modes).
+enum class TextureWrap : std::uint8_t { kRepeat, kClampToEdge, kMirroredRepeat };
+
+// A decoded colour texture. Texel (x, y) is rgb[3 * (y * width + x)]; row 0 is
+// the first row of the file, which glTF puts at v = 0 (texel centres at
+// u = (x + 0.5) / width, v = (y + 0.5) / height).
+struct TextureImage {
+  int width = 0, height = 0;
+  std::vector<float> rgb;            // width x height x 3, linear RGB in [0, 1]
+  // The file's bytes as read (PNG or JPEG) and their MIME type, so an export
+  // can embed the image unchanged; empty when the texture was made in memory.
+  std::vector<unsigned char> encoded;
+  std::string mime_type;
+};
+
+// The base colour of a group of triangles (glTF pbrMetallicRoughness).
+// Albedo = base_color_factor x texture(uv) x vertex colour; importers fold the
+// factor into Mesh::colors already (see gltf_import.h), so renderers multiply
+// the texture by the vertex colour only.
+struct Material {
+  glm::vec3 base_color_factor{1.0f};  // linear RGB
+  int texture = -1;                   // index into MeshMaterials::images, -1: none
+  TextureWrap wrap_s = TextureWrap::kRepeat;  // along u
+  TextureWrap wrap_t = TextureWrap::kRepeat;  // along v
+  std::string name;
+};
+
+// The materials of a mesh. Images are shared (copying a mesh does not copy texels).
+struct MeshMaterials {
+  std::vector<Material> materials;
+  std::vector<std::shared_ptr<const TextureImage>> images;
+  std::vector<std::int32_t> triangle_material;  // #T index into materials, -1: none; or empty
+
+  bool textured() const {
+    for (const Material& m : materials)
+      if (m.texture >= 0) return true;
+    return false;
+  }
 };
 
 // Per-vertex skin weights with a fixed number of influences per vertex
@@ -67,6 +110,8 @@ struct SkinnedMesh {
   // BuildMannequin, for the SWD rig to bind each tube to the chain it was made from
   // (SwdRigOptions::vertex_chains). Valid only for that skeleton in that bind pose.
   std::vector<BodyChainCoord> body_chain_coords;
+  // Materials of the bind triangles (empty for generated bodies).
+  MeshMaterials materials;
 };
 
 // Area-weighted vertex normals of `positions` over `triangles` (zero-area

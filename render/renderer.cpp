@@ -101,6 +101,10 @@ mocap::JobStatus ValidateInputs(std::span<const SceneMesh> meshes, const RenderS
       return Fail(Code::kSizeMismatch, "vertex_colors must be empty or #V");
     if (!mesh.triangle_colors.empty() && mesh.triangle_colors.size() != mesh.triangles.size())
       return Fail(Code::kSizeMismatch, "triangle_colors must be empty or #T");
+    if (!mesh.textures.empty() && mesh.uvs.size() != nv)
+      return Fail(Code::kSizeMismatch, "uvs must be #V when textures are given");
+    if (!mesh.triangle_textures.empty() && mesh.triangle_textures.size() != mesh.triangles.size())
+      return Fail(Code::kSizeMismatch, "triangle_textures must be empty or #T");
   }
   return mocap::kJobOk;
 }
@@ -344,7 +348,8 @@ class Renderer::SampleShader {
       return Kind::kColor;
     }
     glm::vec3 albedo = t.albedo;
-    const bool need_weights = t.interpolate_color || model == LightingModel::kBlinnPhong;
+    const bool need_weights =
+        t.interpolate_color || model == LightingModel::kBlinnPhong || t.texture != nullptr;
     float l0 = w0, l1 = w1, l2 = w2;
     if (need_weights) {
       const float inv = 1.0f / (w0 + w1 + w2);
@@ -353,6 +358,7 @@ class Renderer::SampleShader {
       l2 = w2 * inv;
     }
     if (t.interpolate_color) albedo = l0 * t.col[0] + l1 * t.col[1] + l2 * t.col[2];
+    if (t.texture != nullptr) albedo *= SampleTexture(t, w0 + w1 + w2, fx, fy);
     if (model == LightingModel::kUnlit) {
       color = albedo;
       return Kind::kColor;
@@ -448,7 +454,24 @@ class Renderer::SampleShader {
     int ref_x = 0, ref_y = 0;  // reference sample (the triangle's bounds corner)
     float wa[3] = {}, wb[3] = {}, wc[3] = {};  // weight_i = wc + wa * (x - ref_x) + wb * (y - ref_y)
     glm::vec3 n[3], col[3], p[3], face_normal{0.0f, 0.0f, 1.0f}, albedo{1.0f};
+    // Textured: (u, v) times the unnormalized weights, as planes like wa/wb/wc
+    // (uv_a = sum_i wa[i] * uv_i, ...), and the weights' sum's planes.
+    const Texture* texture = nullptr;
+    glm::vec2 uv_a{0.0f}, uv_b{0.0f}, uv_c{0.0f};
+    float sum_a = 0.0f, sum_b = 0.0f;
   };
+
+  // The texture at a sample: with S = w0 + w1 + w2 (planes in x, y), uv =
+  // (uv_c + uv_a x + uv_b y) / S, so d(uv)/dx = (uv_a - uv * sum_a) / S and
+  // likewise in y: the exact derivatives of the perspective-correct uv.
+  static glm::vec3 SampleTexture(const Entry& t, float sum, float fx, float fy) {
+    if (!(sum != 0.0f)) return t.texture->Sample(glm::vec2(0.0f), 0.0f);
+    const float inv = 1.0f / sum;
+    const glm::vec2 uv = (t.uv_c + t.uv_a * fx + t.uv_b * fy) * inv;
+    const glm::vec2 du_dx = (t.uv_a - uv * t.sum_a) * inv;
+    const glm::vec2 du_dy = (t.uv_b - uv * t.sum_b) * inv;
+    return t.texture->Sample(uv, t.texture->Lod(du_dx, du_dy));
+  }
 
 
   // Lambert from the entry's planes; `alpha` is the w of the result.
@@ -537,7 +560,10 @@ class Renderer::SampleShader {
       for (int k = 0; k < 3; ++k) corner[k] = mesh.vertex_colors[v[k]];
       to_vertices(corner, t.col);
     }
-    t.lambert_plane = r_.context_.model == LightingModel::kLambert && !t.interpolate_color;
+    t.texture = nullptr;
+    if (!mesh.textures.empty()) LoadTexture(mesh, tri, v, weights, t);
+    t.lambert_plane =
+        r_.context_.model == LightingModel::kLambert && !t.interpolate_color && t.texture == nullptr;
     if (t.lambert_plane) {
       const ShadingContext& ctx = r_.context_;
       for (int k = 0; k < 3; ++k) {
@@ -564,6 +590,29 @@ class Renderer::SampleShader {
       }
       t.lit_base[3] = 1.0f;
       t.lit_key[3] = 0.0f;
+    }
+  }
+
+  // The texture of a mesh triangle and its uv planes (see SampleTexture).
+  static void LoadTexture(const SceneMesh& mesh, const RasterTriangle& tri, const glm::uvec3& v,
+                          const glm::mat3* weights, Entry& t) {
+    const std::int32_t k = mesh.triangle_textures.empty() ? 0 : mesh.triangle_textures[tri.triangle];
+    if (k < 0 || static_cast<std::size_t>(k) >= mesh.textures.size()) return;
+    t.texture = &mesh.textures[static_cast<std::size_t>(k)];
+    // Without colours the texture is the albedo (base_color is for untextured triangles).
+    if (mesh.triangle_colors.empty() && mesh.vertex_colors.empty()) t.albedo = glm::vec3(1.0f);
+    t.uv_a = t.uv_b = t.uv_c = glm::vec2(0.0f);
+    t.sum_a = t.sum_b = 0.0f;
+    for (int i = 0; i < 3; ++i) {
+      const glm::vec2 uv = weights == nullptr ? mesh.uvs[v[tri.order[i]]]
+                                              : (*weights)[i].x * mesh.uvs[v[0]] +
+                                                    (*weights)[i].y * mesh.uvs[v[1]] +
+                                                    (*weights)[i].z * mesh.uvs[v[2]];
+      t.uv_a += t.wa[i] * uv;
+      t.uv_b += t.wb[i] * uv;
+      t.uv_c += t.wc[i] * uv;
+      t.sum_a += t.wa[i];
+      t.sum_b += t.wb[i];
     }
   }
 

@@ -30,6 +30,7 @@
 #include "render/raster/shading.h"
 #include "render/raster/shading4.h"
 #include "render/raster/shadow_map.h"
+#include "render/raster/texture.h"
 
 namespace render {
 
@@ -42,6 +43,15 @@ struct SceneMesh {
   std::span<const glm::vec3> triangle_colors{};  // #T albedo per triangle (e.g. per patch), or
                                                // empty; wins over vertex_colors
   glm::vec3 base_color{0.75f, 0.72f, 0.68f};   // albedo when both colour spans are empty
+  // Base colour textures. A textured triangle's albedo is texture(uv) times its
+  // triangle colour, else its interpolated vertex colour, else 1 (base_color is
+  // for untextured triangles only). uv is interpolated perspective-correctly per
+  // sample and filtered trilinearly, its level of detail from the exact screen
+  // derivatives of that interpolation.
+  std::span<const glm::vec2> uvs{};                  // #V, required with textures
+  std::span<const Texture> textures{};               // borrowed like the spans
+  std::span<const std::int32_t> triangle_textures{};  // #T index into textures (-1 or out of
+                                                     // range: untextured), or empty: textures[0]
   bool casts_contact_shadow = true;            // darken the ground under this mesh
   bool closed = false;  // closed and outward (deform::IsClosedOutward): a cheaper shadow map
 };

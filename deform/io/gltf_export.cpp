@@ -123,8 +123,10 @@ struct GltfSequenceWriter::Impl {
   int num_frames = 0;
   int added = 0;
   bool finished = false;
-  int indices_accessor = -1;
+  // One primitive per material group: its indices accessor and material (-1 none).
+  std::vector<std::pair<int, int>> groups;
   int colors_accessor = -1;
+  int uvs_accessor = -1;
   std::vector<glm::vec3> base_positions;  // morph: frame 0
   std::vector<glm::vec3> base_normals;    // morph: frame 0
   std::vector<glm::vec3> delta;           // morph: scratch, #V
@@ -211,14 +213,23 @@ struct GltfSequenceWriter::Impl {
 
   float KeyTime(int k) const { return static_cast<float>(k * options.frame_time_s); }
 
-  tinygltf::Primitive Primitive(const std::map<std::string, int>& attributes) const {
-    tinygltf::Primitive prim;
-    prim.attributes = attributes;
-    if (colors_accessor >= 0) prim.attributes["COLOR_0"] = colors_accessor;
-    prim.indices = indices_accessor;
-    prim.mode = TINYGLTF_MODE_TRIANGLES;
-    return prim;
+  std::vector<tinygltf::Primitive> Primitives(const std::map<std::string, int>& attributes) const {
+    std::vector<tinygltf::Primitive> out;
+    for (const auto& [indices, material] : groups) {
+      tinygltf::Primitive prim;
+      prim.attributes = attributes;
+      if (colors_accessor >= 0) prim.attributes["COLOR_0"] = colors_accessor;
+      if (uvs_accessor >= 0) prim.attributes["TEXCOORD_0"] = uvs_accessor;
+      prim.indices = indices;
+      prim.material = material;
+      prim.mode = TINYGLTF_MODE_TRIANGLES;
+      out.push_back(std::move(prim));
+    }
+    return out;
   }
+
+  void AddTriangles(std::span<const glm::uvec3> triangles, const MeshMaterials* materials);
+  void AddMaterials(const MeshMaterials& materials);
 
   void FinishMorph();
   void FinishBaked();
@@ -269,9 +280,10 @@ void GltfSequenceWriter::Impl::AddCamera(tinygltf::Animation& anim) {
 void GltfSequenceWriter::Impl::FinishMorph() {
   tinygltf::Mesh mesh;
   mesh.name = options.mesh_name;
-  tinygltf::Primitive prim = Primitive(frame_attributes[0]);
-  prim.targets.assign(frame_attributes.begin() + 1, frame_attributes.end());
-  mesh.primitives.push_back(std::move(prim));
+  for (tinygltf::Primitive& prim : Primitives(frame_attributes[0])) {
+    prim.targets.assign(frame_attributes.begin() + 1, frame_attributes.end());
+    mesh.primitives.push_back(std::move(prim));
+  }
   mesh.weights.assign(static_cast<std::size_t>(num_frames), 0.0);
   mesh.weights[0] = 1.0;
   tinygltf::Value::Array names;
@@ -325,7 +337,7 @@ void GltfSequenceWriter::Impl::FinishBaked() {
   for (int k = 0; k < num_frames; ++k) {
     tinygltf::Mesh mesh;
     mesh.name = options.mesh_name + "_" + FrameName(k);
-    mesh.primitives.push_back(Primitive(frame_attributes[static_cast<std::size_t>(k)]));
+    mesh.primitives = Primitives(frame_attributes[static_cast<std::size_t>(k)]);
     model.meshes.push_back(std::move(mesh));
     tinygltf::Node node;
     node.name = FrameName(k);
@@ -364,6 +376,75 @@ void GltfSequenceWriter::Impl::FinishBaked() {
   model.animations.push_back(std::move(anim));
 }
 
+// The index accessors: all triangles in one group, or (several materials) one
+// group per material in order of first use.
+void GltfSequenceWriter::Impl::AddTriangles(std::span<const glm::uvec3> triangles,
+                                            const MeshMaterials* materials) {
+  std::vector<std::int32_t> order;  // materials in order of first use
+  const bool per_triangle = materials != nullptr && !materials->triangle_material.empty();
+  if (per_triangle) {
+    for (const std::int32_t k : materials->triangle_material)
+      if (std::find(order.begin(), order.end(), k) == order.end()) order.push_back(k);
+  } else {
+    order.push_back(materials != nullptr && materials->materials.size() == 1 ? 0 : -1);
+  }
+  std::vector<glm::uvec3> group;
+  for (const std::int32_t k : order) {
+    std::span<const glm::uvec3> tris = triangles;
+    if (order.size() > 1) {
+      group.clear();
+      for (std::size_t t = 0; t < triangles.size(); ++t)
+        if (materials->triangle_material[t] == k) group.push_back(triangles[t]);
+      tris = group;
+    }
+    const int view = AddView(tris.data(), tris.size_bytes(), TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
+    groups.emplace_back(AddAccessor(view, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR,
+                                    tris.size() * 3),
+                        k);
+  }
+}
+
+// glTF materials, textures, samplers and embedded images, in the same order
+// as `materials` (so the groups' material indices carry over).
+void GltfSequenceWriter::Impl::AddMaterials(const MeshMaterials& materials) {
+  auto wrap = [](TextureWrap w) {
+    switch (w) {
+      case TextureWrap::kClampToEdge: return TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE;
+      case TextureWrap::kMirroredRepeat: return TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT;
+      default: return TINYGLTF_TEXTURE_WRAP_REPEAT;
+    }
+  };
+  std::vector<int> image_of(materials.images.size(), -1);
+  for (const Material& src : materials.materials) {
+    tinygltf::Material m;
+    m.name = src.name;
+    const glm::vec3 f = src.base_color_factor;
+    m.pbrMetallicRoughness.baseColorFactor = {f.x, f.y, f.z, 1.0};
+    m.pbrMetallicRoughness.metallicFactor = 0.0;  // the renderer's diffuse look
+    if (src.texture >= 0) {
+      int& image = image_of[static_cast<std::size_t>(src.texture)];
+      if (image < 0) {
+        const TextureImage& img = *materials.images[static_cast<std::size_t>(src.texture)];
+        tinygltf::Image out;
+        out.bufferView = AddView(img.encoded.data(), img.encoded.size(), -1);
+        out.mimeType = img.mime_type;
+        model.images.push_back(std::move(out));
+        image = static_cast<int>(model.images.size()) - 1;
+      }
+      tinygltf::Sampler sampler;
+      sampler.wrapS = wrap(src.wrap_s);
+      sampler.wrapT = wrap(src.wrap_t);
+      model.samplers.push_back(std::move(sampler));
+      tinygltf::Texture texture;
+      texture.source = image;
+      texture.sampler = static_cast<int>(model.samplers.size()) - 1;
+      model.textures.push_back(std::move(texture));
+      m.pbrMetallicRoughness.baseColorTexture.index = static_cast<int>(model.textures.size()) - 1;
+    }
+    model.materials.push_back(std::move(m));
+  }
+}
+
 GltfSequenceWriter::GltfSequenceWriter(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 GltfSequenceWriter::GltfSequenceWriter(GltfSequenceWriter&&) noexcept = default;
 GltfSequenceWriter& GltfSequenceWriter::operator=(GltfSequenceWriter&&) noexcept = default;
@@ -375,7 +456,8 @@ int GltfSequenceWriter::frames_added() const { return impl_->added; }
 mocap::Result<GltfSequenceWriter> GltfSequenceWriter::Create(std::span<const glm::uvec3> triangles,
                                                              std::span<const glm::vec3> colors,
                                                              int num_vertices, int num_frames,
-                                                             const GltfExportOptions& options) {
+                                                             const GltfExportOptions& options,
+                                                             const GltfExportSurface& surface) {
   if (num_vertices < 1) return Invalid("the mesh has no vertices");
   if (num_frames < 1 || num_frames > kMaxFrames) {
     return Invalid("expected 1.." + std::to_string(kMaxFrames) + " frames, found " +
@@ -403,6 +485,30 @@ mocap::Result<GltfSequenceWriter> GltfSequenceWriter::Create(std::span<const glm
     }
   }
 
+  if (!surface.uvs.empty() && surface.uvs.size() != nv) return Invalid("uvs must be empty or one per vertex");
+  for (const glm::vec2& uv : surface.uvs) {
+    if (!std::isfinite(uv.x) || !std::isfinite(uv.y)) return Invalid("uvs must be finite");
+  }
+  const MeshMaterials* materials = surface.materials;
+  if (materials != nullptr) {
+    const auto num_materials = static_cast<std::int32_t>(materials->materials.size());
+    if (!materials->triangle_material.empty() && materials->triangle_material.size() != triangles.size()) {
+      return Invalid("triangle_material must be empty or one per triangle");
+    }
+    for (const std::int32_t k : materials->triangle_material) {
+      if (k < -1 || k >= num_materials) return Invalid("triangle material " + std::to_string(k) + " out of range");
+    }
+    for (const Material& m : materials->materials) {
+      if (m.texture < 0) continue;
+      if (static_cast<std::size_t>(m.texture) >= materials->images.size() ||
+          !materials->images[static_cast<std::size_t>(m.texture)] ||
+          materials->images[static_cast<std::size_t>(m.texture)]->encoded.empty()) {
+        return Invalid("material '" + m.name + "': its texture has no encoded image to embed");
+      }
+      if (surface.uvs.empty()) return Invalid("a textured material needs uvs");
+    }
+  }
+
   auto impl = std::make_unique<Impl>();
   std::string scratch_error;
   impl->scratch = OpenScratch(options.scratch_dir, scratch_error);
@@ -425,12 +531,32 @@ mocap::Result<GltfSequenceWriter> GltfSequenceWriter::Create(std::span<const glm
   m.buffers.resize(1);
   m.scenes.resize(1);
   m.defaultScene = 0;
-  const int idx_view = impl->AddView(triangles.data(), triangles.size_bytes(),
-                                     TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
-  impl->indices_accessor = impl->AddAccessor(idx_view, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT,
-                                             TINYGLTF_TYPE_SCALAR, triangles.size() * 3);
+  impl->AddTriangles(triangles, materials);
+  if (materials != nullptr) impl->AddMaterials(*materials);
   if (!colors.empty()) {
-    impl->colors_accessor = impl->AddVec3(colors, false, TINYGLTF_TARGET_ARRAY_BUFFER);
+    // COLOR_0 x baseColorFactor is the albedo: divide the factor back out.
+    std::vector<glm::vec3> stored(colors.begin(), colors.end());
+    if (materials != nullptr && !materials->materials.empty()) {
+      std::vector<std::int32_t> vertex_material(nv, -1);
+      for (std::size_t t = 0; t < triangles.size(); ++t) {
+        const std::int32_t k = materials->triangle_material.empty() ? 0 : materials->triangle_material[t];
+        for (int c = 0; c < 3; ++c)
+          if (vertex_material[triangles[t][c]] < 0) vertex_material[triangles[t][c]] = k;
+      }
+      for (std::size_t v = 0; v < nv; ++v) {
+        if (vertex_material[v] < 0) continue;
+        const glm::vec3 f = materials->materials[static_cast<std::size_t>(vertex_material[v])].base_color_factor;
+        for (int c = 0; c < 3; ++c) stored[v][c] = f[c] > 0.0f ? std::min(stored[v][c] / f[c], 1.0f) : 0.0f;
+      }
+    }
+    const bool all_white = std::all_of(stored.begin(), stored.end(), [](const glm::vec3& c) { return c == glm::vec3(1.0f); });
+    if (!all_white || materials == nullptr) {
+      impl->colors_accessor = impl->AddVec3(stored, false, TINYGLTF_TARGET_ARRAY_BUFFER);
+    }
+  }
+  if (!surface.uvs.empty()) {
+    const int view = impl->AddView(surface.uvs.data(), surface.uvs.size_bytes(), TINYGLTF_TARGET_ARRAY_BUFFER);
+    impl->uvs_accessor = impl->AddAccessor(view, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC2, nv);
   }
   return GltfSequenceWriter(std::move(impl));
 }

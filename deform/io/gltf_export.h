@@ -55,6 +55,7 @@
 #include <glm/glm.hpp>
 #include <glm/gtc/quaternion.hpp>
 
+#include "deform/mesh.h"
 #include "mocap/error.h"
 
 namespace deform {
@@ -92,6 +93,21 @@ struct GltfExportEstimate {
 GltfExportEstimate EstimateGltfExportBytes(int num_vertices, int num_triangles, int num_frames,
                                            bool with_colors);
 
+// What a textured mesh adds to the file (both empty: an untextured export, as before).
+//  * uvs: TEXCOORD_0 of every primitive (one accessor shared by all frames).
+//  * materials: each material becomes a glTF material (baseColorFactor, metallic 0,
+//    baseColorTexture with its sampler's wrap modes, the image's encoded bytes
+//    embedded in the binary chunk), and the triangles are grouped into one
+//    primitive per material (in order of first use; one material keeps the
+//    triangle order). The primitives share the vertex attributes. Colours passed
+//    to Create are albedo with the factor folded in (as the importer gives them),
+//    so COLOR_0 is written as colour / factor (left out when that is all ones):
+//    importing the file gives the same albedo back.
+struct GltfExportSurface {
+  std::span<const glm::vec2> uvs{};          // #V, or empty
+  const MeshMaterials* materials = nullptr;  // or null; triangle_material #T or empty
+};
+
 // Builds the file frame by frame:
 //   auto w = GltfSequenceWriter::Create(tris, colors, nv, nf, options);
 //   for each frame: w->AddFrame(positions, normals);
@@ -104,12 +120,14 @@ class GltfSequenceWriter {
 
   // triangles: #T, indices < num_vertices; colors: #V linear RGB or empty;
   // num_frames: how many AddFrame calls will follow (>= 1), which fixes the
-  // layout when options.layout is kAuto. Errors: kInvalidArgument, kIo (the
-  // scratch file cannot be created).
+  // layout when options.layout is kAuto; surface: uvs and materials (above).
+  // Errors: kInvalidArgument (also: a texture whose image has no encoded bytes),
+  // kIo (the scratch file cannot be created).
   static mocap::Result<GltfSequenceWriter> Create(std::span<const glm::uvec3> triangles,
                                                   std::span<const glm::vec3> colors,
                                                   int num_vertices, int num_frames,
-                                                  const GltfExportOptions& options);
+                                                  const GltfExportOptions& options,
+                                                  const GltfExportSurface& surface = {});
 
   // Adds the next frame: positions and normals are #V, finite. Errors:
   // kInvalidArgument (sizes, non-finite values, more frames than announced),

@@ -20,6 +20,7 @@
 #include "deform/io/internal/gltf_accessor.h"
 #include "deform/io/internal/gltf_build.h"
 #include "deform/io/internal/gltf_files.h"
+#include "deform/io/internal/gltf_material.h"
 #include "deform/io/internal/gltf_morph.h"
 #include "deform/io/internal/gltf_view.h"
 
@@ -45,11 +46,13 @@ struct FsContext {
 
 bool ConfinedFileExists(const std::string& path, void* user) {
   auto* ctx = static_cast<FsContext*>(user);
+  std::error_code ec;
   if (!InsideFolder(ctx->folder, path)) {
-    ctx->rejected = path;
+    // tinygltf also tries a missing file's name in other folders (the working
+    // one): only a file that is there is a refusal, a missing one stays missing.
+    if (fs::exists(path, ec)) ctx->rejected = path;
     return false;
   }
-  std::error_code ec;
   return fs::is_regular_file(path, ec);
 }
 
@@ -77,9 +80,12 @@ bool RefuseWrite(std::string* err, const std::string&, const std::vector<unsigne
   return false;
 }
 
-// Textures are not used: keep image bytes undecoded.
-bool SkipImage(tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int,
-               void*) {
+// Keeps the bytes of data: URI and file images undecoded (GltfMaterialReader
+// decodes the ones a material uses, with OpenImageIO). Buffer-view images are
+// read later from the buffer, after checking the view's bounds.
+bool CaptureImage(tinygltf::Image* image, const int, std::string*, std::string*, int, int,
+                  const unsigned char* bytes, int size, void*) {
+  if (image->bufferView < 0 && bytes != nullptr && size > 0) image->image.assign(bytes, bytes + size);
   return true;
 }
 
@@ -105,7 +111,8 @@ using internal::Indexed;
 
 class Converter {
  public:
-  Converter(const tinygltf::Model& model, const std::string& path) : m_(model), path_(path) {}
+  Converter(const tinygltf::Model& model, const std::string& path)
+      : m_(model), path_(path), materials_(model, path) {}
 
   mocap::Error Fail(ErrorCode code, std::string field, std::string message) const {
     return mocap::MakeError(code, {path_, 0, 0, std::move(field)}, std::move(message));
@@ -159,7 +166,12 @@ class Converter {
     int mesh = -1;                      // the glTF mesh it came from
     internal::PrimitiveTargets targets;
     std::vector<glm::vec3> colors;      // #V linear albedo, or empty: the file gives none
+    std::vector<glm::vec2> uvs;         // #V TEXCOORD_0, or empty
+    int material = -1;                  // index into out_.mesh.materials.materials
   };
+  mocap::Status ReadMaterial(const tinygltf::Primitive& p, const std::string& at, Part& part);
+  internal::GltfMaterialReader materials_;
+  std::vector<int> material_slot_;  // 2 x file material + has TEXCOORD_0 -> out index, -1 not yet
   std::vector<Part> parts_;
   template <typename VertexView>
   mocap::Status ReadColors(const tinygltf::Primitive& p, int color_index, const VertexView& vertex_view,
@@ -445,6 +457,22 @@ mocap::Status Converter::ReadPrimitive(int mesh, int prim, int skin, int rigid_s
     computed_normals = true;
   }
   if (auto st = ReadColors(p, attribute("COLOR_0"), vertex_view, part); !st) return st;
+  if (const int uv_index = attribute("TEXCOORD_0"); uv_index >= 0) {
+    auto view = vertex_view(uv_index, "TEXCOORD_0", TINYGLTF_TYPE_VEC2,
+                            {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE,
+                             TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT});
+    if (!view.ok()) return std::move(view).error();
+    if (view->component_type != TINYGLTF_COMPONENT_TYPE_FLOAT &&
+        !m_.accessors[static_cast<std::size_t>(uv_index)].normalized) {
+      return Fail(ErrorCode::kUnsupported, Indexed("accessors", uv_index) + ".normalized",
+                  "integer TEXCOORD_0 must be normalized (glTF 2.0, meshes)");
+    }
+    auto uvs = Floats(*view, true);
+    if (!uvs.ok()) return std::move(uvs).error();
+    part.uvs.resize(num_vertices);
+    for (std::size_t v = 0; v < num_vertices; ++v) part.uvs[v] = glm::vec2((*uvs)[2 * v], (*uvs)[2 * v + 1]);
+  }
+  if (auto st = ReadMaterial(p, at, part); !st) return st;
   parts_.push_back(std::move(part));
   return mocap::Status::Ok();
 }
@@ -489,6 +517,28 @@ mocap::Status Converter::ReadColors(const tinygltf::Primitive& p, int color_inde
     const glm::vec3 c((*values)[v * stride], (*values)[v * stride + 1], (*values)[v * stride + 2]);
     part.colors[v] = glm::clamp(c, 0.0f, 1.0f) * factor;
   }
+  return mocap::Status::Ok();
+}
+
+// The primitive's material, imported once per file material (and per
+// with/without TEXCOORD_0: a texture needs them).
+mocap::Status Converter::ReadMaterial(const tinygltf::Primitive& p, const std::string& at, Part& part) {
+  if (p.material < 0) return mocap::Status::Ok();
+  const bool has_uvs = !part.uvs.empty();
+  if (p.material < static_cast<int>(m_.materials.size())) {
+    material_slot_.resize(2 * m_.materials.size(), -1);
+    const int cached = material_slot_[static_cast<std::size_t>(2 * p.material + (has_uvs ? 1 : 0))];
+    if (cached >= 0) {
+      part.material = cached;
+      return mocap::Status::Ok();
+    }
+  }
+  auto material = materials_.Read(p.material, has_uvs, at, out_.warnings);
+  if (!material.ok()) return std::move(material).error();
+  MeshMaterials& out = out_.mesh.materials;
+  part.material = static_cast<int>(out.materials.size());
+  out.materials.push_back(std::move(material).value());
+  material_slot_[static_cast<std::size_t>(2 * p.material + (has_uvs ? 1 : 0))] = part.material;
   return mocap::Status::Ok();
 }
 
@@ -562,10 +612,29 @@ mocap::Status Converter::ReadMeshes(int skin) {
   // the renderer uses for a mesh without colours.
   const bool any_colors =
       std::any_of(parts_.begin(), parts_.end(), [](const Part& part) { return !part.colors.empty(); });
+  const bool any_uvs =
+      std::any_of(parts_.begin(), parts_.end(), [](const Part& part) { return !part.uvs.empty(); });
+  const bool any_material =
+      std::any_of(parts_.begin(), parts_.end(), [](const Part& part) { return part.material >= 0; });
+  MeshMaterials& materials = mesh.materials;
+  materials.images = std::move(materials_.images());
+  auto textured = [&](const Part& part) {
+    return part.material >= 0 && materials.materials[static_cast<std::size_t>(part.material)].texture >= 0;
+  };
   for (const Part& part : parts_) {
+    if (any_uvs) {
+      if (part.uvs.empty()) {
+        mesh.bind.uvs.insert(mesh.bind.uvs.end(), part.positions.size(), glm::vec2(0.0f));
+      } else {
+        mesh.bind.uvs.insert(mesh.bind.uvs.end(), part.uvs.begin(), part.uvs.end());
+      }
+    }
+    if (any_material) materials.triangle_material.insert(materials.triangle_material.end(), part.triangles.size(), part.material);
     if (any_colors) {
       if (part.colors.empty()) {
-        mesh.bind.colors.insert(mesh.bind.colors.end(), part.positions.size(), kDefaultAlbedo);
+        // A textured part's albedo is its texture (times a white factor), not the grey.
+        mesh.bind.colors.insert(mesh.bind.colors.end(), part.positions.size(),
+                                textured(part) ? glm::vec3(1.0f) : kDefaultAlbedo);
       } else {
         mesh.bind.colors.insert(mesh.bind.colors.end(), part.colors.begin(), part.colors.end());
       }
@@ -846,7 +915,7 @@ Result<GltfModel> ReadGltfFromMemory(std::span<const unsigned char> bytes, const
                                   &fs_context};
   tinygltf::TinyGLTF loader;
   loader.SetFsCallbacks(callbacks);
-  loader.SetImageLoader(&SkipImage, nullptr);
+  loader.SetImageLoader(&CaptureImage, nullptr);
   tinygltf::Model model;
   std::string err;
   std::string warn;

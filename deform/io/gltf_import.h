@@ -18,8 +18,21 @@
 // time. A file without any skin is read when GltfReadOptions::require_skin is
 // false: each mesh node is then attached rigidly to its node (see GltfModel).
 //
+// Base colour (glTF 2.0, "Materials"): TEXCOORD_0 (float, or normalized
+// unsigned byte/short) goes to mesh.bind.uvs; each primitive's material to
+// mesh.materials (one per file material, with a material index per triangle):
+// pbrMetallicRoughness.baseColorFactor, and baseColorTexture (texCoord 0 only)
+// with its sampler's wrap modes and its image (buffer view, data: URI or file;
+// PNG or JPEG decoded with OpenImageIO, sRGB converted to linear). The factor
+// times COLOR_0 is also folded into mesh.bind.colors (as before textures were
+// read), so a renderer's albedo is texture(uv) x colour. A texture whose image
+// file is missing, or without TEXCOORD_0, or on another texCoord, is left out
+// with a warning (the specification lets a viewer do without it); an index out
+// of range or bytes that do not decode are errors. Metallic/roughness, normal,
+// occlusion and emissive textures, texture transforms and cameras are not
+// imported.
+//
 // Units are the file's (metres by the specification); the up axis is +Y.
-// Textures, materials and cameras are not imported.
 
 #include <span>
 #include <string>

@@ -42,6 +42,10 @@ void AppendVectors(const char* tag, std::span<const glm::vec3> v, std::string& o
   }
 }
 
+bool HasSpace(const std::string& s) {
+  return s.find_first_of(" \t\n\r") != std::string::npos;
+}
+
 }  // namespace
 
 mocap::Status AppendObj(const ObjFrame& frame, std::string& out) {
@@ -60,9 +64,28 @@ mocap::Status AppendObj(const ObjFrame& frame, std::string& out) {
                      std::to_string(nv) + "-1");
     }
   }
-  for (char c : frame.object_name) {
-    if (c == ' ' || c == '\t' || c == '\n' || c == '\r') {
-      return Invalid("object name '" + frame.object_name + "' holds whitespace");
+  if (HasSpace(frame.object_name)) return Invalid("object name '" + frame.object_name + "' holds whitespace");
+  if (HasSpace(frame.material_library)) {
+    return Invalid("material library '" + frame.material_library + "' holds whitespace");
+  }
+  for (const std::string& name : frame.material_names) {
+    if (name.empty() || HasSpace(name)) return Invalid("material name '" + name + "' is empty or holds whitespace");
+  }
+  if (!frame.uvs.empty() && frame.uvs.size() != nv) {
+    return Invalid("uvs must be empty or one per vertex: " + std::to_string(nv) + " positions, " +
+                   std::to_string(frame.uvs.size()) + " uvs");
+  }
+  for (const glm::vec2& uv : frame.uvs) {
+    if (!std::isfinite(uv.x) || !std::isfinite(uv.y)) return Invalid("uvs must be finite");
+  }
+  if (!frame.triangle_material.empty()) {
+    if (frame.triangle_material.size() != frame.triangles.size()) {
+      return Invalid("triangle_material must be empty or one per triangle");
+    }
+    for (const std::int32_t k : frame.triangle_material) {
+      if (k < -1 || k >= static_cast<std::int32_t>(frame.material_names.size())) {
+        return Invalid("triangle material " + std::to_string(k) + " has no name");
+      }
     }
   }
 
@@ -77,20 +100,42 @@ mocap::Status AppendObj(const ObjFrame& frame, std::string& out) {
       begin = end + 1;
     }
   }
+  if (!frame.material_library.empty()) out += "mtllib " + frame.material_library + "\n";
   out += "o ";
   out += frame.object_name.empty() ? std::string("mesh") : frame.object_name;
   out += '\n';
   AppendVectors("v", frame.positions, out);
   AppendVectors("vn", frame.normals, out);
+  for (const glm::vec2& uv : frame.uvs) {
+    out += "vt ";
+    AppendFloat(uv.x, out);
+    out += ' ';
+    AppendFloat(1.0f - uv.y, out);
+    out += '\n';
+  }
   const bool with_normals = !frame.normals.empty();
-  for (const glm::uvec3& tri : frame.triangles) {
+  const bool with_uvs = !frame.uvs.empty();
+  std::int32_t material = -2;  // the current usemtl run
+  for (std::size_t t = 0; t < frame.triangles.size(); ++t) {
+    const glm::uvec3& tri = frame.triangles[t];
+    if (!frame.triangle_material.empty() && frame.triangle_material[t] != material) {
+      material = frame.triangle_material[t];
+      // "usemtl" with no name is not OBJ; -1 (no material) falls back to the default one.
+      out += material >= 0 ? "usemtl " + frame.material_names[static_cast<std::size_t>(material)] + "\n"
+                           : std::string("usemtl default\n");
+    }
     out += 'f';
     for (int c = 0; c < 3; ++c) {
+      const std::uint64_t index = std::uint64_t{tri[c]} + 1;
       out += ' ';
-      AppendUint(std::uint64_t{tri[c]} + 1, out);
+      AppendUint(index, out);
+      if (with_uvs) {
+        out += '/';
+        AppendUint(index, out);
+      }
       if (with_normals) {
-        out += "//";
-        AppendUint(std::uint64_t{tri[c]} + 1, out);
+        out += with_uvs ? "/" : "//";
+        AppendUint(index, out);
       }
     }
     out += '\n';
@@ -106,6 +151,30 @@ mocap::Status ObjSequenceWriter::Write(const ObjFrame& frame, const std::string&
     return e;
   }
   return WriteFileAtomic(path, buffer_);
+}
+
+mocap::Status WriteObjMaterials(const std::string& path, std::span<const std::string> names,
+                                std::span<const glm::vec3> diffuse,
+                                std::span<const std::string> texture_files) {
+  if (diffuse.size() != names.size() || texture_files.size() != names.size()) {
+    return mocap::MakeError(mocap::ErrorCode::kInvalidArgument, {path, 0, 0, {}},
+                            "expected a colour and a texture file (or none) per material name");
+  }
+  std::string out = "# patchskin materials: Kd is the linear base colour factor\n";
+  for (std::size_t k = 0; k < names.size(); ++k) {
+    if (names[k].empty() || HasSpace(names[k]) || HasSpace(texture_files[k])) {
+      return mocap::MakeError(mocap::ErrorCode::kInvalidArgument, {path, 0, 0, {}},
+                              "material '" + names[k] + "': names and files must be non-empty words");
+    }
+    out += "newmtl " + names[k] + "\nKd";
+    for (int c = 0; c < 3; ++c) {
+      out += ' ';
+      AppendFloat(diffuse[k][c], out);
+    }
+    out += '\n';
+    if (!texture_files[k].empty()) out += "map_Kd " + texture_files[k] + "\n";
+  }
+  return WriteFileAtomic(path, out);
 }
 
 }  // namespace deform

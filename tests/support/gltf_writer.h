@@ -38,7 +38,8 @@ class GltfWriter {
   GltfWriter() { doc["asset"] = {{"version", "2.0"}}; }
 
   // Appends `count` elements (tightly packed) as a new bufferView + accessor;
-  // returns the accessor index.
+  // returns the bufferView's index, which is also the accessor's as long as
+  // no BufferView() call came first (tests add raw views last).
   template <typename T>
   int Accessor(const std::vector<T>& values, int component_type, const std::string& type, std::size_t count) {
     while (bytes_.size() % 4 != 0) bytes_.push_back(0);
@@ -51,6 +52,40 @@ class GltfWriter {
     doc["accessors"].push_back(
         {{"bufferView", view}, {"componentType", component_type}, {"type", type}, {"count", count}});
     return view;
+  }
+
+  // Appends raw bytes (e.g. an encoded image) as a new bufferView without an
+  // accessor; returns its index. Call it after the last Accessor().
+  int BufferView(const std::vector<unsigned char>& bytes) {
+    while (bytes_.size() % 4 != 0) bytes_.push_back(0);
+    const std::size_t offset = bytes_.size();
+    bytes_.insert(bytes_.end(), bytes.begin(), bytes.end());
+    doc["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", offset}, {"byteLength", bytes.size()}});
+    return static_cast<int>(doc["bufferViews"].size()) - 1;
+  }
+
+  // Writes a .glb: the JSON chunk, then the buffer as the BIN chunk (glTF 2.0, "GLB").
+  std::string WriteGlb(const std::string& path) {
+    while (bytes_.size() % 4 != 0) bytes_.push_back(0);
+    doc["buffers"] = nlohmann::json::array({{{"byteLength", bytes_.size()}}});
+    std::string json = doc.dump();
+    while (json.size() % 4 != 0) json += ' ';
+    std::vector<unsigned char> out;
+    auto u32 = [&out](std::uint32_t v) {
+      for (int i = 0; i < 4; ++i) out.push_back(static_cast<unsigned char>(v >> (8 * i)));
+    };
+    out.insert(out.end(), {'g', 'l', 'T', 'F'});
+    u32(2);
+    u32(static_cast<std::uint32_t>(12 + 8 + json.size() + 8 + bytes_.size()));
+    u32(static_cast<std::uint32_t>(json.size()));
+    u32(0x4E4F534Au);  // "JSON"
+    out.insert(out.end(), json.begin(), json.end());
+    u32(static_cast<std::uint32_t>(bytes_.size()));
+    u32(0x004E4942u);  // "BIN"
+    out.insert(out.end(), bytes_.begin(), bytes_.end());
+    std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(out.data()),
+                                                static_cast<std::streamsize>(out.size()));
+    return path;
   }
 
   // Writes the document with its buffer embedded; returns the path.
