@@ -147,6 +147,9 @@ CLI::App* AddExportCommand(CLI::App& parent, ExportOptions& o) {
                   "File number of motion frame 0 (OBJ meshes, camera JSON), e.g. 1001")
       ->capture_default_str();
   cmd->add_flag("--quiet", o.quiet, "No progress output");
+  cmd->add_flag("--resume", o.resume,
+                "OBJ sequence: keep the frame files already written (each is whole) and write "
+                "the missing ones; every frame is still evaluated in order");
   cmd->add_option("--layer", o.layer,
                   "auto: the patch layer placed from the skeleton (as render --layer auto)");
   return cmd;
@@ -229,6 +232,10 @@ int RunExport(const ExportOptions& options) {
   if (!glb && ext != ".obj") {
     return Fail(ArgError("--out", "expected a .obj pattern or a .glb file, found '" + out + "'"));
   }
+  if (glb && o.resume) {
+    return Fail(ArgError("--resume", "expected an OBJ sequence: a .glb is written whole at the end, "
+                                     "so an interrupted one has nothing to resume"));
+  }
   if (!glb && !render::HasFramePlaceholder(out)) {
     return Fail(ArgError("--out", "the OBJ pattern '" + out +
                                       "' needs one frame placeholder such as #### or %04d"));
@@ -299,7 +306,15 @@ int RunExport(const ExportOptions& options) {
   // an hour-long capture holds no per-frame list (issue 8).
   // Ctrl-C (SIGINT) or SIGTERM stops between frames, as in render: the frames
   // written stay complete, the .glb (written only at the end) is not started.
-  OutputGuard guard({.overwrite = true});
+  // Existing files are replaced, or with --resume the frames already written
+  // are kept (files appear only whole, renamed into place).
+  OutputGuard guard({.overwrite = true, .resume = o.resume});
+  if (!glb) {
+    const mocap::Status planned = guard.Plan(
+        plan->count(),
+        [&](std::size_t i) { return render::ExpandFramePattern(out, plan->At(i).number); }, {});
+    if (!planned.ok()) return Fail(planned.error());
+  }
   int frames_done = 0;
   int last_done_number = -1;
   for (std::size_t index = 0; index < plan->count(); ++index) {
@@ -315,6 +330,9 @@ int RunExport(const ExportOptions& options) {
     }
     if (gltf) {
       s = gltf->AddFrame(positions, frame.normals);
+    } else if (guard.skip(index)) {
+      // Written by an earlier run: evaluated above all the same, for the state
+      // one frame hands the next (the elastic layer).
     } else {
       const mocap::Result<std::string> path = render::ExpandFramePattern(out, of.number);
       if (!path.ok()) return Fail(path.error());
@@ -362,9 +380,10 @@ int RunExport(const ExportOptions& options) {
                           : " after frame " + std::to_string(last_done_number) + ": " +
                                 std::to_string(frames_done) + " of " +
                                 std::to_string(plan->count()) + " frames were evaluated";
-    m += glb ? "; the .glb was not written" : "; the OBJ files written are complete";
-    std::fprintf(stderr, "%s: %s; run the same command again to export every frame\n",
-                 out.c_str(), m.c_str());
+    m += glb ? "; the .glb was not written; run the same command again to export it"
+             : "; the OBJ files written are complete; run the same command with --resume to "
+               "write the others";
+    std::fprintf(stderr, "%s: %s\n", out.c_str(), m.c_str());
     return guard.exit_code();
   }
   if (gltf) {
@@ -374,6 +393,9 @@ int RunExport(const ExportOptions& options) {
   if (glb) {
     std::printf("glb:     %s (%zu frames, %s layout)\n", out.c_str(), plan->count(),
                 deform::GltfExportLayoutName(gltf->layout()));
+  } else if (guard.num_skipped() > 0) {
+    std::printf("obj:     %s (%zu frames, %d kept from an earlier run)\n", out.c_str(), plan->count(),
+                guard.num_skipped());
   } else {
     std::printf("obj:     %s (%zu frames)\n", out.c_str(), plan->count());
   }

@@ -46,6 +46,7 @@ struct ExportOptions {
                                   // e.g. 0.01: a capture in cm exported in metres
   int threads = 0;                // 0 = hardware concurrency
   bool quiet = false;
+  bool resume = false;            // OBJ: keep the frame files already written, write the others
   int start_number = 0;           // file number of motion frame 0 (OBJ and camera JSON)
   std::string up;                 // --up y|z: a BVH's up axis; empty = detected
 };
