@@ -467,7 +467,10 @@ mocap::Result<AutoRig> MakeAutoRig(const std::string& capture, const std::string
                                                             nullptr, kind);
   if (!ch.ok()) return std::move(ch).error();
   const std::string name = gltf ? body : kind == BodyKind::kTubes ? "tubes" : "generated";
-  return BuildAutoRig(*ch, name, capture, capture);
+  mocap::Result<AutoRig> made = BuildAutoRig(*ch, name, capture, capture);
+  // An up axis given for the capture is part of the rig: the rig is read the same way again.
+  if (made.ok() && *up_axis) made->rig.up = *up_axis == mocap::UpAxis::kZ ? "z" : "y";
+  return made;
 }
 
 mocap::Result<Rig> AutoRigForCommand(const std::string& layer, const std::string& input,

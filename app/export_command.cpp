@@ -177,6 +177,7 @@ int RunExport(const ExportOptions& options) {
     }
     o.global = rig->global;
     o.fps = rig->fps;
+    if (o.up.empty()) o.up = rig->up;
     o.size = std::to_string(rig->render.size.x) + "x" + std::to_string(rig->render.size.y);
     if (rig->render.camera != "turntable") o.camera = rig->render.camera;
     if (o.frames.empty()) o.frames = rig->render.frames;

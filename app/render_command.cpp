@@ -340,6 +340,7 @@ int RunRender(const RenderOptions& options) {
     }
     if (!given("--global")) o.global = rig->global;
     if (!given("--fps")) o.fps = rig->fps;
+    if (!given("--up")) o.up = rig->up;
     if (!given("--size")) {
       o.size = std::to_string(rig->render.size.x) + "x" + std::to_string(rig->render.size.y);
     }

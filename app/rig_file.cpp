@@ -379,13 +379,17 @@ mocap::Result<Rig> ParseRig(const std::string& text, const std::string& file) {
   if (!IsBuiltInBody(rig.character)) rig.character = Resolve(file, rig.character);
   if (doc.contains("motion")) {
     const json& m = doc["motion"];
-    if (auto e = CheckObject(c, m, "motion", {"file", "fps", "joint_map"})) return *e;
+    if (auto e = CheckObject(c, m, "motion", {"file", "fps", "joint_map", "up"})) return *e;
     if (!m.contains("file")) return c.Fail("motion.file", "missing (a BVH file)");
     if (auto e = GetString(c, m["file"], "motion.file", rig.motion)) return *e;
     rig.motion = Resolve(file, rig.motion);
     if (m.contains("joint_map")) {
       if (auto e = GetString(c, m["joint_map"], "motion.joint_map", rig.joint_map)) return *e;
       rig.joint_map = Resolve(file, rig.joint_map);
+    }
+    if (m.contains("up")) {
+      if (auto e = GetString(c, m["up"], "motion.up", rig.up)) return *e;
+      if (rig.up != "y" && rig.up != "z") return c.Fail("motion.up", "expected \"y\" or \"z\", found \"" + rig.up + "\"");
     }
     if (m.contains("fps")) {
       if (auto e = GetNumber(c, m["fps"], "motion.fps", 0, 10000, rig.fps)) return *e;

@@ -89,6 +89,7 @@ struct Rig {
   std::string motion;                // resolved BVH path; empty = the glTF's animation
   std::string joint_map;             // resolved joint map (JSON) for a glTF character; empty = none
   double fps = 0.0;                  // output frame rate, 0 = the motion's own
+  std::string up;                    // "y" | "z": the BVH's up axis (as --up); empty = detected
   std::string global = "ssd";        // ssd | dqs | swd
   std::vector<RigPatch> patches;
   RigRender render;

@@ -125,6 +125,7 @@ mocap::Result<std::string> WriteRigJson(const Rig& rig, const std::string& folde
     s += "  \"motion\": {\"file\": " + Str(RelativePath(rig.motion, folder));
     if (rig.fps != 0.0) s += ", \"fps\": " + nlohmann::json(rig.fps).dump();
     if (!rig.joint_map.empty()) s += ", \"joint_map\": " + Str(RelativePath(rig.joint_map, folder));
+    if (!rig.up.empty()) s += ", \"up\": " + Str(rig.up);
     s += "},\n";
   }
   s += "  \"global\": " + Str(rig.global) + ",\n";

@@ -24,6 +24,18 @@
 
 namespace {
 
+// One render of `mesh` per benchmark iteration, into `image`.
+void RenderEachIteration(benchmark::State& state, render::Renderer& renderer, const render::Camera& camera,
+                         const render::SceneMesh& mesh, const render::RenderSettings& settings,
+                         render::Image& image) {
+  for (auto _ : state) {
+    const mocap::JobStatus status = renderer.Render(camera, {&mesh, 1}, {}, settings, image);
+    if (!status.ok()) state.SkipWithError(status.what);
+    benchmark::DoNotOptimize(image.rgba.data());
+    benchmark::ClobberMemory();
+  }
+}
+
 void BM_RenderBody(benchmark::State& state) {
   static const bench::BodyMesh body = bench::MakeBody();
   render::RenderSettings settings;
@@ -40,12 +52,7 @@ void BM_RenderBody(benchmark::State& state) {
                                .triangles = body.triangles};
   render::Renderer renderer;
   render::Image image;
-  for (auto _ : state) {
-    const mocap::JobStatus status = renderer.Render(camera, {&mesh, 1}, {}, settings, image);
-    if (!status.ok()) state.SkipWithError(status.what);
-    benchmark::DoNotOptimize(image.rgba.data());
-    benchmark::ClobberMemory();
-  }
+  RenderEachIteration(state, renderer, camera, mesh, settings, image);
   std::size_t covered = 0;
   for (float d : image.depth) covered += std::isfinite(d) ? 1 : 0;
   if (const std::string path = bench::SnapshotPath("raster_" + std::to_string(settings.width) + "x" +
@@ -107,12 +114,7 @@ void BM_RenderCesiumMan(benchmark::State& state) {
   }
   render::Renderer renderer;
   render::Image image;
-  for (auto _ : state) {
-    const mocap::JobStatus status = renderer.Render(camera, {&mesh, 1}, {}, settings, image);
-    if (!status.ok()) state.SkipWithError(status.what);
-    benchmark::DoNotOptimize(image.rgba.data());
-    benchmark::ClobberMemory();
-  }
+  RenderEachIteration(state, renderer, camera, mesh, settings, image);
   state.counters["fps"] = benchmark::Counter(static_cast<double>(state.iterations()),
                                              benchmark::Counter::kIsRate);
 }

@@ -174,6 +174,29 @@ TEST(AutoRig, RigFileRendersTheFramesOfLayerAuto) {
   EXPECT_EQ(differs_from_global, 3);
 }
 
+// An up axis given to `rig auto` is written into the rig (motion.up), so the
+// rig renders the capture as `--layer auto --up z` does, not as detected.
+TEST(AutoRig, RigRecordsTheUpAxisItWasMadeWith) {
+  const fs::path dir = testsupport::TestDir("auto_rig");
+  const std::string capture = testsupport::SampleDataPath("jump.bvh").string();
+  const fs::path rig = dir / "jump_z.json";
+  const testsupport::ProcessResult written = testsupport::RunPatchskin(
+      {"rig", "auto", capture, "--up", "z", "--out", rig.string()}, dir / "logs");
+  ASSERT_EQ(written.exit_code, 0) << written.err;
+  EXPECT_NE(testsupport::SlurpFile(rig).find(R"("up": "z")"), std::string::npos) << testsupport::SlurpFile(rig);
+  Render({"render", capture, "--layer", "auto", "--up", "z"}, dir / "layer_z");
+  Render({"render", rig.string()}, dir / "rig_z");
+  Render({"render", capture, "--layer", "auto"}, dir / "layer_detected");
+  for (const char* f : {"f_0000.png", "f_0020.png", "f_0040.png"}) {
+    auto a = render::ReadImage((dir / "layer_z" / f).string());
+    auto b = render::ReadImage((dir / "rig_z" / f).string());
+    auto d = render::ReadImage((dir / "layer_detected" / f).string());
+    ASSERT_TRUE(a.ok() && b.ok() && d.ok()) << f;
+    EXPECT_TRUE(a->rgba == b->rgba) << f << ": the rig lost --up z";
+    EXPECT_TRUE(a->rgba != d->rgba) << f << ": --up z changed nothing, so this test shows nothing";
+  }
+}
+
 TEST(AutoRig, BadLayerAndRigInputAreRefused) {
   const fs::path dir = testsupport::TestDir("auto_rig");
   const std::string capture = testsupport::SampleDataPath("jump.bvh").string();

@@ -115,6 +115,19 @@ TEST(RigFile, JointMapResolvesAgainstTheRigFolder) {
   EXPECT_TRUE(none->joint_map.empty());
 }
 
+TEST(RigFile, MotionUpIsYOrZ) {
+  const auto z = app::ParseRig(R"({"character": "generated", "motion": {"file": "m.bvh", "up": "z"}})", "r.json");
+  ASSERT_TRUE(z.ok()) << z.error().ToString();
+  EXPECT_EQ(z->up, "z");
+  const auto none = app::ParseRig(R"({"character": "generated", "motion": {"file": "m.bvh"}})", "r.json");
+  ASSERT_TRUE(none.ok());
+  EXPECT_TRUE(none->up.empty());
+  const auto bad = app::ParseRig(R"({"character": "generated", "motion": {"file": "m.bvh", "up": "x"}})", "r.json");
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.error().ToString().find("motion.up"), std::string::npos) << bad.error().ToString();
+  EXPECT_NE(bad.error().ToString().find("expected \"y\" or \"z\""), std::string::npos) << bad.error().ToString();
+}
+
 TEST(RigFile, BuiltInBodiesAreNamesNotFiles) {
   for (const char* body : {"generated", "tubes", "mannequin"}) {
     const std::string text = std::string(R"({"character": ")") + body + R"(", "motion": {"file": "m.bvh"}})";

@@ -29,11 +29,6 @@ namespace {
 using testsupport::GltfWriter;
 namespace fs = std::filesystem;
 
-// sRGB decoding in double, written out independently of the importer's.
-double Linear(int code) {
-  const double c = code / 255.0;
-  return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
-}
 
 // The 2 x 2 RGB image every test uses: red, green / blue, mid grey (128).
 const std::vector<std::uint8_t> kCodes = {255, 0, 0, 0, 255, 0, 0, 0, 255, 128, 128, 128};
@@ -164,8 +159,8 @@ TEST(GltfTexture, GlbWithUvsMaterialAndEmbeddedPng) {
   ExpectTexel(image, 0, 0, 1, 0, 0);
   ExpectTexel(image, 1, 0, 0, 1, 0);
   ExpectTexel(image, 0, 1, 0, 0, 1);
-  ExpectTexel(image, 1, 1, Linear(128), Linear(128), Linear(128));
-  EXPECT_NEAR(Linear(128), 0.2158605, 1e-6);  // not 128 / 255 = 0.502
+  ExpectTexel(image, 1, 1, testsupport::SrgbCodeToLinear(128), testsupport::SrgbCodeToLinear(128), testsupport::SrgbCodeToLinear(128));
+  EXPECT_NEAR(testsupport::SrgbCodeToLinear(128), 0.2158605, 1e-6);  // not 128 / 255 = 0.502
   EXPECT_EQ(image.encoded, Png());
   EXPECT_EQ(image.mime_type, "image/png");
 }
@@ -192,7 +187,7 @@ TEST(GltfTexture, ImageFromDataUriAndFromFile) {
     auto model = deform::ReadGltf(Write("img_" + kind + ".gltf", q));
     ASSERT_TRUE(model.ok()) << model.error().ToString();
     ASSERT_EQ(model->mesh.materials.images.size(), 1u) << kind;
-    ExpectTexel(*model->mesh.materials.images[0], 1, 1, Linear(128), Linear(128), Linear(128));
+    ExpectTexel(*model->mesh.materials.images[0], 1, 1, testsupport::SrgbCodeToLinear(128), testsupport::SrgbCodeToLinear(128), testsupport::SrgbCodeToLinear(128));
   }
 }
 
@@ -281,16 +276,16 @@ TEST(GltfTexture, JpegAndGreyAlphaImagesDecode) {
   ASSERT_TRUE(image.ok()) << image.error().ToString();
   EXPECT_EQ(image->mime_type, "image/jpeg");
   // A flat JPEG at quality 100 decodes within a few codes.
-  EXPECT_NEAR(image->rgb[0], Linear(200), Linear(203) - Linear(200));
-  EXPECT_NEAR(image->rgb[1], Linear(100), Linear(103) - Linear(100));
-  EXPECT_NEAR(image->rgb[2], Linear(50), Linear(53) - Linear(50));
+  EXPECT_NEAR(image->rgb[0], testsupport::SrgbCodeToLinear(200), testsupport::SrgbCodeToLinear(203) - testsupport::SrgbCodeToLinear(200));
+  EXPECT_NEAR(image->rgb[1], testsupport::SrgbCodeToLinear(100), testsupport::SrgbCodeToLinear(103) - testsupport::SrgbCodeToLinear(100));
+  EXPECT_NEAR(image->rgb[2], testsupport::SrgbCodeToLinear(50), testsupport::SrgbCodeToLinear(53) - testsupport::SrgbCodeToLinear(50));
   const auto grey = testsupport::EncodeImage(Folder() / "grey.png", 1, 2, 2, {64, 255, 192, 0});
   auto g = deform::internal::DecodeTextureImage(grey, "image/png", "x.glb", "images[0]");
   ASSERT_TRUE(g.ok()) << g.error().ToString();
   ASSERT_EQ(g->rgb.size(), 6u);
   for (int c = 0; c < 3; ++c) {
-    EXPECT_NEAR(g->rgb[static_cast<std::size_t>(c)], Linear(64), 1e-6);
-    EXPECT_NEAR(g->rgb[static_cast<std::size_t>(3 + c)], Linear(192), 1e-6) << "alpha 0 keeps its colour";
+    EXPECT_NEAR(g->rgb[static_cast<std::size_t>(c)], testsupport::SrgbCodeToLinear(64), 1e-6);
+    EXPECT_NEAR(g->rgb[static_cast<std::size_t>(3 + c)], testsupport::SrgbCodeToLinear(192), 1e-6) << "alpha 0 keeps its colour";
   }
 }
 

@@ -26,10 +26,6 @@ namespace {
 using deform::TextureWrap;
 namespace fs = std::filesystem;
 
-double Linear(int code) {
-  const double c = code / 255.0;
-  return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
-}
 
 // A checker of n x n texels, texel (x, y) white when x + y is odd.
 render::Texture Checker(int n, TextureWrap wrap) {
@@ -145,7 +141,7 @@ TEST(TexturedRender, PixelsShowTheTexelsOfAnImportedGlb) {
   const int n = 200;
   const render::Image image = render::Render(cam, {&mesh, 1}, {}, Unlit(n, n));
   ASSERT_EQ(image.width, n);
-  const double expected[2][2][3] = {{{1, 0, 0}, {0, 1, 0}}, {{0, 0, 1}, {Linear(128), Linear(128), Linear(128)}}};
+  const double expected[2][2][3] = {{{1, 0, 0}, {0, 1, 0}}, {{0, 0, 1}, {testsupport::SrgbCodeToLinear(128), testsupport::SrgbCodeToLinear(128), testsupport::SrgbCodeToLinear(128)}}};
   int checked = 0;
   for (int y = 0; y < n; ++y) {
     for (int x = 0; x < n; ++x) {
