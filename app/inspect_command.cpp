@@ -305,6 +305,7 @@ int RunInspect(const InspectOptions& options) {
   load.up = *up;
   load.add_position_to_offset = options.add_position_to_offset;
   load.allow_short_motion = options.allow_short;
+  load.require_skin = false;  // inspect describes any glTF, an exported (skinless) .glb too
   mocap::Result<MotionSource> src = LoadMotionSource(options.file, load);
   if (!src.ok()) {
     std::fprintf(stderr, "%s\n", src.error().ToString().c_str());

@@ -66,7 +66,9 @@ mocap::Result<MotionSource> LoadMotionSource(const std::string& path,
     return FromBvh(std::move(*file));
   }
   if (ext == ".gltf" || ext == ".glb") {
-    mocap::Result<deform::GltfModel> model = deform::ReadGltf(path);
+    deform::GltfReadOptions read;
+    read.require_skin = options.require_skin;
+    mocap::Result<deform::GltfModel> model = deform::ReadGltf(path, read);
     if (!model.ok()) return std::move(model).error();
     out.format = ext.substr(1);
     out.warnings = model->warnings;

@@ -23,6 +23,8 @@ struct MotionSourceOptions {
   int animation = 0;                   // glTF: which animation drives the skeleton
   double frame_time_s = 0.0;           // glTF: sampling step; 0 = detected from the key times
   std::optional<mocap::UpAxis> up = std::nullopt;  // BVH: the file's up axis (--up); empty = detected
+  bool require_skin = true;            // glTF: false also reads a file without a skin (its
+                                       // meshes rigid on their nodes, e.g. an exported .glb)
 };
 
 struct MotionSource {

@@ -156,6 +156,22 @@ TEST(RoughEdges, ExportResumeWritesTheMissingFramesOnly) {
   EXPECT_FALSE(fs::exists(Dir() / "resume.glb"));
 }
 
+// inspect reads what export writes: a .glb of plain meshes (no skin) is
+// described (its frames and mesh), not refused with "the file has no skin".
+TEST(RoughEdges, InspectDescribesAnExportedGlb) {
+  const fs::path glb = Dir() / "exported.glb";
+  const ProcessResult made = Patchskin({"export", "--frames", "0:5", "--quiet", "--out", glb.string()});
+  ASSERT_EQ(made.exit_code, 0) << made.err;
+  const ProcessResult r = Patchskin({"inspect", glb.string(), "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json doc = nlohmann::json::parse(r.out, nullptr, /*allow_exceptions=*/false);
+  ASSERT_FALSE(doc.is_discarded()) << r.out;
+  EXPECT_EQ(doc["frames"], 6) << r.out;
+  const ProcessResult text = Patchskin({"inspect", glb.string()});
+  ASSERT_EQ(text.exit_code, 0) << text.err;
+  EXPECT_NE(text.out.find("mesh:"), std::string::npos) << text.out;
+}
+
 // One rule: 2 whenever the command cannot run as given, whether the parser
 // (an unknown option, a missing value) or the command (a bad value) finds it.
 TEST(RoughEdges, UsageErrorsAndBadValuesExitTwoInEveryCommand) {
