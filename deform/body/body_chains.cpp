@@ -60,6 +60,22 @@ std::vector<std::uint8_t> MirrorPaired(const std::vector<BodyPoint>& pts,
   }
   return paired;
 }
+// True when a joint has channels and none of them rotates it.
+bool MovesOnly(const mocap::JointChannels& channels) {
+  if (channels.count == 0) return false;  // not animated at all (a glTF node, a test skeleton)
+  for (std::size_t k = 0; k < channels.count; ++k) {
+    switch (channels.types[k]) {
+      case mocap::ChannelType::kXPosition:
+      case mocap::ChannelType::kYPosition:
+      case mocap::ChannelType::kZPosition:
+        break;
+      default:
+        return false;
+    }
+  }
+  return true;
+}
+
 }  // namespace
 
 mocap::Result<BodyChains> BuildBodyChains(const mocap::Skeleton& skeleton,
@@ -169,15 +185,34 @@ mocap::Result<BodyChains> BuildBodyChains(const mocap::Skeleton& skeleton,
     int start, first, parent_chain;
     BodyChainKind kind;
   };
+  // Points whose joints are animated by position channels only (a BVH "World"
+  // or "Reference" above the hips): they carry the body, never bend it.
+  std::vector<std::uint8_t> position_only(pts.size(), 1);
+  for (int j = 0; j < nj; ++j) {
+    if (static_cast<std::size_t>(j) >= skeleton.channels.size() ||
+        !MovesOnly(skeleton.channels[static_cast<std::size_t>(j)])) {
+      position_only[static_cast<std::size_t>(point_of[static_cast<std::size_t>(j)])] = 0;
+    }
+  }
+  const auto only_child = [&pts](int p) {
+    const std::vector<int>& c = pts[static_cast<std::size_t>(p)].children;
+    return c.size() == 1 ? c[0] : -1;
+  };
+  const auto leads_to_branch = [&](int p) {  // a single-child path from p ends in a branch
+    while (only_child(p) >= 0) p = only_child(p);
+    return pts[static_cast<std::size_t>(p)].children.size() >= 2;
+  };
   std::vector<Pending> todo;
   for (std::size_t i = 0; i < pts.size(); ++i) {
     if (pts[i].parent >= 0) continue;
     int r = static_cast<int>(i);
-    // A root that only positions the body (Bandai's joint_Root on the floor) is skipped.
-    while (pts[static_cast<std::size_t>(r)].children.size() == 1 &&
-           pts[static_cast<std::size_t>(pts[static_cast<std::size_t>(r)].children[0])]
-                   .children.size() >= 2) {
-      r = pts[static_cast<std::size_t>(r)].children[0];
+    // A root that only positions the body is skipped: one whose only child
+    // branches (Bandai's joint_Root on the floor), or one moved by position
+    // channels alone above a body that branches further down.
+    for (int c = only_child(r); c >= 0; c = only_child(r)) {
+      const bool child_branches = pts[static_cast<std::size_t>(c)].children.size() >= 2;
+      if (!child_branches && !(position_only[static_cast<std::size_t>(r)] != 0 && leads_to_branch(c))) break;
+      r = c;
     }
     const std::vector<int>& ch = pts[static_cast<std::size_t>(r)].children;
     if (ch.empty()) continue;

@@ -4,7 +4,9 @@
 //  1. Joints closer than 1e-4 S (S = largest extent of joints and end sites) to their
 //     parent merge with it; end sites become leaf points.
 //  2. A spine starts at each root toward the child with the most descendants (a root
-//     with one child that branches only positions the body and is skipped); at every
+//     with one child that branches only positions the body and is skipped, as is one
+//     animated by position channels alone above a single-child path that branches:
+//     a BVH "World" over a "Reference" over the hips); at every
 //     branch point a chain continues into the straightest child and each other child
 //     starts a new chain whose first point is the branch point. A spine skips children
 //     that form a mirror pair (two subtrees with as many points and total bone lengths

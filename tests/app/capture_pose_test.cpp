@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <optional>
+#include <sstream>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -198,6 +199,62 @@ TEST(CapturePose, BandaiPositioningRootGrowsNoLimb) {
     ++checked;
   }
   if (checked == 0) GTEST_SKIP() << "no Bandai Namco capture in " << testsupport::SharedDataPath("bvh/bandai_namco");
+}
+
+// A capture whose hips hang from two joints animated by position channels
+// alone ("World" on the floor at the origin, "Reference" 5 cm above it) walks
+// 2.7 m away: neither grows a part of the body, so at every frame the body has
+// the bounds of the same walk without them, 5 cm higher (before, a limb ran
+// from the origin to the hips).
+TEST(CapturePose, PositionOnlyJointsAboveTheHipsGrowNoLimb) {
+  std::string walk = testsupport::HumanoidWalkBvh(false, 0.0f, 90);
+  const std::size_t root = walk.find("ROOT Hips");
+  const std::size_t motion = walk.find("MOTION");
+  ASSERT_NE(root, std::string::npos);
+  ASSERT_NE(motion, std::string::npos);
+  walk.replace(motion, 0, "}\n}\n");
+  walk.replace(root, std::string("ROOT Hips").size(),
+               "ROOT World\n{\nOFFSET 0 0 0\nCHANNELS 3 Xposition Yposition Zposition\n"
+               "JOINT Reference\n{\nOFFSET 0 5 0\nCHANNELS 3 Xposition Yposition Zposition\nJOINT Hips");
+  // Every frame line gains the two joints' channels first: World at the
+  // origin, Reference 5 cm above it.
+  std::string out = walk.substr(0, walk.find("Frame Time:"));
+  std::istringstream rest(walk.substr(out.size()));
+  std::string line;
+  std::getline(rest, line);
+  out += line + "\n";
+  while (std::getline(rest, line)) {
+    if (!line.empty()) out += "0 0 0 0 5 0 " + line + "\n";
+  }
+  const fs::path bvh = testsupport::TestDir("capture_pose") / "world_reference_walk.bvh";
+  std::ofstream(bvh) << out;
+  mocap::Result<app::Character> ch = app::LoadCommandCharacter(bvh.string(), "", true);
+  ASSERT_TRUE(ch.ok()) << ch.error().ToString();
+  for (const char* name : {"World", "Reference"}) {
+    const int j = ch->skeleton.FindJoint(name);
+    ASSERT_GE(j, 0) << name;
+    EXPECT_EQ(std::find(ch->mesh.skin_joints.begin(), ch->mesh.skin_joints.end(), j), ch->mesh.skin_joints.end())
+        << name << " carries skin";
+  }
+  // The same walk without the two joints: the same body, frame by frame.
+  const fs::path plain_bvh = testsupport::TestDir("capture_pose") / "plain_walk.bvh";
+  std::ofstream(plain_bvh) << testsupport::HumanoidWalkBvh(false, 0.0f, 90);
+  mocap::Result<app::Character> plain = app::LoadCommandCharacter(plain_bvh.string(), "", true);
+  ASSERT_TRUE(plain.ok()) << plain.error().ToString();
+  mocap::Result<app::FramePipeline> p = app::FramePipeline::Create(*ch, app::GlobalMethod::kSsd, 1);
+  mocap::Result<app::FramePipeline> q = app::FramePipeline::Create(*plain, app::GlobalMethod::kSsd, 1);
+  ASSERT_TRUE(p.ok() && q.ok());
+  app::DeformedFrame frame, plain_frame;
+  for (int f = 0; f < ch->motion.num_frames; f += 10) {
+    ASSERT_TRUE(p->Evaluate(f * ch->motion.frame_time_s, frame).ok());
+    ASSERT_TRUE(q->Evaluate(f * ch->motion.frame_time_s, plain_frame).ok());
+    for (int a = 0; a < 3; ++a) {  // centimetres; the hips are 2.7 m from World at the end
+      EXPECT_NEAR(frame.bounds.min[a], plain_frame.bounds.min[a] + (a == 1 ? 5.0f : 0.0f), 1.0f)
+          << "frame " << f << " axis " << a;
+      EXPECT_NEAR(frame.bounds.max[a], plain_frame.bounds.max[a] + (a == 1 ? 5.0f : 0.0f), 1.0f)
+          << "frame " << f << " axis " << a;
+    }
+  }
 }
 
 }  // namespace

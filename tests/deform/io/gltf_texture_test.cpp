@@ -95,7 +95,7 @@ std::string Write(const std::string& name, const Quad& q) {
   if (q.texture >= 0) {
     textured["pbrMetallicRoughness"]["baseColorTexture"] = {{"index", q.texture}, {"texCoord", q.tex_coord}};
   }
-  w.doc["materials"] = {textured};
+  w.doc["materials"] = nlohmann::json::array({textured});
   if (!q.second_factor.empty()) {
     w.doc["materials"].push_back({{"pbrMetallicRoughness", {{"baseColorFactor", q.second_factor}}}});
   }
@@ -104,7 +104,7 @@ std::string Write(const std::string& name, const Quad& q) {
     w.doc["samplers"] = {{{"wrapS", q.wrap[0]}, {"wrapT", q.wrap[1]}}};
     texture["sampler"] = 0;
   }
-  w.doc["textures"] = {texture};
+  w.doc["textures"] = nlohmann::json::array({texture});
   std::vector<unsigned char> bytes = Png();
   if (q.image == "garbage") bytes = {'n', 'o', 't', ' ', 'a', 'n', ' ', 'i', 'm', 'a', 'g', 'e'};
   if (q.image == "truncated") bytes.resize(40);

@@ -121,7 +121,7 @@ std::string WriteTexturedQuad(const fs::path& path) {
   w.doc["scenes"] = {{{"nodes", {0, 1}}}};
   w.doc["nodes"] = {{{"name", "root"}}, {{"name", "quad"}, {"mesh", 0}, {"skin", 0}}};
   w.doc["skins"] = {{{"joints", {0}}, {"inverseBindMatrices", ibm_accessor}}};
-  w.doc["meshes"] = {{{"primitives", {prim}}}};
+  w.doc["meshes"] = {{{"primitives", nlohmann::json::array({prim})}}};
   return w.WriteGlb(path.string());
 }
 
