@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include <unistd.h>
+
 #include <OpenImageIO/imageio.h>
 
 namespace testsupport {
@@ -22,18 +24,29 @@ inline double SrgbCodeToLinear(int code) {
 }
 
 // `codes`: width x height x channels 8-bit values, row 0 first (the top).
+// The file is written under a name of this process's and renamed into place:
+// test processes running in parallel share the folder, and one must never
+// read another's half-written image.
 inline std::vector<unsigned char> EncodeImage(const std::filesystem::path& path, int width, int height,
                                               int channels, const std::vector<std::uint8_t>& codes) {
-  auto out = OIIO::ImageOutput::create(path.string());
+  std::filesystem::path scratch = path;
+  scratch += "." + std::to_string(::getpid()) + path.extension().string();
+  auto out = OIIO::ImageOutput::create(scratch.string());
   if (!out) return {};
   OIIO::ImageSpec spec(width, height, channels, OIIO::TypeDesc::UINT8);
   if (path.extension() == ".jpg") spec.attribute("Compression", "jpeg:100");
-  if (!out->open(path.string(), spec) || !out->write_image(OIIO::TypeDesc::UINT8, codes.data()) ||
+  if (!out->open(scratch.string(), spec) || !out->write_image(OIIO::TypeDesc::UINT8, codes.data()) ||
       !out->close()) {
     return {};
   }
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  std::vector<unsigned char> bytes;
+  {
+    std::ifstream in(scratch, std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  std::error_code ec;
+  std::filesystem::rename(scratch, path, ec);
+  return bytes;
 }
 
 }  // namespace testsupport
