@@ -60,6 +60,7 @@ std::vector<std::uint8_t> MirrorPaired(const std::vector<BodyPoint>& pts,
   }
   return paired;
 }
+
 // True when a joint has channels and none of them rotates it.
 bool MovesOnly(const mocap::JointChannels& channels) {
   if (channels.count == 0) return false;  // not animated at all (a glTF node, a test skeleton)
@@ -211,7 +212,8 @@ mocap::Result<BodyChains> BuildBodyChains(const mocap::Skeleton& skeleton,
     // channels alone above a body that branches further down.
     for (int c = only_child(r); c >= 0; c = only_child(r)) {
       const bool child_branches = pts[static_cast<std::size_t>(c)].children.size() >= 2;
-      if (!child_branches && !(position_only[static_cast<std::size_t>(r)] != 0 && leads_to_branch(c))) break;
+      const bool carries_body = position_only[static_cast<std::size_t>(r)] != 0 && leads_to_branch(c);
+      if (!child_branches && !carries_body) break;
       r = c;
     }
     const std::vector<int>& ch = pts[static_cast<std::size_t>(r)].children;

@@ -22,8 +22,6 @@ constexpr float kLog2E = 1.44269504088896f;
 constexpr float kIntegerFloat = 8388608.0f;  // 2^23: floats this large are integers
 constexpr float kShadowCutR2 = 9.0f;        // ContactShadowFactor's cut (3 radii)
 
-}  // namespace
-
 // The sample-space bounding box of the ground the shadow map can darken: its
 // corners on the ground, projected. The whole raster when a corner is behind
 // the eye (its projection says nothing) or the map does not reach the ground.
@@ -47,6 +45,8 @@ glm::ivec4 ShadowedSampleBox(const ShadowMap& map, const GroundShaderParams& par
   hi = glm::clamp(hi + 1.0f, glm::vec2(-1.0f), max_xy);
   return {static_cast<int>(lo.x), static_cast<int>(lo.y), static_cast<int>(hi.x), static_cast<int>(hi.y)};
 }
+
+}  // namespace
 
 GroundShader GroundShader::Create(const GroundShaderParams& params) {
   GroundShader g;

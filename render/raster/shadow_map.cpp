@@ -79,9 +79,7 @@ void ShadowMap::Build(const glm::vec3& light_dir, std::span<const ShadowCaster> 
   std::vector<std::vector<glm::vec3>> projected(casters.size());
   for (std::size_t m = 0; m < casters.size(); ++m) {
     projected[m].reserve(casters[m].positions.size());
-    for (const glm::vec3& p : casters[m].positions)
-      projected[m].push_back({(glm::dot(p, axis_u_) - origin_.x) * inv_texel_,
-                              (glm::dot(p, axis_v_) - origin_.y) * inv_texel_, glm::dot(p, axis_w_)});
+    for (const glm::vec3& p : casters[m].positions) projected[m].push_back(ToTexel(p));
   }
 
   size_ = size;
@@ -97,7 +95,7 @@ void ShadowMap::Build(const glm::vec3& light_dir, std::span<const ShadowCaster> 
     BlockBounds(b0, b1, own);
   });
   narrow_cells_ = size / 2 + 1;
-  NarrowRanges(bands);
+  NarrowMaxima(bands);
 
   // Each block's range over its 3 x 3 neighbourhood, which holds every
   // footprint of a point inside it; beyond the map counts as no caster.
@@ -195,7 +193,7 @@ void ShadowMap::RasterBand(std::span<const std::vector<glm::vec3>> projected,
 
 // Two separable passes of a 5-wide max at every other texel: along rows into
 // `across` (rows -3 .. size_ + 2), then down its columns into narrow_max_.
-void ShadowMap::NarrowRanges(int threads) {
+void ShadowMap::NarrowMaxima(int threads) {
   const int n = narrow_cells_;
   const int rows = size_ + 6;
   std::vector<float> across(static_cast<std::size_t>(rows) * static_cast<std::size_t>(n));
@@ -319,11 +317,10 @@ float ShadowMap::Filter(float x, float y, float depth, const std::uint8_t (&disc
 
 float ShadowMap::Visibility(const glm::vec3& p) const {
   if (size_ == 0) return 1.0f;
-  const float x = (glm::dot(p, axis_u_) - origin_.x) * inv_texel_;
-  const float y = (glm::dot(p, axis_v_) - origin_.y) * inv_texel_;
+  const glm::vec3 t = ToTexel(p);
   const auto extent = static_cast<float>(size_);
-  if (!(x >= 0.0f && y >= 0.0f && x < extent && y < extent)) return 1.0f;  // also NaN
-  return VisibilityAt(x, y, glm::dot(p, axis_w_) + bias_);  // occluders must be nearer than that
+  if (!(t.x >= 0.0f && t.y >= 0.0f && t.x < extent && t.y < extent)) return 1.0f;  // also NaN
+  return VisibilityAt(t.x, t.y, t.z + bias_);  // occluders must be nearer than that
 }
 
 float ShadowMap::VisibilityAt(float x, float y, float depth) const {
@@ -369,10 +366,8 @@ float ShadowMap::SurfaceVisibility(const glm::vec3& p, const glm::vec3& n) const
   // normal), where a texel spans the most depth along the surface.
   const float cos_l = std::clamp(glm::dot(n, axis_w_), -1.0f, 1.0f);
   const float push = normal_offset_ * (1.0f + 2.0f * std::sqrt(1.0f - cos_l * cos_l));
-  const glm::vec3 q = p + n * push;
-  const float x = (glm::dot(q, axis_u_) - origin_.x) * inv_texel_;
-  const float y = (glm::dot(q, axis_v_) - origin_.y) * inv_texel_;
-  return SurfaceVisibilityAt(x, y, glm::dot(q, axis_w_) + bias_);
+  const glm::vec3 t = ToTexel(p + n * push);
+  return SurfaceVisibilityAt(t.x, t.y, t.z + bias_);
 }
 
 float ShadowMap::SurfaceVisibilityAt(float x, float y, float depth) const {

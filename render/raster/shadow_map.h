@@ -123,7 +123,7 @@ class ShadowMap {
   float VisibilityAt(float x, float y, float depth) const;
   float SurfaceVisibilityAt(float x, float y, float depth) const;
   void BlockBounds(int block_row0, int block_row1, std::vector<Range>& own) const;
-  void NarrowRanges(int threads);
+  void NarrowMaxima(int threads);  // fills narrow_max_
   const float* Row(int j) const { return depth_.data() + static_cast<std::size_t>(j + kPad) * stride_ + kPad; }
   float* Row(int j) { return depth_.data() + static_cast<std::size_t>(j + kPad) * stride_ + kPad; }
 

@@ -50,6 +50,14 @@ struct Quad {
 
 // A skinned quad (two triangles, four vertices bound to one joint) with the
 // texture of `q`; returns the written file.
+// The textured quad plus an untextured one with its own base colour factor.
+Quad TwoMaterials() {
+  Quad q;
+  q.second_primitive = true;
+  q.second_factor = {0.5, 0.25, 1.0, 1.0};
+  return q;
+}
+
 std::string Write(const std::string& name, const Quad& q) {
   GltfWriter w;
   nlohmann::json primitives = nlohmann::json::array();
@@ -248,9 +256,7 @@ TEST(GltfTexture, BadInputIsAnErrorNamingTheFileAndField) {
 }
 
 TEST(GltfTexture, MaterialPerTriangleAndWhiteUnderTheTextureWhenOthersHaveColours) {
-  Quad q;
-  q.second_primitive = true;
-  q.second_factor = {0.5, 0.25, 1.0, 1.0};
+  const Quad q = TwoMaterials();
   auto model = deform::ReadGltf(Write("two.glb", q));
   ASSERT_TRUE(model.ok()) << model.error().ToString();
   const deform::MeshMaterials& m = model->mesh.materials;
@@ -352,9 +358,7 @@ TEST(GltfTextureExport, GlbRoundTripKeepsUvsMaterialAndTexturePixels) {
 }
 
 TEST(GltfTextureExport, GlbOnePrimitivePerMaterial) {
-  Quad q;
-  q.second_primitive = true;
-  q.second_factor = {0.5, 0.25, 1.0, 1.0};
+  const Quad q = TwoMaterials();
   auto original = deform::ReadGltf(Write("export_two.glb", q));
   ASSERT_TRUE(original.ok()) << original.error().ToString();
   auto back = ExportAndReimport(original->mesh, "export_two_back.glb", deform::GltfExportLayout::kMorphTargets);
@@ -374,9 +378,7 @@ TEST(GltfTextureExport, GlbOnePrimitivePerMaterial) {
 }
 
 TEST(GltfTextureExport, ObjKeepsUvsAndMaterials) {
-  Quad q;
-  q.second_primitive = true;
-  q.second_factor = {0.5, 0.25, 1.0, 1.0};
+  const Quad q = TwoMaterials();
   auto model = deform::ReadGltf(Write("obj_src.glb", q));
   ASSERT_TRUE(model.ok()) << model.error().ToString();
   const deform::Mesh& bind = model->mesh.bind;
