@@ -6,6 +6,7 @@
 #include <system_error>
 
 #include "mocap/bvh_reader.h"
+#include "mocap/channel_use.h"
 
 namespace app {
 namespace {
@@ -89,6 +90,7 @@ mocap::Result<MotionSource> LoadMotionSource(const std::string& path,
       if (!motion.ok()) return std::move(motion).error();
       out.motion = std::move(*motion);
     }
+    out.skeleton.channel_use = mocap::ChannelUse(out.skeleton, out.motion);
     out.mesh_vertices = model->mesh.bind.num_vertices();
     out.mesh_triangles = model->mesh.bind.num_triangles();
     out.gltf = std::move(*model);

@@ -17,6 +17,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "mocap/channel_use.h"
 #include "mocap/internal/bvh_number.h"
 #include "mocap/pose.h"
 
@@ -378,7 +379,8 @@ UpAxis DetectBvhUpAxis(const Skeleton& skeleton) {
 namespace {
 
 // The limbs that hold the body up, as (hips, knee) joint pairs: the hips are
-// the first joint below the first root with two or more children; each child
+// the first joint below the first root with two or more children (passing
+// joints the motion pulls away from their parents, Skeleton::channel_use); each child
 // of it but the one with the most descendants (the spine) starts a limb (legs,
 // a tail), whose knee is the first joint down it (first children) at least
 // 40% of the limb's rest reach from the hips. Rest positions only, so the
@@ -400,14 +402,29 @@ std::vector<std::pair<int, int>> HipsToKnees(const Skeleton& skeleton) {
   }
   std::vector<std::pair<int, int>> out;
   if (n == 0) return out;
+  // What the motion pulls away from its parent (hips walking away from a root
+  // on the floor, IK targets, props) is not a limb.
+  const auto pulled = [&skeleton](int j) {
+    return skeleton.channel_use.size() == skeleton.parents.size() &&
+           (skeleton.channel_use[static_cast<std::size_t>(j)] & kJointStretches) != 0;
+  };
+  const auto heaviest = [&](int j) {
+    int heavy = -1;
+    for (int c : children[static_cast<std::size_t>(j)]) {
+      if (heavy < 0 || descendants[static_cast<std::size_t>(c)] > descendants[static_cast<std::size_t>(heavy)]) heavy = c;
+    }
+    return heavy;
+  };
   int hips = 0;
-  while (children[static_cast<std::size_t>(hips)].size() == 1) hips = children[static_cast<std::size_t>(hips)][0];
-  const std::vector<int>& limbs = children[static_cast<std::size_t>(hips)];
-  if (limbs.size() < 2) return out;
-  int spine = limbs[0];
-  for (int c : limbs) {
-    if (descendants[static_cast<std::size_t>(c)] > descendants[static_cast<std::size_t>(spine)]) spine = c;
+  while (children[static_cast<std::size_t>(hips)].size() == 1 || (heaviest(hips) >= 0 && pulled(heaviest(hips)))) {
+    hips = heaviest(hips);
   }
+  std::vector<int> limbs;
+  for (int c : children[static_cast<std::size_t>(hips)]) {
+    if (!pulled(c)) limbs.push_back(c);
+  }
+  if (limbs.size() < 2) return out;
+  const int spine = heaviest(hips);
   const glm::vec3 h = rest[static_cast<std::size_t>(hips)];
   for (int c : limbs) {
     if (c == spine) continue;
@@ -596,6 +613,7 @@ Result<BvhFile> ParseBvhText(std::string_view text, const std::string& file_name
       !s)
     return s.error();
 
+  file.skeleton.channel_use = ChannelUse(file.skeleton, file.motion);
   SkeletonInfo& info = file.skeleton.info;
   if (options.up_axis.has_value()) {
     info.up_axis = *options.up_axis;

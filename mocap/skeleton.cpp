@@ -41,7 +41,8 @@ Status Skeleton::Check() const {
                          std::to_string(kMaxJoints));
   }
   if (names.size() != n || rest_translations.size() != n || rest_rotations.size() != n ||
-      rest_scales.size() != n || channels.size() != n) {
+      rest_scales.size() != n || channels.size() != n ||
+      (!channel_use.empty() && channel_use.size() != n)) {
     return MakeError(ErrorCode::kInternal, loc, "skeleton arrays have different sizes");
   }
   int expected_first = 0;

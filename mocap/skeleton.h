@@ -100,6 +100,9 @@ struct Skeleton {
   std::vector<EndSite> end_sites;             // any number, each names its parent joint
   int num_channels = 0;                       // floats per motion frame
   PositionChannelMode position_mode = PositionChannelMode::kReplaceOffset;
+  // Per joint, what the loaded motion does with its channels (JointUse bits of
+  // mocap/channel_use.h); empty when no motion was read with it.
+  std::vector<std::uint8_t> channel_use;
   SkeletonInfo info;
 
   int num_joints() const { return static_cast<int>(parents.size()); }

@@ -3,11 +3,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "deform/mesh.h"
+#include "mocap/channel_use.h"
 
 namespace deform {
 
@@ -75,6 +77,67 @@ bool MovesOnly(const mocap::JointChannels& channels) {
     }
   }
   return true;
+}
+
+// What each point's link to its parent point is, from the motion's use of the
+// channels (Skeleton::channel_use; without it, channels only say whether a
+// joint can rotate at all).
+struct LinkRoles {
+  // The point's joints only position the body: position channels alone, or
+  // rotation channels that never change (a "World" or "Reference" node).
+  std::vector<std::uint8_t> position_only;
+  // The motion moves the point away from its parent point by position channels:
+  // a positioning link (hips walking away from a root on the floor, an IK target).
+  std::vector<std::uint8_t> pulled;
+};
+
+LinkRoles FindLinkRoles(const mocap::Skeleton& skeleton, const std::vector<BodyPoint>& pts,
+                        const std::vector<int>& point_of) {
+  const int nj = skeleton.num_joints();
+  const bool known = skeleton.channel_use.size() == static_cast<std::size_t>(nj);
+  const auto use = [&](int j) {
+    return known ? skeleton.channel_use[static_cast<std::size_t>(j)] : std::uint8_t{mocap::kJointRotates};
+  };
+  LinkRoles roles{std::vector<std::uint8_t>(pts.size(), 1), std::vector<std::uint8_t>(pts.size(), 0)};
+  for (int j = 0; j < nj; ++j) {
+    const mocap::JointChannels* ch =
+        static_cast<std::size_t>(j) < skeleton.channels.size() ? &skeleton.channels[static_cast<std::size_t>(j)] : nullptr;
+    const bool positions = ch != nullptr && (MovesOnly(*ch) || (ch->count > 0 && (use(j) & mocap::kJointRotates) == 0));
+    if (!positions) roles.position_only[static_cast<std::size_t>(point_of[static_cast<std::size_t>(j)])] = 0;
+  }
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    if (pts[i].parent < 0) continue;
+    // Every joint between the parent point's and this one (merged joints
+    // included) can pull the link.
+    const int stop = pts[static_cast<std::size_t>(pts[i].parent)].joint;
+    for (int j = pts[i].joint >= 0 ? pts[i].joint : pts[i].bone_joint; j >= 0 && j != stop;
+         j = skeleton.parents[static_cast<std::size_t>(j)]) {
+      if ((use(j) & mocap::kJointStretches) != 0) roles.pulled[i] = 1;
+    }
+  }
+  return roles;
+}
+
+// A root on the floor under the body it holds: at or below every point of its
+// subtree (within 5 % of the subtree's height), its heavy child straight above
+// it, and that child carrying at least three quarters of the subtree (so a
+// root with the legs hanging from it is not one).
+bool IsFloorAnchor(const std::vector<BodyPoint>& pts, int root, int heavy, const glm::vec3& up) {
+  const BodyPoint& r = pts[static_cast<std::size_t>(root)];
+  if (4 * (pts[static_cast<std::size_t>(heavy)].descendants + 1) < 3 * r.descendants) return false;
+  float lo = std::numeric_limits<float>::max(), hi = std::numeric_limits<float>::lowest();
+  std::vector<int> stack(r.children.begin(), r.children.end());
+  while (!stack.empty()) {
+    const BodyPoint& p = pts[static_cast<std::size_t>(stack.back())];
+    stack.pop_back();
+    lo = std::min(lo, glm::dot(p.pos, up));
+    hi = std::max(hi, glm::dot(p.pos, up));
+    stack.insert(stack.end(), p.children.begin(), p.children.end());
+  }
+  const float height = glm::dot(r.pos, up);
+  const glm::vec3 link = pts[static_cast<std::size_t>(heavy)].pos - r.pos;
+  const bool upright = glm::dot(link, up) > 0.87f * glm::length(link);  // within 30 degrees
+  return !r.children.empty() && hi > lo && height <= lo + 0.05f * (hi - lo) && upright;
 }
 
 }  // namespace
@@ -186,15 +249,9 @@ mocap::Result<BodyChains> BuildBodyChains(const mocap::Skeleton& skeleton,
     int start, first, parent_chain;
     BodyChainKind kind;
   };
-  // Points whose joints are animated by position channels only (a BVH "World"
-  // or "Reference" above the hips): they carry the body, never bend it.
-  std::vector<std::uint8_t> position_only(pts.size(), 1);
-  for (int j = 0; j < nj; ++j) {
-    if (static_cast<std::size_t>(j) >= skeleton.channels.size() ||
-        !MovesOnly(skeleton.channels[static_cast<std::size_t>(j)])) {
-      position_only[static_cast<std::size_t>(point_of[static_cast<std::size_t>(j)])] = 0;
-    }
-  }
+  const LinkRoles roles = FindLinkRoles(skeleton, pts, point_of);
+  const std::vector<std::uint8_t>& position_only = roles.position_only;
+  const std::vector<std::uint8_t>& pulled = roles.pulled;
   const auto only_child = [&pts](int p) {
     const std::vector<int>& c = pts[static_cast<std::size_t>(p)].children;
     return c.size() == 1 ? c[0] : -1;
@@ -203,26 +260,36 @@ mocap::Result<BodyChains> BuildBodyChains(const mocap::Skeleton& skeleton,
     while (only_child(p) >= 0) p = only_child(p);
     return pts[static_cast<std::size_t>(p)].children.size() >= 2;
   };
+  const auto heaviest = [&pts](int p) {
+    int heavy = -1;
+    for (int c : pts[static_cast<std::size_t>(p)].children) {
+      if (heavy < 0 || pts[static_cast<std::size_t>(c)].descendants > pts[static_cast<std::size_t>(heavy)].descendants) {
+        heavy = c;
+      }
+    }
+    return heavy;
+  };
+  const glm::vec3 up = skeleton.info.up_axis == mocap::UpAxis::kZ ? glm::vec3(0, 0, 1) : glm::vec3(0, 1, 0);
   std::vector<Pending> todo;
   for (std::size_t i = 0; i < pts.size(); ++i) {
     if (pts[i].parent >= 0) continue;
     int r = static_cast<int>(i);
     // A root that only positions the body is skipped: one whose only child
-    // branches (Bandai's joint_Root on the floor), or one moved by position
-    // channels alone above a body that branches further down.
-    for (int c = only_child(r); c >= 0; c = only_child(r)) {
-      const bool child_branches = pts[static_cast<std::size_t>(c)].children.size() >= 2;
-      const bool carries_body = position_only[static_cast<std::size_t>(r)] != 0 && leads_to_branch(c);
-      if (!child_branches && !carries_body) break;
+    // branches (Bandai's joint_Root on the floor), one moved by position
+    // channels alone above a body that branches further down, one the motion
+    // pulls the body away from, or one on the floor under the body.
+    for (int c = heaviest(r); c >= 0; c = heaviest(r)) {
+      const bool single = only_child(r) >= 0;
+      const bool child_branches = single && pts[static_cast<std::size_t>(c)].children.size() >= 2;
+      const bool carries_body = single && position_only[static_cast<std::size_t>(r)] != 0 && leads_to_branch(c);
+      if (!child_branches && !carries_body && pulled[static_cast<std::size_t>(c)] == 0 &&
+          !IsFloorAnchor(pts, r, c, up)) {
+        break;
+      }
       r = c;
     }
-    const std::vector<int>& ch = pts[static_cast<std::size_t>(r)].children;
-    if (ch.empty()) continue;
-    int heavy = ch[0];
-    for (int c : ch) {
-      if (pts[static_cast<std::size_t>(c)].descendants > pts[static_cast<std::size_t>(heavy)].descendants) heavy = c;
-    }
-    todo.push_back({r, heavy, -1, BodyChainKind::kSpine});
+    if (pts[static_cast<std::size_t>(r)].children.empty()) continue;
+    todo.push_back({r, heaviest(r), -1, BodyChainKind::kSpine});
   }
   // Body size S over the points that make up the body: a positioning root
   // (often left at the origin while the capture walks away) must not count.
@@ -233,17 +300,20 @@ mocap::Result<BodyChains> BuildBodyChains(const mocap::Skeleton& skeleton,
       const int c = stack.back();
       stack.pop_back();
       body.Extend(pos_of(c));
-      for (int g : pts[static_cast<std::size_t>(c)].children) stack.push_back(g);
+      for (int g : pts[static_cast<std::size_t>(c)].children) {
+        if (pulled[static_cast<std::size_t>(g)] == 0) stack.push_back(g);
+      }
     }
   }
   const float size = body.empty() ? 0.0f : std::max({body.size().x, body.size().y, body.size().z});
   // The joints of the points at or below a spine's start get body parts; the
-  // roots passed over above only position the body.
+  // roots passed over above only position the body, and what the motion pulls
+  // away from the body (IK targets, props) is no part of it.
   std::vector<std::uint8_t> body_point(pts.size(), 0);
   for (const Pending& spine : todo) body_point[static_cast<std::size_t>(spine.start)] = 1;
   for (std::size_t i = 0; i < pts.size(); ++i) {  // parents come before their children
     const int p = pts[i].parent;
-    if (p >= 0 && body_point[static_cast<std::size_t>(p)] != 0) body_point[i] = 1;
+    if (p >= 0 && body_point[static_cast<std::size_t>(p)] != 0 && pulled[i] == 0) body_point[i] = 1;
   }
   out.body_part_joints.assign(static_cast<std::size_t>(nj), 0);
   for (int j = 0; j < nj; ++j) {
@@ -264,13 +334,20 @@ mocap::Result<BodyChains> BuildBodyChains(const mocap::Skeleton& skeleton,
     const int chain_id = static_cast<int>(chains.size());
     int cur = job.first;
     glm::vec3 dir = glm::normalize(pos_of(job.first) - pos_of(job.start));
+    // Children the motion pulls away start no chain.
+    const auto body_children = [&](int p) {
+      std::vector<int> kept;
+      for (int k : pts[static_cast<std::size_t>(p)].children) {
+        if (pulled[static_cast<std::size_t>(k)] == 0) kept.push_back(k);
+      }
+      return kept;
+    };
     if (job.kind == BodyChainKind::kSpine) {  // siblings of the spine's first bone hang from the root
-      for (int s : pts[static_cast<std::size_t>(job.start)].children) {
+      for (int s : body_children(job.start)) {
         if (s != job.first) todo.push_back({job.start, s, chain_id, BodyChainKind::kLimb});
       }
     }
-    while (!pts[static_cast<std::size_t>(cur)].children.empty()) {
-      const std::vector<int>& ch = pts[static_cast<std::size_t>(cur)].children;
+    for (std::vector<int> ch = body_children(cur); !ch.empty(); ch = body_children(cur)) {
       // A spine never continues into one of a mirror pair (arms, legs): mocapbank's
       // collars and neck all start at one point, and the straightest of them was an arm.
       const std::vector<std::uint8_t> paired = job.kind == BodyChainKind::kSpine

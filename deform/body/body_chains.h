@@ -3,10 +3,14 @@
 // the mannequin (one tube per chain) and the SWD rig (one sweep per chain):
 //  1. Joints closer than 1e-4 S (S = largest extent of joints and end sites) to their
 //     parent merge with it; end sites become leaf points.
-//  2. A spine starts at each root toward the child with the most descendants (a root
-//     with one child that branches only positions the body and is skipped, as is one
-//     animated by position channels alone above a single-child path that branches:
-//     a BVH "World" over a "Reference" over the hips); at every
+//  2. A spine starts at each root toward the child with the most descendants. A root
+//     that only positions the body is skipped: one with one child that branches, one
+//     animated by position channels alone (or rotation channels the motion never
+//     changes, Skeleton::channel_use) above a single-child path that branches (a BVH
+//     "World" over a "Reference" over the hips), one whose heavy child the motion
+//     pulls away by position channels (hips walking away from a root on the floor),
+//     and one on the floor straight under the body it holds. A child the motion pulls
+//     away from its parent (an IK target, a prop) is no part of the body. At every
 //     branch point a chain continues into the straightest child and each other child
 //     starts a new chain whose first point is the branch point. A spine skips children
 //     that form a mirror pair (two subtrees with as many points and total bone lengths

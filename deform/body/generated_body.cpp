@@ -181,6 +181,12 @@ std::uint64_t GeneratedBodyKey(const mocap::Skeleton& skeleton, std::span<const 
   h.Add(skeleton.info.up_axis);
   h.Add(skeleton.end_sites.size());
   for (const mocap::EndSite& e : skeleton.end_sites) h.Add(e.parent), h.Add(e.offset);
+  for (const mocap::JointChannels& c : skeleton.channels) {  // these and the motion's use of them
+    h.Add(c.count);                                            // decide which joints are body
+    for (std::size_t k = 0; k < c.count; ++k) h.Add(c.types[k]);
+  }
+  h.Add(skeleton.channel_use.size());
+  for (const std::uint8_t u : skeleton.channel_use) h.Add(u);
   h.Add(rest_model_from_joint.size());
   for (const glm::mat4& m : rest_model_from_joint) h.Add(m);
   h.Add(o.shape.min_branch_extent), h.Add(o.shape.blend), h.Add(o.shape.radius_scale);

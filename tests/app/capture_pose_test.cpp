@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <functional>
+#include <initializer_list>
 #include <fstream>
 #include <optional>
 #include <sstream>
@@ -201,42 +203,45 @@ TEST(CapturePose, BandaiPositioningRootGrowsNoLimb) {
   if (checked == 0) GTEST_SKIP() << "no Bandai Namco capture in " << testsupport::SharedDataPath("bvh/bandai_namco");
 }
 
-// A capture whose hips hang from two joints animated by position channels
-// alone ("World" on the floor at the origin, "Reference" 5 cm above it) walks
-// 2.7 m away: neither grows a part of the body, so at every frame the body has
-// the bounds of the same walk without them, 5 cm higher (before, a limb ran
-// from the origin to the hips).
-TEST(CapturePose, PositionOnlyJointsAboveTheHipsGrowNoLimb) {
+// The humanoid walk (90 frames, 2.7 m) with its hips hung from other joints:
+// `above` opens `opened` joints before the hips (which become a JOINT),
+// `beside` adds joints after the hips' block inside the innermost of them,
+// and `line(f, walk)` writes frame f's values from the plain walk's.
+std::string HipsHungFrom(const std::string& above, int opened, const std::string& beside,
+                         const std::function<std::string(int, const std::string&)>& line) {
   std::string walk = testsupport::HumanoidWalkBvh(false, 0.0f, 90);
-  const std::size_t root = walk.find("ROOT Hips");
   const std::size_t motion = walk.find("MOTION");
-  ASSERT_NE(root, std::string::npos);
-  ASSERT_NE(motion, std::string::npos);
-  walk.replace(motion, 0, "}\n}\n");
-  walk.replace(root, std::string("ROOT Hips").size(),
-               "ROOT World\n{\nOFFSET 0 0 0\nCHANNELS 3 Xposition Yposition Zposition\n"
-               "JOINT Reference\n{\nOFFSET 0 5 0\nCHANNELS 3 Xposition Yposition Zposition\nJOINT Hips");
-  // Every frame line gains the two joints' channels first: World at the
-  // origin, Reference 5 cm above it.
+  std::string closers;
+  for (int i = 0; i < opened; ++i) closers += "}\n";
+  walk.replace(motion, 0, beside + closers);
+  walk.replace(walk.find("ROOT Hips"), std::string("ROOT Hips").size(), above + "JOINT Hips");
   std::string out = walk.substr(0, walk.find("Frame Time:"));
   std::istringstream rest(walk.substr(out.size()));
-  std::string line;
-  std::getline(rest, line);
-  out += line + "\n";
-  while (std::getline(rest, line)) {
-    if (!line.empty()) out += "0 0 0 0 5 0 " + line + "\n";
+  std::string text;
+  std::getline(rest, text);
+  out += text + "\n";
+  for (int f = 0; std::getline(rest, text);) {
+    if (!text.empty()) out += line(f++, text) + "\n";
   }
-  const fs::path bvh = testsupport::TestDir("capture_pose") / "world_reference_walk.bvh";
-  std::ofstream(bvh) << out;
+  return out;
+}
+
+// Loads `bvh_text` and checks that the joints named in `not_body` carry no
+// skin and that at every tenth frame the body has the bounds of the plain
+// walk, raised by `lift` cm (before, each such capture grew a limb from the
+// origin to the hips, 2.7 m long by the end).
+void ExpectBodyOfThePlainWalk(const std::string& bvh_text, const char* file,
+                              std::initializer_list<const char*> not_body, float lift) {
+  const fs::path bvh = testsupport::TestDir("capture_pose") / file;
+  std::ofstream(bvh) << bvh_text;
   mocap::Result<app::Character> ch = app::LoadCommandCharacter(bvh.string(), "", true);
   ASSERT_TRUE(ch.ok()) << ch.error().ToString();
-  for (const char* name : {"World", "Reference"}) {
+  for (const char* name : not_body) {
     const int j = ch->skeleton.FindJoint(name);
     ASSERT_GE(j, 0) << name;
     EXPECT_EQ(std::find(ch->mesh.skin_joints.begin(), ch->mesh.skin_joints.end(), j), ch->mesh.skin_joints.end())
         << name << " carries skin";
   }
-  // The same walk without the two joints: the same body, frame by frame.
   const fs::path plain_bvh = testsupport::TestDir("capture_pose") / "plain_walk.bvh";
   std::ofstream(plain_bvh) << testsupport::HumanoidWalkBvh(false, 0.0f, 90);
   mocap::Result<app::Character> plain = app::LoadCommandCharacter(plain_bvh.string(), "", true);
@@ -248,13 +253,72 @@ TEST(CapturePose, PositionOnlyJointsAboveTheHipsGrowNoLimb) {
   for (int f = 0; f < ch->motion.num_frames; f += 10) {
     ASSERT_TRUE(p->Evaluate(f * ch->motion.frame_time_s, frame).ok());
     ASSERT_TRUE(q->Evaluate(f * ch->motion.frame_time_s, plain_frame).ok());
-    for (int a = 0; a < 3; ++a) {  // centimetres; the hips are 2.7 m from World at the end
-      EXPECT_NEAR(frame.bounds.min[a], plain_frame.bounds.min[a] + (a == 1 ? 5.0f : 0.0f), 1.0f)
+    for (int a = 0; a < 3; ++a) {  // centimetres
+      EXPECT_NEAR(frame.bounds.min[a], plain_frame.bounds.min[a] + (a == 1 ? lift : 0.0f), 1.0f)
           << "frame " << f << " axis " << a;
-      EXPECT_NEAR(frame.bounds.max[a], plain_frame.bounds.max[a] + (a == 1 ? 5.0f : 0.0f), 1.0f)
+      EXPECT_NEAR(frame.bounds.max[a], plain_frame.bounds.max[a] + (a == 1 ? lift : 0.0f), 1.0f)
           << "frame " << f << " axis " << a;
     }
   }
+}
+
+// "World" on the floor at the origin and "Reference" 5 cm above it, animated
+// by position channels alone.
+TEST(CapturePose, PositionOnlyJointsAboveTheHipsGrowNoLimb) {
+  const std::string bvh = HipsHungFrom(
+      "ROOT World\n{\nOFFSET 0 0 0\nCHANNELS 3 Xposition Yposition Zposition\n"
+      "JOINT Reference\n{\nOFFSET 0 5 0\nCHANNELS 3 Xposition Yposition Zposition\n",
+      2, "", [](int, const std::string& walk) { return "0 0 0 0 5 0 " + walk; });
+  ExpectBodyOfThePlainWalk(bvh, "world_reference_walk.bvh", {"World", "Reference"}, 5.0f);
+}
+
+// The same two joints with rotation channels that are declared but zero in
+// every frame: they orient nothing and bend nothing.
+TEST(CapturePose, StillRotationChannelsAboveTheHipsGrowNoLimb) {
+  const char* six = "CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation\n";
+  const std::string bvh = HipsHungFrom(
+      std::string("ROOT World\n{\nOFFSET 0 0 0\n") + six + "JOINT Reference\n{\nOFFSET 0 5 0\n" + six, 2, "",
+      [](int, const std::string& walk) { return "0 0 0 0 0 0 0 5 0 0 0 0 " + walk; });
+  ExpectBodyOfThePlainWalk(bvh, "still_world_reference_walk.bvh", {"World", "Reference"}, 5.0f);
+}
+
+// A root on the floor with three children: the hips walking away by their
+// position channels, a prop standing beside the root and an IK target
+// following the left foot. Only the hips' subtree is body.
+TEST(CapturePose, FloorRootWithPropAndIkTargetGrowsNoLimb) {
+  const char* six = "CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation\n";
+  const std::string bvh = HipsHungFrom(
+      std::string("ROOT Root\n{\nOFFSET 0 0 0\n") + six, 1,
+      std::string("JOINT Prop\n{\nOFFSET 60 0 0\n") + six + "End Site\n{\nOFFSET 0 120 0\n}\n}\n" +
+          "JOINT IkFootL\n{\nOFFSET 10 5 0\n" + six + "End Site\n{\nOFFSET 0 0 15\n}\n}\n",
+      [](int f, const std::string& walk) {
+        return "0 0 0 0 0 0 " + walk + " 60 0 0 0 0 0 10 5 " + std::to_string(3 * f) + " 0 0 0";
+      });
+  ExpectBodyOfThePlainWalk(bvh, "floor_root_prop_walk.bvh", {"Root", "Prop", "IkFootL"}, 0.0f);
+}
+
+// A root on the floor that carries the walk's translation, with the hips a
+// fixed 95 cm above it (rotation channels only) and a prop beside it: the
+// root is an anchor under the body, not a bone from the floor to the hips.
+TEST(CapturePose, FloorAnchorUnderTheHipsGrowsNoLimb) {
+  std::string bvh = HipsHungFrom(
+      "ROOT Root\n{\nOFFSET 0 0 0\nCHANNELS 3 Xposition Yposition Zposition\n", 1,
+      "JOINT Prop\n{\nOFFSET 40 0 0\nCHANNELS 3 Zrotation Xrotation Yrotation\nEnd Site\n{\nOFFSET 0 100 0\n}\n}\n",
+      [](int, const std::string& walk) {
+        std::istringstream in(walk);
+        float x = 0, y = 0, z = 0;
+        in >> x >> y >> z;  // the hips' position moves to the root, 95 cm lower
+        std::string rest;
+        std::getline(in, rest);
+        std::ostringstream out;
+        out << x << " " << y - 95.0f << " " << z << rest << " 0 0 0";
+        return out.str();
+      });
+  const std::string six = "CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation";
+  const std::size_t hips = bvh.find(six, bvh.find("JOINT Hips"));
+  ASSERT_NE(hips, std::string::npos);
+  bvh.replace(hips, six.size(), "CHANNELS 3 Zrotation Xrotation Yrotation");
+  ExpectBodyOfThePlainWalk(bvh, "floor_anchor_walk.bvh", {"Root", "Prop"}, 0.0f);
 }
 
 }  // namespace
