@@ -16,6 +16,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <span>
 
 #include "deform/io/internal/gltf_accessor.h"
 #include "deform/io/internal/gltf_build.h"
@@ -167,9 +168,18 @@ class Converter {
     internal::PrimitiveTargets targets;
     std::vector<glm::vec3> colors;      // #V linear albedo, or empty: the file gives none
     std::vector<glm::vec2> uvs;         // #V TEXCOORD_0, or empty
-    int material = -1;                  // index into out_.mesh.materials.materials
+    // Per triangle, an index into out_.mesh.materials.materials or -1.
+    std::vector<std::int32_t> triangle_material;
+    // The albedo of a vertex without colours: white under a texture, else grey.
+    glm::vec3 fill_color{0.0f};
+    int prim = -1;  // the first glTF primitive read into it
   };
-  mocap::Status ReadMaterial(const tinygltf::Primitive& p, const std::string& at, Part& part);
+  // Primitives of one mesh with the same vertex accessors (an exporter's one
+  // primitive per material) share their vertices instead of copying them.
+  bool SharesVertices(const Part& into, const Part& from) const;
+  static void MergeSharedPrimitive(Part& into, Part& from);
+  static void AppendVertexCopies(Part& part, std::span<const std::uint32_t> sources);
+  mocap::Status ReadMaterial(const tinygltf::Primitive& p, const std::string& at, bool has_uvs, int& material_out);
   internal::GltfMaterialReader materials_;
   std::vector<int> material_slot_;  // 2 x file material + has TEXCOORD_0 -> out index, -1 not yet
   std::vector<Part> parts_;
@@ -472,9 +482,98 @@ mocap::Status Converter::ReadPrimitive(int mesh, int prim, int skin, int rigid_s
     part.uvs.resize(num_vertices);
     for (std::size_t v = 0; v < num_vertices; ++v) part.uvs[v] = glm::vec2((*uvs)[2 * v], (*uvs)[2 * v + 1]);
   }
-  if (auto st = ReadMaterial(p, at, part); !st) return st;
+  int material = -1;
+  if (auto st = ReadMaterial(p, at, !part.uvs.empty(), material); !st) return st;
+  part.triangle_material.assign(part.triangles.size(), material);
+  const bool textured = material >= 0 &&
+                        out_.mesh.materials.materials[static_cast<std::size_t>(material)].texture >= 0;
+  part.fill_color = textured ? glm::vec3(1.0f) : kDefaultAlbedo;
+  part.prim = prim;
+  for (Part& earlier : parts_) {
+    if (SharesVertices(earlier, part)) {
+      MergeSharedPrimitive(earlier, part);
+      return mocap::Status::Ok();
+    }
+  }
   parts_.push_back(std::move(part));
   return mocap::Status::Ok();
+}
+
+bool Converter::SharesVertices(const Part& into, const Part& from) const {
+  if (into.mesh != from.mesh) return false;
+  const auto& prims = m_.meshes[static_cast<std::size_t>(from.mesh)].primitives;
+  const tinygltf::Primitive& a = prims[static_cast<std::size_t>(into.prim)];
+  const tinygltf::Primitive& b = prims[static_cast<std::size_t>(from.prim)];
+  // Computed normals depend on each primitive's own triangles: not shared.
+  return a.attributes == b.attributes && a.targets == b.targets && a.attributes.count("NORMAL") != 0;
+}
+
+// Appends `from`'s triangles to `into`, which holds the same vertices. A vertex
+// both use with different colours (two materials' factors) is copied, morph
+// deltas included, so each corner keeps its material's albedo.
+void Converter::MergeSharedPrimitive(Part& into, Part& from) {
+  const std::size_t nv = into.positions.size();
+  const auto colour = [](const Part& part, std::size_t v) {
+    return part.colors.empty() ? part.fill_color : part.colors[v];
+  };
+  if (!(into.colors.empty() && from.colors.empty() && into.fill_color == from.fill_color)) {
+    std::vector<std::uint8_t> used(nv, 0);
+    for (const glm::uvec3& t : into.triangles) used[t.x] = used[t.y] = used[t.z] = 1;
+    if (into.colors.empty()) into.colors.assign(nv, into.fill_color);
+    std::vector<std::uint32_t> copies;  // source vertex of each copy, in order
+    std::vector<std::uint32_t> copy_of(nv, std::numeric_limits<std::uint32_t>::max());
+    for (glm::uvec3& t : from.triangles) {
+      for (int c = 0; c < 3; ++c) {
+        const std::uint32_t v = t[c];
+        const glm::vec3 want = colour(from, v);
+        if (used[v] == 0) {  // only `from` uses it: its colour
+          into.colors[v] = want;
+          used[v] = 1;
+        } else if (into.colors[v] != want) {
+          if (copy_of[v] == std::numeric_limits<std::uint32_t>::max()) {
+            copy_of[v] = static_cast<std::uint32_t>(nv + copies.size());
+            copies.push_back(v);
+            into.colors.push_back(want);
+          }
+          t[c] = copy_of[v];
+        }
+      }
+    }
+    AppendVertexCopies(into, copies);
+  }
+  into.triangles.insert(into.triangles.end(), from.triangles.begin(), from.triangles.end());
+  into.triangle_material.insert(into.triangle_material.end(), from.triangle_material.begin(),
+                                from.triangle_material.end());
+}
+
+// Appends copies of `sources` to every per-vertex array of `part` but its
+// colours (set by the caller), morph deltas included.
+void Converter::AppendVertexCopies(Part& part, std::span<const std::uint32_t> sources) {
+  if (sources.empty()) return;
+  const std::size_t nv = part.positions.size();
+  const auto k = static_cast<std::size_t>(part.influences);
+  for (const std::uint32_t v : sources) {
+    part.positions.push_back(part.positions[v]);
+    part.normals.push_back(part.normals[v]);
+    if (!part.uvs.empty()) part.uvs.push_back(part.uvs[v]);
+    for (std::size_t i = 0; i < k; ++i) {
+      part.joints.push_back(part.joints[v * k + i]);
+      part.weights.push_back(part.weights[v * k + i]);
+    }
+  }
+  const auto widen = [&](std::vector<glm::vec3>& deltas) {  // #K x #V rows, each row grows
+    if (deltas.empty()) return;
+    std::vector<glm::vec3> out;
+    out.reserve(static_cast<std::size_t>(part.targets.num_targets) * part.positions.size());
+    for (std::size_t t = 0; t < static_cast<std::size_t>(part.targets.num_targets); ++t) {
+      const auto row = deltas.begin() + static_cast<std::ptrdiff_t>(t * nv);
+      out.insert(out.end(), row, row + static_cast<std::ptrdiff_t>(nv));
+      for (const std::uint32_t v : sources) out.push_back(row[v]);
+    }
+    deltas = std::move(out);
+  };
+  widen(part.targets.positions);
+  widen(part.targets.normals);
 }
 
 // The primitive's albedo: COLOR_0 (linear RGB, alpha dropped) times the material's
@@ -522,23 +621,23 @@ mocap::Status Converter::ReadColors(const tinygltf::Primitive& p, int color_inde
 
 // The primitive's material, imported once per file material (and per
 // with/without TEXCOORD_0: a texture needs them).
-mocap::Status Converter::ReadMaterial(const tinygltf::Primitive& p, const std::string& at, Part& part) {
+mocap::Status Converter::ReadMaterial(const tinygltf::Primitive& p, const std::string& at, bool has_uvs,
+                                      int& material_out) {
   if (p.material < 0) return mocap::Status::Ok();
-  const bool has_uvs = !part.uvs.empty();
   if (p.material < static_cast<int>(m_.materials.size())) {
     material_slot_.resize(2 * m_.materials.size(), -1);
     const int cached = material_slot_[static_cast<std::size_t>(2 * p.material + (has_uvs ? 1 : 0))];
     if (cached >= 0) {
-      part.material = cached;
+      material_out = cached;
       return mocap::Status::Ok();
     }
   }
   auto material = materials_.Read(p.material, has_uvs, at, out_.warnings);
   if (!material.ok()) return std::move(material).error();
   MeshMaterials& out = out_.mesh.materials;
-  part.material = static_cast<int>(out.materials.size());
+  material_out = static_cast<int>(out.materials.size());
   out.materials.push_back(std::move(material).value());
-  material_slot_[static_cast<std::size_t>(2 * p.material + (has_uvs ? 1 : 0))] = part.material;
+  material_slot_[static_cast<std::size_t>(2 * p.material + (has_uvs ? 1 : 0))] = material_out;
   return mocap::Status::Ok();
 }
 
@@ -614,13 +713,12 @@ mocap::Status Converter::ReadMeshes(int skin) {
       std::any_of(parts_.begin(), parts_.end(), [](const Part& part) { return !part.colors.empty(); });
   const bool any_uvs =
       std::any_of(parts_.begin(), parts_.end(), [](const Part& part) { return !part.uvs.empty(); });
-  const bool any_material =
-      std::any_of(parts_.begin(), parts_.end(), [](const Part& part) { return part.material >= 0; });
+  const bool any_material = std::any_of(parts_.begin(), parts_.end(), [](const Part& part) {
+    return std::any_of(part.triangle_material.begin(), part.triangle_material.end(),
+                       [](std::int32_t k) { return k >= 0; });
+  });
   MeshMaterials& materials = mesh.materials;
   materials.images = std::move(materials_.images());
-  auto textured = [&](const Part& part) {
-    return part.material >= 0 && materials.materials[static_cast<std::size_t>(part.material)].texture >= 0;
-  };
   for (const Part& part : parts_) {
     if (any_uvs) {
       if (part.uvs.empty()) {
@@ -629,12 +727,14 @@ mocap::Status Converter::ReadMeshes(int skin) {
         mesh.bind.uvs.insert(mesh.bind.uvs.end(), part.uvs.begin(), part.uvs.end());
       }
     }
-    if (any_material) materials.triangle_material.insert(materials.triangle_material.end(), part.triangles.size(), part.material);
+    if (any_material) {
+      materials.triangle_material.insert(materials.triangle_material.end(), part.triangle_material.begin(),
+                                         part.triangle_material.end());
+    }
     if (any_colors) {
       if (part.colors.empty()) {
         // A textured part's albedo is its texture (times a white factor), not the grey.
-        mesh.bind.colors.insert(mesh.bind.colors.end(), part.positions.size(),
-                                textured(part) ? glm::vec3(1.0f) : kDefaultAlbedo);
+        mesh.bind.colors.insert(mesh.bind.colors.end(), part.positions.size(), part.fill_color);
       } else {
         mesh.bind.colors.insert(mesh.bind.colors.end(), part.colors.begin(), part.colors.end());
       }

@@ -20,6 +20,7 @@
 #include "deform/io/gltf_import.h"
 #include "deform/io/internal/gltf_material.h"
 #include "deform/io/obj_writer.h"
+#include "deform/mesh.h"
 #include "support/data_paths.h"
 #include "support/gltf_writer.h"
 #include "support/texture_files.h"
@@ -368,13 +369,65 @@ TEST(GltfTextureExport, GlbOnePrimitivePerMaterial) {
   EXPECT_EQ(m.materials[0].texture, 0);
   EXPECT_EQ(m.materials[1].texture, -1);
   EXPECT_EQ(m.materials[1].base_color_factor, glm::vec3(0.5f, 0.25f, 1.0f));
-  // The primitives share the vertex attributes, so the importer reads them once per primitive.
-  ASSERT_EQ(back->mesh.bind.num_vertices(), 2 * original->mesh.bind.num_vertices());
+  // The primitives share the vertex attributes, and the importer reads them
+  // once: the same vertices and triangles as the original (it had one copy of
+  // the vertices per primitive before).
+  ASSERT_EQ(back->mesh.bind.num_vertices(), original->mesh.bind.num_vertices());
+  EXPECT_EQ(back->mesh.bind.triangles, original->mesh.bind.triangles);
+  EXPECT_EQ(back->mesh.bind.uvs, original->mesh.bind.uvs);
   EXPECT_EQ(m.triangle_material, (std::vector<std::int32_t>{0, 0, 1, 1}));
-  // The second primitive's triangles (in the second copy of the vertices) keep
-  // their albedo: the factor, as in the original.
-  const glm::uvec3 t = back->mesh.bind.triangles[2];
-  EXPECT_EQ(back->mesh.bind.colors[t.x], original->mesh.bind.colors[original->mesh.bind.triangles[2].x]);
+  // Every corner keeps its albedo: white under the texture, the factor on the other part.
+  EXPECT_EQ(back->mesh.bind.colors, original->mesh.bind.colors);
+}
+
+// A closed octahedron, its upper half in one material and its lower half in
+// another; the four equator vertices belong to both.
+deform::SkinnedMesh TwoMaterialOctahedron(const glm::vec3& upper, const glm::vec3& lower) {
+  deform::SkinnedMesh mesh;
+  mesh.bind.positions = {{1, 0, 0}, {0, 0, 1}, {-1, 0, 0}, {0, 0, -1}, {0, 1, 0}, {0, -1, 0}};
+  for (std::uint32_t i = 0; i < 4; ++i) {
+    const std::uint32_t next = (i + 1) % 4;
+    mesh.bind.triangles.push_back({next, i, 4});
+  }
+  for (std::uint32_t i = 0; i < 4; ++i) {
+    const std::uint32_t next = (i + 1) % 4;
+    mesh.bind.triangles.push_back({i, next, 5});
+  }
+  mesh.materials.materials = {{.base_color_factor = upper, .name = "upper"}, {.base_color_factor = lower, .name = "lower"}};
+  mesh.materials.triangle_material = {0, 0, 0, 0, 1, 1, 1, 1};
+  return mesh;
+}
+
+TEST(GltfTextureExport, SharedVerticesStayOneClosedSurface) {
+  const deform::SkinnedMesh octahedron = TwoMaterialOctahedron(glm::vec3(0.8f, 0.2f, 0.2f), glm::vec3(0.8f, 0.2f, 0.2f));
+  ASSERT_TRUE(deform::IsClosedOutward(octahedron.bind.positions, octahedron.bind.triangles));
+  auto back = ExportAndReimport(octahedron, "octahedron_back.glb", deform::GltfExportLayout::kMorphTargets);
+  ASSERT_TRUE(back.ok()) << back.error().ToString();
+  const deform::Mesh& b = back->mesh.bind;
+  EXPECT_EQ(b.positions, octahedron.bind.positions);
+  EXPECT_EQ(b.triangles, octahedron.bind.triangles);
+  EXPECT_TRUE(deform::IsClosedOutward(b.positions, b.triangles)) << "the materials' seam stays closed";
+  EXPECT_EQ(back->mesh.materials.triangle_material, octahedron.materials.triangle_material);
+  ASSERT_EQ(b.colors.size(), 6u);
+  for (const glm::vec3& c : b.colors) EXPECT_EQ(c, glm::vec3(0.8f, 0.2f, 0.2f));
+}
+
+// Two different factors: an equator vertex has two albedos, so it is copied
+// once (for the lower half) and every corner keeps its own material's colour.
+TEST(GltfTextureExport, SharedVertexWithTwoAlbedosIsCopiedOnce) {
+  const glm::vec3 red(0.8f, 0.2f, 0.2f), blue(0.2f, 0.2f, 0.8f);
+  const deform::SkinnedMesh octahedron = TwoMaterialOctahedron(red, blue);
+  auto back = ExportAndReimport(octahedron, "octahedron_two_back.glb", deform::GltfExportLayout::kMorphTargets);
+  ASSERT_TRUE(back.ok()) << back.error().ToString();
+  const deform::Mesh& b = back->mesh.bind;
+  EXPECT_EQ(b.num_vertices(), 6 + 4) << "the four equator vertices, once more";
+  ASSERT_EQ(b.triangles.size(), 8u);
+  for (std::size_t t = 0; t < 8; ++t) {
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_EQ(b.positions[b.triangles[t][c]], octahedron.bind.positions[octahedron.bind.triangles[t][c]]);
+      EXPECT_EQ(b.colors[b.triangles[t][c]], t < 4 ? red : blue) << "triangle " << t;
+    }
+  }
 }
 
 TEST(GltfTextureExport, ObjKeepsUvsAndMaterials) {
