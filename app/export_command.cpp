@@ -376,15 +376,12 @@ int RunExport(const ExportOptions& options) {
   }
   if (guard.interrupted()) {
     progress.Finish();
-    std::string m = std::string("interrupted by ") + guard.signal_name();
-    m += frames_done == 0 ? " before any frame was complete"
-                          : " after frame " + std::to_string(last_done_number) + ": " +
-                                std::to_string(frames_done) + " of " +
-                                std::to_string(plan->count()) + " frames were evaluated";
-    m += glb ? "; the .glb was not written; run the same command again to export it"
-             : "; the OBJ files written are complete; run the same command with --resume to "
-               "write the others";
-    std::fprintf(stderr, "%s: %s\n", out.c_str(), m.c_str());
+    const int total = static_cast<int>(plan->count());
+    const std::string next =
+        glb ? "the .glb was not written; run the same command again to export it"
+            : "run the same command with --resume to write the other " + std::to_string(total - frames_done);
+    std::fprintf(stderr, "%s: %s\n", out.c_str(),
+                 guard.StopMessage(last_done_number, frames_done, total, next).c_str());
     return guard.exit_code();
   }
   if (gltf) {

@@ -140,8 +140,8 @@ bool OutputGuard::interrupted() const { return g_signal != 0; }
 
 int OutputGuard::signal_number() const { return static_cast<int>(g_signal); }
 
-std::string OutputGuard::StopMessage(int last_done_number, int frames_done,
-                                     int frames_total) const {
+std::string OutputGuard::StopMessage(int last_done_number, int frames_done, int frames_total,
+                                     std::string_view next) const {
   std::string m = std::string("interrupted by ") + SignalName(signal_number());
   if (frames_done == 0) {
     m += " before any frame was complete";
@@ -149,8 +149,10 @@ std::string OutputGuard::StopMessage(int last_done_number, int frames_done,
     m += " after frame " + std::to_string(last_done_number) + ": " + std::to_string(frames_done) +
          " of " + std::to_string(frames_total) + " frames are complete";
   }
-  m += "; run the same command with --resume to render the other " +
-       std::to_string(frames_total - frames_done);
+  m += "; ";
+  m += next.empty() ? "run the same command with --resume to render the other " +
+                          std::to_string(frames_total - frames_done)
+                    : std::string(next);
   return m;
 }
 

@@ -23,6 +23,7 @@
 #include <filesystem>
 #include <functional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "mocap/error.h"
@@ -92,8 +93,10 @@ class OutputGuard {
   int exit_code() const { return 128 + signal_number(); }
   // "interrupted by SIGINT after frame 11: 12 of 48 frames are complete; run
   // the same command with --resume to render the other 36". last_done_number
-  // is the file number of the last frame written (ignored when frames_done is 0).
-  std::string StopMessage(int last_done_number, int frames_done, int frames_total) const;
+  // is the file number of the last frame done (ignored when frames_done is 0);
+  // `next`, when given, replaces the advice after the semicolon.
+  std::string StopMessage(int last_done_number, int frames_done, int frames_total,
+                          std::string_view next = {}) const;
 
   // Test hook: behaves as if `signal` had arrived.
   static void SimulateSignal(int signal);

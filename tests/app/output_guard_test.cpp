@@ -104,6 +104,8 @@ TEST_F(OutputGuardTest, SignalIsRecordedAndReported) {
   EXPECT_EQ(guard.StopMessage(-1, 0, 5),
             "interrupted by SIGTERM before any frame was complete; run the same command with "
             "--resume to render the other 5");
+  EXPECT_EQ(guard.StopMessage(11, 12, 48, "the .glb was not written"),
+            "interrupted by SIGTERM after frame 11: 12 of 48 frames are complete; the .glb was not written");
 }
 
 TEST_F(OutputGuardTest, RealSignalSetsTheFlagInsteadOfEndingTheProcess) {
