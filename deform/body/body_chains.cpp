@@ -79,6 +79,27 @@ bool MovesOnly(const mocap::JointChannels& channels) {
   return true;
 }
 
+// A link longer than this many times the body's reach is no bone of it.
+constexpr float kFarLinkReaches = 1.5f;
+
+// Length of the path from `top` down the child with the most descendants at
+// each point: about the body's reach from its spine's start (the spine and an
+// arm, for a humanoid), whatever the pose.
+float HeavyPathLength(const std::vector<BodyPoint>& pts, int top) {
+  float length = 0.0f;
+  for (int p = top; !pts[static_cast<std::size_t>(p)].children.empty();) {
+    int heavy = -1;
+    for (int c : pts[static_cast<std::size_t>(p)].children) {
+      if (heavy < 0 || pts[static_cast<std::size_t>(c)].descendants > pts[static_cast<std::size_t>(heavy)].descendants) {
+        heavy = c;
+      }
+    }
+    length += glm::distance(pts[static_cast<std::size_t>(p)].pos, pts[static_cast<std::size_t>(heavy)].pos);
+    p = heavy;
+  }
+  return length;
+}
+
 // What each point's link to its parent point is, from the motion's use of the
 // channels (Skeleton::channel_use; without it, channels only say whether a
 // joint can rotate at all).
@@ -249,9 +270,9 @@ mocap::Result<BodyChains> BuildBodyChains(const mocap::Skeleton& skeleton,
     int start, first, parent_chain;
     BodyChainKind kind;
   };
-  const LinkRoles roles = FindLinkRoles(skeleton, pts, point_of);
+  LinkRoles roles = FindLinkRoles(skeleton, pts, point_of);
   const std::vector<std::uint8_t>& position_only = roles.position_only;
-  const std::vector<std::uint8_t>& pulled = roles.pulled;
+  std::vector<std::uint8_t>& pulled = roles.pulled;
   const auto only_child = [&pts](int p) {
     const std::vector<int>& c = pts[static_cast<std::size_t>(p)].children;
     return c.size() == 1 ? c[0] : -1;
@@ -290,6 +311,16 @@ mocap::Result<BodyChains> BuildBodyChains(const mocap::Skeleton& skeleton,
     }
     if (pts[static_cast<std::size_t>(r)].children.empty()) continue;
     todo.push_back({r, heaviest(r), -1, BodyChainKind::kSpine});
+  }
+  // A link far longer than the body reaches (the heaviest path from a spine's
+  // start) ends nowhere near the body: a camera or prop joint parked metres
+  // away. It is passed over as a pulled one is.
+  float body_reach = 0.0f;
+  for (const Pending& spine : todo) body_reach = std::max(body_reach, HeavyPathLength(pts, spine.start));
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    if (pts[i].parent >= 0 && glm::distance(pts[i].pos, pos_of(pts[i].parent)) > kFarLinkReaches * body_reach) {
+      pulled[i] = 1;
+    }
   }
   // Body size S over the points that make up the body: a positioning root
   // (often left at the origin while the capture walks away) must not count.

@@ -10,7 +10,9 @@
 //     "World" over a "Reference" over the hips), one whose heavy child the motion
 //     pulls away by position channels (hips walking away from a root on the floor),
 //     and one on the floor straight under the body it holds. A child the motion pulls
-//     away from its parent (an IK target, a prop) is no part of the body. At every
+//     away from its parent (an IK target, a prop) is no part of the body, nor is one
+//     linked to it by a bone 1.5 times longer than the body's reach (the heaviest
+//     path from a spine's start): a camera or prop joint parked metres away. At every
 //     branch point a chain continues into the straightest child and each other child
 //     starts a new chain whose first point is the branch point. A spine skips children
 //     that form a mirror pair (two subtrees with as many points and total bone lengths

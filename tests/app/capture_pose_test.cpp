@@ -297,6 +297,25 @@ TEST(CapturePose, FloorRootWithPropAndIkTargetGrowsNoLimb) {
   ExpectBodyOfThePlainWalk(bvh, "floor_root_prop_walk.bvh", {"Root", "Prop", "IkFootL"}, 0.0f);
 }
 
+// A camera joint parked 5 m in front of the hips, never moved: it ends
+// nowhere near the body, so it grows no 5 m limb.
+TEST(CapturePose, FarParkedJointGrowsNoLimb) {
+  std::string walk = testsupport::HumanoidWalkBvh(false, 0.0f, 90);
+  const std::size_t hips_end = walk.rfind("}\n", walk.find("MOTION"));
+  ASSERT_NE(hips_end, std::string::npos);
+  walk.insert(hips_end, "JOINT Camera\n{\nOFFSET 0 60 500\nCHANNELS 3 Zrotation Xrotation Yrotation\n"
+                        "End Site\n{\nOFFSET 0 0 -20\n}\n}\n");
+  std::string out = walk.substr(0, walk.find("Frame Time:"));
+  std::istringstream rest(walk.substr(out.size()));
+  std::string line;
+  std::getline(rest, line);
+  out += line + "\n";
+  while (std::getline(rest, line)) {
+    if (!line.empty()) out += line + " 0 0 0\n";
+  }
+  ExpectBodyOfThePlainWalk(out, "far_camera_walk.bvh", {"Camera"}, 0.0f);
+}
+
 // A root on the floor that carries the walk's translation, with the hips a
 // fixed 95 cm above it (rotation channels only) and a prop beside it: the
 // root is an anchor under the body, not a bone from the floor to the hips.
