@@ -72,6 +72,9 @@ render::Image Draw(const app::Character& ch, const app::DeformedFrame& f, const 
   settings.height = kHeight;
   settings.supersample = 2;
   settings.threads = 1;
+  // The key light's cast shadow would carry a changed shape's shadow onto
+  // other surfaces: a real effect of the patch, but not one of its pixels.
+  settings.shadows = false;
   if (!colors.empty()) {
     const render::SceneMesh mesh{.positions = f.positions, .normals = f.normals,
                                  .triangles = ch.mesh.bind.triangles, .vertex_colors = colors};
