@@ -12,6 +12,7 @@
 #include <type_traits>
 #include <vector>
 
+#include "deform/body/body_chains.h"
 #include "deform/global/skinning_job.h"
 
 namespace deform {
@@ -181,12 +182,13 @@ std::uint64_t GeneratedBodyKey(const mocap::Skeleton& skeleton, std::span<const 
   h.Add(skeleton.info.up_axis);
   h.Add(skeleton.end_sites.size());
   for (const mocap::EndSite& e : skeleton.end_sites) h.Add(e.parent), h.Add(e.offset);
-  for (const mocap::JointChannels& c : skeleton.channels) {  // these and the motion's use of them
-    h.Add(c.count);                                            // decide which joints are body
-    for (std::size_t k = 0; k < c.count; ++k) h.Add(c.types[k]);
+  // Which joints are body: the only thing the channels and the motion's use of
+  // them change (so captures of one skeleton share a body whatever they do).
+  mocap::Result<std::vector<std::uint8_t>> body =
+      BodyPartJoints(skeleton, rest_model_from_joint, o.shape.min_branch_extent);
+  if (body.ok()) {
+    for (const std::uint8_t b : *body) h.Add(b);
   }
-  h.Add(skeleton.channel_use.size());
-  for (const std::uint8_t u : skeleton.channel_use) h.Add(u);
   h.Add(rest_model_from_joint.size());
   for (const glm::mat4& m : rest_model_from_joint) h.Add(m);
   h.Add(o.shape.min_branch_extent), h.Add(o.shape.blend), h.Add(o.shape.radius_scale);

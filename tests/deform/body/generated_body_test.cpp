@@ -17,6 +17,7 @@
 #include "deform/global/rig_artifacts.h"
 #include "deform/global/skinning_job.h"
 #include "mocap/bvh_reader.h"
+#include "mocap/channel_use.h"
 #include "mocap/pose.h"
 #include "mocap/synthetic.h"
 #include "support/data_paths.h"
@@ -237,6 +238,24 @@ TEST(GeneratedBody, CacheReturnsTheSameBodyForTheSameRestPose) {
   ASSERT_TRUE(fourth.ok());
   EXPECT_FALSE(hit);
   EXPECT_EQ(fourth->weights.weights, first->weights.weights);
+}
+
+// The cache key follows which joints are body, not the motion: two motions of
+// one skeleton share a body; a motion that pulls a limb off (an IK-like joint)
+// gets its own.
+TEST(GeneratedBody, CacheKeyFollowsTheBodyNotTheMotion) {
+  const BuiltSkeleton b = SkeletonFrom(testsupport::Quadruped(), false, 3.0f);
+  mocap::Skeleton still = b.skeleton, moving = b.skeleton, pulled = b.skeleton;
+  const auto nj = static_cast<std::size_t>(b.skeleton.num_joints());
+  still.channel_use.assign(nj, 0);
+  moving.channel_use.assign(nj, mocap::kJointRotates);
+  moving.channel_use[0] |= mocap::kJointStretches;  // the root walks
+  pulled.channel_use = moving.channel_use;
+  pulled.channel_use[nj - 1] |= mocap::kJointStretches;  // a leaf pulled off its parent
+  const auto key = [&](const mocap::Skeleton& s) { return deform::GeneratedBodyKey(s, b.model_from_joint, {}); };
+  EXPECT_EQ(key(still), key(b.skeleton));
+  EXPECT_EQ(key(moving), key(b.skeleton));
+  EXPECT_NE(key(pulled), key(b.skeleton));
 }
 
 TEST(GeneratedBody, BadSkeletonsGetABodyOrAnErrorNamingTheJoint) {
