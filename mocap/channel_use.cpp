@@ -9,24 +9,14 @@
 namespace mocap {
 namespace {
 
-bool IsRotation(ChannelType t) {
-  switch (t) {
-    case ChannelType::kXRotation:
-    case ChannelType::kYRotation:
-    case ChannelType::kZRotation:
-    case ChannelType::kQuatX:
-    case ChannelType::kQuatY:
-    case ChannelType::kQuatZ:
-    case ChannelType::kQuatW:
-      return true;
-    default:
-      return false;
-  }
-}
-
 bool IsQuaternion(ChannelType t) {
   return t == ChannelType::kQuatX || t == ChannelType::kQuatY || t == ChannelType::kQuatZ ||
          t == ChannelType::kQuatW;
+}
+
+bool IsRotation(ChannelType t) {
+  return IsQuaternion(t) || t == ChannelType::kXRotation || t == ChannelType::kYRotation ||
+         t == ChannelType::kZRotation;
 }
 
 int PositionAxis(ChannelType t) {

@@ -82,20 +82,24 @@ bool MovesOnly(const mocap::JointChannels& channels) {
 // A link longer than this many times the body's reach is no bone of it.
 constexpr float kFarLinkReaches = 1.5f;
 
-// Length of the path from `top` down the child with the most descendants at
-// each point: about the body's reach from its spine's start (the spine and an
-// arm, for a humanoid), whatever the pose.
+// The child of `p` with the most descendants (the first on ties), or -1.
+int HeaviestChild(const std::vector<BodyPoint>& pts, int p) {
+  int heavy = -1;
+  for (int c : pts[static_cast<std::size_t>(p)].children) {
+    if (heavy < 0 || pts[static_cast<std::size_t>(c)].descendants > pts[static_cast<std::size_t>(heavy)].descendants) {
+      heavy = c;
+    }
+  }
+  return heavy;
+}
+
+// Length of the path from `top` down the heaviest child at each point: about
+// the body's reach from its spine's start (the spine and an arm, for a
+// humanoid), whatever the pose.
 float HeavyPathLength(const std::vector<BodyPoint>& pts, int top) {
   float length = 0.0f;
-  for (int p = top; !pts[static_cast<std::size_t>(p)].children.empty();) {
-    int heavy = -1;
-    for (int c : pts[static_cast<std::size_t>(p)].children) {
-      if (heavy < 0 || pts[static_cast<std::size_t>(c)].descendants > pts[static_cast<std::size_t>(heavy)].descendants) {
-        heavy = c;
-      }
-    }
+  for (int p = top, heavy = HeaviestChild(pts, p); heavy >= 0; p = heavy, heavy = HeaviestChild(pts, p)) {
     length += glm::distance(pts[static_cast<std::size_t>(p)].pos, pts[static_cast<std::size_t>(heavy)].pos);
-    p = heavy;
   }
   return length;
 }
@@ -158,7 +162,7 @@ bool IsFloorAnchor(const std::vector<BodyPoint>& pts, int root, int heavy, const
   const float height = glm::dot(r.pos, up);
   const glm::vec3 link = pts[static_cast<std::size_t>(heavy)].pos - r.pos;
   const bool upright = glm::dot(link, up) > 0.87f * glm::length(link);  // within 30 degrees
-  return !r.children.empty() && hi > lo && height <= lo + 0.05f * (hi - lo) && upright;
+  return hi > lo && height <= lo + 0.05f * (hi - lo) && upright;
 }
 
 }  // namespace
@@ -281,15 +285,6 @@ mocap::Result<BodyChains> BuildBodyChains(const mocap::Skeleton& skeleton,
     while (only_child(p) >= 0) p = only_child(p);
     return pts[static_cast<std::size_t>(p)].children.size() >= 2;
   };
-  const auto heaviest = [&pts](int p) {
-    int heavy = -1;
-    for (int c : pts[static_cast<std::size_t>(p)].children) {
-      if (heavy < 0 || pts[static_cast<std::size_t>(c)].descendants > pts[static_cast<std::size_t>(heavy)].descendants) {
-        heavy = c;
-      }
-    }
-    return heavy;
-  };
   const glm::vec3 up = skeleton.info.up_axis == mocap::UpAxis::kZ ? glm::vec3(0, 0, 1) : glm::vec3(0, 1, 0);
   std::vector<Pending> todo;
   for (std::size_t i = 0; i < pts.size(); ++i) {
@@ -299,7 +294,7 @@ mocap::Result<BodyChains> BuildBodyChains(const mocap::Skeleton& skeleton,
     // branches (Bandai's joint_Root on the floor), one moved by position
     // channels alone above a body that branches further down, one the motion
     // pulls the body away from, or one on the floor under the body.
-    for (int c = heaviest(r); c >= 0; c = heaviest(r)) {
+    for (int c = HeaviestChild(pts, r); c >= 0; c = HeaviestChild(pts, r)) {
       const bool single = only_child(r) >= 0;
       const bool child_branches = single && pts[static_cast<std::size_t>(c)].children.size() >= 2;
       const bool carries_body = single && position_only[static_cast<std::size_t>(r)] != 0 && leads_to_branch(c);
@@ -310,7 +305,7 @@ mocap::Result<BodyChains> BuildBodyChains(const mocap::Skeleton& skeleton,
       r = c;
     }
     if (pts[static_cast<std::size_t>(r)].children.empty()) continue;
-    todo.push_back({r, heaviest(r), -1, BodyChainKind::kSpine});
+    todo.push_back({r, HeaviestChild(pts, r), -1, BodyChainKind::kSpine});
   }
   // A link far longer than the body reaches (the heaviest path from a spine's
   // start) ends nowhere near the body: a camera or prop joint parked metres
