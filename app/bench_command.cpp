@@ -18,7 +18,6 @@
 #include <thread>
 #include <vector>
 
-#include <CLI/CLI.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 #include <nlohmann/json.hpp>
 
@@ -219,18 +218,6 @@ int Fail(const mocap::Error& e) {
 }
 
 }  // namespace
-
-CLI::App* AddBenchCommand(CLI::App& parent, BenchOptions& o) {
-  CLI::App* cmd = parent.add_subcommand(
-      "bench", "Measure the paper's Table 1 and every speed figure (run in a Release build)");
-  cmd->add_flag("--quick", o.quick, "A few short runs (seconds); figures are rough");
-  cmd->add_option("--json", o.json, "Also write the figures as JSON to this file");
-  cmd->add_option("--threads", o.threads, "Workers of the end-to-end row (0 = all cores)")
-      ->capture_default_str();
-  cmd->add_option("--data", o.data_dir, "Shared data folder (for bvh/cmu_cgspeed/01_01.bvh)");
-  cmd->add_flag("--allow-debug", o.allow_debug, "Run even in a non-Release build");
-  return cmd;
-}
 
 int RunBench(const BenchOptions& o) {
   if (o.threads < 0 || o.threads > 256) return Fail(ArgError("--threads", "expected 0..256"));

@@ -31,10 +31,6 @@
 
 #include <string>
 
-namespace CLI {
-class App;
-}
-
 namespace app {
 
 struct BenchOptions {
@@ -44,9 +40,6 @@ struct BenchOptions {
   std::string data_dir;      // shared data folder (for the CMU row); empty = build default
   bool allow_debug = false;  // run even in a non-Release build
 };
-
-// Adds the `bench` subcommand; `options` must outlive parsing.
-CLI::App* AddBenchCommand(CLI::App& parent, BenchOptions& options);
 
 // Runs every measurement, prints the table to stdout; returns the exit code.
 int RunBench(const BenchOptions& options);

@@ -7,7 +7,6 @@
 #include <filesystem>
 #include <regex>
 
-#include <CLI/CLI.hpp>
 
 #include "app/check_manifest.h"
 #include "app/check_report.h"
@@ -264,27 +263,6 @@ void PrintCaseLine(const CaseCheck& c, std::size_t name_width) {
 }
 
 }  // namespace
-
-CLI::App* AddCheckCommand(CLI::App& app, CheckOptions* o) {
-  CLI::App* cmd = app.add_subcommand(
-      "check",
-      "Render a manifest's cases and compare them with reference frames: exit 0 pass, 1 warnings, "
-      "2 failure, 4 error");
-  cmd->add_option("manifest", o->manifest, "JSON manifest of cases (see docs/command-line.md#check)")->required();
-  cmd->add_option("--out", o->out, "Folder of the new frames (default out/check/<manifest name>)");
-  cmd->add_option("--references", o->references,
-                  "Folder of the reference frames (default: the manifest's, next to it)");
-  cmd->add_option("--html", o->html, "HTML report (default <out>/report.html)");
-  cmd->add_option("--junit", o->junit, "Also write a JUnit XML file for CI");
-  CLI::Option* update = cmd->add_flag(
-      "--update", o->update, "Write the new frames of the cases that did not pass as references");
-  cmd->add_flag("--update-all", o->update_all, "Write the new frames of every case as references")
-      ->excludes(update);
-  cmd->add_option("--threads", o->threads, "Worker threads of each render (0 = all cores)")
-      ->capture_default_str()
-      ->check(CLI::Range(0, 256));
-  return cmd;
-}
 
 int RunCheck(const CheckOptions& options) {
   mocap::Result<CheckManifest> manifest = LoadCheckManifest(options.manifest);

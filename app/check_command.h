@@ -22,10 +22,6 @@
 
 #include <string>
 
-namespace CLI {
-class App;
-}
-
 namespace app {
 
 struct CheckOptions {
@@ -43,8 +39,6 @@ inline constexpr int kCheckPass = 0;
 inline constexpr int kCheckWarning = 1;
 inline constexpr int kCheckFail = 2;
 inline constexpr int kCheckError = 4;
-
-CLI::App* AddCheckCommand(CLI::App& app, CheckOptions* options);
 
 int RunCheck(const CheckOptions& options);
 

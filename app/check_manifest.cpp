@@ -5,9 +5,9 @@
 #include <fstream>
 #include <sstream>
 
-#include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include "app/command_line.h"
 #include "app/internal/json_describe.h"
 
 namespace app {
@@ -111,22 +111,11 @@ std::optional<mocap::Error> OptionWords(const Ctx& c, const json& v, const std::
 }
 
 // Parses `words` with the render command's parser into `out`.
-std::optional<mocap::Error> ParseRenderWords(const Ctx& c, const std::string& path,
+std::optional<mocap::Error> ParseCaseOptions(const Ctx& c, const std::string& path,
                                              const std::string& input,
                                              const std::vector<std::string>& words,
                                              RenderOptions& out) {
-  CLI::App root;
-  AddRenderCommand(root, out);
-  std::vector<std::string> args{"render", input};
-  args.insert(args.end(), words.begin(), words.end());
-  std::reverse(args.begin(), args.end());  // CLI11 takes the vector last word first
-  try {
-    root.parse(args);
-  } catch (const CLI::CallForHelp&) {
-    return c.Fail(path, "render option --help is not a render setting");
-  } catch (const CLI::ParseError& e) {
-    return c.Fail(path, std::string("render options: ") + e.what());
-  }
+  if (std::optional<std::string> bad = app::ParseRenderWords(input, words, out)) return c.Fail(path, *bad);
   for (const char* refused : {"--out", "--frames", "--overwrite", "--resume", "--stats", "--help"}) {
     if (out.given.count(refused) > 0) {
       return c.Fail(path, std::string("render option ") + refused +
@@ -152,7 +141,7 @@ std::optional<mocap::Error> ParseCase(const Ctx& c, const json& v, const std::st
   if (v.contains("options")) {
     if (auto e = OptionWords(c, v["options"], path + ".options", words)) return e;
   }
-  if (auto e = ParseRenderWords(c, path + ".options", out.input, words, out.render)) return e;
+  if (auto e = ParseCaseOptions(c, path + ".options", out.input, words, out.render)) return e;
   if (!out.render.motion.empty()) out.render.motion = Resolve(c.file, out.render.motion);
   if (v.contains("frames")) {
     if (!v["frames"].is_string()) return c.Expected(path + ".frames", "a range \"A:B[:STEP]\"", v["frames"]);

@@ -4,7 +4,6 @@
 #include <cmath>
 #include <cstdio>
 
-#include <CLI/CLI.hpp>
 
 #include "render/output/image_compare.h"
 #include "render/output/image_file_compare.h"
@@ -90,32 +89,6 @@ int WriteDiff(const CompareCommandOptions& o) {
 }
 
 }  // namespace
-
-CLI::App* AddCompareCommand(CLI::App& app, CompareCommandOptions* o) {
-  CLI::App* cmd = app.add_subcommand(
-      "compare",
-      "Compare two images as OpenImageIO's idiff: exit 0 pass, 1 warning, 2 failure, 4 error");
-  cmd->add_option("A", o->image_a, "first image")->required();
-  cmd->add_option("B", o->image_b, "second image (the reference)")->required();
-  const auto threshold = [cmd](const char* name, float& value, const char* what) {
-    cmd->add_option(name, value, what)->capture_default_str()->check(CLI::NonNegativeNumber);
-  };
-  threshold("--fail", o->fail, "per-value difference that makes a pixel fail (also -fail)");
-  threshold("--failpercent", o->fail_percent, "percent of pixels allowed to fail (also -failpercent)");
-  threshold("--hardfail", o->hard_fail, "fail if any value differs more than this (also -hardfail)");
-  threshold("--warn", o->warn, "per-value difference that makes a pixel warn (also -warn)");
-  threshold("--warnpercent", o->warn_percent, "percent of pixels allowed to warn (also -warnpercent)");
-  threshold("--hardwarn", o->hard_warn, "warn if any value differs more than this (also -hardwarn)");
-  cmd->add_option("--allowfailures", o->allow_failures,
-                  "this many pixels may fail by any amount (also -allowfailures)")
-      ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
-  cmd->add_option("--diff", o->diff_path, "write the amplified difference image here");
-  cmd->add_option("--scale", o->diff_scale, "amplification of the difference image")
-      ->capture_default_str()
-      ->check(CLI::PositiveNumber);
-  return cmd;
-}
 
 void NormalizeIdiffSpelling(std::vector<std::string>& args) {
   bool in_compare = false;

@@ -23,10 +23,6 @@
 #include <string>
 #include <vector>
 
-namespace CLI {
-class App;
-}
-
 namespace app {
 
 struct CompareCommandOptions {
@@ -48,10 +44,6 @@ inline constexpr int kComparePass = 0;
 inline constexpr int kCompareWarning = 1;
 inline constexpr int kCompareFail = 2;
 inline constexpr int kCompareError = 4;
-
-// Adds the `compare` subcommand to `app`, storing its arguments in `*options`
-// (which must outlive parsing). Returns the subcommand.
-CLI::App* AddCompareCommand(CLI::App& app, CompareCommandOptions* options);
 
 // Rewrites idiff's single-dash option names after a "compare" argument into
 // the double-dash ones CLI11 parses ("-fail" -> "--fail"); others are unchanged.

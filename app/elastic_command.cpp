@@ -47,25 +47,6 @@ mocap::Result<std::vector<mocap::JointKinematics>> Kinematics(const mocap::Skele
 
 }  // namespace
 
-CLI::App* AddElasticCommand(CLI::App& parent, ElasticOptions& o) {
-  CLI::App* cmd = parent.add_subcommand(
-      "elastic", "Simulate an elastic patch driven by a joint and plot its response (PNG)");
-  cmd->add_option("file", o.file, "BVH or glTF motion (default: the built-in synthetic jump)");
-  cmd->add_option("--joint", o.joint, "Driving joint")->capture_default_str();
-  cmd->add_option("--out", o.out, "Output PNG")->capture_default_str();
-  cmd->add_option("--grid", o.grid, "Control points per side (3..16)")->capture_default_str();
-  cmd->add_option("--spacing-m", o.spacing_m, "Control-point spacing, metres")->capture_default_str();
-  cmd->add_option("--frequency", o.frequency_hz, "Slowest-mode frequency f0, Hz")->capture_default_str();
-  cmd->add_option("--damping", o.damping_ratio, "Damping ratio z0")->capture_default_str();
-  cmd->add_option("--gain", o.gain, "Inertial gain")->capture_default_str();
-  cmd->add_option("--preroll", o.preroll_s, "Seconds simulated before the first frame")->capture_default_str();
-  cmd->add_option("--cutoff-hz", o.cutoff_hz, "Low-pass of the joint paths (0 = off)")->capture_default_str();
-  cmd->add_option("--scale", o.scale, "File length factor (0 = detected units to metres)")->capture_default_str();
-  cmd->add_option("--units-per-metre", o.units_per_metre,
-                  "Model units per metre (0 = 1 for files, 100 for the built-in jump)");
-  return cmd;
-}
-
 int RunElastic(const ElasticOptions& o) {
   mocap::Skeleton skel;
   mocap::Motion motion;

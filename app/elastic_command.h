@@ -8,8 +8,6 @@
 
 #include <string>
 
-#include <CLI/CLI.hpp>
-
 namespace app {
 
 struct ElasticOptions {
@@ -26,8 +24,6 @@ struct ElasticOptions {
   float scale = 0.0f;            // file length factor; 0 = detected units to metres
   float units_per_metre = 0.0f;  // 0 = 1 for files (after scaling), 100 for the built-in jump
 };
-
-CLI::App* AddElasticCommand(CLI::App& parent, ElasticOptions& options);
 
 // Returns the exit code (0 ok, 2 bad input, 3 internal); errors go to stderr.
 int RunElastic(const ElasticOptions& options);

@@ -111,50 +111,6 @@ std::string CameraJson(const render::Camera& camera, glm::ivec2 size, float grou
   return j.dump(2) + "\n";
 }
 
-CLI::App* AddExportCommand(CLI::App& parent, ExportOptions& o) {
-  CLI::App* cmd = parent.add_subcommand(
-      "export", "Write the deformed mesh of every frame as an OBJ sequence or one glTF (.glb)");
-  cmd->add_option("input", o.input, "BVH, glTF or GLB file, or a rig (.json); none = the built-in demo");
-  cmd->add_option("--frames", o.frames, "A:B[:STEP] output frames, inclusive (default all)");
-  cmd->add_option("--fps", o.fps, "Output frame rate; the motion is resampled (default: its own)");
-  cmd->add_option("--out", o.out,
-                  "mesh_####.obj (one OBJ per frame, #### = frame number) or FILE.glb "
-                  "(default out/<name>_export/mesh_####.obj)");
-  cmd->add_option("--global", o.global, "Global skinning: ssd, dqs or swd")->capture_default_str();
-  cmd->add_option("--body", o.body, "Body of a BVH INPUT: generated or tubes (as render)")->capture_default_str();
-  cmd->add_option("--layout", o.layout, ".glb: auto (smaller), morph or baked")
-      ->capture_default_str();
-  cmd->add_flag("--step", o.step, ".glb: hold each frame (STEP) instead of blending (LINEAR)");
-  cmd->add_flag("--with-camera", o.with_camera,
-                "Also write camera_####.json per frame: the camera render would use (a .glb also "
-                "carries it as an animated camera node)");
-  cmd->add_option("--camera", o.camera, "Camera for --with-camera: follow or fixed")
-      ->capture_default_str();
-  cmd->add_option("--size", o.size, "Image size for --with-camera, WxH")->capture_default_str();
-  cmd->add_option("--elevation", o.elevation_deg, "Camera elevation in degrees")
-      ->capture_default_str();
-  cmd->add_option("--motion", o.motion,
-                  "BVH motion driving a glTF INPUT (joints matched by body topology), as for render");
-  cmd->add_option("--joint-map", o.joint_map,
-                  "JSON {\"glTF joint\": \"BVH joint\" or null} overriding the matched joints (with --motion)");
-  cmd->add_option("--scale", o.scale,
-                  "Multiply positions (and the camera JSON's lengths) by this, e.g. 0.01 for a "
-                  "capture in centimetres to metres; 0: the detected units to metres, as inspect")
-      ->capture_default_str();
-  cmd->add_option("--threads", o.threads, "Worker threads (0 = all cores)")->capture_default_str();
-  cmd->add_option("--up", o.up, "The BVH's up axis, y or z, when detection picks the wrong one (default: detected)");
-  cmd->add_option("--start-number", o.start_number,
-                  "File number of motion frame 0 (OBJ meshes, camera JSON), e.g. 1001")
-      ->capture_default_str();
-  cmd->add_flag("--quiet", o.quiet, "No progress output");
-  cmd->add_flag("--resume", o.resume,
-                "OBJ sequence: keep the frame files already written (each is whole) and write "
-                "the missing ones; every frame is still evaluated in order");
-  cmd->add_option("--layer", o.layer,
-                  "auto: the patch layer placed from the skeleton (as render --layer auto)");
-  return cmd;
-}
-
 int RunExport(const ExportOptions& options) {
   // --- A rig file sets the inputs, the method and the layers, as for render ---
   ExportOptions o = options;

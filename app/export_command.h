@@ -17,7 +17,6 @@
 
 #include <string>
 
-#include <CLI/CLI.hpp>
 #include <glm/glm.hpp>
 
 #include "render/camera.h"
@@ -50,8 +49,6 @@ struct ExportOptions {
   int start_number = 0;           // file number of motion frame 0 (OBJ and camera JSON)
   std::string up;                 // --up y|z: a BVH's up axis; empty = detected
 };
-
-CLI::App* AddExportCommand(CLI::App& parent, ExportOptions& options);
 
 // Runs an export. Exit code: 0 ok, 2 bad input, 3 internal error, 128 + signal
 // when SIGINT or SIGTERM stopped it (no .glb then; the OBJ files written are complete).

@@ -27,8 +27,6 @@
 #include <string>
 #include <vector>
 
-#include <CLI/CLI.hpp>
-
 namespace app {
 
 struct FarmOptions {
@@ -46,8 +44,6 @@ struct FarmOptions {
   bool submit = false;                   // run sbatch (else print)
   bool wait = false;                     // with --submit: wait for the sheet job to end
 };
-
-CLI::App* AddFarmCommand(CLI::App& parent, FarmOptions& options);
 
 // Exit code: 0 ok (with --wait: every job succeeded), 1 usage, 2 bad input
 // (input, range, chunk, render options that farm sets itself), 3 when sbatch

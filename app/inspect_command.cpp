@@ -268,30 +268,6 @@ int PrintRetarget(const InspectOptions& options) {
 
 }  // namespace
 
-CLI::App* AddInspectCommand(CLI::App& parent, InspectOptions& options) {
-  CLI::App* cmd = parent.add_subcommand("inspect", "Print a capture's skeleton, timing and poses");
-  cmd->add_option("file", options.file, "BVH, glTF or GLB file")->required();
-  cmd->add_option("--frame", options.frame, "Also print world joint positions at this frame (0-based)");
-  cmd->add_flag("--json", options.json, "Print one JSON document (schema in docs/command-line.md)");
-  cmd->add_flag("--artifacts", options.artifacts,
-                "Print collapse (elbow/knee bent 90/120/150 deg) and candy-wrapper (hand "
-                "twisted 90/180 deg) figures of SSD, DQS and SWD on the file's body");
-  cmd->add_option("--scale", options.scale,
-                  "Multiply lengths by this factor (0: convert detected units to metres)");
-  cmd->add_flag("--y-up", options.y_up, "Rotate a Z-up capture to Y-up");
-  cmd->add_option("--up", options.up, "The BVH's up axis, y or z, when detection picks the wrong one (default: detected)");
-  cmd->add_flag("--add-position-to-offset", options.add_position_to_offset,
-                "BVH position channels add to OFFSET (three.js) instead of replacing it");
-  cmd->add_flag("--allow-short", options.allow_short,
-                "BVH with fewer frames than 'Frames:' declares: load those present (with a warning)");
-  cmd->add_option("--motion", options.motion,
-                  "Print how this BVH motion's joints drive the glTF FILE's (as render --motion does)");
-  cmd->add_option("--joint-map", options.joint_map,
-                  "JSON {\"glTF joint\": \"BVH joint\" or null} overriding the matched joints")
-      ->needs("--motion");
-  return cmd;
-}
-
 int RunInspect(const InspectOptions& options) {
   if (!options.motion.empty()) return PrintRetarget(options);
   MotionSourceOptions load;

@@ -10,8 +10,6 @@
 #include <optional>
 #include <string>
 
-#include <CLI/CLI.hpp>
-
 namespace app {
 
 struct InspectOptions {
@@ -27,9 +25,6 @@ struct InspectOptions {
   std::string motion;             // BVH driving the glTF `file`: print the joint matching instead
   std::string joint_map;          // with `motion`: JSON overrides (as render --joint-map)
 };
-
-// Registers the subcommand and its options; the callback stores into `options`.
-CLI::App* AddInspectCommand(CLI::App& parent, InspectOptions& options);
 
 // Runs it. Returns the process exit code (0 ok, 2 bad input); errors go to stderr.
 int RunInspect(const InspectOptions& options);

@@ -9,8 +9,6 @@
 #include <set>
 #include <string>
 
-#include <CLI/CLI.hpp>
-
 namespace app {
 
 struct RenderOptions {
@@ -70,9 +68,6 @@ struct RenderOptions {
   // false: no summary lines on stdout (`check` renders cases and reports itself).
   bool print_outputs = true;
 };
-
-CLI::App* AddRenderCommand(CLI::App& parent, RenderOptions& options);
-CLI::App* AddTurntableCommand(CLI::App& parent, RenderOptions& options);
 
 // Runs a render. Exit code: 0 ok, 2 bad input (also: outputs exist without
 // --overwrite / --resume), 3 internal error, 128 + signal when SIGINT or

@@ -9,20 +9,6 @@
 
 namespace app {
 
-CLI::App* AddRigCommand(CLI::App& parent, RigCommandOptions& o) {
-  CLI::App* rig = parent.add_subcommand("rig", "Make rig files");
-  rig->require_subcommand(1, 1);
-  CLI::App* cmd = rig->add_subcommand(
-      "auto", "The rig of --layer auto for a capture, as an editable rig file (stdout or --out)");
-  cmd->add_option("capture", o.capture, "BVH capture")->required();
-  cmd->add_option("--body", o.body, "generated, tubes, or a glTF/GLB character the capture drives")
-      ->capture_default_str();
-  cmd->add_option("--up", o.up, "The BVH's up axis, y or z (default: detected)");
-  cmd->add_option("--out", o.out, "Rig file to write (default: stdout)");
-  cmd->add_flag("--quiet", o.quiet, "No notes on stderr");
-  return cmd;
-}
-
 int RunRigAuto(const RigCommandOptions& o) {
   mocap::Result<AutoRig> made = MakeAutoRig(o.capture, o.body, o.up, o.quiet);
   if (!made.ok()) {

@@ -2,11 +2,9 @@
 // `patchskin rig auto CAPTURE [--body B] [--out rig.json]`: the rig that
 // `render CAPTURE --layer auto` uses (app/auto_rig.h), written as an editable
 // rig file (app/rig_writer.h) to stdout or --out; the placement notes go to
-// stderr. Exit codes as every command (app/main.cpp).
+// stderr. Exit codes as every command (app/command_line.h).
 
 #include <string>
-
-#include <CLI/CLI.hpp>
 
 namespace app {
 
@@ -18,8 +16,6 @@ struct RigCommandOptions {
   bool quiet = false;
 };
 
-// Adds `rig` with its `auto` subcommand; returns the `auto` one.
-CLI::App* AddRigCommand(CLI::App& parent, RigCommandOptions& o);
 int RunRigAuto(const RigCommandOptions& o);
 
 }  // namespace app

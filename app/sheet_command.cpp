@@ -24,23 +24,6 @@ int Fail(const mocap::Error& e) {
   return e.code == mocap::ErrorCode::kInternal ? 3 : 2;
 }
 
-}  // namespace
-
-CLI::App* AddSheetCommand(CLI::App& parent, SheetOptions& o) {
-  CLI::App* cmd = parent.add_subcommand(
-      "sheet", "Build the contact sheet and preview video from frames already rendered");
-  cmd->add_option("pattern", o.pattern, "Frame pattern, as given to render --out (#### = number)")
-      ->required();
-  cmd->add_option("--frames", o.frames, "A:B[:STEP] the rendered frames, inclusive")->required();
-  cmd->add_option("--fps", o.fps, "The render's output frame rate")->capture_default_str();
-  cmd->add_flag("--no-sheet", o.no_sheet, "Do not write the contact sheet");
-  cmd->add_flag("--no-video", o.no_video, "Do not write the preview video");
-  cmd->add_flag("--overwrite", o.overwrite, "Replace an existing contact sheet and video");
-  cmd->add_flag("--quiet", o.quiet, "Print nothing on success");
-  return cmd;
-}
-
-namespace {
 
 // True for "A:B" or "A:B:STEP" with every part a non-empty run of digits: a sheet
 // needs both ends of the range, which ParseFrames lets a render leave open.

@@ -8,8 +8,6 @@
 
 #include <string>
 
-#include <CLI/CLI.hpp>
-
 namespace app {
 
 struct SheetOptions {
@@ -21,8 +19,6 @@ struct SheetOptions {
   bool overwrite = false;    // replace an existing sheet / video (else refuse)
   bool quiet = false;
 };
-
-CLI::App* AddSheetCommand(CLI::App& parent, SheetOptions& options);
 
 // Exit code: 0 ok; 2 bad input (a frame missing, named with the count of
 // missing frames; an existing sheet or video without --overwrite; an
