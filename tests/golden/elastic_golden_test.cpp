@@ -18,8 +18,8 @@
 
 namespace {
 
-constexpr int kWidth = 320;
-constexpr int kHeight = 180;
+constexpr int kElasticWidth = 320;
+constexpr int kElasticHeight = 180;
 
 struct ElasticCase {
   std::string name;
@@ -49,8 +49,8 @@ render::Image RenderElasticFrame(const ElasticCase& c) {
   // Two renders, 160 x 180 each, with the same camera: SSD alone on the left,
   // SSD + the elastic patch on the right, side by side (the split view would
   // cut the patch in two).
-  const int half = kWidth / 2;
-  const float aspect = static_cast<float>(half) / static_cast<float>(kHeight);
+  const int half = kElasticWidth / 2;
+  const float aspect = static_cast<float>(half) / static_cast<float>(kElasticHeight);
   const float elevation = 0.15f;
   const glm::vec3 view_dir =
       -glm::normalize(glm::normalize(c.eye_direction) * std::cos(elevation) +
@@ -58,20 +58,20 @@ render::Image RenderElasticFrame(const ElasticCase& c) {
   const render::Camera camera = render::FrameBounds(framed, 35.0f, aspect, view_dir);
   render::RenderSettings settings;
   settings.width = half;
-  settings.height = kHeight;
+  settings.height = kElasticHeight;
   settings.supersample = 2;
   settings.threads = 1;
   settings.ground_at_scene_min = false;
   settings.ground_y = left.bounds.min.y;
   render::Renderer renderer, unused_renderer;
-  render::Image image(kWidth, kHeight), part, scratch;
+  render::Image image(kElasticWidth, kElasticHeight), part, scratch;
   for (int side = 0; side < 2; ++side) {
     const app::FrameDrawOptions options{.frame_number = c.frame, .left_label = "", .right_label = ""};
     EXPECT_TRUE(app::DrawCharacterFrame(*l.character, side == 0 ? left : right, nullptr, camera,
                                         settings, options, renderer, unused_renderer, scratch,
                                         part)
                     .ok());
-    for (int y = 0; y < kHeight; ++y) {
+    for (int y = 0; y < kElasticHeight; ++y) {
       for (int x = 0; x < half; ++x) {
         // A dark one-pixel divider between the two renders.
         image.at(side * half + x, y) =

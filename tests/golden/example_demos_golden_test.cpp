@@ -17,8 +17,8 @@
 
 namespace {
 
-constexpr int kWidth = 256;
-constexpr int kHeight = 144;
+constexpr int kDemoWidth = 256;
+constexpr int kDemoHeight = 144;
 
 struct DemoCase {
   std::string name;     // golden reference name
@@ -33,7 +33,7 @@ void PrintTo(const DemoCase& c, std::ostream* os) { *os << c.name; }
 render::Image RenderDemo(const DemoCase& c) {
   const auto demo = testsupport::LoadDemo(c.demo);
   EXPECT_TRUE(demo->error.empty()) << demo->error;
-  if (!demo->error.empty()) return render::Image(kWidth, kHeight);
+  if (!demo->error.empty()) return render::Image(kDemoWidth, kDemoHeight);
   const double t = c.frame * demo->character.motion.frame_time_s;
   app::DeformedFrame left, right;
   EXPECT_TRUE(demo->global->Evaluate(t, left).ok());
@@ -44,27 +44,27 @@ render::Image RenderDemo(const DemoCase& c) {
     box.Extend(p - glm::vec3(c.margin));
     box.Extend(p + glm::vec3(c.margin));
   }
-  const float aspect = static_cast<float>(kWidth / 2) / static_cast<float>(kHeight);
+  const float aspect = static_cast<float>(kDemoWidth / 2) / static_cast<float>(kDemoHeight);
   const render::Camera camera =
       render::FrameBounds(box, 35.0f, aspect, glm::normalize(c.view_dir), 1.0f);
   render::RenderSettings settings;
-  settings.width = kWidth / 2;
-  settings.height = kHeight;
+  settings.width = kDemoWidth / 2;
+  settings.height = kDemoHeight;
   settings.supersample = 2;
   settings.threads = 1;
   settings.ground = false;
   // Side by side, the same camera: global only | global + examples.
-  render::Image out(kWidth, kHeight);
+  render::Image out(kDemoWidth, kDemoHeight);
   for (int side = 0; side < 2; ++side) {
     const app::DeformedFrame& f = side == 0 ? left : right;
     const render::SceneMesh mesh{.positions = f.positions, .normals = f.normals,
                                  .triangles = demo->character.mesh.bind.triangles};
     const render::Image half = render::Render(camera, {&mesh, 1}, {}, settings);
-    for (int y = 0; y < kHeight; ++y) {
-      for (int x = 0; x < kWidth / 2; ++x) out.at(side * (kWidth / 2) + x, y) = half.at(x, y);
+    for (int y = 0; y < kDemoHeight; ++y) {
+      for (int x = 0; x < kDemoWidth / 2; ++x) out.at(side * (kDemoWidth / 2) + x, y) = half.at(x, y);
     }
   }
-  for (int y = 0; y < kHeight; ++y) out.at(kWidth / 2, y) = glm::vec4(1.0f);  // divider
+  for (int y = 0; y < kDemoHeight; ++y) out.at(kDemoWidth / 2, y) = glm::vec4(1.0f);  // divider
   return out;
 }
 

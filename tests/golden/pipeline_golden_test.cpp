@@ -28,8 +28,8 @@
 
 namespace {
 
-constexpr int kWidth = 256;
-constexpr int kHeight = 144;
+constexpr int kPipelineWidth = 256;
+constexpr int kPipelineHeight = 144;
 
 app::Character Demo() {
   app::MotionSourceOptions load;
@@ -83,14 +83,14 @@ render::Image Render(const app::Character& c, int frame, bool split,
     EXPECT_TRUE(ssd.ok());
     EXPECT_TRUE(ssd->Evaluate(t, left).ok());
   }
-  const float aspect = static_cast<float>(kWidth) / static_cast<float>(kHeight);
+  const float aspect = static_cast<float>(kPipelineWidth) / static_cast<float>(kPipelineHeight);
   const float elevation = 0.26f;
   const glm::vec3 view_dir = -glm::normalize(glm::vec3(0.45f, 0.0f, 1.0f) * std::cos(elevation) +
                                              glm::vec3(0.0f, std::sin(elevation), 0.0f));
   const render::Camera camera = render::FrameBounds(right.bounds, 35.0f, aspect, view_dir);
   render::RenderSettings settings;
-  settings.width = kWidth;
-  settings.height = kHeight;
+  settings.width = kPipelineWidth;
+  settings.height = kPipelineHeight;
   settings.supersample = 2;
   settings.threads = 1;
   settings.ground_at_scene_min = false;

@@ -40,6 +40,14 @@ inline std::filesystem::path TestDir(const std::string& folder) {
   return d;
 }
 
+// TEST_OUTPUT_DIR/<relative>/, emptied: a fresh folder for one test's files.
+inline std::filesystem::path FreshOutputDir(const std::string& relative) {
+  const std::filesystem::path d = std::filesystem::path(TEST_OUTPUT_DIR) / relative;
+  std::filesystem::remove_all(d);
+  std::filesystem::create_directories(d);
+  return d;
+}
+
 inline bool HaveSharedData() { return std::filesystem::is_directory(SHARED_DATA_DIR); }
 
 // A folder under the build tree for files a test writes (created on demand).

@@ -18,13 +18,6 @@ namespace {
 namespace fs = std::filesystem;
 using testsupport::kMorphRoundTripTol;
 
-fs::path Dir(const std::string& name) {
-  const fs::path d = testsupport::TestOutputPath("gltf_export/" + name + "/x").parent_path();
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
-
 // A flag of nx x ny vertices waving in time: frame k of `frames`.
 struct Flag {
   int nx = 0, ny = 0;
@@ -106,7 +99,7 @@ void ExpectFramesAtKeyTimes(const Flag& flag, int frames, double frame_time, con
 
 TEST(GltfExport, MorphTargetsGiveEveryFrameAtItsKeyTime) {
   const Flag flag = MakeFlag(9, 5);
-  const fs::path path = Dir("morph") / "flag.glb";
+  const fs::path path = testsupport::FreshOutputDir("gltf_export/morph") / "flag.glb";
   const double dt = 1.0 / 24.0;
   Write(flag, 12, {.frame_time_s = dt, .layout = deform::GltfExportLayout::kMorphTargets}, path);
   ExpectFramesAtKeyTimes(flag, 12, dt, path, kMorphRoundTripTol);
@@ -139,7 +132,7 @@ TEST(GltfExport, MorphTargetsGiveEveryFrameAtItsKeyTime) {
 
 TEST(GltfExport, StepMorphHoldsEachFrame) {
   const Flag flag = MakeFlag(6, 4);
-  const fs::path path = Dir("step") / "flag.glb";
+  const fs::path path = testsupport::FreshOutputDir("gltf_export/step") / "flag.glb";
   const double dt = 1.0 / 30.0;
   Write(flag, 7,
         {.frame_time_s = dt, .layout = deform::GltfExportLayout::kMorphTargets,
@@ -158,7 +151,7 @@ TEST(GltfExport, StepMorphHoldsEachFrame) {
 
 TEST(GltfExport, BakedMeshesShowExactlyOneExactFrame) {
   const Flag flag = MakeFlag(5, 5);
-  const fs::path path = Dir("baked") / "flag.glb";
+  const fs::path path = testsupport::FreshOutputDir("gltf_export/baked") / "flag.glb";
   const double dt = 1.0 / 25.0;
   Write(flag, 6, {.frame_time_s = dt, .layout = deform::GltfExportLayout::kBakedMeshes}, path);
   ExpectFramesAtKeyTimes(flag, 6, dt, path, 0.0f);  // baked vertices are the frames' own floats
@@ -184,7 +177,7 @@ TEST(GltfExport, AutoPicksTheSmallerFile) {
     name += std::to_string(c.nx);
     name += "_";
     name += std::to_string(c.frames);
-    const fs::path dir = Dir(name);
+    const fs::path dir = testsupport::FreshOutputDir("gltf_export/" + name);
     const fs::path morph = Write(flag, c.frames, {.layout = deform::GltfExportLayout::kMorphTargets},
                                  dir / "morph.glb");
     const fs::path baked = Write(flag, c.frames, {.layout = deform::GltfExportLayout::kBakedMeshes},
@@ -234,7 +227,7 @@ TEST(GltfExport, BadInputIsRefused) {
   p[4].x = NAN;
   EXPECT_FALSE(w->AddFrame(p, flag.Normals(0)));
   ASSERT_TRUE(w->AddFrame(flag.Positions(0), flag.Normals(0)));
-  const fs::path dir = Dir("bad");
+  const fs::path dir = testsupport::FreshOutputDir("gltf_export/bad");
   const mocap::Status s = w->Finish((dir / "short.glb").string());
   ASSERT_FALSE(s);
   EXPECT_NE(s.error().ToString().find("short.glb"), std::string::npos);

@@ -16,13 +16,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-fs::path Dir(const std::string& name) {
-  const fs::path d = testsupport::TestOutputPath("obj_writer/" + name + "/x").parent_path();
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
-
 // A bent strip of n x 2 vertices with awkward float values.
 struct Strip {
   std::vector<glm::vec3> positions, normals;
@@ -48,7 +41,7 @@ Strip MakeStrip(int n, float phase) {
 }
 
 TEST(ObjWriter, RoundTripIsBitExact) {
-  const fs::path dir = Dir("round_trip");
+  const fs::path dir = testsupport::FreshOutputDir("obj_writer/round_trip");
   const Strip s = MakeStrip(17, 0.3f);
   deform::ObjSequenceWriter w;
   const std::string path = (dir / "mesh_0001.obj").string();
@@ -70,7 +63,7 @@ TEST(ObjWriter, RoundTripIsBitExact) {
 }
 
 TEST(ObjWriter, WithoutNormalsWritesPlainFaces) {
-  const fs::path dir = Dir("no_normals");
+  const fs::path dir = testsupport::FreshOutputDir("obj_writer/no_normals");
   const Strip s = MakeStrip(3, 0.0f);
   deform::ObjSequenceWriter w;
   const std::string path = (dir / "a.obj").string();
@@ -83,7 +76,7 @@ TEST(ObjWriter, WithoutNormalsWritesPlainFaces) {
 }
 
 TEST(ObjWriter, BadInputIsAnErrorAndWritesNothing) {
-  const fs::path dir = Dir("bad");
+  const fs::path dir = testsupport::FreshOutputDir("obj_writer/bad");
   Strip s = MakeStrip(3, 0.0f);
   deform::ObjSequenceWriter w;
   const std::string path = (dir / "bad.obj").string();
@@ -109,7 +102,7 @@ TEST(ObjWriter, BadInputIsAnErrorAndWritesNothing) {
 }
 
 TEST(ObjWriter, MissingFolderIsAnIoErrorNamingTheFile) {
-  const fs::path dir = Dir("missing");
+  const fs::path dir = testsupport::FreshOutputDir("obj_writer/missing");
   const Strip s = MakeStrip(3, 0.0f);
   deform::ObjSequenceWriter w;
   const std::string path = (dir / "no" / "such" / "a.obj").string();
@@ -121,7 +114,7 @@ TEST(ObjWriter, MissingFolderIsAnIoErrorNamingTheFile) {
 
 // The writer keeps one frame's text: writing 60 frames holds no more than one.
 TEST(ObjWriter, MemoryDoesNotGrowWithFrames) {
-  const fs::path dir = Dir("memory");
+  const fs::path dir = testsupport::FreshOutputDir("obj_writer/memory");
   deform::ObjSequenceWriter w;
   Strip s = MakeStrip(200, 0.0f);
   ASSERT_TRUE(w.Write({.positions = s.positions, .normals = s.normals, .triangles = s.triangles},

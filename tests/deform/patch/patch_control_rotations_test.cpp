@@ -17,10 +17,12 @@
 #include "deform/shapes/example_shapes.h"
 #include "deform/shapes/polar_rotation.h"
 #include "support/random_blends.h"
+#include "support/rotations.h"
 #include "support/tolerances.h"
 
 namespace {
 
+using testsupport::QuatDistance;
 using testsupport::RandomRotation;
 
 // #C control points with `influences` slots over `bones` skin joints; point
@@ -73,11 +75,6 @@ glm::dmat3 Blend(const deform::PatchSetup& p, std::span<const glm::mat4> palette
     blend += static_cast<double>(w) * glm::dmat3(glm::mat3(palette[p.control_weights.joints[i]]));
   }
   return blend;
-}
-
-float QuatDistance(const glm::quat& a, const glm::quat& b) {
-  const glm::quat s = glm::dot(a, b) < 0.0f ? -b : b;
-  return glm::length(glm::vec4(a.x - s.x, a.y - s.y, a.z - s.z, a.w - s.w));
 }
 
 bool SameBits(std::span<const glm::quat> a, std::span<const glm::quat> b) {

@@ -14,10 +14,12 @@
 #include "deform/shapes/example_shapes.h"
 #include "deform/shapes/polar_rotation.h"
 #include "support/random_blends.h"
+#include "support/rotations.h"
 #include "support/tolerances.h"
 
 namespace {
 
+using testsupport::QuatDistance;
 using testsupport::RandomBlend;
 using testsupport::RandomRotation;
 
@@ -119,12 +121,6 @@ deform::PatchSetup RandomWeightsPatch(std::mt19937& rng, int count, int bones) {
     }
   }
   return p;
-}
-
-float QuatDistance(const glm::quat& a, const glm::quat& b) {
-  const glm::quat s = glm::dot(a, b) < 0.0f ? -b : b;
-  const glm::quat d = a - s;
-  return glm::length(glm::vec4(d.x, d.y, d.z, d.w));
 }
 
 TEST(PatchControlRotations, ThreeAndFourBonesMatchTheSvdPolarDecomposition) {

@@ -25,14 +25,6 @@ namespace {
 namespace fs = std::filesystem;
 using testsupport::kFloatTol;
 
-// A fresh, empty folder under the build tree for one test.
-fs::path FreshDir(const std::string& name) {
-  fs::path dir = testsupport::TestOutputPath("image_io/" + name + "/x").parent_path();
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
-
 // Every pixel different: colour ramps, a hue pattern and partial alpha.
 Image TestPattern(int w, int h) {
   Image img(w, h);
@@ -99,7 +91,7 @@ TEST(ImageFormat, FollowsTheExtension) {
 }
 
 TEST(WriteImage, PngRoundTripIsExactAfterQuantization) {
-  const fs::path dir = FreshDir("png");
+  const fs::path dir = testsupport::FreshOutputDir("image_io/png");
   const Image src = TestPattern(37, 23);
   ASSERT_TRUE(WriteImage(src, (dir / "a.png").string()));
   ReadInfo info;
@@ -119,7 +111,7 @@ TEST(WriteImage, PngRoundTripIsExactAfterQuantization) {
 }
 
 TEST(WriteImage, PngCompressionLevelChangesSizeNotPixels) {
-  const fs::path dir = FreshDir("png_levels");
+  const fs::path dir = testsupport::FreshOutputDir("image_io/png_levels");
   const Image src = TestPattern(64, 64);
   WriteOptions fast;
   fast.png_compression = 0;
@@ -135,7 +127,7 @@ TEST(WriteImage, PngCompressionLevelChangesSizeNotPixels) {
 }
 
 TEST(WriteImage, PngFilterChangesBytesNotPixels) {
-  const fs::path dir = FreshDir("png_filters");
+  const fs::path dir = testsupport::FreshOutputDir("image_io/png_filters");
   const Image src = TestPattern(64, 64);
   WriteOptions none, adaptive;
   none.png_filter = PngFilter::kNone;
@@ -150,7 +142,7 @@ TEST(WriteImage, PngFilterChangesBytesNotPixels) {
 }
 
 TEST(WriteImage, ExrKeepsHalfPrecisionAndDepth) {
-  const fs::path dir = FreshDir("exr");
+  const fs::path dir = testsupport::FreshOutputDir("image_io/exr");
   Image src = TestPattern(16, 8);
   src.at(3, 2) = glm::vec4(12.5f, 0.001f, 100.0f, 1.0f);  // HDR values survive
   src.depth.resize(src.rgba.size());
@@ -175,7 +167,7 @@ TEST(WriteImage, ExrKeepsHalfPrecisionAndDepth) {
 // Same image, same bytes, whenever it is written: the EXR and TIFF writers
 // would otherwise stamp the current time (the writes are a second apart).
 TEST(WriteImage, SameImageGivesSameBytesAcrossTime) {
-  const fs::path dir = FreshDir("same_bytes");
+  const fs::path dir = testsupport::FreshOutputDir("image_io/same_bytes");
   const Image src = TestPattern(16, 8);
   for (const char* ext : {".exr", ".tif", ".png"}) {
     const std::string a = (dir / (std::string("a") + ext)).string();
@@ -188,7 +180,7 @@ TEST(WriteImage, SameImageGivesSameBytesAcrossTime) {
 }
 
 TEST(WriteImage, ExrWithoutDepthHasFourChannels) {
-  const fs::path dir = FreshDir("exr_nodepth");
+  const fs::path dir = testsupport::FreshOutputDir("image_io/exr_nodepth");
   Image src = TestPattern(8, 8);
   src.depth.assign(src.rgba.size(), 2.0f);
   WriteOptions o;
@@ -203,7 +195,7 @@ TEST(WriteImage, ExrWithoutDepthHasFourChannels) {
 }
 
 TEST(WriteImage, TiffEightAndSixteenBitRoundTrip) {
-  const fs::path dir = FreshDir("tiff");
+  const fs::path dir = testsupport::FreshOutputDir("image_io/tiff");
   const Image src = TestPattern(20, 10);
   ASSERT_TRUE(WriteImage(src, (dir / "a8.tif").string()));
   WriteOptions o16;
@@ -226,7 +218,7 @@ TEST(WriteImage, TiffEightAndSixteenBitRoundTrip) {
 }
 
 TEST(WriteImage, JpegIsCloseAndQualityMatters) {
-  const fs::path dir = FreshDir("jpeg");
+  const fs::path dir = testsupport::FreshOutputDir("image_io/jpeg");
   Image src(32, 32, glm::vec4(0.2f, 0.4f, 0.6f, 1.0f));  // flat colour: JPEG keeps it well
   WriteOptions hi, lo;
   hi.jpeg_quality = 95;
@@ -248,7 +240,7 @@ TEST(WriteImage, JpegIsCloseAndQualityMatters) {
 }
 
 TEST(WriteImage, StoresMetadata) {
-  const fs::path dir = FreshDir("meta");
+  const fs::path dir = testsupport::FreshOutputDir("image_io/meta");
   WriteOptions o;
   o.frame = 42;
   o.source_file = "walk.bvh";
@@ -270,7 +262,7 @@ TEST(WriteImage, StoresMetadata) {
 }
 
 TEST(WriteImage, IsAtomicAndLeavesNoTemporaryFile) {
-  const fs::path dir = FreshDir("atomic");
+  const fs::path dir = testsupport::FreshOutputDir("image_io/atomic");
   ASSERT_TRUE(WriteImage(TestPattern(8, 8), (dir / "ok.png").string()));
   EXPECT_EQ(CountEntries(dir), 1u) << "only the final file";
   EXPECT_FALSE(fs::exists(TemporaryPathFor((dir / "ok.png").string())));
@@ -293,7 +285,7 @@ TEST(WriteImage, IsAtomicAndLeavesNoTemporaryFile) {
 }
 
 TEST(WriteImage, RejectsBadImagesAndOptions) {
-  const fs::path dir = FreshDir("reject");
+  const fs::path dir = testsupport::FreshOutputDir("image_io/reject");
   EXPECT_EQ(WriteImage(Image(), (dir / "e.png").string()).error().code,
             mocap::ErrorCode::kInvalidArgument);
   Image broken(4, 4);
@@ -310,7 +302,7 @@ TEST(WriteImage, RejectsBadImagesAndOptions) {
 }
 
 TEST(ReadImage, ReportsMissingAndCorruptFiles) {
-  const fs::path dir = FreshDir("read_bad");
+  const fs::path dir = testsupport::FreshOutputDir("image_io/read_bad");
   auto missing = ReadImage((dir / "none.png").string());
   ASSERT_FALSE(missing.ok());
   EXPECT_EQ(missing.error().code, mocap::ErrorCode::kIo);
@@ -338,7 +330,7 @@ std::string BigEndian(std::uint32_t v) {
 
 TEST(ReadImage, RefusesHugeDimensionsBeforeAllocating) {
   // A valid PNG header announcing 100000 x 100000 RGBA pixels, and no pixel data.
-  const fs::path dir = FreshDir("read_huge");
+  const fs::path dir = testsupport::FreshOutputDir("image_io/read_huge");
   std::string ihdr = "IHDR" + BigEndian(100000) + BigEndian(100000);
   ihdr += std::string{'\x08', '\x06', '\0', '\0', '\0'};  // 8-bit RGBA
   std::string png = "\x89PNG\r\n\x1a\n";

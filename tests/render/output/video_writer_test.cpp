@@ -19,13 +19,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-fs::path FreshDir(const std::string& name) {
-  fs::path dir = testsupport::TestOutputPath("video/" + name + "/x").parent_path();
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
-
 constexpr int kWidth = 64;
 constexpr int kHeight = 48;
 constexpr int kFrames = 10;
@@ -38,7 +31,8 @@ glm::vec4 Grey(int f) {
 // Writes kFrames flat grey frames with `codecs` and checks them read back.
 void RoundTrip(const std::vector<VideoCodec>& codecs, VideoCodec expected,
                const std::string& expected_ext) {
-  const fs::path dir = FreshDir(VideoCodecName(expected) + std::string("x") + expected_ext.substr(1));
+  const fs::path dir =
+      testsupport::FreshOutputDir(std::string("video/") + VideoCodecName(expected) + "x" + expected_ext.substr(1));
   VideoOptions options;
   options.codecs = codecs;
   auto video = VideoWriter::Open((dir / "preview.mp4").string(), kWidth, kHeight, options);
@@ -87,7 +81,7 @@ TEST(VideoWriter, MjpegFallbackWritesAvi) {
 // An odd render size (65x49) goes into the even video (64x48) cropped at its
 // right and bottom edges: the white last column and row are not in the video.
 TEST(VideoWriter, CropsAFrameOnePixelLargerThanTheVideo) {
-  const fs::path dir = FreshDir("odd");
+  const fs::path dir = testsupport::FreshOutputDir("video/odd");
   auto video = VideoWriter::Open((dir / "v.mp4").string(), kWidth, kHeight);
   ASSERT_TRUE(video.ok()) << video.error().ToString();
   Image odd(kWidth + 1, kHeight + 1, Grey(2));
@@ -109,7 +103,7 @@ TEST(VideoWriter, RejectsBadArgumentsAndUnwritablePaths) {
   VideoOptions none;
   none.codecs.clear();
   EXPECT_FALSE(VideoWriter::Open("x.mp4", 16, 16, none).ok());
-  const fs::path dir = FreshDir("bad");
+  const fs::path dir = testsupport::FreshOutputDir("video/bad");
   auto r = VideoWriter::Open((dir / "missing" / "v.mp4").string(), 16, 16);
   ASSERT_FALSE(r.ok());
   EXPECT_EQ(r.error().code, mocap::ErrorCode::kIo);
@@ -117,7 +111,7 @@ TEST(VideoWriter, RejectsBadArgumentsAndUnwritablePaths) {
 }
 
 TEST(VideoWriter, DestroyingWithoutCloseLeavesNothing) {
-  const fs::path dir = FreshDir("abandon");
+  const fs::path dir = testsupport::FreshOutputDir("video/abandon");
   {
     auto video = VideoWriter::Open((dir / "v.mp4").string(), kWidth, kHeight);
     ASSERT_TRUE(video.ok());

@@ -16,17 +16,13 @@
 
 #include "render/renderer.h"
 #include "render/raster/shading.h"
+#include "support/sample_space.h"
 
 namespace {
 
 using render::BackgroundFill;
+using testsupport::AtSample;
 using render::kTileSize;
-
-// Clip-space point (w = 1) landing on sample-space (sx, sy).
-glm::vec4 AtSample(float sx, float sy, int width, int height) {
-  return {sx / static_cast<float>(width) * 2.0f - 1.0f, 1.0f - sy / static_cast<float>(height) * 2.0f,
-          0.0f, 1.0f};
-}
 
 struct Scene {
   int width, height, ss;  // output pixels, samples per axis

@@ -15,7 +15,7 @@
 
 namespace {
 
-struct Scene {
+struct GroundScene {
   render::Camera camera;
   int width = 320, height = 180;
   float ground_y = -0.4f;
@@ -24,7 +24,7 @@ struct Scene {
   std::vector<render::ContactShadow> shadows;
   glm::vec3 light{0.9f, 0.85f, 0.8f};
 
-  Scene() {
+  GroundScene() {
     camera.eye = glm::vec3(0.7f, 1.6f, 4.0f);
     camera.target = glm::vec3(0.0f, -0.2f, 0.0f);
     camera.aspect = static_cast<float>(width) / static_cast<float>(height);
@@ -58,7 +58,7 @@ struct Scene {
 };
 
 TEST(GroundShader, MatchesGroundAlbedoTimesContactShadowAtTheRayHit) {
-  const Scene scene;
+  const GroundScene scene;
   for (const float spacing : {scene.spacing, 0.0f}) {  // with and without grid lines
     const render::GroundShader shader = scene.Shader(spacing);
     int checked = 0, on_lines = 0, shadowed = 0;
@@ -98,7 +98,7 @@ TEST(GroundShader, MatchesGroundAlbedoTimesContactShadowAtTheRayHit) {
 }
 
 TEST(GroundShader, EachLaneEqualsThatSampleShadedAlone) {
-  const Scene scene;
+  const GroundScene scene;
   const render::GroundShader shader = scene.Shader(scene.spacing);
   for (int y = 60; y < scene.height; y += 7) {
     for (int x = 0; x + 4 <= scene.width; x += 3) {  // groups at every alignment
@@ -113,7 +113,7 @@ TEST(GroundShader, EachLaneEqualsThatSampleShadedAlone) {
 }
 
 TEST(GroundShader, WithoutShadowsOrLinesTheGroundIsItsColourTimesTheLight) {
-  Scene scene;
+  GroundScene scene;
   scene.shadows.clear();
   const render::GroundShader shader = scene.Shader(0.0f);
   const glm::vec3 expected = scene.style.color * scene.light;

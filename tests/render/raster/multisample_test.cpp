@@ -20,12 +20,12 @@ namespace {
 
 // Smooth-shaded spheres (curved shading inside, silhouettes at every angle),
 // thin slivers a fraction of a pixel wide at several slants, and the ground.
-struct EdgeScene {
+struct MsaaEdgeScene {
   int w = 160, h = 120;
   render::Camera cam;
   std::vector<rendertest::TriMesh> meshes;
 
-  EdgeScene() {
+  MsaaEdgeScene() {
     cam.eye = glm::vec3(0.3f, 1.2f, 4.0f);
     cam.target = glm::vec3(0.0f, 0.6f, 0.0f);
     cam.aspect = static_cast<float>(w) / static_cast<float>(h);
@@ -97,7 +97,7 @@ TEST(Multisample, EqualsSupersamplingWhereEachTriangleHasOneColour) {
   // Unlit, one albedo per mesh: a sample's colour depends only on which
   // triangle covers it, so shading once per pixel changes nothing (the ground
   // is shaded per sample in both modes).
-  const EdgeScene scene;
+  const MsaaEdgeScene scene;
   for (const int ss : {2, 4}) {
     const render::Image msaa = scene.Render(ss, render::AntiAlias::kMultisample,
                                             render::LightingModel::kUnlit);
@@ -108,7 +108,7 @@ TEST(Multisample, EqualsSupersamplingWhereEachTriangleHasOneColour) {
 }
 
 TEST(Multisample, P99ErrorAsCloseToFourByFourAsSupersampling) {
-  const EdgeScene scene;
+  const MsaaEdgeScene scene;
   for (const render::LightingModel lighting :
        {render::LightingModel::kBlinnPhong, render::LightingModel::kLambert}) {
     const render::Image ref = scene.Render(4, render::AntiAlias::kSupersample, lighting);
@@ -139,7 +139,7 @@ TEST(Multisample, P99ErrorAsCloseToFourByFourAsSupersampling) {
 }
 
 TEST(Multisample, SameBytesForAnyThreadCount) {
-  const EdgeScene scene;
+  const MsaaEdgeScene scene;
   for (const int ss : {2, 4}) {
     const render::Image one = scene.Render(ss, render::AntiAlias::kMultisample,
                                            render::LightingModel::kBlinnPhong, 1);

@@ -12,19 +12,15 @@
 
 #include "render/renderer.h"
 #include "support/tolerances.h"
+#include "support/sample_space.h"
 #include "tests/render/render_fixtures.h"
 
 namespace {
 
+using testsupport::AtSample;
 using render::ClipMesh;
 using render::Rasterizer;
 using render::RasterSettings;
-
-// Clip-space point (w = 1) landing exactly on sample-space (sx, sy).
-glm::vec4 AtSample(float sx, float sy, int width, int height) {
-  return {sx / static_cast<float>(width) * 2.0f - 1.0f, 1.0f - sy / static_cast<float>(height) * 2.0f,
-          0.0f, 1.0f};
-}
 
 // Fragments per sample over all triangles (no depth test).
 std::vector<int> CountFragments(std::span<const ClipMesh> meshes, int width, int height, bool cull) {
