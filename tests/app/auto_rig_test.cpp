@@ -34,7 +34,7 @@ const app::RigPatch* Find(const app::Rig& rig, const std::string& name) {
   return nullptr;
 }
 
-app::AutoRig Walk() {
+app::AutoRig AutoRigOfTheWalk() {
   auto made = app::MakeAutoRig(testsupport::SampleDataPath("demo_walk.bvh").string(), "generated",
                                "", true);
   EXPECT_TRUE(made.ok()) << made.error().ToString();
@@ -42,7 +42,7 @@ app::AutoRig Walk() {
 }
 
 TEST(AutoRig, PlacesTheDemosPatchesOnTheWalksJoints) {
-  const app::AutoRig a = Walk();
+  const app::AutoRig a = AutoRigOfTheWalk();
   ASSERT_EQ(a.rig.patches.size(), 12u);
   const std::pair<const char*, const char*> expected[] = {
       {"left_elbow_back", "LeftForeArm"}, {"left_biceps", "LeftForeArm"},
@@ -91,7 +91,7 @@ TEST(AutoRig, QuadrupedGetsAnElasticBellyUnderItsSpineAndANote) {
 }
 
 TEST(AutoRig, WrittenRigReadsBackToTheSameRig) {
-  const app::AutoRig a = Walk();
+  const app::AutoRig a = AutoRigOfTheWalk();
   const fs::path dir = testsupport::TestDir("auto_rig");
   auto text = app::WriteRigJson(a.rig, dir.string());
   ASSERT_TRUE(text.ok()) << text.error().ToString();
@@ -140,7 +140,7 @@ TEST(AutoRig, WrittenRigReadsBackToTheSameRig) {
 }
 
 // Renders frames 0, 20, 40 of the jump into `folder` with `args` first.
-void Render(std::vector<std::string> args, const fs::path& folder) {
+void RenderAutoRig(std::vector<std::string> args, const fs::path& folder) {
   for (const char* a : {"--frames", "0:40:20", "--size", "320x180", "--supersample", "1", "--quiet",
                         "--no-video", "--no-sheet", "--out"}) {
     args.push_back(a);
@@ -150,7 +150,7 @@ void Render(std::vector<std::string> args, const fs::path& folder) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
 }
 
-// Frames 0, 20 and 40 (as Render writes them) are the same bytes in folders
+// Frames 0, 20 and 40 (as RenderAutoRig writes them) are the same bytes in folders
 // `a` and `b`, and each differs from the one in `other` (else the comparison
 // would show nothing).
 void ExpectSameFramesUnlikeThird(const fs::path& a, const fs::path& b, const fs::path& other,
@@ -173,9 +173,9 @@ TEST(AutoRig, RigFileRendersTheFramesOfLayerAuto) {
       testsupport::RunPatchskin({"rig", "auto", capture, "--out", rig.string()}, dir / "logs");
   ASSERT_EQ(written.exit_code, 0) << written.err;
   EXPECT_NE(written.err.find("patches"), std::string::npos);
-  Render({"render", capture, "--layer", "auto"}, dir / "layer");
-  Render({"render", rig.string()}, dir / "rig");
-  Render({"render", capture}, dir / "global");
+  RenderAutoRig({"render", capture, "--layer", "auto"}, dir / "layer");
+  RenderAutoRig({"render", rig.string()}, dir / "rig");
+  RenderAutoRig({"render", capture}, dir / "global");
   // The layer view is the comparison: twice the body, so not the global image.
   ExpectSameFramesUnlikeThird(dir / "layer", dir / "rig", dir / "global", "rig.json and --layer auto differ");
 }
@@ -190,9 +190,9 @@ TEST(AutoRig, RigRecordsTheUpAxisItWasMadeWith) {
       {"rig", "auto", capture, "--up", "z", "--out", rig.string()}, dir / "logs");
   ASSERT_EQ(written.exit_code, 0) << written.err;
   EXPECT_NE(testsupport::SlurpFile(rig).find(R"("up": "z")"), std::string::npos) << testsupport::SlurpFile(rig);
-  Render({"render", capture, "--layer", "auto", "--up", "z"}, dir / "layer_z");
-  Render({"render", rig.string()}, dir / "rig_z");
-  Render({"render", capture, "--layer", "auto"}, dir / "layer_detected");
+  RenderAutoRig({"render", capture, "--layer", "auto", "--up", "z"}, dir / "layer_z");
+  RenderAutoRig({"render", rig.string()}, dir / "rig_z");
+  RenderAutoRig({"render", capture, "--layer", "auto"}, dir / "layer_detected");
   ExpectSameFramesUnlikeThird(dir / "layer_z", dir / "rig_z", dir / "layer_detected", "the rig lost --up z");
 }
 

@@ -21,7 +21,7 @@
 namespace {
 
 // The walk (90 frames: past the follow camera's 60-frame window).
-app::Character Walk() {
+app::Character WalkCharacter() {
   auto source = app::LoadMotionSource(testsupport::SampleDataPath("demo_walk.bvh").string(), {.y_up = true});
   EXPECT_TRUE(source.ok());
   auto character = app::MakeCharacter(std::move(*source));
@@ -30,7 +30,7 @@ app::Character Walk() {
 }
 
 struct Scene {
-  app::Character character = Walk();
+  app::Character character = WalkCharacter();
   app::FramePlan plan;
   std::optional<app::FramePipeline> pipeline;
   Scene() {

@@ -19,6 +19,8 @@
 
 namespace {
 
+using testsupport::TestDir;
+
 namespace fs = std::filesystem;
 using testsupport::ProcessResult;
 
@@ -27,8 +29,6 @@ fs::path Samples(const std::string& name) {
 }
 
 // A fresh folder per test (ctest runs the tests of this file as parallel processes).
-fs::path Dir() { return testsupport::TestDir("check_command"); }
-
 void WriteText(const fs::path& path, const std::string& text) {
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   out << text;
@@ -42,7 +42,7 @@ struct Project {
 
 Project MakeProject() {
   Project p;
-  p.dir = Dir();
+  p.dir = TestDir();
   fs::remove_all(p.dir);
   fs::create_directories(p.dir / "rigs");
   fs::copy_file(Samples("data/elbow_knee.json"), p.dir / "rigs/elbow_knee.json");
@@ -285,7 +285,7 @@ TEST(CheckCommand, WarningsErrorsAndBadManifests) {
 
 // The README's sample: the first run writes its references, the second passes.
 TEST(CheckCommand, SampleManifestRunsAsDocumented) {
-  const fs::path dir = Dir();
+  const fs::path dir = TestDir();
   fs::remove_all(dir);
   const std::vector<std::string> base{"check", Samples("check/manifest.json").string(), "--out",
                                       (dir / "out").string(), "--references",

@@ -19,12 +19,10 @@
 
 namespace {
 
+using testsupport::TestDir;
+
 namespace fs = std::filesystem;
 using testsupport::SlurpFile;
-
-const fs::path kSamples = fs::path(GOLDEN_DIR) / ".." / ".." / "samples" / "data";
-
-fs::path Dir() { return testsupport::TestDir("chunked_render"); }
 
 // Renders `input` (empty: the demo) frames `frames` into folder/f_####.png.
 void Render(const std::string& input, const std::string& frames, const fs::path& folder,
@@ -42,19 +40,12 @@ void Render(const std::string& input, const std::string& frames, const fs::path&
   ASSERT_EQ(r.exit_code, 0) << frames << ": " << r.err;
 }
 
-std::vector<fs::path> Files(const fs::path& folder) {
-  std::vector<fs::path> out;
-  for (const auto& e : fs::directory_iterator(folder)) out.push_back(e.path());
-  std::sort(out.begin(), out.end());
-  return out;
-}
-
 // Whole 0:29 vs chunks of ten; every frame byte-identical.
 void ExpectChunksMatchWhole(const std::string& input, const std::vector<std::string>& extra = {}) {
-  const fs::path dir = Dir();
+  const fs::path dir = TestDir();
   Render(input, "0:29", dir / "whole", extra);
   for (const char* chunk : {"0:9", "10:19", "20:29"}) Render(input, chunk, dir / "chunks", extra);
-  const std::vector<fs::path> whole = Files(dir / "whole"), chunks = Files(dir / "chunks");
+  const std::vector<fs::path> whole = testsupport::FilesIn(dir / "whole"), chunks = testsupport::FilesIn(dir / "chunks");
   ASSERT_EQ(whole.size(), 30u);
   ASSERT_EQ(chunks.size(), 30u);
   for (std::size_t i = 0; i < whole.size(); ++i) {
@@ -67,11 +58,11 @@ void ExpectChunksMatchWhole(const std::string& input, const std::vector<std::str
 TEST(ChunkedRender, DemoWithTheFollowCameraMatchesTheWholeRender) { ExpectChunksMatchWhole(""); }
 
 TEST(ChunkedRender, BvhWithTheFollowCameraMatchesTheWholeRender) {
-  ExpectChunksMatchWhole((kSamples / "bend.bvh").string(), {"--global", "dqs"});
+  ExpectChunksMatchWhole(testsupport::SampleDataPath("bend.bvh").string(), {"--global", "dqs"});
 }
 
 TEST(ChunkedRender, BvhWithTheFixedCameraMatchesTheWholeRender) {
-  ExpectChunksMatchWhole((kSamples / "bend.bvh").string(), {"--camera", "fixed"});
+  ExpectChunksMatchWhole(testsupport::SampleDataPath("bend.bvh").string(), {"--camera", "fixed"});
 }
 
 TEST(ChunkedRender, RigWithPatchesMatchesTheWholeRender) {
@@ -79,7 +70,7 @@ TEST(ChunkedRender, RigWithPatchesMatchesTheWholeRender) {
   fs::create_directories(dir);
   const fs::path rig = dir / "patches.json";
   std::ofstream(rig) << R"({"character": "mannequin", "motion": {"file": ")"
-                     << fs::absolute(kSamples / "bend.bvh").lexically_normal().string()
+                     << testsupport::SampleDataPath("bend.bvh").string()
                      << R"("}, "global": "ssd", "patches": [)"
                      << R"({"name": "left_elbow", "region": {"joint": "LeftForeArm", "radius": 14,)"
                      << R"( "side": [0, 0, 1], "half_angle_deg": 120}, "parametrization": "cylinder",)"
@@ -93,25 +84,25 @@ TEST(ChunkedRender, RigWithPatchesMatchesTheWholeRender) {
 // camera frames samples of the whole motion. The example-shape demos at their
 // own cameras, side by side, with patches and examples.
 TEST(ChunkedRender, LookAtTheElbowFromTheSideMatchesTheWholeRender) {
-  ExpectChunksMatchWhole((kSamples / "bend.bvh").string(),
+  ExpectChunksMatchWhole(testsupport::SampleDataPath("bend.bvh").string(),
                          {"--look-at", "LeftForeArm", "--azimuth", "90", "--zoom", "1.5",
                           "--compare", "ssd,dqs"});
 }
 
 TEST(ChunkedRender, FixedCameraOnAJointMatchesTheWholeRender) {
-  ExpectChunksMatchWhole((kSamples / "bend.bvh").string(),
+  ExpectChunksMatchWhole(testsupport::SampleDataPath("bend.bvh").string(),
                          {"--camera", "fixed", "--look-at", "LeftLeg", "--elevation", "-10",
                           "--distance", "60"});
 }
 
 TEST(ChunkedRender, DemoRigAtItsOwnCameraMatchesTheWholeRender) {
-  ExpectChunksMatchWhole((kSamples / "elbow.json").string(), {"--threads", "2"});
+  ExpectChunksMatchWhole(testsupport::SampleDataPath("elbow.json").string(), {"--threads", "2"});
 }
 
 // The overlays of the layer (the delta's scale is the frame's own), the
 // timecode and a transparent background, on an elastic demo (state carried).
 TEST(ChunkedRender, OverlaysLabelsAndTransparencyMatchTheWholeRender) {
-  ExpectChunksMatchWhole((kSamples / "jowl.json").string(),
+  ExpectChunksMatchWhole(testsupport::SampleDataPath("jowl.json").string(),
                          {"--overlay", "delta,patches,wire", "--label", "timecode", "--background",
                           "transparent", "--threads", "3"});
 }

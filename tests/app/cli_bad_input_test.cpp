@@ -17,26 +17,23 @@
 
 #include <gtest/gtest.h>
 
+#include "support/cli_outputs.h"
 #include "support/data_paths.h"
 #include "support/run_process.h"
 
 namespace {
 
+using testsupport::RunPatchskin;
+using testsupport::ExpectNoOutput;
+using testsupport::kExitBadInput;
+using testsupport::OutDir;
+using testsupport::TestDir;
+
 namespace fs = std::filesystem;
 using testsupport::ProcessResult;
 
-constexpr int kBadInput = 2;
-
 // A fresh folder per test (ctest runs each test as its own process).
-fs::path Dir() { return testsupport::TestDir("cli_bad_input"); }
-
-fs::path OutDir() { return Dir() / "out"; }
-
-ProcessResult Patchskin(std::vector<std::string> args) {
-  return testsupport::RunPatchskin(args, Dir() / "logs");
-}
-
-ProcessResult Render(const std::string& input, std::vector<std::string> extra = {}) {
+ProcessResult RenderInput(const std::string& input, std::vector<std::string> extra = {}) {
   std::vector<std::string> args{"render"};
   if (!input.empty()) args.push_back(input);
   if (std::find(extra.begin(), extra.end(), "--size") == extra.end()) {
@@ -44,21 +41,14 @@ ProcessResult Render(const std::string& input, std::vector<std::string> extra = 
   }
   args.insert(args.end(), {"--quiet", "--out", (OutDir() / "f_####.png").string()});
   args.insert(args.end(), extra.begin(), extra.end());
-  return Patchskin(args);
+  return RunPatchskin(args);
 }
 
 // No file (not even a temporary one) was created where the frames would go.
-void ExpectNoOutput() {
-  if (!fs::exists(OutDir())) return;
-  for (const auto& e : fs::recursive_directory_iterator(OutDir())) {
-    ADD_FAILURE() << "unexpected output " << e.path();
-  }
-}
-
 // Exit 2; first stderr line "<file>[:line[:col]]: error: ..." holding `expect`.
 void ExpectBadInput(const ProcessResult& r, const std::string& file, bool with_line,
                     const std::string& expect) {
-  EXPECT_EQ(r.exit_code, kBadInput) << r.err;
+  EXPECT_EQ(r.exit_code, kExitBadInput) << r.err;
   const std::string first = r.FirstErrLine();
   const std::string loc = with_line ? "(:[0-9]+)(:[0-9]+)?" : "(:[0-9]+)?(:[0-9]+)?(: [^:]+)?";
   // Regex-escape the file name.
@@ -92,27 +82,27 @@ const BvhCase kBvhCases[] = {
 TEST(CliBadInput, InspectMalformedBvh) {
   for (const BvhCase& c : kBvhCases) {
     SCOPED_TRACE(c.file);
-    ExpectBadInput(Patchskin({"inspect", BadBvh(c.file)}), BadBvh(c.file), true, c.expect);
+    ExpectBadInput(RunPatchskin({"inspect", BadBvh(c.file)}), BadBvh(c.file), true, c.expect);
   }
 }
 
 TEST(CliBadInput, RenderMalformedBvh) {
   for (const BvhCase& c : kBvhCases) {
     SCOPED_TRACE(c.file);
-    ExpectBadInput(Render(BadBvh(c.file)), BadBvh(c.file), true, c.expect);
+    ExpectBadInput(RenderInput(BadBvh(c.file)), BadBvh(c.file), true, c.expect);
     ExpectNoOutput();
   }
 }
 
 TEST(CliBadInput, BinaryNoiseAsBvh) {
-  const fs::path noise = Dir() / "noise.bvh";
+  const fs::path noise = TestDir() / "noise.bvh";
   {
     std::mt19937 rng(9);
     std::ofstream f(noise, std::ios::binary);
     for (int i = 0; i < 4096; ++i) f.put(static_cast<char>(rng() & 0xff));
   }
-  ExpectBadInput(Patchskin({"inspect", noise.string()}), noise.string(), true, "HIERARCHY");
-  ExpectBadInput(Render(noise.string()), noise.string(), true, "HIERARCHY");
+  ExpectBadInput(RunPatchskin({"inspect", noise.string()}), noise.string(), true, "HIERARCHY");
+  ExpectBadInput(RenderInput(noise.string()), noise.string(), true, "HIERARCHY");
   ExpectNoOutput();
 }
 
@@ -125,42 +115,42 @@ TEST(CliBadInput, MalformedGltf) {
   };
   for (const auto& [file, expect] : cases) {
     SCOPED_TRACE(file);
-    ExpectBadInput(Patchskin({"inspect", BadGltf(file)}), BadGltf(file), false, expect);
-    ExpectBadInput(Render(BadGltf(file)), BadGltf(file), false, expect);
+    ExpectBadInput(RunPatchskin({"inspect", BadGltf(file)}), BadGltf(file), false, expect);
+    ExpectBadInput(RenderInput(BadGltf(file)), BadGltf(file), false, expect);
     ExpectNoOutput();
   }
 }
 
 TEST(CliBadInput, EmptyGltf) {
-  const fs::path empty = Dir() / "empty.gltf";
+  const fs::path empty = TestDir() / "empty.gltf";
   std::ofstream(empty).close();
-  ExpectBadInput(Render(empty.string()), empty.string(), false, "tinygltf");
+  ExpectBadInput(RenderInput(empty.string()), empty.string(), false, "tinygltf");
   ExpectNoOutput();
 }
 
 TEST(CliBadInput, DirectoryWhereAFileBelongs) {
-  const fs::path folder = Dir() / "walk.bvh";
+  const fs::path folder = TestDir() / "walk.bvh";
   fs::create_directories(folder);
-  ExpectBadInput(Patchskin({"inspect", folder.string()}), folder.string(), false, "found a directory");
-  ExpectBadInput(Render(folder.string()), folder.string(), false, "found a directory");
+  ExpectBadInput(RunPatchskin({"inspect", folder.string()}), folder.string(), false, "found a directory");
+  ExpectBadInput(RenderInput(folder.string()), folder.string(), false, "found a directory");
   ExpectNoOutput();
 }
 
 TEST(CliBadInput, MissingFile) {
-  const std::string missing = (Dir() / "missing.bvh").string();
-  ExpectBadInput(Render(missing), missing, false, "no such file");
+  const std::string missing = (TestDir() / "missing.bvh").string();
+  ExpectBadInput(RenderInput(missing), missing, false, "no such file");
   ExpectNoOutput();
 }
 
 TEST(CliBadInput, UnknownExtension) {
-  const fs::path txt = Dir() / "walk.txt";
+  const fs::path txt = TestDir() / "walk.txt";
   std::ofstream(txt) << "HIERARCHY\n";
-  ExpectBadInput(Render(txt.string()), txt.string(), false, "expected a .bvh, .gltf or .glb");
+  ExpectBadInput(RenderInput(txt.string()), txt.string(), false, "expected a .bvh, .gltf or .glb");
   ExpectNoOutput();
 }
 
 TEST(CliBadInput, UnreadableFile) {
-  const fs::path locked = Dir() / "locked.bvh";
+  const fs::path locked = TestDir() / "locked.bvh";
   fs::copy_file(testsupport::TestDataPath("../../samples/data/demo_walk.bvh"), locked,
                 fs::copy_options::overwrite_existing);
   ASSERT_EQ(chmod(locked.c_str(), 0), 0);
@@ -168,8 +158,8 @@ TEST(CliBadInput, UnreadableFile) {
     chmod(locked.c_str(), 0644);
     GTEST_SKIP() << "running as root (or with CAP_DAC_OVERRIDE): a mode-000 file is still readable";
   }
-  const ProcessResult inspect = Patchskin({"inspect", locked.string()});
-  const ProcessResult render = Render(locked.string());
+  const ProcessResult inspect = RunPatchskin({"inspect", locked.string()});
+  const ProcessResult render = RenderInput(locked.string());
   chmod(locked.c_str(), 0644);
   ExpectBadInput(inspect, locked.string(), false, "open");
   ExpectBadInput(render, locked.string(), false, "open");
@@ -213,8 +203,8 @@ TEST(CliBadInput, BadRenderOptions) {
   };
   for (const auto& c : cases) {
     SCOPED_TRACE(c.args[0] + " " + c.args[1]);
-    const ProcessResult r = Render("", c.args);
-    EXPECT_EQ(r.exit_code, kBadInput) << r.err;
+    const ProcessResult r = RenderInput("", c.args);
+    EXPECT_EQ(r.exit_code, kExitBadInput) << r.err;
     EXPECT_EQ(r.FirstErrLine().rfind(std::string(c.option) + ": error: ", 0), 0u) << r.err;
     EXPECT_NE(r.FirstErrLine().find(c.expect), std::string::npos) << r.err;
     ExpectNoOutput();
@@ -222,8 +212,8 @@ TEST(CliBadInput, BadRenderOptions) {
 }
 
 TEST(CliBadInput, OutputPatternWithoutPlaceholder) {
-  const ProcessResult r = Patchskin({"render", "--quiet", "--out", (OutDir() / "frame.png").string()});
-  EXPECT_EQ(r.exit_code, kBadInput) << r.err;
+  const ProcessResult r = RunPatchskin({"render", "--quiet", "--out", (OutDir() / "frame.png").string()});
+  EXPECT_EQ(r.exit_code, kExitBadInput) << r.err;
   EXPECT_EQ(r.FirstErrLine().rfind("--out: error: ", 0), 0u) << r.err;
   EXPECT_NE(r.FirstErrLine().find("placeholder"), std::string::npos) << r.err;
   ExpectNoOutput();

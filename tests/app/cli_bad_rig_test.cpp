@@ -16,43 +16,36 @@
 #include <gtest/gtest.h>
 
 #include "app/rig_file.h"
+#include "support/cli_outputs.h"
 #include "support/data_paths.h"
 #include "support/run_process.h"
 
 namespace {
 
+using testsupport::ExpectNoOutput;
+using testsupport::kExitBadInput;
+using testsupport::OutDir;
+using testsupport::TestDir;
+
 namespace fs = std::filesystem;
 using testsupport::ProcessResult;
 
-constexpr int kBadInput = 2;
-
-fs::path Dir() { return testsupport::TestDir("cli_bad_rig"); }
-
-fs::path OutDir() { return Dir() / "out"; }
-
 ProcessResult RenderRig(const std::string& rig) {
   return testsupport::RunPatchskin(
-      {"render", rig, "--quiet", "--out", (OutDir() / "f_####.png").string()}, Dir() / "logs");
-}
-
-void ExpectNoOutput() {
-  if (!fs::exists(OutDir())) return;
-  for (const auto& e : fs::recursive_directory_iterator(OutDir())) {
-    ADD_FAILURE() << "unexpected output " << e.path();
-  }
+      {"render", rig, "--quiet", "--out", (OutDir() / "f_####.png").string()}, TestDir() / "logs");
 }
 
 // Exit 2 and a first stderr line "<file>[:line:col][: field]: error: ..." that
 // starts with `file` and holds `expect`.
-void ExpectBadInput(const ProcessResult& r, const std::string& file, const std::string& expect) {
-  EXPECT_EQ(r.exit_code, kBadInput) << r.err;
+void ExpectRigRefused(const ProcessResult& r, const std::string& file, const std::string& expect) {
+  EXPECT_EQ(r.exit_code, kExitBadInput) << r.err;
   const std::string first = r.FirstErrLine();
   EXPECT_EQ(first.rfind(file, 0), 0u) << "first stderr line: " << first;
   EXPECT_NE(first.find(": error: "), std::string::npos) << "first stderr line: " << first;
   EXPECT_NE(first.find(expect), std::string::npos) << "first stderr line: " << first;
 }
 
-std::string BadRig(const std::string& name) {
+std::string BadRigPath(const std::string& name) {
   return testsupport::TestDataPath("rig/bad/" + name).lexically_normal().string();
 }
 
@@ -105,33 +98,33 @@ TEST(CliBadRig, EveryCorpusFileIsRefusedWithItsMessage) {
   EXPECT_EQ(files, std::size(kRigCases)) << "every corpus file needs a row here";
   for (const RigCase& c : kRigCases) {
     SCOPED_TRACE(c.file);
-    const std::string rig = BadRig(c.file);
+    const std::string rig = BadRigPath(c.file);
     const fs::path folder = fs::path(rig).parent_path();
     const std::string named = !c.file_in_message ? rig
                               : *c.file_in_message ? (folder / c.file_in_message).string()
                                                    : folder.string();
-    ExpectBadInput(RenderRig(rig), named, c.expect);
+    ExpectRigRefused(RenderRig(rig), named, c.expect);
     ExpectNoOutput();
   }
 }
 
 TEST(CliBadRig, FolderWhereTheRigBelongs) {
-  const fs::path folder = Dir() / "rig.json";
+  const fs::path folder = TestDir() / "rig.json";
   fs::create_directories(folder);
-  ExpectBadInput(RenderRig(folder.string()), folder.string(),
+  ExpectRigRefused(RenderRig(folder.string()), folder.string(),
                  "error: expected a rig file, found a directory");
   ExpectNoOutput();
 }
 
 TEST(CliBadRig, MissingRig) {
-  const std::string missing = (Dir() / "missing.json").string();
-  ExpectBadInput(RenderRig(missing), missing, "error: no such file");
+  const std::string missing = (TestDir() / "missing.json").string();
+  ExpectRigRefused(RenderRig(missing), missing, "error: no such file");
   ExpectNoOutput();
 }
 
 TEST(CliBadRig, UnreadableRig) {
-  const fs::path locked = Dir() / "locked.json";
-  fs::copy_file(BadRig("size_absurd.json"), locked, fs::copy_options::overwrite_existing);
+  const fs::path locked = TestDir() / "locked.json";
+  fs::copy_file(BadRigPath("size_absurd.json"), locked, fs::copy_options::overwrite_existing);
   ASSERT_EQ(chmod(locked.c_str(), 0), 0);
   if (access(locked.c_str(), R_OK) == 0) {
     chmod(locked.c_str(), 0644);
@@ -139,15 +132,15 @@ TEST(CliBadRig, UnreadableRig) {
   }
   const ProcessResult r = RenderRig(locked.string());
   chmod(locked.c_str(), 0644);
-  ExpectBadInput(r, locked.string(), "error: cannot open the rig file");
+  ExpectRigRefused(r, locked.string(), "error: cannot open the rig file");
   ExpectNoOutput();
 }
 
 TEST(CliBadRig, RigOverTheSizeLimitIsRefusedBeforeReading) {
-  const fs::path huge = Dir() / "huge.json";
+  const fs::path huge = TestDir() / "huge.json";
   std::ofstream(huge).close();
   fs::resize_file(huge, app::kMaxRigFileBytes + 1);  // sparse: no disk used
-  ExpectBadInput(RenderRig(huge.string()), huge.string(),
+  ExpectRigRefused(RenderRig(huge.string()), huge.string(),
                  "error: expected a rig file of at most 16 MiB, found 16777217 bytes");
   ExpectNoOutput();
 }
@@ -156,7 +149,7 @@ TEST(CliBadRig, RigOverTheSizeLimitIsRefusedBeforeReading) {
 TEST(CliBadRig, ParseRigAnswersEveryCorpusFileWithAnError) {
   for (const RigCase& c : kRigCases) {
     SCOPED_TRACE(c.file);
-    std::ifstream in(BadRig(c.file), std::ios::binary);
+    std::ifstream in(BadRigPath(c.file), std::ios::binary);
     const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
     const mocap::Result<app::Rig> rig = app::ParseRig(text, "r.json");
     // The motion and the frame range are checked when rendering, not parsing.

@@ -17,16 +17,16 @@
 
 namespace {
 
+using testsupport::TestDir;
+
 namespace fs = std::filesystem;
 using testsupport::ProcessResult;
 
 // One folder per test: ctest runs the tests of this file as parallel processes.
-fs::path Dir() { return testsupport::TestDir("compare_command"); }
-
-ProcessResult Patchskin(const std::vector<std::string>& args) {
+ProcessResult RunCompare(const std::vector<std::string>& args) {
   std::vector<std::string> all{"compare"};
   all.insert(all.end(), args.begin(), args.end());
-  return testsupport::RunPatchskin(all, Dir() / "patchskin_log");
+  return testsupport::RunPatchskin(all, TestDir() / "patchskin_log");
 }
 
 // 100x100 mid grey, with `changed` pixels of row 7 brightened by `steps` 8-bit codes.
@@ -36,7 +36,7 @@ std::string MakePng(const std::string& name, int changed, int steps, int width =
   for (int i = 0; i < changed; ++i) {
     img.at(i, 7).r = render::Srgb8ToLinear(static_cast<std::uint8_t>(128 + steps));
   }
-  const std::string path = (Dir() / name).string();
+  const std::string path = (TestDir() / name).string();
   EXPECT_TRUE(render::WriteImage(img, path));
   return path;
 }
@@ -46,7 +46,7 @@ std::string MakeExr(const std::string& name, float z) {
   render::Image img(40, 30, glm::vec4(0.25f, 0.5f, 0.75f, 1.0f));
   img.depth.assign(img.rgba.size(), z);
   for (int x = 0; x < 40; ++x) img.at(x, 3).g = 0.01f * static_cast<float>(x);
-  const std::string path = (Dir() / name).string();
+  const std::string path = (TestDir() / name).string();
   EXPECT_TRUE(render::WriteImage(img, path));
   return path;
 }
@@ -94,7 +94,7 @@ void ExpectSameAsIdiff(const std::string& a, const std::string& b,
   std::vector<std::string> ours = options;
   ours.push_back(a);
   ours.push_back(b);
-  const ProcessResult p = Patchskin(ours);
+  const ProcessResult p = RunCompare(ours);
   EXPECT_EQ(p.exit_code, expected_exit) << p.out << p.err;
   const std::string idiff = testsupport::FindProgram("idiff");
   if (idiff.empty()) {
@@ -103,7 +103,7 @@ void ExpectSameAsIdiff(const std::string& a, const std::string& b,
   }
   std::vector<std::string> theirs{"-v"};
   theirs.insert(theirs.end(), ours.begin(), ours.end());
-  const ProcessResult i = testsupport::RunProgram(idiff, theirs, Dir() / "idiff_log");
+  const ProcessResult i = testsupport::RunProgram(idiff, theirs, TestDir() / "idiff_log");
   ASSERT_EQ(p.exit_code, i.exit_code) << "patchskin:\n" << p.out << p.err << "idiff:\n" << i.out << i.err;
   if (expected_exit == 4) return;  // an unreadable file: no figures to compare
   const Report rp = ParseReport(p.out), ri = ParseReport(i.out);
@@ -133,7 +133,7 @@ TEST(CompareCommand, IdenticalImagesPass) {
   const std::string a = MakePng("same_a.png", 0, 0);
   const std::string b = MakePng("same_b.png", 0, 0);
   ExpectSameAsIdiff(a, b, {}, 0);
-  const ProcessResult r = Patchskin({a, b});
+  const ProcessResult r = RunCompare({a, b});
   EXPECT_NE(r.out.find("Max error  = 0\n"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("Peak SNR = inf"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("\nPASS\n"), std::string::npos);
@@ -144,7 +144,7 @@ TEST(CompareCommand, SlightDifferenceFailsAtIdiffsDefaults) {
   const std::string a = MakePng("two_a.png", 0, 0);
   const std::string b = MakePng("two_b.png", 2, 2);
   ExpectSameAsIdiff(a, b, {}, 2);
-  const ProcessResult r = Patchskin({a, b});
+  const ProcessResult r = RunCompare({a, b});
   EXPECT_NE(r.out.find("2 pixels (0.02%) over 1e-06"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("@ (0, 7, R)  values are 0.5019608, 0.5019608, 0.5019608, 1 vs "
                        "0.50980395, 0.5019608, 0.5019608, 1"),
@@ -171,17 +171,17 @@ TEST(CompareCommand, ThresholdsInBothSpellingsGiveIdiffsVerdicts) {
   ExpectSameAsIdiff(a, b, {"-allowfailures", "3", "-hardfail", "0.001"}, 0);
   ExpectSameAsIdiff(a, b, {"-allowfailures", "2"}, 2);
   // The double-dash spelling means the same.
-  EXPECT_EQ(Patchskin({"--failpercent", "0.05", a, b}).exit_code, 1);
-  EXPECT_EQ(Patchskin({"--fail", "0.01", "--warn", "0.01", a, b}).exit_code, 0);
-  EXPECT_EQ(Patchskin({"--hardfail", "0.005", "--failpercent", "0.05", a, b}).exit_code, 2);
+  EXPECT_EQ(RunCompare({"--failpercent", "0.05", a, b}).exit_code, 1);
+  EXPECT_EQ(RunCompare({"--fail", "0.01", "--warn", "0.01", a, b}).exit_code, 0);
+  EXPECT_EQ(RunCompare({"--hardfail", "0.005", "--failpercent", "0.05", a, b}).exit_code, 2);
 }
 
 TEST(CompareCommand, VeryDifferentImagesFailAndWriteADiff) {
   const std::string a = MakePng("diff_a.png", 0, 0);
   const std::string b = MakePng("diff_b.png", 100, 120);
   ExpectSameAsIdiff(a, b, {"-failpercent", "0.5", "-warnpercent", "0.5"}, 2);
-  const std::string d = (Dir() / "d.png").string();
-  const ProcessResult r = Patchskin({a, b, "--diff", d});
+  const std::string d = (TestDir() / "d.png").string();
+  const ProcessResult r = RunCompare({a, b, "--diff", d});
   EXPECT_EQ(r.exit_code, 2) << r.out << r.err;
   ASSERT_TRUE(fs::exists(d));
   auto diff = render::ReadImage(d);
@@ -195,7 +195,7 @@ TEST(CompareCommand, DifferentSizesAreComparedOverBothAsIdiffDoes) {
   const std::string a = MakePng("size_a.png", 0, 0);
   const std::string b = MakePng("size_b.png", 0, 0, 40);
   ExpectSameAsIdiff(a, b, {}, 2);
-  const ProcessResult r = Patchskin({a, b});
+  const ProcessResult r = RunCompare({a, b});
   EXPECT_NE(r.out.find("Sizes differ: 100x100 and 40x100"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("6000 pixels (60%) over 1e-06"), std::string::npos) << r.out;
 }
@@ -205,10 +205,10 @@ TEST(CompareCommand, DifferentChannelsAreComparedEveryOne) {
   const std::string a = MakePng("ch_a.png", 0, 0);
   render::Image rgb(100, 100, glm::vec4(render::Srgb8ToLinear(128), render::Srgb8ToLinear(128),
                                         render::Srgb8ToLinear(128), 1.0f));
-  const std::string b = (Dir() / "ch_b.jpg").string();
+  const std::string b = (TestDir() / "ch_b.jpg").string();
   ASSERT_TRUE(render::WriteImage(rgb, b));
   ExpectSameAsIdiff(a, b, {"-fail", "0.01", "-warn", "0.01"}, 2);
-  const ProcessResult r = Patchskin({a, b});
+  const ProcessResult r = RunCompare({a, b});
   EXPECT_NE(r.out.find("Channels differ: 4 and 3"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find(" A 1\n"), std::string::npos) << r.out;
 }
@@ -218,7 +218,7 @@ TEST(CompareCommand, ExrWithChangedDepthFails) {
   const std::string a = MakeExr("z_a.exr", 2.0f);
   const std::string b = MakeExr("z_b.exr", 4.0f);
   ExpectSameAsIdiff(a, b, {}, 2);
-  const ProcessResult r = Patchskin({a, b});
+  const ProcessResult r = RunCompare({a, b});
   EXPECT_NE(r.out.find("Max error  = 2 @ (0, 0, Z)"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("Max error per channel: R 0 G 0 B 0 A 0 Z 2\n"), std::string::npos) << r.out;
   // The same depth: a pass, also through idiff.
@@ -227,15 +227,15 @@ TEST(CompareCommand, ExrWithChangedDepthFails) {
 
 TEST(CompareCommand, MissingFileIsAnError) {
   const std::string a = MakePng("missing_a.png", 0, 0);
-  const std::string missing = (Dir() / "nope.png").string();
+  const std::string missing = (TestDir() / "nope.png").string();
   ExpectSameAsIdiff(a, missing, {}, 4);
-  const ProcessResult r = Patchskin({a, missing});
+  const ProcessResult r = RunCompare({a, missing});
   EXPECT_EQ(r.FirstErrLine(), missing + ": error: no such image file");
 }
 
 TEST(CompareCommand, UnreadableFileIsAnError) {
   const std::string a = MakePng("bad_a.png", 0, 0);
-  const std::string bad = (Dir() / "bad.png").string();
+  const std::string bad = (TestDir() / "bad.png").string();
   { std::FILE* f = std::fopen(bad.c_str(), "w"); std::fputs("not a png", f); std::fclose(f); }
   ExpectSameAsIdiff(a, bad, {}, 4);
 }
@@ -243,8 +243,8 @@ TEST(CompareCommand, UnreadableFileIsAnError) {
 TEST(CompareCommand, BadOptionIsAnError) {
   // idiff exits 1 here; patchskin 4, so that CI never takes a typo for a warning.
   const std::string a = MakePng("opt_a.png", 0, 0);
-  EXPECT_EQ(Patchskin({a, a, "--fail", "-1"}).exit_code, 4);
-  EXPECT_EQ(Patchskin({a}).exit_code, 4);
+  EXPECT_EQ(RunCompare({a, a, "--fail", "-1"}).exit_code, 4);
+  EXPECT_EQ(RunCompare({a}).exit_code, 4);
 }
 
 }  // namespace

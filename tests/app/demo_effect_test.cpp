@@ -40,15 +40,15 @@ int Level(float linear) {
   return static_cast<int>(std::lround(255.0f * render::LinearToSrgb(std::clamp(linear, 0.0f, 1.0f))));
 }
 
-struct Measured {
+struct EffectMeasure {
   int frame = 0;
   double moved = 0.0;   // largest |layered - global| over the vertices at that frame, model units
   double share = 0.0;   // of the image
   int region_pixels = 0;
 };
 
-Measured Measure(const std::string& demo) {
-  Measured m;
+EffectMeasure Measure(const std::string& demo) {
+  EffectMeasure m;
   auto rig = app::LoadRig(testsupport::SampleDataPath(demo + ".json").string());
   EXPECT_TRUE(rig.ok()) << rig.error().ToString();
   if (!rig.ok()) return m;
@@ -162,7 +162,7 @@ class DemoEffectTest : public ::testing::TestWithParam<DemoCase> {};
 
 TEST_P(DemoEffectTest, TheLayerChangesEnoughOfThePicture) {
   const DemoCase& c = GetParam();
-  const Measured m = Measure(c.demo);
+  const EffectMeasure m = Measure(c.demo);
   std::printf("%s: frame %d (layer moves the skin up to %.2f), %d pixels in the patch region, "
               "%.2f %% of the image differ by more than 8/255 (required %.1f %%)\n",
               c.demo, m.frame, m.moved, m.region_pixels, 100.0 * m.share, 100.0 * c.required);

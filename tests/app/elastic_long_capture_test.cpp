@@ -23,15 +23,15 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct Measured {
+struct ElasticRun {
   int frames = 0;
   int channels = 0;
   double peak_mb = 0.0;
 };
 
 // belly_jump.json's elastic belly patch on the generated walk of `frames` frames.
-Measured RenderElastic(const fs::path& dir, int frames) {
-  Measured m;
+ElasticRun RenderElastic(const fs::path& dir, int frames) {
+  ElasticRun m;
   m.frames = frames;
   const std::string tag = std::to_string(frames);
   const fs::path bvh = dir / ("long_" + tag + ".bvh");
@@ -75,9 +75,9 @@ TEST(ElasticLongCapture, PeakMemoryGrowsOnlyWithTheMotionDataAndTheDrivingJoints
   const fs::path dir = testsupport::TestOutputPath("elastic_long_capture/x").parent_path();
   fs::remove_all(dir);
   fs::create_directories(dir);
-  const Measured small = RenderElastic(dir, 1000);
+  const ElasticRun small = RenderElastic(dir, 1000);
   for (const int frames : {10000, 100000}) {
-    const Measured big = RenderElastic(dir, frames);
+    const ElasticRun big = RenderElastic(dir, frames);
     // Allowed growth per extra frame: its floats (#C x 4 B) and one driving
     // joint's compact kinematics while they are built (smoothed matrix 64 B +
     // JointKinematics 124 B); plus the reader's and allocator's constant

@@ -35,7 +35,7 @@ Frames Evaluate(Demo& d, int frame) {
   return f;
 }
 
-std::unique_ptr<Demo> Load(const std::string& name) {
+std::unique_ptr<Demo> LoadDemo(const std::string& name) {
   auto d = testsupport::LoadDemo(name);
   EXPECT_TRUE(d->error.empty()) << d->error;
   for (const std::string& note : d->spaces.notes) std::printf("%s: %s\n", name.c_str(), note.c_str());
@@ -56,7 +56,7 @@ std::pair<double, double> TipProtrusion(const Demo& d, const Frames& f, const ch
 }
 
 TEST(ExampleDemos, ElbowUlnaProtrudesAtTheBend) {
-  auto d = Load("elbow");
+  auto d = LoadDemo("elbow");
   ASSERT_TRUE(d->error.empty());
   // Examples at frames 30 (75 degrees) and 60 (150 degrees): the tip moved
   // out 2 and 5 cm. SSD pulls the back of the elbow onto the chord between
@@ -71,7 +71,7 @@ TEST(ExampleDemos, ElbowUlnaProtrudesAtTheBend) {
 }
 
 TEST(ExampleDemos, BicepsBulgesAsTheElbowBends) {
-  auto d = Load("biceps");
+  auto d = LoadDemo("biceps");
   ASSERT_TRUE(d->error.empty());
   // The 9x10 patch of the paper over the front of the upper arm with 5
   // examples (30..150 degrees, a brush stroke 0.6 cm higher each). The figure: the largest distance from the upper-arm bone of
@@ -110,7 +110,7 @@ TEST(ExampleDemos, BicepsBulgesAsTheElbowBends) {
 constexpr double kProfileSlab = 2.0;
 
 TEST(ExampleDemos, KneeIsRounderAtTheBend) {
-  auto d = Load("knee");
+  auto d = LoadDemo("knee");
   ASSERT_TRUE(d->error.empty());
   // A round knee keeps the curvature of the leg at rest around the joint,
   // 1 / (kneecap distance from the knee joint in the bind pose): the kneecap is
@@ -142,7 +142,7 @@ TEST(ExampleDemos, KneeIsRounderAtTheBend) {
 }
 
 TEST(ExampleDemos, ShoulderReproducesItsFiveExamplePoses) {
-  auto d = Load("shoulder");
+  auto d = LoadDemo("shoulder");
   ASSERT_TRUE(d->error.empty());
   const app::RigPatch& rp = d->rig.patches[0];
   ASSERT_EQ(rp.examples.size(), 5u);
@@ -177,7 +177,7 @@ TEST(ExampleDemos, ShoulderReproducesItsFiveExamplePoses) {
 }
 
 TEST(ExampleDemos, HipKeepsItsVolumeWhenTheLegStretchesBack) {
-  auto d = Load("hip");
+  auto d = LoadDemo("hip");
   ASSERT_TRUE(d->error.empty());
   const std::vector<glm::uvec3>& tris = d->character.mesh.bind.triangles;
   const Frames rest = Evaluate(*d, 0);

@@ -22,6 +22,8 @@
 
 namespace {
 
+using testsupport::TestDir;
+
 namespace fs = std::filesystem;
 using testsupport::GltfWriter;
 
@@ -97,11 +99,9 @@ Growth Measure(const fs::path& input, const std::string& out_name, const std::ve
   return g;
 }
 
-fs::path Dir() { return testsupport::TestDir("export_memory"); }
-
 TEST(ExportMemory, ObjSequenceDoesNotGrowWithTheFrameCount) {
   PATCHSKIN_SKIP_MEMORY_BOUND_UNDER_ASAN();
-  const fs::path dir = Dir();
+  const fs::path dir = TestDir();
   const int side = 24;  // 576 vertices: 50 KB of OBJ per frame
   const fs::path grid = WriteGrid(dir, side);
   const Growth g = Measure(grid, "mesh_####.obj", {}, dir);
@@ -113,7 +113,7 @@ TEST(ExportMemory, ObjSequenceDoesNotGrowWithTheFrameCount) {
 
 TEST(ExportMemory, GlbDoesNotHoldTheFrames) {
   PATCHSKIN_SKIP_MEMORY_BOUND_UNDER_ASAN();
-  const fs::path dir = Dir();
+  const fs::path dir = TestDir();
   const int side = 64;  // 4096 vertices: 98 KB of data per frame (~10 KB of bookkeeping)
   const fs::path grid = WriteGrid(dir, side);
   const long held = 24L * side * side * 900;

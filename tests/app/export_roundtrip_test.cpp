@@ -32,20 +32,16 @@
 
 namespace {
 
+using testsupport::TestDir;
+
 namespace fs = std::filesystem;
-
-const fs::path kSamples = fs::path(GOLDEN_DIR) / ".." / ".." / "samples" / "data";
-
-fs::path Dir() { return testsupport::TestDir("export_roundtrip"); }
-
-std::string BendBvh() { return fs::absolute(kSamples / "bend.bvh").lexically_normal().string(); }
 
 // A rig with one cylinder patch on the left elbow of the mannequin driven by
 // bend.bvh, with one example shape (a patch without any adds nothing), unsplit
 // so render draws exactly the layered mesh.
 fs::path WriteElbowRig(const fs::path& dir) {
   const fs::path rig = dir / "elbow.json";
-  std::ofstream(rig) << R"({"character": "mannequin", "motion": {"file": ")" << BendBvh() << R"("},
+  std::ofstream(rig) << R"({"character": "mannequin", "motion": {"file": ")" << testsupport::SampleDataPath("bend.bvh").string() << R"("},
     "global": "ssd",
     "patches": [{"name": "left_elbow",
                  "region": {"joint": "LeftForeArm", "radius": 14, "side": [0, 0, 1], "half_angle_deg": 120},
@@ -93,7 +89,7 @@ float MaxAbs(const std::vector<glm::vec3>& v) {
 }
 
 TEST(ExportRoundTrip, PatchRigGlbReadsBackWithOurImporter) {
-  const fs::path dir = Dir();
+  const fs::path dir = TestDir();
   const fs::path rig = WriteElbowRig(dir);
   const testsupport::ProcessResult run = testsupport::RunPatchskin(
       {"export", rig.string(), "--frames", "0:60:6", "--layout", "morph", "--quiet", "--out",
@@ -154,14 +150,14 @@ TEST(ExportRoundTrip, PatchRigGlbReadsBackWithOurImporter) {
 // (exact: identity node transforms) at key k, and every other block has
 // scale 0 (collapsed onto its node's origin).
 TEST(ExportRoundTrip, BvhBakedGlbShowsOneFramePerKey) {
-  const fs::path dir = Dir();
+  const fs::path dir = TestDir();
   const testsupport::ProcessResult run = testsupport::RunPatchskin(
-      {"export", BendBvh(), "--frames", "10:30:5", "--layout", "baked", "--global", "dqs", "--quiet",
+      {"export", testsupport::SampleDataPath("bend.bvh").string(), "--frames", "10:30:5", "--layout", "baked", "--global", "dqs", "--quiet",
        "--out", (dir / "bend.glb").string()},
       dir);
   ASSERT_EQ(run.exit_code, 0) << run.err;
 
-  auto src = app::LoadMotionSource(BendBvh(), {.y_up = true});
+  auto src = app::LoadMotionSource(testsupport::SampleDataPath("bend.bvh").string(), {.y_up = true});
   ASSERT_TRUE(src.ok());
   auto ch = app::MakeCharacter(std::move(*src), {}, app::BodyKind::kGenerated);  // export's default body
   ASSERT_TRUE(ch.ok());
@@ -205,7 +201,7 @@ TEST(ExportRoundTrip, BvhBakedGlbShowsOneFramePerKey) {
 // The OBJ of a patch rig drawn with its exported camera is the frame `render`
 // draws for that rig, pixel for pixel.
 TEST(ExportRoundTrip, PatchRigObjIsWhatRenderDrew) {
-  const fs::path dir = Dir();
+  const fs::path dir = TestDir();
   const fs::path rig = WriteElbowRig(dir);
   testsupport::ProcessResult run = testsupport::RunPatchskin(
       {"render", rig.string(), "--frames", "45:45", "--supersample", "1", "--no-sheet", "--no-video",
@@ -274,10 +270,10 @@ TEST(ExportRoundTrip, PatchRigObjIsWhatRenderDrew) {
 // scaled scene seen by the scaled camera projects every vertex where the
 // unscaled one did.
 TEST(ExportRoundTrip, ScaleMultipliesPositionsAndCameraLengths) {
-  const fs::path dir = Dir();
+  const fs::path dir = TestDir();
   for (const std::string scale : {"1", "0.01"}) {
     const testsupport::ProcessResult run = testsupport::RunPatchskin(
-        {"export", BendBvh(), "--frames", "20:20", "--with-camera", "--scale", scale, "--quiet", "--out",
+        {"export", testsupport::SampleDataPath("bend.bvh").string(), "--frames", "20:20", "--with-camera", "--scale", scale, "--quiet", "--out",
          (dir / scale / "mesh_####.obj").string()},
         dir);
     ASSERT_EQ(run.exit_code, 0) << run.err;
@@ -307,16 +303,16 @@ TEST(ExportRoundTrip, ScaleMultipliesPositionsAndCameraLengths) {
     EXPECT_NEAR(pa.y / pa.w, pb.y / pb.w, testsupport::kFloatTol * 10.0f) << v;
   }
   const testsupport::ProcessResult bad = testsupport::RunPatchskin(
-      {"export", BendBvh(), "--scale", "-1", "--quiet", "--out", (dir / "bad.glb").string()}, dir);
+      {"export", testsupport::SampleDataPath("bend.bvh").string(), "--scale", "-1", "--quiet", "--out", (dir / "bad.glb").string()}, dir);
   EXPECT_EQ(bad.exit_code, 2);
   EXPECT_NE(bad.FirstErrLine().find("--scale"), std::string::npos) << bad.err;
   EXPECT_FALSE(fs::exists(dir / "bad.glb"));
 }
 
 TEST(ExportRoundTrip, BadRigIsRefusedWithoutOutput) {
-  const fs::path dir = Dir();
+  const fs::path dir = TestDir();
   const fs::path rig = dir / "bad.json";
-  std::ofstream(rig) << R"({"character": "mannequin", "motion": {"file": ")" << BendBvh()
+  std::ofstream(rig) << R"({"character": "mannequin", "motion": {"file": ")" << testsupport::SampleDataPath("bend.bvh").string()
                      << R"("}, "patches": [{"name": "e", "region": {"joint": "Elbow", "radius": 9}}]})";
   const testsupport::ProcessResult run = testsupport::RunPatchskin(
       {"export", rig.string(), "--quiet", "--out", (dir / "out.glb").string()}, dir);
@@ -365,12 +361,12 @@ Glb ReadGlb(const fs::path& path) {
 // node keyed at every frame, in both layouts: at key k its position is the eye of
 // camera_####.json and its node transform inverted is that file's view matrix.
 TEST(ExportRoundTrip, GlbCarriesTheRenderCameraAsAnAnimatedNode) {
-  const fs::path dir = Dir();
+  const fs::path dir = TestDir();
   for (const std::string layout : {"morph", "baked"}) {
     SCOPED_TRACE(layout);
     const fs::path out = dir / ("camera_" + layout) / "bend.glb";
     const testsupport::ProcessResult run = testsupport::RunPatchskin(
-        {"export", BendBvh(), "--frames", "10:30:10", "--with-camera", "--scale", "0.01", "--layout", layout,
+        {"export", testsupport::SampleDataPath("bend.bvh").string(), "--frames", "10:30:10", "--with-camera", "--scale", "0.01", "--layout", layout,
          "--quiet", "--out", out.string()},
         dir);
     ASSERT_EQ(run.exit_code, 0) << run.err;

@@ -22,26 +22,14 @@
 #include "render/renderer.h"
 #include "support/data_paths.h"
 #include "support/exported_geometry.h"
+#include "support/run_process.h"
 #include "support/tolerances.h"
 
 namespace {
 
+using testsupport::TestDir;
+
 namespace fs = std::filesystem;
-
-fs::path Dir() { return testsupport::TestDir("export_command"); }
-
-int Patchskin(const std::string& args, const fs::path& dir) {
-  const std::string cmd = std::string("'") + PATCHSKIN_BINARY + "' " + args + " >'" +
-                          (dir / "stdout.txt").string() + "' 2>'" + (dir / "stderr.txt").string() +
-                          "'";
-  const int status = std::system(cmd.c_str());
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-
-std::string Slurp(const fs::path& p) {
-  std::ifstream in(p);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
 
 // The demo character, loaded as render loads it.
 app::Character Demo() {
@@ -69,13 +57,19 @@ void ExpectJsonMat(const nlohmann::json& j, const glm::mat4& m, float tol) {
   }
 }
 
+// The exit code of `patchskin ARGS` (one shell line); its stdout.txt and
+// stderr.txt go to `dir`.
+int PatchskinExit(const std::string& args, const fs::path& dir) {
+  return testsupport::RunPatchskinLine(args, dir).exit_code;
+}
+
 TEST(ExportCommand, ObjFramesAreThePipelineFramesAndCamerasAreRenders) {
-  const fs::path dir = Dir();
-  ASSERT_EQ(Patchskin("export --frames 10:40:10 --global dqs --with-camera --size 320x200 "
+  const fs::path dir = TestDir();
+  ASSERT_EQ(PatchskinExit("export --frames 10:40:10 --global dqs --with-camera --size 320x200 "
                       "--quiet --out '" + (dir / "mesh_####.obj").string() + "'",
                       dir),
             0)
-      << Slurp(dir / "stderr.txt");
+      << testsupport::SlurpFile(dir / "stderr.txt");
 
   const app::Character ch = Demo();
   mocap::Result<app::FramePlan> plan = app::PlanFrames(ch.motion, {.frames = "10:40:10"});
@@ -103,7 +97,7 @@ TEST(ExportCommand, ObjFramesAreThePipelineFramesAndCamerasAreRenders) {
     EXPECT_EQ(obj.triangles, ch.mesh.bind.triangles);
 
     std::snprintf(name, sizeof(name), "camera_%04d.json", of.number);
-    const nlohmann::json j = nlohmann::json::parse(Slurp(dir / name));
+    const nlohmann::json j = nlohmann::json::parse(testsupport::SlurpFile(dir / name));
     const render::Camera cam = cameras->At(of);
     EXPECT_EQ(j["frame"].get<int>(), of.number);
     EXPECT_EQ(j["width"].get<int>(), 320);
@@ -132,12 +126,12 @@ TEST(ExportCommand, ObjFramesAreThePipelineFramesAndCamerasAreRenders) {
 }
 
 TEST(ExportCommand, GlbGivesEachFrameAtItsTime) {
-  const fs::path dir = Dir();
-  ASSERT_EQ(Patchskin("export --frames 0:20:4 --quiet --out '" + (dir / "walk.glb").string() + "'",
+  const fs::path dir = TestDir();
+  ASSERT_EQ(PatchskinExit("export --frames 0:20:4 --quiet --out '" + (dir / "walk.glb").string() + "'",
                       dir),
             0)
-      << Slurp(dir / "stderr.txt");
-  EXPECT_NE(Slurp(dir / "stdout.txt").find("morph"), std::string::npos);
+      << testsupport::SlurpFile(dir / "stderr.txt");
+  EXPECT_NE(testsupport::SlurpFile(dir / "stdout.txt").find("morph"), std::string::npos);
   tinygltf::Model m;
   std::string msg;
   ASSERT_TRUE(testsupport::LoadGlb((dir / "walk.glb").string(), m, msg)) << msg;
@@ -169,22 +163,22 @@ TEST(ExportCommand, GlbGivesEachFrameAtItsTime) {
 // `patchskin render`, then draw the exported OBJ from the exported camera JSON
 // with the same renderer settings; the two PNGs must be identical.
 TEST(ExportCommand, ObjDrawnWithItsCameraJsonIsTheRenderedFrame) {
-  const fs::path dir = Dir();
+  const fs::path dir = TestDir();
   const std::string common = " --frames 12:12 --size 96x64 --camera fixed --quiet ";
-  ASSERT_EQ(Patchskin("render" + common + "--supersample 1 --no-sheet --no-video --out '" +
+  ASSERT_EQ(PatchskinExit("render" + common + "--supersample 1 --no-sheet --no-video --out '" +
                           (dir / "frame_####.png").string() + "'",
                       dir),
             0)
-      << Slurp(dir / "stderr.txt");
-  ASSERT_EQ(Patchskin("export" + common + "--with-camera --out '" +
+      << testsupport::SlurpFile(dir / "stderr.txt");
+  ASSERT_EQ(PatchskinExit("export" + common + "--with-camera --out '" +
                           (dir / "mesh_####.obj").string() + "'",
                       dir),
             0)
-      << Slurp(dir / "stderr.txt");
+      << testsupport::SlurpFile(dir / "stderr.txt");
 
   const testsupport::ParsedObj obj = testsupport::ParseObjFile((dir / "mesh_0012.obj").string());
   ASSERT_TRUE(obj.error.empty()) << obj.error;
-  const nlohmann::json j = nlohmann::json::parse(Slurp(dir / "camera_0012.json"));
+  const nlohmann::json j = nlohmann::json::parse(testsupport::SlurpFile(dir / "camera_0012.json"));
   render::Camera cam;
   for (int c = 0; c < 3; ++c) {
     const auto i = static_cast<std::size_t>(c);
@@ -230,28 +224,28 @@ TEST(ExportCommand, ObjDrawnWithItsCameraJsonIsTheRenderedFrame) {
 // --scale 0 converts the detected units (the demo is in centimetres) to metres,
 // as inspect --scale 0 does: the same bytes as --scale 0.01.
 TEST(ExportCommand, ScaleZeroConvertsTheDetectedUnitsToMetres) {
-  const fs::path dir = Dir();
+  const fs::path dir = TestDir();
   for (const char* scale : {"0", "0.01", "1"}) {
-    ASSERT_EQ(Patchskin(std::string("export --frames 12:12 --quiet --scale ") + scale + " --out '" +
+    ASSERT_EQ(PatchskinExit(std::string("export --frames 12:12 --quiet --scale ") + scale + " --out '" +
                             (dir / (std::string("s") + scale + "_####.obj")).string() + "'",
                         dir),
               0)
-        << Slurp(dir / "stderr.txt");
+        << testsupport::SlurpFile(dir / "stderr.txt");
   }
-  const std::string automatic = Slurp(dir / "s0_0012.obj"), metres = Slurp(dir / "s0.01_0012.obj");
+  const std::string automatic = testsupport::SlurpFile(dir / "s0_0012.obj"), metres = testsupport::SlurpFile(dir / "s0.01_0012.obj");
   ASSERT_FALSE(automatic.empty());
   EXPECT_EQ(automatic, metres);
-  EXPECT_NE(automatic, Slurp(dir / "s1_0012.obj"));
+  EXPECT_NE(automatic, testsupport::SlurpFile(dir / "s1_0012.obj"));
 }
 
 TEST(ExportCommand, BadArgumentsAreRefused) {
-  const fs::path dir = Dir();
-  EXPECT_EQ(Patchskin("export --quiet --out '" + (dir / "mesh.obj").string() + "'", dir), 2);
-  EXPECT_NE(Slurp(dir / "stderr.txt").find("placeholder"), std::string::npos);
-  EXPECT_EQ(Patchskin("export --quiet --out '" + (dir / "mesh_####.ply").string() + "'", dir), 2);
-  EXPECT_EQ(Patchskin("export --quiet --frames 5:2 --out '" + (dir / "a.glb").string() + "'", dir), 2);
-  EXPECT_NE(Slurp(dir / "stderr.txt").find("--frames"), std::string::npos);
-  EXPECT_EQ(Patchskin("export --quiet --layout x --out '" + (dir / "a.glb").string() + "'", dir), 2);
+  const fs::path dir = TestDir();
+  EXPECT_EQ(PatchskinExit("export --quiet --out '" + (dir / "mesh.obj").string() + "'", dir), 2);
+  EXPECT_NE(testsupport::SlurpFile(dir / "stderr.txt").find("placeholder"), std::string::npos);
+  EXPECT_EQ(PatchskinExit("export --quiet --out '" + (dir / "mesh_####.ply").string() + "'", dir), 2);
+  EXPECT_EQ(PatchskinExit("export --quiet --frames 5:2 --out '" + (dir / "a.glb").string() + "'", dir), 2);
+  EXPECT_NE(testsupport::SlurpFile(dir / "stderr.txt").find("--frames"), std::string::npos);
+  EXPECT_EQ(PatchskinExit("export --quiet --layout x --out '" + (dir / "a.glb").string() + "'", dir), 2);
   EXPECT_FALSE(fs::exists(dir / "a.glb"));
 }
 

@@ -17,17 +17,13 @@
 
 namespace {
 
+using testsupport::TestDir;
+
 namespace fs = std::filesystem;
 using testsupport::ProcessResult;
 using testsupport::SlurpFile;
 
-fs::path Dir() { return testsupport::TestDir("farm"); }
-
-std::string BendBvh() {
-  return (fs::path(TEST_DATA_DIR) / "../../samples/data/bend.bvh").lexically_normal().string();
-}
-
-ProcessResult Patchskin(const fs::path& d, const std::vector<std::string>& args) {
+ProcessResult PatchskinIn(const fs::path& d, const std::vector<std::string>& args) {
   return testsupport::RunPatchskin(args, d / "logs");
 }
 
@@ -41,7 +37,7 @@ int RunTask(const fs::path& script, int task, const fs::path& log) {
 const std::vector<std::string> kRenderArgs{"--", "--size", "64x36", "--supersample", "1"};
 
 std::vector<std::string> FarmArgs(const fs::path& d, const std::string& frames, int chunk) {
-  std::vector<std::string> args{"farm", "slurm", BendBvh(), "--frames", frames, "--chunk",
+  std::vector<std::string> args{"farm", "slurm", testsupport::SampleDataPath("bend.bvh").string(), "--frames", frames, "--chunk",
                                 std::to_string(chunk), "--out", (d / "farm/f_####.png").string(),
                                 "--partition", "debug", "--sbatch-arg=--time=00:05:00"};
   args.insert(args.end(), kRenderArgs.begin(), kRenderArgs.end());
@@ -50,8 +46,8 @@ std::vector<std::string> FarmArgs(const fs::path& d, const std::string& frames, 
 
 void ExpectChunksEqualOneRender(const std::string& frames, int chunk, int tasks,
                                 const std::vector<int>& numbers) {
-  const fs::path d = Dir();
-  const ProcessResult farm = Patchskin(d, FarmArgs(d, frames, chunk));
+  const fs::path d = TestDir();
+  const ProcessResult farm = PatchskinIn(d, FarmArgs(d, frames, chunk));
   ASSERT_EQ(farm.exit_code, 0) << farm.err;
   // Printed: the scripts and the command; nothing rendered yet.
   EXPECT_NE(farm.out.find("#SBATCH --array=0-" + std::to_string(tasks - 1)), std::string::npos) << farm.out;
@@ -61,10 +57,10 @@ void ExpectChunksEqualOneRender(const std::string& frames, int chunk, int tasks,
   EXPECT_NE(farm.out.find("sh " + (d / "farm/slurm/submit.sh").string()), std::string::npos);
   EXPECT_FALSE(fs::exists(d / "farm/f_0000.png"));
 
-  std::vector<std::string> single{"render", BendBvh(), "--frames", frames, "--out",
+  std::vector<std::string> single{"render", testsupport::SampleDataPath("bend.bvh").string(), "--frames", frames, "--out",
                                   (d / "single/f_####.png").string(), "--quiet", "--no-video",
                                   "--size", "64x36", "--supersample", "1"};
-  const ProcessResult one = Patchskin(d, single);
+  const ProcessResult one = PatchskinIn(d, single);
   ASSERT_EQ(one.exit_code, 0) << one.err;
 
   // Tasks in reverse order: chunks are independent of each other.
@@ -86,7 +82,7 @@ void ExpectChunksEqualOneRender(const std::string& frames, int chunk, int tasks,
   // The same frames on the sheet. Not the same bytes: `sheet` shrinks the 8-bit
   // frame files, render the float frames before quantizing, so thumbnails
   // differ by a few 8-bit levels (measured: at most 5/255 on 0.07% of values).
-  const ProcessResult sheets = Patchskin(
+  const ProcessResult sheets = PatchskinIn(
       d, {"compare", (d / "single/contact_sheet.png").string(), (d / "farm/contact_sheet.png").string(),
           "--fail", "0.004", "--failpercent", "1", "--hardfail", "0.03"});
   EXPECT_EQ(sheets.exit_code, 0) << sheets.out;
@@ -101,26 +97,26 @@ TEST(FarmSlurm, ChunksHonourTheStep) {
 }
 
 TEST(FarmSlurm, RefusesBadArguments) {
-  const fs::path d = Dir();
+  const fs::path d = TestDir();
   std::vector<std::string> args = FarmArgs(d, "0:6", 0);
-  ProcessResult r = Patchskin(d, args);
+  ProcessResult r = PatchskinIn(d, args);
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.FirstErrLine().find("--chunk"), std::string::npos) << r.err;
 
   args = FarmArgs(d, "0:6", 2);
   args.insert(args.end(), {"--frames", "0:3"});  // after "--": a render option farm sets itself
-  r = Patchskin(d, args);
+  r = PatchskinIn(d, args);
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.FirstErrLine().find("--frames: error: farm sets this render option itself"),
             std::string::npos)
       << r.err;
 
-  r = Patchskin(d, FarmArgs(d, "0:99999", 2));
+  r = PatchskinIn(d, FarmArgs(d, "0:99999", 2));
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.FirstErrLine().find("--frames"), std::string::npos) << r.err;
 
   // The framing range of a chunk must hold the chunk's frames.
-  r = Patchskin(d, {"render", BendBvh(), "--frames", "0:5", "--framing", "2:3", "--quiet",
+  r = PatchskinIn(d, {"render", testsupport::SampleDataPath("bend.bvh").string(), "--frames", "0:5", "--framing", "2:3", "--quiet",
                     "--out", (d / "farm/f_####.png").string()});
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.FirstErrLine().find("--framing: error: expected a range holding every output frame"),
@@ -129,38 +125,38 @@ TEST(FarmSlurm, RefusesBadArguments) {
 
   args = FarmArgs(d, "0:6", 2);
   args.insert(args.begin() + 3, "--wait");
-  r = Patchskin(d, args);
+  r = PatchskinIn(d, args);
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_FALSE(fs::exists(d / "farm")) << "nothing written for bad arguments";
 }
 
 TEST(SheetCommand, RefusesMissingFramesAndExistingSheet) {
-  const fs::path d = Dir();
-  const ProcessResult one = Patchskin(
-      d, {"render", BendBvh(), "--frames", "0:3", "--out", (d / "f_####.png").string(), "--quiet",
+  const fs::path d = TestDir();
+  const ProcessResult one = PatchskinIn(
+      d, {"render", testsupport::SampleDataPath("bend.bvh").string(), "--frames", "0:3", "--out", (d / "f_####.png").string(), "--quiet",
           "--no-video", "--no-sheet", "--size", "64x36", "--supersample", "1"});
   ASSERT_EQ(one.exit_code, 0) << one.err;
-  ProcessResult r = Patchskin(d, {"sheet", (d / "f_####.png").string(), "--frames", "0:5"});
+  ProcessResult r = PatchskinIn(d, {"sheet", (d / "f_####.png").string(), "--frames", "0:5"});
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.FirstErrLine().find("f_0004.png: error: frame missing (2 of 6"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(d / "contact_sheet.png"));
   EXPECT_FALSE(fs::exists(d / "preview.mp4"));
 
-  r = Patchskin(d, {"sheet", (d / "f_####.png").string(), "--frames", "0:3", "--no-video"});
+  r = PatchskinIn(d, {"sheet", (d / "f_####.png").string(), "--frames", "0:3", "--no-video"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_TRUE(fs::exists(d / "contact_sheet.png"));
-  r = Patchskin(d, {"sheet", (d / "f_####.png").string(), "--frames", "0:3", "--no-video"});
+  r = PatchskinIn(d, {"sheet", (d / "f_####.png").string(), "--frames", "0:3", "--no-video"});
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.FirstErrLine().find("--overwrite"), std::string::npos) << r.err;
   // A sheet needs a closed range: open ends, empty parts and stray characters are refused
   // with the option named; a step is accepted.
   for (const char* bad : {"0:", ":3", "0:3:", "0::2", "a:b", "0:3:1:1", "0:3 ", ""}) {
-    r = Patchskin(d, {"sheet", (d / "f_####.png").string(), "--frames", bad, "--no-video",
+    r = PatchskinIn(d, {"sheet", (d / "f_####.png").string(), "--frames", bad, "--no-video",
                       "--overwrite"});
     EXPECT_EQ(r.exit_code, 2) << "'" << bad << "'";
     EXPECT_NE(r.FirstErrLine().find("--frames"), std::string::npos) << "'" << bad << "': " << r.err;
   }
-  r = Patchskin(d, {"sheet", (d / "f_####.png").string(), "--frames", "0:3:3", "--no-video",
+  r = PatchskinIn(d, {"sheet", (d / "f_####.png").string(), "--frames", "0:3:3", "--no-video",
                     "--overwrite"});
   EXPECT_EQ(r.exit_code, 0) << r.err;
 }

@@ -10,7 +10,7 @@
 
 namespace {
 
-mocap::Motion Frames(int num_frames, double frame_time_s) {
+mocap::Motion TimingOnly(int num_frames, double frame_time_s) {
   mocap::Motion m;
   m.num_frames = num_frames;
   m.num_channels = 0;  // timing only
@@ -19,7 +19,7 @@ mocap::Motion Frames(int num_frames, double frame_time_s) {
 }
 
 TEST(FramePlan, AtGivesTheListedFrames) {
-  const mocap::Motion motion = Frames(1000, 1.0 / 120.0);
+  const mocap::Motion motion = TimingOnly(1000, 1.0 / 120.0);
   const app::FramePlanOptions cases[] = {
       {.frames = ""},
       {.frames = "10:990:7"},
@@ -48,7 +48,7 @@ TEST(FramePlan, AtGivesTheListedFrames) {
 }
 
 TEST(FramePlan, AnHourAt120FpsIsCountedNotListed) {
-  const mocap::Motion motion = Frames(432000, 1.0 / 120.0);
+  const mocap::Motion motion = TimingOnly(432000, 1.0 / 120.0);
   const mocap::Result<app::FramePlan> plan =
       app::PlanFrames(motion, {.frames = "1:431999:2", .list_frames = false});
   ASSERT_TRUE(plan.ok());

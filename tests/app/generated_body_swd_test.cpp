@@ -21,19 +21,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// Largest growth of a triangle edge over its rest length, in body sizes.
-float MaxEdgeGrowth(const deform::Mesh& rest, std::span<const glm::vec3> pos) {
-  float worst = 0.0f;
-  for (const glm::uvec3& t : rest.triangles) {
-    for (int e = 0; e < 3; ++e) {
-      const std::uint32_t a = t[e], b = t[(e + 1) % 3];
-      worst = std::max(worst, glm::distance(pos[a], pos[b]) - glm::distance(rest.positions[a], rest.positions[b]));
-    }
-  }
-  const glm::vec3 e = deform::ComputeBounds(rest.positions).size();
-  return worst / std::max({e.x, e.y, e.z});
-}
-
 bool IsBackJoint(const std::string& name) {
   return name.find("Spine") != std::string::npos || name.find("Neck") != std::string::npos ||
          name.find("Back") != std::string::npos;
@@ -86,7 +73,7 @@ TEST(SwdPipeline, GeneratedBodyHasNoCrackOrSeamOnCmuFrames750And1500) {
   app::DeformedFrame frame;
   for (const int f : {750, 1500}) {
     ASSERT_TRUE(pipeline->Evaluate(f * c->motion.frame_time_s, frame).ok());
-    const float growth = MaxEdgeGrowth(c->mesh.bind, frame.positions);
+    const float growth = testsupport::MaxEdgeGrowthFraction(c->mesh.bind, frame.positions);
     std::vector<std::uint32_t> where;
     const int folds = NewSharpEdges(c->mesh.bind, frame.positions, &where);
     std::map<std::string, int> near;

@@ -28,6 +28,8 @@
 
 namespace {
 
+using testsupport::TestDir;
+
 namespace fs = std::filesystem;
 using testsupport::GltfWriter;
 using testsupport::kPositionTol;
@@ -115,9 +117,7 @@ std::string WriteMotion(const fs::path& path, const std::string& spine_name = "s
   return path.string();
 }
 
-fs::path Dir() { return testsupport::TestDir("gltf_bvh_motion"); }
-
-app::Character Load(const fs::path& d) {
+app::Character LoadDrivenCharacter(const fs::path& d) {
   const std::string model = WriteCharacter(d / "body.gltf");
   const std::string motion = WriteMotion(d / "motion.bvh");
   app::MotionSourceOptions options;
@@ -131,8 +131,8 @@ app::Character Load(const fs::path& d) {
 }
 
 TEST(GltfBvhMotion, VerticesFollowTheRetargetedMotion) {
-  const fs::path d = Dir();
-  const app::Character ch = Load(d);
+  const fs::path d = TestDir();
+  const app::Character ch = LoadDrivenCharacter(d);
   ASSERT_EQ(ch.mesh.bind.num_vertices(), 12);
   EXPECT_EQ(ch.motion.num_frames, 2);
   auto pipeline = app::FramePipeline::Create(ch, app::GlobalMethod::kSsd, 1);
@@ -176,7 +176,7 @@ TEST(GltfBvhMotion, VerticesFollowTheRetargetedMotion) {
 }
 
 TEST(GltfBvhMotion, CommandLineAndRigRenderTheSameFrames) {
-  const fs::path d = Dir();
+  const fs::path d = TestDir();
   const std::string model = WriteCharacter(d / "body.gltf");
   const std::string motion = WriteMotion(d / "motion.bvh");
   const std::vector<std::string> common{"--quiet", "--no-video", "--no-sheet", "--supersample", "1"};
@@ -206,7 +206,7 @@ TEST(GltfBvhMotion, CommandLineAndRigRenderTheSameFrames) {
 }
 
 TEST(GltfBvhMotion, MissingRequiredJointIsNamed) {
-  const fs::path d = Dir();
+  const fs::path d = TestDir();
   const std::string model = WriteCharacter(d / "body.gltf");
   const std::string motion = WriteMotion(d / "chest.bvh", "Chest");  // no spine
   const auto r = testsupport::RunPatchskin(

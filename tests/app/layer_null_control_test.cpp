@@ -43,7 +43,7 @@ struct Bodies {
 
 // samples/data/<demo>.json with `edit` applied to its rig, on the mannequin.
 template <typename Edit>
-void Load(const std::string& demo, Edit edit, Bodies& b) {
+void LoadBodies(const std::string& demo, Edit edit, Bodies& b) {
   auto rig = app::LoadRig(testsupport::SampleDataPath(demo + ".json").string());
   ASSERT_TRUE(rig.ok()) << rig.error().ToString();
   b.rig = std::move(*rig);
@@ -113,7 +113,7 @@ TEST(LayerNullControl, PatchesWithoutExamplesOrElasticRenderTheGlobalFrames) {
   for (const char* demo : {"biceps", "knee", "belly_jump"}) {
     SCOPED_TRACE(demo);
     Bodies b;
-    Load(demo, [](app::Rig& rig) {
+    LoadBodies(demo, [](app::Rig& rig) {
       for (app::RigPatch& p : rig.patches) {
         p.examples.clear();
         p.elastic.reset();
@@ -128,7 +128,7 @@ TEST(LayerNullControl, ExamplesWhoseEditsAreAllZeroRenderTheGlobalFrames) {
   for (const char* demo : {"biceps", "knee"}) {
     SCOPED_TRACE(demo);
     Bodies b;
-    Load(demo, [](app::Rig& rig) {
+    LoadBodies(demo, [](app::Rig& rig) {
       for (app::RigPatch& p : rig.patches) {
         for (app::RigExample& e : p.examples) {
           for (app::RigEdit& edit : e.edits) edit.move = glm::dvec3(0.0);
@@ -168,7 +168,7 @@ std::vector<bool> MarkedPixels(const app::Character& ch, const app::DeformedFram
 
 TEST(LayerNullControl, ExamplesChangeOnlyThePixelsOfTheirPatchRegion) {
   Bodies b;
-  Load("biceps", [](app::Rig&) {}, b);
+  LoadBodies("biceps", [](app::Rig&) {}, b);
   if (HasFatalFailure()) return;
   const app::Character& ch = *b.character;
   // Seen from above, the biceps' front is the silhouette (as the golden frames).

@@ -26,7 +26,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct Measured {
+struct CaptureRun {
   int frames = 0;
   std::uintmax_t file_bytes = 0;
   int channels = 0;
@@ -35,8 +35,8 @@ struct Measured {
   double cpu_s = 0.0;
 };
 
-Measured RenderFirstFrames(const fs::path& dir, int frames) {
-  Measured m;
+CaptureRun RenderFirstFrames(const fs::path& dir, int frames) {
+  CaptureRun m;
   m.frames = frames;
   char name[64];
   std::snprintf(name, sizeof(name), "long_%d.bvh", frames);
@@ -79,12 +79,12 @@ TEST(LongCapture, PeakMemoryGrowsOnlyWithTheMotionDataAndTheFirstFrameComesAtOnc
   const fs::path dir = testsupport::TestOutputPath("long_capture/x").parent_path();
   fs::remove_all(dir);
   fs::create_directories(dir);
-  std::vector<Measured> runs;
+  std::vector<CaptureRun> runs;
   for (const int frames : {1000, 10000, 100000}) runs.push_back(RenderFirstFrames(dir, frames));
   ASSERT_EQ(runs.size(), 3u);
-  const Measured& small = runs.front();
+  const CaptureRun& small = runs.front();
   for (std::size_t i = 1; i < runs.size(); ++i) {
-    const Measured& big = runs[i];
+    const CaptureRun& big = runs[i];
     // Allowed growth: the extra frames' floats, plus what two parsing threads
     // hold besides them (a 4 MiB block of text each, given back once parsed,
     // and that block's floats until appended) and allocator slack: 12 MiB,

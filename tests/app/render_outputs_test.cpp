@@ -21,11 +21,12 @@
 
 namespace {
 
+using testsupport::RunPatchskin;
+using testsupport::TestDir;
+
 namespace fs = std::filesystem;
 using testsupport::ProcessResult;
 using testsupport::SlurpFile;
-
-fs::path Dir() { return testsupport::TestDir("render_outputs"); }
 
 // Renders the built-in demo into `folder`/f_####.png at 320x180, without the
 // contact sheet unless `extra` holds "--sheet" (taken out here).
@@ -40,21 +41,8 @@ std::vector<std::string> DemoArgs(const fs::path& folder, const std::string& fra
   return args;
 }
 
-ProcessResult Patchskin(const std::vector<std::string>& args) {
-  return testsupport::RunPatchskin(args, Dir() / "logs");
-}
-
-// Regular files in `folder`, sorted by name.
-std::vector<fs::path> Files(const fs::path& folder) {
-  std::vector<fs::path> out;
-  if (!fs::exists(folder)) return out;
-  for (const auto& e : fs::directory_iterator(folder)) out.push_back(e.path());
-  std::sort(out.begin(), out.end());
-  return out;
-}
-
 void ExpectSameFrames(const fs::path& a, const fs::path& b) {
-  const std::vector<fs::path> fa = Files(a), fb = Files(b);
+  const std::vector<fs::path> fa = testsupport::FilesIn(a), fb = testsupport::FilesIn(b);
   ASSERT_EQ(fa.size(), fb.size());
   for (std::size_t i = 0; i < fa.size(); ++i) {
     EXPECT_EQ(fa[i].filename(), fb[i].filename());
@@ -63,17 +51,17 @@ void ExpectSameFrames(const fs::path& a, const fs::path& b) {
 }
 
 TEST(RenderOutputs, SameBytesWithOneTwoAndEightThreads) {
-  const fs::path d = Dir();
+  const fs::path d = TestDir();
   for (const char* t : {"1", "2", "8"}) {
     const ProcessResult r =
-        Patchskin(DemoArgs(d / (std::string("threads_") + t), "0:5", {"--threads", t, "--sheet"}));
+        RunPatchskin(DemoArgs(d / (std::string("threads_") + t), "0:5", {"--threads", t, "--sheet"}));
     ASSERT_EQ(r.exit_code, 0) << r.err;
   }
-  ASSERT_EQ(Files(d / "threads_1").size(), 7u);  // 6 frames and the contact sheet
+  ASSERT_EQ(testsupport::FilesIn(d / "threads_1").size(), 7u);  // 6 frames and the contact sheet
   ExpectSameFrames(d / "threads_1", d / "threads_2");
   ExpectSameFrames(d / "threads_1", d / "threads_8");
   // And across runs.
-  ASSERT_EQ(Patchskin(DemoArgs(d / "again", "0:5", {"--threads", "2", "--sheet"})).exit_code, 0);
+  ASSERT_EQ(RunPatchskin(DemoArgs(d / "again", "0:5", {"--threads", "2", "--sheet"})).exit_code, 0);
   ExpectSameFrames(d / "threads_1", d / "again");
 }
 
@@ -81,7 +69,7 @@ TEST(RenderOutputs, SameBytesWithOneTwoAndEightThreads) {
 // patches), the camera following the elbow patch: the patch rebuild runs on
 // the worker threads too.
 TEST(RenderOutputs, RigWithPatchesGivesTheSameBytesWithOneTwoAndEightThreads) {
-  const fs::path d = Dir();
+  const fs::path d = TestDir();
   const fs::path bend = (testsupport::TestDataPath("../../samples/data/bend.bvh")).lexically_normal();
   ASSERT_TRUE(fs::exists(bend)) << bend;
   const fs::path rig = d / "patches.json";
@@ -94,23 +82,23 @@ TEST(RenderOutputs, RigWithPatchesGivesTheSameBytesWithOneTwoAndEightThreads) {
     "render": {"size": [192, 108], "camera": "fixed", "split": true, "frames": "40:47"}})";
   for (const char* t : {"1", "2", "8"}) {
     const ProcessResult r =
-        Patchskin({"render", rig.string(), "--threads", t, "--quiet", "--no-video", "--look-at",
+        RunPatchskin({"render", rig.string(), "--threads", t, "--quiet", "--no-video", "--look-at",
                    "patch:left_elbow", "--azimuth", "150", "--zoom", "1.2", "--out",
                    (d / (std::string("threads_") + t) / "f_####.png").string()});
     ASSERT_EQ(r.exit_code, 0) << r.err;
   }
-  ASSERT_EQ(Files(d / "threads_1").size(), 9u);  // 8 frames and the contact sheet
+  ASSERT_EQ(testsupport::FilesIn(d / "threads_1").size(), 9u);  // 8 frames and the contact sheet
   ExpectSameFrames(d / "threads_1", d / "threads_2");
   ExpectSameFrames(d / "threads_1", d / "threads_8");
 }
 
 TEST(RenderOutputs, RefusesExistingFramesWithoutOverwrite) {
-  const fs::path out = Dir() / "out";
-  ASSERT_EQ(Patchskin(DemoArgs(out, "0:2")).exit_code, 0);
+  const fs::path out = TestDir() / "out";
+  ASSERT_EQ(RunPatchskin(DemoArgs(out, "0:2")).exit_code, 0);
   const std::string before = SlurpFile(out / "f_0001.png");
   const auto stamp = fs::last_write_time(out / "f_0001.png");
 
-  ProcessResult again = Patchskin(DemoArgs(out, "0:2"));
+  ProcessResult again = RunPatchskin(DemoArgs(out, "0:2"));
   EXPECT_EQ(again.exit_code, 2) << again.err;
   EXPECT_EQ(again.FirstErrLine().rfind((out / "f_0000.png").string() + ": error: ", 0), 0u)
       << again.err;
@@ -118,18 +106,18 @@ TEST(RenderOutputs, RefusesExistingFramesWithoutOverwrite) {
   EXPECT_EQ(fs::last_write_time(out / "f_0001.png"), stamp);
 
   // A larger range that includes existing frames is refused as a whole.
-  EXPECT_EQ(Patchskin(DemoArgs(out, "0:4")).exit_code, 2);
+  EXPECT_EQ(RunPatchskin(DemoArgs(out, "0:4")).exit_code, 2);
   EXPECT_FALSE(fs::exists(out / "f_0004.png"));
 
-  ProcessResult forced = Patchskin(DemoArgs(out, "0:2", {"--overwrite"}));
+  ProcessResult forced = RunPatchskin(DemoArgs(out, "0:2", {"--overwrite"}));
   EXPECT_EQ(forced.exit_code, 0) << forced.err;
   EXPECT_EQ(SlurpFile(out / "f_0001.png"), before);
 }
 
 TEST(RenderOutputs, FolderNamedLikeAFrameIsAnError) {
-  const fs::path out = Dir() / "out";
+  const fs::path out = TestDir() / "out";
   fs::create_directories(out / "f_0001.png");
-  const ProcessResult r = Patchskin(DemoArgs(out, "0:2", {"--overwrite"}));
+  const ProcessResult r = RunPatchskin(DemoArgs(out, "0:2", {"--overwrite"}));
   EXPECT_EQ(r.exit_code, 2) << r.err;
   EXPECT_EQ(r.FirstErrLine().rfind((out / "f_0001.png").string() + ": error: ", 0), 0u) << r.err;
   EXPECT_FALSE(fs::exists(out / "f_0000.png"));
@@ -139,10 +127,10 @@ TEST(RenderOutputs, FolderNamedLikeAFrameIsAnError) {
 // frames and the contact sheet (rebuilt from the finished frames read back)
 // are byte-identical to an uninterrupted render's, and no finished frame is redone.
 TEST(RenderOutputs, InterruptedRenderResumesToTheSameFramesAndSheet) {
-  const fs::path d = Dir();
+  const fs::path d = TestDir();
   const std::string range = "0:89";  // the whole demo: long enough to interrupt
-  ASSERT_EQ(Patchskin(DemoArgs(d / "reference", range, {"--sheet"})).exit_code, 0);
-  const std::size_t total = Files(d / "reference").size();
+  ASSERT_EQ(RunPatchskin(DemoArgs(d / "reference", range, {"--sheet"})).exit_code, 0);
+  const std::size_t total = testsupport::FilesIn(d / "reference").size();
   ASSERT_EQ(total, 91u);  // 90 frames and the contact sheet
 
   int interrupted = 0;
@@ -155,7 +143,7 @@ TEST(RenderOutputs, InterruptedRenderResumesToTheSameFramesAndSheet) {
     ASSERT_GT(p.pid, 0);
     // Wait for a few finished frames, then interrupt.
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
-    while (Files(out).size() < 3 && std::chrono::steady_clock::now() < deadline) {
+    while (testsupport::FilesIn(out).size() < 3 && std::chrono::steady_clock::now() < deadline) {
       std::this_thread::sleep_for(std::chrono::milliseconds(2));
     }
     ASSERT_EQ(kill(p.pid, sig), 0);
@@ -168,7 +156,7 @@ TEST(RenderOutputs, InterruptedRenderResumesToTheSameFramesAndSheet) {
     EXPECT_NE(stopped.err.find("--resume"), std::string::npos) << stopped.err;
 
     // Only complete frames under final names: no temporary file, no sheet.
-    const std::vector<fs::path> partial = Files(out);
+    const std::vector<fs::path> partial = testsupport::FilesIn(out);
     ASSERT_LT(partial.size(), total);
     ASSERT_FALSE(partial.empty());
     EXPECT_FALSE(fs::exists(out / "contact_sheet.png"));
@@ -178,9 +166,9 @@ TEST(RenderOutputs, InterruptedRenderResumesToTheSameFramesAndSheet) {
     }
 
     // Without --resume the existing frames are refused; with it the rest is rendered.
-    EXPECT_EQ(Patchskin(DemoArgs(out, range, {"--sheet"})).exit_code, 2);
+    EXPECT_EQ(RunPatchskin(DemoArgs(out, range, {"--sheet"})).exit_code, 2);
     const auto first_stamp = fs::last_write_time(partial.front());
-    const ProcessResult resumed = Patchskin(DemoArgs(out, range, {"--sheet", "--resume"}));
+    const ProcessResult resumed = RunPatchskin(DemoArgs(out, range, {"--sheet", "--resume"}));
     ASSERT_EQ(resumed.exit_code, 0) << resumed.err;
     EXPECT_EQ(fs::last_write_time(partial.front()), first_stamp) << "a finished frame was redone";
     ExpectSameFrames(d / "reference", out);  // the 90 frames and contact_sheet.png

@@ -23,11 +23,11 @@
 
 namespace {
 
+using testsupport::TestDir;
+
 namespace fs = std::filesystem;
 
-fs::path Dir() { return testsupport::TestDir("render_overlays"); }
-
-testsupport::ProcessResult Render(const fs::path& d, std::vector<std::string> args) {
+testsupport::ProcessResult RenderWith(const fs::path& d, std::vector<std::string> args) {
   args.insert(args.begin(), "render");
   for (const char* a : {"--quiet", "--no-video", "--no-sheet"}) args.push_back(a);
   return testsupport::RunPatchskin(args, d / "logs");
@@ -78,9 +78,9 @@ TEST(RenderOverlays, WireStaysReadableOnTheWholeBodyAt640x360) {
 }
 
 TEST(RenderOverlays, TransparentBackgroundKeepsTheBodyAndGroundOpaque) {
-  const fs::path d = Dir();
+  const fs::path d = TestDir();
   const std::string bend = testsupport::SampleDataPath("bend.bvh").string();
-  auto r = Render(d, {bend, "--frames", "30", "--size", "160x90", "--background", "transparent",
+  auto r = RenderWith(d, {bend, "--frames", "30", "--size", "160x90", "--background", "transparent",
                       "--camera", "fixed", "--out", (d / "t_####.png").string()});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   auto image = render::ReadImage((d / "t_0030.png").string());
@@ -89,7 +89,7 @@ TEST(RenderOverlays, TransparentBackgroundKeepsTheBodyAndGroundOpaque) {
   EXPECT_EQ(image->at(80, 85).a, 1.0f);   // the ground in front of the body
   EXPECT_EQ(image->at(80, 45).a, 1.0f);   // the body
   // JPEG has no alpha: refused before anything is written.
-  r = Render(d, {bend, "--frames", "30", "--background", "transparent", "--out",
+  r = RenderWith(d, {bend, "--frames", "30", "--background", "transparent", "--out",
                  (d / "j/t_####.jpg").string()});
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("--background"), std::string::npos) << r.err;
@@ -98,10 +98,10 @@ TEST(RenderOverlays, TransparentBackgroundKeepsTheBodyAndGroundOpaque) {
 
 // The label sits in the bottom left quarter (x < 240, y > 140 of 320x180).
 TEST(RenderOverlays, LabelNoneFrameAndTimecodeChangeOnlyTheBottomLeft) {
-  const fs::path d = Dir();
+  const fs::path d = TestDir();
   const std::string bend = testsupport::SampleDataPath("bend.bvh").string();
   for (const char* label : {"none", "frame", "timecode"}) {
-    const auto r = Render(d, {bend, "--frames", "45", "--size", "320x180", "--camera", "fixed",
+    const auto r = RenderWith(d, {bend, "--frames", "45", "--size", "320x180", "--camera", "fixed",
                               "--label", label, "--out", (d / label / "f_####.png").string()});
     ASSERT_EQ(r.exit_code, 0) << r.err;
   }
@@ -121,7 +121,7 @@ TEST(RenderOverlays, LabelNoneFrameAndTimecodeChangeOnlyTheBottomLeft) {
     EXPECT_EQ(outside, 0);
   }
   EXPECT_NE(frame->rgba, timecode->rgba);
-  const auto bad = Render(d, {bend, "--label", "seconds", "--out", (d / "bad/f_####.png").string()});
+  const auto bad = RenderWith(d, {bend, "--label", "seconds", "--out", (d / "bad/f_####.png").string()});
   EXPECT_EQ(bad.exit_code, 2);
 }
 
@@ -129,9 +129,9 @@ TEST(RenderOverlays, LabelNoneFrameAndTimecodeChangeOnlyTheBottomLeft) {
 // the heat ramp, the global one keeps its albedo, and the colour bar's top is
 // the ramp's hottest colour.
 TEST(RenderOverlays, DeltaColoursTheLayeredBodyAndDrawsItsScale) {
-  const fs::path d = Dir();
+  const fs::path d = TestDir();
   const std::string rig = testsupport::SampleDataPath("elbow.json").string();
-  auto r = Render(d, {rig, "--frames", "60", "--size", "640x360", "--overlay", "delta",
+  auto r = RenderWith(d, {rig, "--frames", "60", "--size", "640x360", "--overlay", "delta",
                       "--supersample", "1", "--out", (d / "f_####.png").string()});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   auto image = render::ReadImage((d / "f_0060.png").string());
@@ -153,7 +153,7 @@ TEST(RenderOverlays, DeltaColoursTheLayeredBodyAndDrawsItsScale) {
   EXPECT_NEAR(top.g, hot.g, 0.04f);
   EXPECT_NEAR(top.b, hot.b, 0.04f);
   // Without patches there is no layer to colour.
-  r = Render(d, {testsupport::SampleDataPath("bend.bvh").string(), "--overlay", "delta", "--out",
+  r = RenderWith(d, {testsupport::SampleDataPath("bend.bvh").string(), "--overlay", "delta", "--out",
                  (d / "bad/f_####.png").string()});
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("--overlay"), std::string::npos) << r.err;

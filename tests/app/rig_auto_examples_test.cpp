@@ -23,7 +23,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-const fs::path kSamples = fs::path(GOLDEN_DIR) / ".." / ".." / "samples" / "data";
 constexpr int kBentFrame = 60;  // both elbows at 150 degrees
 
 std::string Rig(const std::string& examples) {
@@ -34,18 +33,18 @@ std::string Rig(const std::string& examples) {
          examples + "}]}";
 }
 
-struct Fixture {
+struct AutoFixture {
   app::Character character;
   std::vector<deform::PatchSetup> patches;
 };
 
-std::optional<Fixture> Load() {
-  const std::string bvh = fs::absolute(kSamples / "bend.bvh").lexically_normal().string();
+std::optional<AutoFixture> LoadAutoFixture() {
+  const std::string bvh = testsupport::SampleDataPath("bend.bvh").string();
   auto source = app::LoadMotionSource(bvh, {.y_up = true});
   if (!source.ok()) return std::nullopt;
   auto character = app::MakeCharacter(std::move(*source), {}, app::BodyKind::kGenerated);
   if (!character.ok()) return std::nullopt;
-  Fixture f{std::move(*character), {}};
+  AutoFixture f{std::move(*character), {}};
   auto rig = app::ParseRig(Rig(""), "r.json");
   if (!rig.ok()) return std::nullopt;
   auto patches = app::BuildRigPatches(*rig, f.character);
@@ -55,7 +54,7 @@ std::optional<Fixture> Load() {
 }
 
 // Positions at the bent frame: the patch layer alone, or with the example.
-std::vector<glm::vec3> Bent(const Fixture& f, const std::string& examples,
+std::vector<glm::vec3> Bent(const AutoFixture& f, const std::string& examples,
                             std::vector<std::string>* notes = nullptr) {
   auto pipeline = app::FramePipeline::Create(f.character, app::GlobalMethod::kSsd, 1);
   EXPECT_TRUE(pipeline.ok());
@@ -90,7 +89,7 @@ std::vector<glm::mat4> BentPalette(const app::Character& ch) {
 std::vector<glm::dvec3> Double(std::span<const glm::vec3> p) { return {p.begin(), p.end()}; }
 
 TEST(RigAutoExamples, VolumeRestoresTheBentElbowRegion) {
-  const auto f = Load();
+  const auto f = LoadAutoFixture();
   ASSERT_TRUE(f.has_value());
   const app::Character& ch = f->character;
   const deform::PatchSetup& patch = f->patches[0];
@@ -121,7 +120,7 @@ TEST(RigAutoExamples, VolumeRestoresTheBentElbowRegion) {
 }
 
 TEST(RigAutoExamples, RestPullsTowardTheRigidRestShape) {
-  const auto f = Load();
+  const auto f = LoadAutoFixture();
   ASSERT_TRUE(f.has_value());
   const app::Character& ch = f->character;
   const deform::PatchSetup& patch = f->patches[0];

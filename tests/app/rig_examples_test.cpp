@@ -26,8 +26,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-const fs::path kSamples = fs::path(GOLDEN_DIR) / ".." / ".." / "samples" / "data";
-
 // The left elbow patch of samples/data/elbow_knee.json, on bend.bvh (elbows
 // 0 -> 150 degrees over frames 0..60), with `extra` appended to the patch.
 std::string ElbowRig(const std::string& extra) {
@@ -38,18 +36,18 @@ std::string ElbowRig(const std::string& extra) {
          extra + "}]}";
 }
 
-struct Fixture {
+struct ElbowFixture {
   app::Character character;
   std::vector<deform::PatchSetup> patches;
 };
 
-std::optional<Fixture> Load() {
-  const std::string bvh = fs::absolute(kSamples / "bend.bvh").lexically_normal().string();
+std::optional<ElbowFixture> LoadElbowFixture() {
+  const std::string bvh = testsupport::SampleDataPath("bend.bvh").string();
   auto source = app::LoadMotionSource(bvh, {.y_up = true});
   if (!source.ok()) return std::nullopt;
   auto character = app::MakeCharacter(std::move(*source));
   if (!character.ok()) return std::nullopt;
-  Fixture f{std::move(*character), {}};
+  ElbowFixture f{std::move(*character), {}};
   auto rig = app::ParseRig(ElbowRig(""), "r.json");
   if (!rig.ok()) return std::nullopt;
   auto patches = app::BuildRigPatches(*rig, f.character);
@@ -88,7 +86,7 @@ struct Evaluated {
   std::vector<glm::vec3> with_examples;   // patches + dS
 };
 
-mocap::Result<app::FramePipeline> MakePipeline(const Fixture& f, const app::Rig* rig) {
+mocap::Result<app::FramePipeline> MakePipeline(const ElbowFixture& f, const app::Rig* rig) {
   auto pipeline = app::FramePipeline::Create(f.character, app::GlobalMethod::kSsd, 1);
   if (!pipeline.ok()) return pipeline;
   if (mocap::Status s = pipeline->SetPatches(f.patches); !s.ok()) return s.error();
@@ -217,7 +215,7 @@ TEST(RigExamples, BadExamplesGiveExactMessages) {
 }
 
 TEST(RigExamples, BuildErrorsNameTheFieldPath) {
-  const auto f = Load();
+  const auto f = LoadElbowFixture();
   ASSERT_TRUE(f.has_value());
   struct Case {
     std::string extra;
@@ -261,7 +259,7 @@ TEST(RigExamples, BuildErrorsNameTheFieldPath) {
 // solved together) sit at (patches without examples) + move; at rest nothing
 // changes; in between the change is continuous.
 TEST(RigExamples, VertexEditsLandAtTheirExamplePoseAndNothingMovesAtRest) {
-  const auto f = Load();
+  const auto f = LoadElbowFixture();
   ASSERT_TRUE(f.has_value());
   const std::vector<int> v = InteriorVertices(f->patches[0], 2);
   ASSERT_EQ(v.size(), 2u);
@@ -304,7 +302,7 @@ TEST(RigExamples, VertexEditsLandAtTheirExamplePoseAndNothingMovesAtRest) {
 // forearm alone the world move is the forearm's rotation from bind to the
 // example pose applied to it, computed here from the joint matrices.
 TEST(RigExamples, BindFrameMoveTurnsWithTheLimb) {
-  const auto f = Load();
+  const auto f = LoadElbowFixture();
   ASSERT_TRUE(f.has_value());
   const app::Character& ch = f->character;
   const int forearm = ch.skeleton.FindJoint("LeftForeArm");
@@ -366,7 +364,7 @@ TEST(RigExamples, BindFrameMoveTurnsWithTheLimb) {
 // displacement of the edited vertex is continuous: halving the time step
 // halves the largest change between neighbouring samples (a jump would not).
 TEST(RigExamples, TwoExamplesAreExactAndContinuousBetween) {
-  const auto f = Load();
+  const auto f = LoadElbowFixture();
   ASSERT_TRUE(f.has_value());
   const int vertex = InteriorVertices(f->patches[0], 1).at(0);
   const glm::dvec3 m30(0.0, 0.0, 1.0), m60(0.0, 0.8, 0.0);
@@ -416,7 +414,7 @@ namespace {
 // the SVD polar decomposition of SsdControlRotations, at every pose of the
 // bend.
 TEST(RigExamples, ControlRotationsMatchThePolarDecomposition) {
-  const auto f = Load();
+  const auto f = LoadElbowFixture();
   ASSERT_TRUE(f.has_value());
   const app::Character& ch = f->character;
   const deform::PatchSetup& p = f->patches[0];
@@ -453,7 +451,7 @@ namespace {
 // polar iteration there. Against the SVD of each control point's blend, at
 // every 5th frame of shoulder.bvh (arm raised and lowered).
 TEST(RigExamples, ShoulderThreeBoneRotationsMatchTheSvd) {
-  auto rig = app::LoadRig((kSamples / "shoulder.json").string());
+  auto rig = app::LoadRig(testsupport::SampleDataPath("shoulder.json").string());
   ASSERT_TRUE(rig.ok()) << rig.error().ToString();
   auto source = app::LoadMotionSource(rig->motion, {.y_up = true});
   ASSERT_TRUE(source.ok()) << source.error().ToString();
@@ -515,7 +513,7 @@ int CountMoved(const app::DeformedFrame& a, const app::DeformedFrame& b, double 
 // surface point under the brush moves by the move, and many more skin
 // vertices follow than with the same edit without a radius.
 TEST(RigExamples, BrushEditMovesTheNeighbourhoodSmoothly) {
-  auto f = Load();
+  auto f = LoadElbowFixture();
   ASSERT_TRUE(f.has_value());
   // A 10 x 10 grid: on the fixture's 6 x 6 every basis function already spans
   // a third of the patch, so a plain edit is as wide as a brush there.

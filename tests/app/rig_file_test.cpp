@@ -15,6 +15,7 @@
 #include "app/rig_setup.h"
 #include "render/output/image_io.h"
 #include "support/data_paths.h"
+#include "support/run_process.h"
 
 namespace {
 
@@ -332,28 +333,11 @@ TEST(RigFile, MissingFileIsAnIoError) {
 
 namespace fs = std::filesystem;
 
-const fs::path kSamples = fs::path(GOLDEN_DIR) / ".." / ".." / "samples" / "data";
-
-struct ProcessRun {
-  int exit_code = -1;
-  std::string err;
-};
-
-ProcessRun Patchskin(const std::string& args, const fs::path& dir) {
-  const fs::path err = dir / "stderr.txt";
-  const std::string cmd = std::string("'") + PATCHSKIN_BINARY + "' " + args + " >/dev/null 2>'" +
-                          err.string() + "'";
-  const int status = std::system(cmd.c_str());
-  std::ifstream in(err);
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1,
-          {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()}};
-}
-
 TEST(RigFile, RenderCommandRendersTheSampleRigAsASplitFrame) {
   const fs::path dir = testsupport::TestOutputPath("rig_file/render/x").parent_path();
   fs::remove_all(dir);
   fs::create_directories(dir);
-  const ProcessRun r = Patchskin("render '" + (kSamples / "elbow_knee.json").string() +
+  const testsupport::ProcessResult r = testsupport::RunPatchskinLine("render '" + testsupport::SampleDataPath("elbow_knee.json").string() +
                               "' --frames 45:45 --no-video --no-sheet --quiet --out '" +
                               (dir / "f_####.png").string() + "'",
                           dir);
@@ -370,9 +354,9 @@ TEST(RigFile, RenderCommandReportsABadJointWithItsFieldPath) {
   fs::create_directories(dir);
   const fs::path rig = dir / "bad.json";
   std::ofstream(rig) << R"({"character": "mannequin", "motion": {"file": ")"
-                     << fs::absolute(kSamples / "bend.bvh").lexically_normal().string()
+                     << testsupport::SampleDataPath("bend.bvh").string()
                      << R"("}, "patches": [{"name": "e", "region": {"joint": "Elbow", "radius": 9}}]})";
-  const ProcessRun r = Patchskin("render '" + rig.string() + "' --no-video --no-sheet --quiet --out '" +
+  const testsupport::ProcessResult r = testsupport::RunPatchskinLine("render '" + rig.string() + "' --no-video --no-sheet --quiet --out '" +
                               (dir / "f_####.png").string() + "'",
                           dir);
   EXPECT_EQ(r.exit_code, 2);
@@ -382,7 +366,7 @@ TEST(RigFile, RenderCommandReportsABadJointWithItsFieldPath) {
 }
 
 TEST(RigFile, ScreenRegionBuildsAFrontPatchOnTheBelly) {
-  const std::string bvh = fs::absolute(kSamples / "bend.bvh").lexically_normal().string();
+  const std::string bvh = testsupport::SampleDataPath("bend.bvh").string();
   auto source = app::LoadMotionSource(bvh, {.y_up = true});
   ASSERT_TRUE(source.ok()) << source.error().ToString();
   auto character = app::MakeCharacter(std::move(*source));

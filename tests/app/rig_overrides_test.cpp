@@ -18,21 +18,17 @@
 
 namespace {
 
+using testsupport::TestDir;
+
 namespace fs = std::filesystem;
 using nlohmann::json;
 using testsupport::ProcessResult;
 using testsupport::SlurpFile;
 
-fs::path Dir() { return testsupport::TestDir("rig_overrides"); }
-
-std::string BendBvh() {
-  return (fs::path(TEST_DATA_DIR) / "../../samples/data/bend.bvh").lexically_normal().string();
-}
-
 // A rig on the mannequin bending its elbows (samples/data/bend.bvh), tiny frames.
 json BaseRig(const std::string& output) {
   return {{"character", "mannequin"},
-          {"motion", {{"file", BendBvh()}}},
+          {"motion", {{"file", testsupport::SampleDataPath("bend.bvh").string()}}},
           {"global", "ssd"},
           {"render",
            {{"size", {64, 36}}, {"camera", "follow"}, {"frames", "30:31"}, {"output", output}}}};
@@ -53,7 +49,7 @@ std::string WriteRig(const fs::path& dir, const std::string& name, const json& r
   return path.string();
 }
 
-ProcessResult Render(const fs::path& dir, const std::string& rig, std::vector<std::string> extra) {
+ProcessResult RenderRig(const fs::path& dir, const std::string& rig, std::vector<std::string> extra) {
   std::vector<std::string> args{"render", rig, "--quiet", "--no-video", "--no-sheet",
                                 "--supersample", "1"};
   args.insert(args.end(), extra.begin(), extra.end());
@@ -78,12 +74,12 @@ bool SamePixels(const fs::path& a, const fs::path& b) {
 // the same bytes in frame 30 (and frame 31).
 void ExpectSameAsRig(const std::string& name, const json& a, const std::vector<std::string>& option,
                      const json& b) {
-  const fs::path d = Dir();
+  const fs::path d = TestDir();
   const std::string rig_a = WriteRig(d, "a.json", a);
   const std::string rig_b = WriteRig(d, "b.json", b);
-  const ProcessResult ra = Render(d, rig_a, option);
+  const ProcessResult ra = RenderRig(d, rig_a, option);
   ASSERT_EQ(ra.exit_code, 0) << ra.err;
-  const ProcessResult rb = Render(d, rig_b, {});
+  const ProcessResult rb = RenderRig(d, rig_b, {});
   ASSERT_EQ(rb.exit_code, 0) << rb.err;
   for (const char* frame : {"0030", "0031"}) {
     EXPECT_TRUE(SamePixels(d / "out_a" / (std::string("f_") + frame + ".png"),
@@ -91,15 +87,15 @@ void ExpectSameAsRig(const std::string& name, const json& a, const std::vector<s
         << name << " frame " << frame;
   }
   // And the option really changed something: the rig alone gives other bytes.
-  const ProcessResult plain = Render(d, rig_a, {"--out", (d / "plain/f_####.png").string()});
+  const ProcessResult plain = RenderRig(d, rig_a, {"--out", (d / "plain/f_####.png").string()});
   ASSERT_EQ(plain.exit_code, 0) << plain.err;
   EXPECT_FALSE(SamePixels(d / "plain/f_0030.png", d / "out_b/f_0030.png")) << name;
 }
 
 TEST(RigOverrides, SizeWins) {
-  const fs::path d = Dir();
+  const fs::path d = TestDir();
   const std::string rig = WriteRig(d, "rig.json", BaseRig("out/f_####.png"));
-  const ProcessResult r = Render(d, rig, {"--size", "80x48"});
+  const ProcessResult r = RenderRig(d, rig, {"--size", "80x48"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto image = render::ReadImage((d / "out/f_0030.png").string());
   ASSERT_TRUE(image.ok()) << image.error().ToString();
@@ -129,11 +125,11 @@ TEST(RigOverrides, SplitWins) {
   // --wipe on the rig: left ssd, right ssd + patches, one view. --split (the
   // old name of --wipe) ssd,dqs: left ssd, right dqs + patches. Same left half,
   // a different right half.
-  const fs::path d = Dir();
+  const fs::path d = TestDir();
   const std::string rig = WriteRig(d, "rig.json", WithElbowPatch(BaseRig("out/f_####.png")));
-  ASSERT_EQ(Render(d, rig, {"--size", "96x48", "--wipe"}).exit_code, 0);
+  ASSERT_EQ(RenderRig(d, rig, {"--size", "96x48", "--wipe"}).exit_code, 0);
   const ProcessResult r =
-      Render(d, rig, {"--size", "96x48", "--split", "ssd,dqs", "--out", (d / "cli/f_####.png").string()});
+      RenderRig(d, rig, {"--size", "96x48", "--split", "ssd,dqs", "--out", (d / "cli/f_####.png").string()});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto from_rig = render::ReadImage((d / "out/f_0031.png").string());
   const auto from_cli = render::ReadImage((d / "cli/f_0031.png").string());
@@ -155,13 +151,13 @@ TEST(RigOverrides, SplitWins) {
 // framed alike: the two halves agree pixel for pixel below the labels, apart
 // from the frame number (bottom left) and the divider.
 TEST(RigOverrides, RigWithPatchesComparesSideBySide) {
-  const fs::path d = Dir();
+  const fs::path d = TestDir();
   const std::string rig = WriteRig(d, "rig.json", WithElbowPatch(BaseRig("out/f_####.png")));
-  ASSERT_EQ(Render(d, rig, {"--size", "192x96"}).exit_code, 0);
-  ProcessResult r = Render(d, rig, {"--size", "192x96", "--compare", "ssd,ssd + patches", "--out",
+  ASSERT_EQ(RenderRig(d, rig, {"--size", "192x96"}).exit_code, 0);
+  ProcessResult r = RenderRig(d, rig, {"--size", "192x96", "--compare", "ssd,ssd + patches", "--out",
                                     (d / "cli/f_####.png").string()});
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  r = Render(d, rig, {"--size", "192x96", "--compare", "ssd,ssd", "--out", (d / "same/f_####.png").string()});
+  r = RenderRig(d, rig, {"--size", "192x96", "--compare", "ssd,ssd", "--out", (d / "same/f_####.png").string()});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto from_rig = render::ReadImage((d / "out/f_0031.png").string());
   const auto from_cli = render::ReadImage((d / "cli/f_0031.png").string());
@@ -188,9 +184,9 @@ TEST(RigOverrides, RigWithPatchesComparesSideBySide) {
 }
 
 TEST(RigOverrides, OutWins) {
-  const fs::path d = Dir();
+  const fs::path d = TestDir();
   const std::string rig = WriteRig(d, "rig.json", BaseRig("out/f_####.png"));
-  const ProcessResult r = Render(d, rig, {"--out", (d / "elsewhere/g_####.png").string()});
+  const ProcessResult r = RenderRig(d, rig, {"--out", (d / "elsewhere/g_####.png").string()});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_TRUE(fs::exists(d / "elsewhere/g_0030.png"));
   EXPECT_TRUE(fs::exists(d / "elsewhere/g_0031.png"));
@@ -198,9 +194,9 @@ TEST(RigOverrides, OutWins) {
 }
 
 TEST(RigOverrides, FramesWin) {
-  const fs::path d = Dir();
+  const fs::path d = TestDir();
   const std::string rig = WriteRig(d, "rig.json", BaseRig("out/f_####.png"));
-  const ProcessResult r = Render(d, rig, {"--frames", "5:7:2"});
+  const ProcessResult r = RenderRig(d, rig, {"--frames", "5:7:2"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   std::vector<std::string> names;
   for (const auto& e : fs::directory_iterator(d / "out")) names.push_back(e.path().filename().string());
@@ -209,13 +205,13 @@ TEST(RigOverrides, FramesWin) {
 }
 
 TEST(RigOverrides, ThreadsAreRead) {
-  const fs::path d = Dir();
+  const fs::path d = TestDir();
   const std::string rig = WriteRig(d, "rig.json", BaseRig("out/f_####.png"));
-  const ProcessResult bad = Render(d, rig, {"--threads", "999"});
+  const ProcessResult bad = RenderRig(d, rig, {"--threads", "999"});
   EXPECT_EQ(bad.exit_code, 2);
   EXPECT_NE(bad.FirstErrLine().find("--threads"), std::string::npos) << bad.err;
-  ASSERT_EQ(Render(d, rig, {"--threads", "1", "--out", (d / "t1/f_####.png").string()}).exit_code, 0);
-  ASSERT_EQ(Render(d, rig, {"--threads", "2", "--out", (d / "t2/f_####.png").string()}).exit_code, 0);
+  ASSERT_EQ(RenderRig(d, rig, {"--threads", "1", "--out", (d / "t1/f_####.png").string()}).exit_code, 0);
+  ASSERT_EQ(RenderRig(d, rig, {"--threads", "2", "--out", (d / "t2/f_####.png").string()}).exit_code, 0);
   EXPECT_TRUE(Bytes(d / "t1/f_0031.png") == Bytes(d / "t2/f_0031.png"));
 }
 
@@ -224,10 +220,10 @@ TEST(RigOverrides, ThreadsAreRead) {
 // --global swd on a rig with example shapes is refused with the rig's field
 // path (their frames A exist for SSD and DQS only), not rendered without them.
 TEST(RigOverrides, GlobalSwdRefusesExampleShapes) {
-  const fs::path dir = Dir();
+  const fs::path dir = TestDir();
   const std::string rig =
       (fs::path(TEST_DATA_DIR) / "../../samples/data/elbow.json").lexically_normal().string();
-  const ProcessResult r = Render(dir, rig, {"--global", "swd", "--frames", "0:0", "--out",
+  const ProcessResult r = RenderRig(dir, rig, {"--global", "swd", "--frames", "0:0", "--out",
                                             (dir / "f_####.png").string()});
   EXPECT_EQ(r.exit_code, 2) << r.err;
   EXPECT_NE(r.err.find("elbow.json"), std::string::npos) << r.err;

@@ -24,14 +24,11 @@
 
 namespace {
 
+using testsupport::RunPatchskin;
+using testsupport::TestDir;
+
 namespace fs = std::filesystem;
 using testsupport::ProcessResult;
-
-fs::path Dir() { return testsupport::TestDir("rough_edges"); }
-
-ProcessResult Patchskin(const std::vector<std::string>& args) {
-  return testsupport::RunPatchskin(args, Dir() / "logs");
-}
 
 std::vector<std::string> Names(const fs::path& folder) {
   std::vector<std::string> out;
@@ -44,8 +41,8 @@ std::vector<std::string> Names(const fs::path& folder) {
 // 101x57 is within 16..16384: the frames keep that size, the preview video is
 // cropped to 100x56 and the render succeeds (it failed on the video before).
 TEST(RoughEdges, OddSizeRendersFramesAndVideo) {
-  const fs::path out = Dir() / "odd";
-  const ProcessResult r = Patchskin({"render", "--size", "101x57", "--frames", "0:3", "--quiet",
+  const fs::path out = TestDir() / "odd";
+  const ProcessResult r = RunPatchskin({"render", "--size", "101x57", "--frames", "0:3", "--quiet",
                                      "--out", (out / "f_####.png").string()});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
@@ -59,13 +56,13 @@ TEST(RoughEdges, OddSizeRendersFramesAndVideo) {
 // A joint named in Latin-1 bytes ("Épaule", 0xC9) is written by inspect --json
 // as valid UTF-8 JSON (the internal error, exit 3, came from the JSON writer).
 TEST(RoughEdges, Latin1JointNameGivesValidJson) {
-  const fs::path bvh = Dir() / "latin1.bvh";
+  const fs::path bvh = TestDir() / "latin1.bvh";
   std::ofstream(bvh, std::ios::binary)
       << "HIERARCHY\nROOT Hips\n{\n  OFFSET 0 0 0\n  CHANNELS 6 Xposition Yposition Zposition "
          "Zrotation Xrotation Yrotation\n  JOINT \xC9paule\n  {\n    OFFSET 0 10 0\n    CHANNELS 3 "
          "Zrotation Xrotation Yrotation\n    End Site\n    {\n      OFFSET 0 5 0\n    }\n  }\n}\n"
          "MOTION\nFrames: 1\nFrame Time: 0.033333\n0 0 0 0 0 0 0 0 0\n";
-  const ProcessResult r = Patchskin({"inspect", bvh.string(), "--json", "--frame", "0"});
+  const ProcessResult r = RunPatchskin({"inspect", bvh.string(), "--json", "--frame", "0"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.err.find("Latin-1"), std::string::npos) << r.err;
   const nlohmann::json doc = nlohmann::json::parse(r.out, nullptr, /*allow_exceptions=*/false);
@@ -81,11 +78,11 @@ TEST(RoughEdges, InterruptedExportLeavesNoTemporaries) {
   int interrupted = 0;
   for (const std::string ext : {"obj", "glb"}) {
     SCOPED_TRACE(ext);
-    const fs::path out = Dir() / ext;
+    const fs::path out = TestDir() / ext;
     const std::string target = ext == "obj" ? (out / "m_####.obj").string() : (out / "a.glb").string();
     // The demo resampled to 900 frames: long enough to interrupt.
     testsupport::RunningProcess p = testsupport::StartPatchskin(
-        {"export", "--fps", "300", "--threads", "1", "--out", target}, Dir() / ("logs_" + ext));
+        {"export", "--fps", "300", "--threads", "1", "--out", target}, TestDir() / ("logs_" + ext));
     ASSERT_GT(p.pid, 0);
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
     // Interrupt once the export is under way (its progress line is on stderr).
@@ -120,7 +117,7 @@ TEST(RoughEdges, InterruptedExportLeavesNoTemporaries) {
 // A kept file is not rewritten; a .glb cannot be resumed.
 TEST(RoughEdges, ExportResumeWritesTheMissingFramesOnly) {
   const std::string rig = testsupport::SampleDataPath("belly_jump.json").string();
-  const fs::path full = Dir() / "resume_full", part = Dir() / "resume_part";
+  const fs::path full = TestDir() / "resume_full", part = TestDir() / "resume_part";
   fs::remove_all(full);
   fs::remove_all(part);
   const std::vector<std::string> args = {"export", rig, "--frames", "44:52", "--quiet"};
@@ -129,7 +126,7 @@ TEST(RoughEdges, ExportResumeWritesTheMissingFramesOnly) {
     a.push_back("--out");
     a.push_back((dir / "m_####.obj").string());
     a.insert(a.end(), extra.begin(), extra.end());
-    return Patchskin(a);
+    return RunPatchskin(a);
   };
   ProcessResult r = with_out(full, {});
   ASSERT_EQ(r.exit_code, 0) << r.err;
@@ -153,25 +150,25 @@ TEST(RoughEdges, ExportResumeWritesTheMissingFramesOnly) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(testsupport::SlurpFile(part / "m_0045.obj"), testsupport::SlurpFile(full / "m_0045.obj"));
 
-  const ProcessResult glb = Patchskin({"export", "--frames", "0:2", "--quiet", "--resume", "--out",
-                                       (Dir() / "resume.glb").string()});
+  const ProcessResult glb = RunPatchskin({"export", "--frames", "0:2", "--quiet", "--resume", "--out",
+                                       (TestDir() / "resume.glb").string()});
   EXPECT_EQ(glb.exit_code, 2);
   EXPECT_NE(glb.err.find("--resume"), std::string::npos) << glb.err;
-  EXPECT_FALSE(fs::exists(Dir() / "resume.glb"));
+  EXPECT_FALSE(fs::exists(TestDir() / "resume.glb"));
 }
 
 // inspect reads what export writes: a .glb of plain meshes (no skin) is
 // described (its frames and mesh), not refused with "the file has no skin".
 TEST(RoughEdges, InspectDescribesAnExportedGlb) {
-  const fs::path glb = Dir() / "exported.glb";
-  const ProcessResult made = Patchskin({"export", "--frames", "0:5", "--quiet", "--out", glb.string()});
+  const fs::path glb = TestDir() / "exported.glb";
+  const ProcessResult made = RunPatchskin({"export", "--frames", "0:5", "--quiet", "--out", glb.string()});
   ASSERT_EQ(made.exit_code, 0) << made.err;
-  const ProcessResult r = Patchskin({"inspect", glb.string(), "--json"});
+  const ProcessResult r = RunPatchskin({"inspect", glb.string(), "--json"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const nlohmann::json doc = nlohmann::json::parse(r.out, nullptr, /*allow_exceptions=*/false);
   ASSERT_FALSE(doc.is_discarded()) << r.out;
   EXPECT_EQ(doc["frames"], 6) << r.out;
-  const ProcessResult text = Patchskin({"inspect", glb.string()});
+  const ProcessResult text = RunPatchskin({"inspect", glb.string()});
   ASSERT_EQ(text.exit_code, 0) << text.err;
   EXPECT_NE(text.out.find("mesh:"), std::string::npos) << text.out;
 }
@@ -199,12 +196,12 @@ TEST(RoughEdges, UsageErrorsAndBadValuesExitTwoInEveryCommand) {
   for (const std::vector<std::string>& args : cases) {
     std::string line;
     for (const std::string& a : args) line += a + " ";
-    const ProcessResult r = Patchskin(args);
+    const ProcessResult r = RunPatchskin(args);
     EXPECT_EQ(r.exit_code, 2) << line << "\n" << r.err;
   }
   // compare and check exit as idiff does: 4 for anything but a verdict.
   for (const char* command : {"compare", "check"}) {
-    const ProcessResult r = Patchskin({command, "--bogus"});
+    const ProcessResult r = RunPatchskin({command, "--bogus"});
     EXPECT_EQ(r.exit_code, 4) << command << "\n" << r.err;
   }
 }
@@ -213,7 +210,7 @@ TEST(RoughEdges, UsageErrorsAndBadValuesExitTwoInEveryCommand) {
 // folder and says "permission denied", before any rendering. As root (which
 // may write anywhere) the command runs as user nobody through setpriv.
 TEST(RoughEdges, UnwritableOutputFolderSaysPermissionDenied) {
-  const fs::path locked = Dir() / "locked";
+  const fs::path locked = TestDir() / "locked";
   fs::create_directories(locked);
   fs::permissions(locked, fs::perms::owner_read | fs::perms::owner_exec | fs::perms::group_read |
                               fs::perms::group_exec | fs::perms::others_read |
@@ -230,7 +227,7 @@ TEST(RoughEdges, UnwritableOutputFolderSaysPermissionDenied) {
         if (std::system("setpriv --version > /dev/null 2>&1") != 0) {
           GTEST_SKIP() << "running as root without setpriv: cannot drop the permission to write";
         }
-        const fs::path err = Dir() / "logs" / "setpriv_err.txt";
+        const fs::path err = TestDir() / "logs" / "setpriv_err.txt";
         std::string line = "setpriv --reuid=65534 --regid=65534 --clear-groups '" +
                            std::string(PATCHSKIN_BINARY) + "'";
         for (const std::string& a : args) line += " '" + a + "'";
@@ -239,7 +236,7 @@ TEST(RoughEdges, UnwritableOutputFolderSaysPermissionDenied) {
         r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
         r.err = testsupport::SlurpFile(err);
       } else {
-        r = Patchskin(args);
+        r = RunPatchskin(args);
       }
       EXPECT_EQ(r.exit_code, 2) << r.err;
       const std::string first = r.FirstErrLine();
@@ -258,8 +255,8 @@ TEST(RoughEdges, TurntableOfARigHonoursItsOptions) {
   const fs::path rig = testsupport::TestDataPath("../../samples/data/belly_jump.json");
   ASSERT_TRUE(fs::exists(rig)) << rig;
   for (const std::string frame : {"0", "40"}) {
-    const fs::path out = Dir() / ("f" + frame);
-    const ProcessResult r = Patchskin({"turntable", rig.string(), "--frames", frame,
+    const fs::path out = TestDir() / ("f" + frame);
+    const ProcessResult r = RunPatchskin({"turntable", rig.string(), "--frames", frame,
                                        "--turntable-frames", "3", "--size", "96x64", "--out",
                                        (out / "t_####.png").string(), "--start-number", "1001",
                                        "--quiet", "--no-video", "--no-sheet"});
@@ -270,8 +267,8 @@ TEST(RoughEdges, TurntableOfARigHonoursItsOptions) {
     EXPECT_EQ(img->width, 96);
     EXPECT_EQ(img->height, 64);
   }
-  const render::Image a = *render::ReadImage((Dir() / "f0" / "t_1001.png").string());
-  const render::Image b = *render::ReadImage((Dir() / "f40" / "t_1001.png").string());
+  const render::Image a = *render::ReadImage((TestDir() / "f0" / "t_1001.png").string());
+  const render::Image b = *render::ReadImage((TestDir() / "f40" / "t_1001.png").string());
   int differ = 0;  // pixels above the label row that differ
   for (int y = 0; y < 40; ++y) {
     for (int x = 0; x < a.width; ++x) differ += a.at(x, y) != b.at(x, y) ? 1 : 0;
@@ -281,16 +278,16 @@ TEST(RoughEdges, TurntableOfARigHonoursItsOptions) {
 
 // --start-number 1001: motion frame 0 is file 1001 (render and export).
 TEST(RoughEdges, StartNumberNumbersTheFiles) {
-  const ProcessResult r = Patchskin({"render", "--frames", "2:4", "--size", "64x36", "--quiet",
+  const ProcessResult r = RunPatchskin({"render", "--frames", "2:4", "--size", "64x36", "--quiet",
                                      "--no-video", "--no-sheet", "--start-number", "1001", "--out",
-                                     (Dir() / "r" / "f_####.png").string()});
+                                     (TestDir() / "r" / "f_####.png").string()});
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_EQ(Names(Dir() / "r"), (std::vector<std::string>{"f_1003.png", "f_1004.png", "f_1005.png"}));
-  const ProcessResult e = Patchskin({"export", "--frames", "0:1", "--quiet", "--start-number",
-                                     "1001", "--out", (Dir() / "e" / "m_####.obj").string()});
+  EXPECT_EQ(Names(TestDir() / "r"), (std::vector<std::string>{"f_1003.png", "f_1004.png", "f_1005.png"}));
+  const ProcessResult e = RunPatchskin({"export", "--frames", "0:1", "--quiet", "--start-number",
+                                     "1001", "--out", (TestDir() / "e" / "m_####.obj").string()});
   ASSERT_EQ(e.exit_code, 0) << e.err;
-  EXPECT_EQ(Names(Dir() / "e"), (std::vector<std::string>{"m_1001.obj", "m_1002.obj"}));
-  EXPECT_EQ(Patchskin({"render", "--start-number", "-1"}).exit_code, 2);
+  EXPECT_EQ(Names(TestDir() / "e"), (std::vector<std::string>{"m_1001.obj", "m_1002.obj"}));
+  EXPECT_EQ(RunPatchskin({"render", "--start-number", "-1"}).exit_code, 2);
 }
 
 }  // namespace

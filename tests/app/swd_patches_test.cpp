@@ -26,12 +26,10 @@ namespace {
 
 namespace fs = std::filesystem;
 
-const fs::path kSamples = fs::path(GOLDEN_DIR) / ".." / ".." / "samples" / "data";
-
 // The sample bend (elbows and knees from straight to 150 degrees) on the mannequin.
 app::Character BendCharacter() {
   auto src = app::LoadMotionSource(
-      fs::absolute(kSamples / "bend.bvh").lexically_normal().string(), {.y_up = true});
+      testsupport::SampleDataPath("bend.bvh").string(), {.y_up = true});
   EXPECT_TRUE(src.ok()) << src.error().ToString();
   auto c = app::MakeCharacter(std::move(*src));
   EXPECT_TRUE(c.ok()) << c.error().ToString();
@@ -39,7 +37,7 @@ app::Character BendCharacter() {
 }
 
 std::vector<deform::PatchSetup> SampleSwdPatches(const app::Character& c) {
-  auto rig = app::LoadRig((kSamples / "elbow_knee_swd.json").string());
+  auto rig = app::LoadRig(testsupport::SampleDataPath("elbow_knee_swd.json").string());
   EXPECT_TRUE(rig.ok()) << rig.error().ToString();
   EXPECT_EQ(rig->global, "swd");
   auto patches = app::BuildRigPatches(*rig, c);
@@ -115,7 +113,7 @@ TEST(SwdPatches, RenderCommandRendersTheSwdSampleRig) {
   fs::remove_all(dir);
   fs::create_directories(dir);
   const testsupport::ProcessResult r = testsupport::RunPatchskin(
-      {"render", (kSamples / "elbow_knee_swd.json").string(), "--frames", "45:45", "--no-video",
+      {"render", testsupport::SampleDataPath("elbow_knee_swd.json").string(), "--frames", "45:45", "--no-video",
        "--no-sheet", "--quiet", "--out", (dir / "f_####.png").string()},
       dir);
   ASSERT_EQ(r.exit_code, 0) << r.err;

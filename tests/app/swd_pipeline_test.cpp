@@ -27,6 +27,7 @@
 #include "deform/global/skinning_job.h"
 #include "deform/global/swd_rig.h"
 #include "mocap/synthetic.h"
+#include "support/body_checks.h"
 #include "support/data_paths.h"
 #include "support/tolerances.h"
 
@@ -75,22 +76,7 @@ void ExpectClosed(const deform::Mesh& m, const std::string& what) {
   EXPECT_EQ(bad, 0) << what << ": edges not shared by exactly two triangles";
 }
 
-// Largest growth of an edge (deformed minus rest length) over the body size: a tear
-// (a part following the wrong bone) opens gaps of a limb's radius, several percent.
-float MaxEdgeGrowth(const deform::Mesh& rest, const std::vector<glm::vec3>& pos) {
-  float worst = 0.0f;
-  for (const glm::uvec3& t : rest.triangles) {
-    for (int e = 0; e < 3; ++e) {
-      const std::uint32_t a = t[e], b = t[(e + 1) % 3];
-      worst = std::max(worst, glm::distance(pos[a], pos[b]) -
-                                  glm::distance(rest.positions[a], rest.positions[b]));
-    }
-  }
-  const glm::vec3 e = deform::ComputeBounds(rest.positions).size();
-  return worst / std::max({e.x, e.y, e.z});
-}
-
-// max_growth: bound on MaxEdgeGrowth at the first, middle and last frame (0: print only).
+// max_growth: bound on testsupport::MaxEdgeGrowthFraction at the first, middle and last frame (0: print only).
 void CheckCharacter(const app::Character& c, const std::string& what, float max_growth) {
   {  // At the bind pose the rig rebuilds the mesh (ALGORITHMS.md 2.3).
     auto bind = app::BindModelFromJoint(c);
@@ -133,7 +119,7 @@ void CheckCharacter(const app::Character& c, const std::string& what, float max_
       ASSERT_TRUE(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z)) << what;
     }
     // No tearing: no edge of the closed body gets much longer (shoulders, hips).
-    const float growth = MaxEdgeGrowth(c.mesh.bind, a.positions);
+    const float growth = testsupport::MaxEdgeGrowthFraction(c.mesh.bind, a.positions);
     std::printf("%s t = %.2f s: largest edge growth %.4f of the body size\n", what.c_str(), t, growth);
     if (max_growth > 0.0f) {
       EXPECT_LT(growth, max_growth) << what << " at t = " << t;

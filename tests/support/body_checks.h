@@ -21,6 +21,22 @@
 
 namespace testsupport {
 
+// The largest growth of a triangle edge from `rest` to `pos` (deformed minus
+// rest length) over the body's size: a tear (a part following the wrong bone)
+// opens gaps of a limb's radius, several percent.
+inline float MaxEdgeGrowthFraction(const deform::Mesh& rest, std::span<const glm::vec3> pos) {
+  float worst = 0.0f;
+  for (const glm::uvec3& t : rest.triangles) {
+    for (int e = 0; e < 3; ++e) {
+      const std::uint32_t a = t[e], b = t[(e + 1) % 3];
+      worst = std::max(worst, glm::distance(pos[a], pos[b]) -
+                                  glm::distance(rest.positions[a], rest.positions[b]));
+    }
+  }
+  const glm::vec3 e = deform::ComputeBounds(rest.positions).size();
+  return worst / std::max({e.x, e.y, e.z});
+}
+
 // Directed edges that are not matched by exactly one opposite edge (0: closed, manifold
 // and consistently oriented).
 inline int BadEdges(const deform::Mesh& mesh) {

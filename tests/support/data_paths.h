@@ -3,8 +3,10 @@
 // project made); SHARED_DATA_DIR is ../shared/data (real captures, not in the
 // repo). Tests that need the shared data skip with a clear message without it.
 
+#include <algorithm>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -46,6 +48,20 @@ inline std::filesystem::path FreshOutputDir(const std::string& relative) {
   std::filesystem::remove_all(d);
   std::filesystem::create_directories(d);
   return d;
+}
+
+// The same, in a folder named after the test's suite.
+inline std::filesystem::path TestDir() {
+  return TestDir(::testing::UnitTest::GetInstance()->current_test_info()->test_suite_name());
+}
+
+// The regular files of `folder`, sorted by name (none when it does not exist).
+inline std::vector<std::filesystem::path> FilesIn(const std::filesystem::path& folder) {
+  std::vector<std::filesystem::path> out;
+  if (!std::filesystem::exists(folder)) return out;
+  for (const auto& e : std::filesystem::directory_iterator(folder)) out.push_back(e.path());
+  std::sort(out.begin(), out.end());
+  return out;
 }
 
 inline bool HaveSharedData() { return std::filesystem::is_directory(SHARED_DATA_DIR); }

@@ -20,6 +20,8 @@
 #include <string>
 #include <vector>
 
+#include "support/data_paths.h"
+
 extern char** environ;
 
 namespace testsupport {
@@ -114,6 +116,17 @@ inline ProcessResult RunProgram(const std::string& program, const std::vector<st
 inline ProcessResult RunPatchskin(const std::vector<std::string>& args,
                                   const std::filesystem::path& log_dir) {
   return WaitFor(StartPatchskin(args, log_dir));
+}
+
+// The same, logging to the current test's own folder (TestDir()/logs).
+inline ProcessResult RunPatchskin(const std::vector<std::string>& args) {
+  return RunPatchskin(args, TestDir() / "logs");
+}
+
+// Runs `patchskin ARGS` through /bin/sh, so `args` is one line that may quote
+// paths ('...'); stdout and stderr go to `log_dir`/{stdout,stderr}.txt.
+inline ProcessResult RunPatchskinLine(const std::string& args, const std::filesystem::path& log_dir) {
+  return RunProgram("/bin/sh", {"-c", std::string("'") + PATCHSKIN_BINARY + "' " + args}, log_dir);
 }
 
 }  // namespace testsupport
