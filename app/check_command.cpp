@@ -7,7 +7,6 @@
 #include <filesystem>
 #include <regex>
 
-
 #include "app/check_manifest.h"
 #include "app/check_report.h"
 #include "app/render_command.h"

@@ -115,7 +115,8 @@ std::optional<mocap::Error> ParseCaseOptions(const Ctx& c, const std::string& pa
                                              const std::string& input,
                                              const std::vector<std::string>& words,
                                              RenderOptions& out) {
-  if (std::optional<std::string> bad = app::ParseRenderWords(input, words, out)) return c.Fail(path, *bad);
+  if (std::optional<std::string> bad = app::ParseRenderWords(input, words, out))
+    return c.Fail(path, *bad);
   for (const char* refused : {"--out", "--frames", "--overwrite", "--resume", "--stats", "--help"}) {
     if (out.given.count(refused) > 0) {
       return c.Fail(path, std::string("render option ") + refused +

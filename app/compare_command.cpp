@@ -4,7 +4,6 @@
 #include <cmath>
 #include <cstdio>
 
-
 #include "render/output/image_compare.h"
 #include "render/output/image_file_compare.h"
 #include "render/output/image_io.h"

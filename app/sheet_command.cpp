@@ -24,7 +24,6 @@ int Fail(const mocap::Error& e) {
   return e.code == mocap::ErrorCode::kInternal ? 3 : 2;
 }
 
-
 // True for "A:B" or "A:B:STEP" with every part a non-empty run of digits: a sheet
 // needs both ends of the range, which ParseFrames lets a render leave open.
 bool IsClosedRange(const std::string& text) {

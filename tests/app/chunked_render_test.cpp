@@ -45,7 +45,8 @@ void ExpectChunksMatchWhole(const std::string& input, const std::vector<std::str
   const fs::path dir = TestDir();
   Render(input, "0:29", dir / "whole", extra);
   for (const char* chunk : {"0:9", "10:19", "20:29"}) Render(input, chunk, dir / "chunks", extra);
-  const std::vector<fs::path> whole = testsupport::FilesIn(dir / "whole"), chunks = testsupport::FilesIn(dir / "chunks");
+  const std::vector<fs::path> whole = testsupport::FilesIn(dir / "whole"),
+                              chunks = testsupport::FilesIn(dir / "chunks");
   ASSERT_EQ(whole.size(), 30u);
   ASSERT_EQ(chunks.size(), 30u);
   for (std::size_t i = 0; i < whole.size(); ++i) {
@@ -69,13 +70,13 @@ TEST(ChunkedRender, RigWithPatchesMatchesTheWholeRender) {
   const fs::path dir = testsupport::TestOutputPath("chunked_render/rig/x").parent_path();
   fs::create_directories(dir);
   const fs::path rig = dir / "patches.json";
-  std::ofstream(rig) << R"({"character": "mannequin", "motion": {"file": ")"
-                     << testsupport::SampleDataPath("bend.bvh").string()
-                     << R"("}, "global": "ssd", "patches": [)"
-                     << R"({"name": "left_elbow", "region": {"joint": "LeftForeArm", "radius": 14,)"
-                     << R"( "side": [0, 0, 1], "half_angle_deg": 120}, "parametrization": "cylinder",)"
-                     << R"( "sampling": [8, 8], "grid": [6, 6], "border_width": 0.1}],)"
-                     << R"( "render": {"size": [160, 90], "camera": "follow"}})";
+  std::ofstream(rig)
+      << R"({"character": "mannequin", "motion": {"file": ")"
+      << testsupport::SampleDataPath("bend.bvh").string() << R"("}, "global": "ssd", "patches": [)"
+      << R"({"name": "left_elbow", "region": {"joint": "LeftForeArm", "radius": 14,)"
+      << R"( "side": [0, 0, 1], "half_angle_deg": 120}, "parametrization": "cylinder",)"
+      << R"( "sampling": [8, 8], "grid": [6, 6], "border_width": 0.1}],)"
+      << R"( "render": {"size": [160, 90], "camera": "follow"}})";
   ExpectChunksMatchWhole(rig.string());
 }
 
@@ -84,15 +85,15 @@ TEST(ChunkedRender, RigWithPatchesMatchesTheWholeRender) {
 // camera frames samples of the whole motion. The example-shape demos at their
 // own cameras, side by side, with patches and examples.
 TEST(ChunkedRender, LookAtTheElbowFromTheSideMatchesTheWholeRender) {
-  ExpectChunksMatchWhole(testsupport::SampleDataPath("bend.bvh").string(),
-                         {"--look-at", "LeftForeArm", "--azimuth", "90", "--zoom", "1.5",
-                          "--compare", "ssd,dqs"});
+  ExpectChunksMatchWhole(
+      testsupport::SampleDataPath("bend.bvh").string(),
+      {"--look-at", "LeftForeArm", "--azimuth", "90", "--zoom", "1.5", "--compare", "ssd,dqs"});
 }
 
 TEST(ChunkedRender, FixedCameraOnAJointMatchesTheWholeRender) {
-  ExpectChunksMatchWhole(testsupport::SampleDataPath("bend.bvh").string(),
-                         {"--camera", "fixed", "--look-at", "LeftLeg", "--elevation", "-10",
-                          "--distance", "60"});
+  ExpectChunksMatchWhole(
+      testsupport::SampleDataPath("bend.bvh").string(),
+      {"--camera", "fixed", "--look-at", "LeftLeg", "--elevation", "-10", "--distance", "60"});
 }
 
 TEST(ChunkedRender, DemoRigAtItsOwnCameraMatchesTheWholeRender) {

@@ -23,10 +23,10 @@
 
 namespace {
 
-using testsupport::RunPatchskin;
 using testsupport::ExpectNoOutput;
 using testsupport::kExitBadInput;
 using testsupport::OutDir;
+using testsupport::RunPatchskin;
 using testsupport::TestDir;
 
 namespace fs = std::filesystem;
@@ -131,7 +131,8 @@ TEST(CliBadInput, EmptyGltf) {
 TEST(CliBadInput, DirectoryWhereAFileBelongs) {
   const fs::path folder = TestDir() / "walk.bvh";
   fs::create_directories(folder);
-  ExpectBadInput(RunPatchskin({"inspect", folder.string()}), folder.string(), false, "found a directory");
+  ExpectBadInput(RunPatchskin({"inspect", folder.string()}), folder.string(), false,
+                 "found a directory");
   ExpectBadInput(RenderInput(folder.string()), folder.string(), false, "found a directory");
   ExpectNoOutput();
 }
@@ -212,7 +213,8 @@ TEST(CliBadInput, BadRenderOptions) {
 }
 
 TEST(CliBadInput, OutputPatternWithoutPlaceholder) {
-  const ProcessResult r = RunPatchskin({"render", "--quiet", "--out", (OutDir() / "frame.png").string()});
+  const ProcessResult r =
+      RunPatchskin({"render", "--quiet", "--out", (OutDir() / "frame.png").string()});
   EXPECT_EQ(r.exit_code, kExitBadInput) << r.err;
   EXPECT_EQ(r.FirstErrLine().rfind("--out: error: ", 0), 0u) << r.err;
   EXPECT_NE(r.FirstErrLine().find("placeholder"), std::string::npos) << r.err;

@@ -112,7 +112,7 @@ TEST(CliBadRig, FolderWhereTheRigBelongs) {
   const fs::path folder = TestDir() / "rig.json";
   fs::create_directories(folder);
   ExpectRigRefused(RenderRig(folder.string()), folder.string(),
-                 "error: expected a rig file, found a directory");
+                   "error: expected a rig file, found a directory");
   ExpectNoOutput();
 }
 
@@ -141,7 +141,7 @@ TEST(CliBadRig, RigOverTheSizeLimitIsRefusedBeforeReading) {
   std::ofstream(huge).close();
   fs::resize_file(huge, app::kMaxRigFileBytes + 1);  // sparse: no disk used
   ExpectRigRefused(RenderRig(huge.string()), huge.string(),
-                 "error: expected a rig file of at most 16 MiB, found 16777217 bytes");
+                   "error: expected a rig file of at most 16 MiB, found 16777217 bytes");
   ExpectNoOutput();
 }
 

@@ -40,8 +40,8 @@ TEST(ElasticCommand, PlotsTheBuiltInJump) {
 
 TEST(ElasticCommand, UnknownJointIsBadInput) {
   const fs::path dir = testsupport::TestOutputPath("elastic_command/bad/x").parent_path();
-  const ProcessResult r = RunPatchskinLine("elastic --joint Tail --out '" + (dir / "x.png").string() + "'",
-                                    dir);
+  const ProcessResult r =
+      RunPatchskinLine("elastic --joint Tail --out '" + (dir / "x.png").string() + "'", dir);
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("error: no joint named 'Tail'"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir / "x.png"));

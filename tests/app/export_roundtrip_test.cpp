@@ -41,7 +41,8 @@ namespace fs = std::filesystem;
 // so render draws exactly the layered mesh.
 fs::path WriteElbowRig(const fs::path& dir) {
   const fs::path rig = dir / "elbow.json";
-  std::ofstream(rig) << R"({"character": "mannequin", "motion": {"file": ")" << testsupport::SampleDataPath("bend.bvh").string() << R"("},
+  std::ofstream(rig) << R"({"character": "mannequin", "motion": {"file": ")"
+                     << testsupport::SampleDataPath("bend.bvh").string() << R"("},
     "global": "ssd",
     "patches": [{"name": "left_elbow",
                  "region": {"joint": "LeftForeArm", "radius": 14, "side": [0, 0, 1], "half_angle_deg": 120},
@@ -152,12 +153,13 @@ TEST(ExportRoundTrip, PatchRigGlbReadsBackWithOurImporter) {
 TEST(ExportRoundTrip, BvhBakedGlbShowsOneFramePerKey) {
   const fs::path dir = TestDir();
   const testsupport::ProcessResult run = testsupport::RunPatchskin(
-      {"export", testsupport::SampleDataPath("bend.bvh").string(), "--frames", "10:30:5", "--layout", "baked", "--global", "dqs", "--quiet",
-       "--out", (dir / "bend.glb").string()},
+      {"export", testsupport::SampleDataPath("bend.bvh").string(), "--frames", "10:30:5",
+       "--layout", "baked", "--global", "dqs", "--quiet", "--out", (dir / "bend.glb").string()},
       dir);
   ASSERT_EQ(run.exit_code, 0) << run.err;
 
-  auto src = app::LoadMotionSource(testsupport::SampleDataPath("bend.bvh").string(), {.y_up = true});
+  auto src =
+      app::LoadMotionSource(testsupport::SampleDataPath("bend.bvh").string(), {.y_up = true});
   ASSERT_TRUE(src.ok());
   auto ch = app::MakeCharacter(std::move(*src), {}, app::BodyKind::kGenerated);  // export's default body
   ASSERT_TRUE(ch.ok());
@@ -272,10 +274,11 @@ TEST(ExportRoundTrip, PatchRigObjIsWhatRenderDrew) {
 TEST(ExportRoundTrip, ScaleMultipliesPositionsAndCameraLengths) {
   const fs::path dir = TestDir();
   for (const std::string scale : {"1", "0.01"}) {
-    const testsupport::ProcessResult run = testsupport::RunPatchskin(
-        {"export", testsupport::SampleDataPath("bend.bvh").string(), "--frames", "20:20", "--with-camera", "--scale", scale, "--quiet", "--out",
-         (dir / scale / "mesh_####.obj").string()},
-        dir);
+    const testsupport::ProcessResult run =
+        testsupport::RunPatchskin({"export", testsupport::SampleDataPath("bend.bvh").string(),
+                                   "--frames", "20:20", "--with-camera", "--scale", scale,
+                                   "--quiet", "--out", (dir / scale / "mesh_####.obj").string()},
+                                  dir);
     ASSERT_EQ(run.exit_code, 0) << run.err;
   }
   const testsupport::ParsedObj a = testsupport::ParseObjFile((dir / "1" / "mesh_0020.obj").string());
@@ -302,8 +305,10 @@ TEST(ExportRoundTrip, ScaleMultipliesPositionsAndCameraLengths) {
     EXPECT_NEAR(pa.x / pa.w, pb.x / pb.w, testsupport::kFloatTol * 10.0f) << v;
     EXPECT_NEAR(pa.y / pa.w, pb.y / pb.w, testsupport::kFloatTol * 10.0f) << v;
   }
-  const testsupport::ProcessResult bad = testsupport::RunPatchskin(
-      {"export", testsupport::SampleDataPath("bend.bvh").string(), "--scale", "-1", "--quiet", "--out", (dir / "bad.glb").string()}, dir);
+  const testsupport::ProcessResult bad =
+      testsupport::RunPatchskin({"export", testsupport::SampleDataPath("bend.bvh").string(),
+                                 "--scale", "-1", "--quiet", "--out", (dir / "bad.glb").string()},
+                                dir);
   EXPECT_EQ(bad.exit_code, 2);
   EXPECT_NE(bad.FirstErrLine().find("--scale"), std::string::npos) << bad.err;
   EXPECT_FALSE(fs::exists(dir / "bad.glb"));
@@ -312,8 +317,10 @@ TEST(ExportRoundTrip, ScaleMultipliesPositionsAndCameraLengths) {
 TEST(ExportRoundTrip, BadRigIsRefusedWithoutOutput) {
   const fs::path dir = TestDir();
   const fs::path rig = dir / "bad.json";
-  std::ofstream(rig) << R"({"character": "mannequin", "motion": {"file": ")" << testsupport::SampleDataPath("bend.bvh").string()
-                     << R"("}, "patches": [{"name": "e", "region": {"joint": "Elbow", "radius": 9}}]})";
+  std::ofstream(rig)
+      << R"({"character": "mannequin", "motion": {"file": ")"
+      << testsupport::SampleDataPath("bend.bvh").string()
+      << R"("}, "patches": [{"name": "e", "region": {"joint": "Elbow", "radius": 9}}]})";
   const testsupport::ProcessResult run = testsupport::RunPatchskin(
       {"export", rig.string(), "--quiet", "--out", (dir / "out.glb").string()}, dir);
   EXPECT_EQ(run.exit_code, 2);
@@ -366,8 +373,8 @@ TEST(ExportRoundTrip, GlbCarriesTheRenderCameraAsAnAnimatedNode) {
     SCOPED_TRACE(layout);
     const fs::path out = dir / ("camera_" + layout) / "bend.glb";
     const testsupport::ProcessResult run = testsupport::RunPatchskin(
-        {"export", testsupport::SampleDataPath("bend.bvh").string(), "--frames", "10:30:10", "--with-camera", "--scale", "0.01", "--layout", layout,
-         "--quiet", "--out", out.string()},
+        {"export", testsupport::SampleDataPath("bend.bvh").string(), "--frames", "10:30:10",
+         "--with-camera", "--scale", "0.01", "--layout", layout, "--quiet", "--out", out.string()},
         dir);
     ASSERT_EQ(run.exit_code, 0) << run.err;
     const Glb glb = ReadGlb(out);

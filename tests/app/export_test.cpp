@@ -66,8 +66,9 @@ int PatchskinExit(const std::string& args, const fs::path& dir) {
 TEST(ExportCommand, ObjFramesAreThePipelineFramesAndCamerasAreRenders) {
   const fs::path dir = TestDir();
   ASSERT_EQ(PatchskinExit("export --frames 10:40:10 --global dqs --with-camera --size 320x200 "
-                      "--quiet --out '" + (dir / "mesh_####.obj").string() + "'",
-                      dir),
+                          "--quiet --out '" +
+                              (dir / "mesh_####.obj").string() + "'",
+                          dir),
             0)
       << testsupport::SlurpFile(dir / "stderr.txt");
 
@@ -127,8 +128,8 @@ TEST(ExportCommand, ObjFramesAreThePipelineFramesAndCamerasAreRenders) {
 
 TEST(ExportCommand, GlbGivesEachFrameAtItsTime) {
   const fs::path dir = TestDir();
-  ASSERT_EQ(PatchskinExit("export --frames 0:20:4 --quiet --out '" + (dir / "walk.glb").string() + "'",
-                      dir),
+  ASSERT_EQ(PatchskinExit(
+                "export --frames 0:20:4 --quiet --out '" + (dir / "walk.glb").string() + "'", dir),
             0)
       << testsupport::SlurpFile(dir / "stderr.txt");
   EXPECT_NE(testsupport::SlurpFile(dir / "stdout.txt").find("morph"), std::string::npos);
@@ -166,13 +167,13 @@ TEST(ExportCommand, ObjDrawnWithItsCameraJsonIsTheRenderedFrame) {
   const fs::path dir = TestDir();
   const std::string common = " --frames 12:12 --size 96x64 --camera fixed --quiet ";
   ASSERT_EQ(PatchskinExit("render" + common + "--supersample 1 --no-sheet --no-video --out '" +
-                          (dir / "frame_####.png").string() + "'",
-                      dir),
+                              (dir / "frame_####.png").string() + "'",
+                          dir),
             0)
       << testsupport::SlurpFile(dir / "stderr.txt");
   ASSERT_EQ(PatchskinExit("export" + common + "--with-camera --out '" +
-                          (dir / "mesh_####.obj").string() + "'",
-                      dir),
+                              (dir / "mesh_####.obj").string() + "'",
+                          dir),
             0)
       << testsupport::SlurpFile(dir / "stderr.txt");
 
@@ -226,13 +227,15 @@ TEST(ExportCommand, ObjDrawnWithItsCameraJsonIsTheRenderedFrame) {
 TEST(ExportCommand, ScaleZeroConvertsTheDetectedUnitsToMetres) {
   const fs::path dir = TestDir();
   for (const char* scale : {"0", "0.01", "1"}) {
-    ASSERT_EQ(PatchskinExit(std::string("export --frames 12:12 --quiet --scale ") + scale + " --out '" +
-                            (dir / (std::string("s") + scale + "_####.obj")).string() + "'",
-                        dir),
-              0)
+    ASSERT_EQ(
+        PatchskinExit(std::string("export --frames 12:12 --quiet --scale ") + scale + " --out '" +
+                          (dir / (std::string("s") + scale + "_####.obj")).string() + "'",
+                      dir),
+        0)
         << testsupport::SlurpFile(dir / "stderr.txt");
   }
-  const std::string automatic = testsupport::SlurpFile(dir / "s0_0012.obj"), metres = testsupport::SlurpFile(dir / "s0.01_0012.obj");
+  const std::string automatic = testsupport::SlurpFile(dir / "s0_0012.obj"),
+                    metres = testsupport::SlurpFile(dir / "s0.01_0012.obj");
   ASSERT_FALSE(automatic.empty());
   EXPECT_EQ(automatic, metres);
   EXPECT_NE(automatic, testsupport::SlurpFile(dir / "s1_0012.obj"));
@@ -242,10 +245,14 @@ TEST(ExportCommand, BadArgumentsAreRefused) {
   const fs::path dir = TestDir();
   EXPECT_EQ(PatchskinExit("export --quiet --out '" + (dir / "mesh.obj").string() + "'", dir), 2);
   EXPECT_NE(testsupport::SlurpFile(dir / "stderr.txt").find("placeholder"), std::string::npos);
-  EXPECT_EQ(PatchskinExit("export --quiet --out '" + (dir / "mesh_####.ply").string() + "'", dir), 2);
-  EXPECT_EQ(PatchskinExit("export --quiet --frames 5:2 --out '" + (dir / "a.glb").string() + "'", dir), 2);
+  EXPECT_EQ(PatchskinExit("export --quiet --out '" + (dir / "mesh_####.ply").string() + "'", dir),
+            2);
+  EXPECT_EQ(
+      PatchskinExit("export --quiet --frames 5:2 --out '" + (dir / "a.glb").string() + "'", dir),
+      2);
   EXPECT_NE(testsupport::SlurpFile(dir / "stderr.txt").find("--frames"), std::string::npos);
-  EXPECT_EQ(PatchskinExit("export --quiet --layout x --out '" + (dir / "a.glb").string() + "'", dir), 2);
+  EXPECT_EQ(
+      PatchskinExit("export --quiet --layout x --out '" + (dir / "a.glb").string() + "'", dir), 2);
   EXPECT_FALSE(fs::exists(dir / "a.glb"));
 }
 

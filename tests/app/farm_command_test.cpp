@@ -37,9 +37,18 @@ int RunTask(const fs::path& script, int task, const fs::path& log) {
 const std::vector<std::string> kRenderArgs{"--", "--size", "64x36", "--supersample", "1"};
 
 std::vector<std::string> FarmArgs(const fs::path& d, const std::string& frames, int chunk) {
-  std::vector<std::string> args{"farm", "slurm", testsupport::SampleDataPath("bend.bvh").string(), "--frames", frames, "--chunk",
-                                std::to_string(chunk), "--out", (d / "farm/f_####.png").string(),
-                                "--partition", "debug", "--sbatch-arg=--time=00:05:00"};
+  std::vector<std::string> args{"farm",
+                                "slurm",
+                                testsupport::SampleDataPath("bend.bvh").string(),
+                                "--frames",
+                                frames,
+                                "--chunk",
+                                std::to_string(chunk),
+                                "--out",
+                                (d / "farm/f_####.png").string(),
+                                "--partition",
+                                "debug",
+                                "--sbatch-arg=--time=00:05:00"};
   args.insert(args.end(), kRenderArgs.begin(), kRenderArgs.end());
   return args;
 }
@@ -57,9 +66,12 @@ void ExpectChunksEqualOneRender(const std::string& frames, int chunk, int tasks,
   EXPECT_NE(farm.out.find("sh " + (d / "farm/slurm/submit.sh").string()), std::string::npos);
   EXPECT_FALSE(fs::exists(d / "farm/f_0000.png"));
 
-  std::vector<std::string> single{"render", testsupport::SampleDataPath("bend.bvh").string(), "--frames", frames, "--out",
-                                  (d / "single/f_####.png").string(), "--quiet", "--no-video",
-                                  "--size", "64x36", "--supersample", "1"};
+  std::vector<std::string> single{"render",        testsupport::SampleDataPath("bend.bvh").string(),
+                                  "--frames",      frames,
+                                  "--out",         (d / "single/f_####.png").string(),
+                                  "--quiet",       "--no-video",
+                                  "--size",        "64x36",
+                                  "--supersample", "1"};
   const ProcessResult one = PatchskinIn(d, single);
   ASSERT_EQ(one.exit_code, 0) << one.err;
 
@@ -82,9 +94,10 @@ void ExpectChunksEqualOneRender(const std::string& frames, int chunk, int tasks,
   // The same frames on the sheet. Not the same bytes: `sheet` shrinks the 8-bit
   // frame files, render the float frames before quantizing, so thumbnails
   // differ by a few 8-bit levels (measured: at most 5/255 on 0.07% of values).
-  const ProcessResult sheets = PatchskinIn(
-      d, {"compare", (d / "single/contact_sheet.png").string(), (d / "farm/contact_sheet.png").string(),
-          "--fail", "0.004", "--failpercent", "1", "--hardfail", "0.03"});
+  const ProcessResult sheets =
+      PatchskinIn(d, {"compare", (d / "single/contact_sheet.png").string(),
+                      (d / "farm/contact_sheet.png").string(), "--fail", "0.004", "--failpercent",
+                      "1", "--hardfail", "0.03"});
   EXPECT_EQ(sheets.exit_code, 0) << sheets.out;
 }
 
@@ -116,8 +129,8 @@ TEST(FarmSlurm, RefusesBadArguments) {
   EXPECT_NE(r.FirstErrLine().find("--frames"), std::string::npos) << r.err;
 
   // The framing range of a chunk must hold the chunk's frames.
-  r = PatchskinIn(d, {"render", testsupport::SampleDataPath("bend.bvh").string(), "--frames", "0:5", "--framing", "2:3", "--quiet",
-                    "--out", (d / "farm/f_####.png").string()});
+  r = PatchskinIn(d, {"render", testsupport::SampleDataPath("bend.bvh").string(), "--frames", "0:5",
+                      "--framing", "2:3", "--quiet", "--out", (d / "farm/f_####.png").string()});
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.FirstErrLine().find("--framing: error: expected a range holding every output frame"),
             std::string::npos)
@@ -132,9 +145,10 @@ TEST(FarmSlurm, RefusesBadArguments) {
 
 TEST(SheetCommand, RefusesMissingFramesAndExistingSheet) {
   const fs::path d = TestDir();
-  const ProcessResult one = PatchskinIn(
-      d, {"render", testsupport::SampleDataPath("bend.bvh").string(), "--frames", "0:3", "--out", (d / "f_####.png").string(), "--quiet",
-          "--no-video", "--no-sheet", "--size", "64x36", "--supersample", "1"});
+  const ProcessResult one =
+      PatchskinIn(d, {"render", testsupport::SampleDataPath("bend.bvh").string(), "--frames", "0:3",
+                      "--out", (d / "f_####.png").string(), "--quiet", "--no-video", "--no-sheet",
+                      "--size", "64x36", "--supersample", "1"});
   ASSERT_EQ(one.exit_code, 0) << one.err;
   ProcessResult r = PatchskinIn(d, {"sheet", (d / "f_####.png").string(), "--frames", "0:5"});
   EXPECT_EQ(r.exit_code, 2);
@@ -151,13 +165,13 @@ TEST(SheetCommand, RefusesMissingFramesAndExistingSheet) {
   // A sheet needs a closed range: open ends, empty parts and stray characters are refused
   // with the option named; a step is accepted.
   for (const char* bad : {"0:", ":3", "0:3:", "0::2", "a:b", "0:3:1:1", "0:3 ", ""}) {
-    r = PatchskinIn(d, {"sheet", (d / "f_####.png").string(), "--frames", bad, "--no-video",
-                      "--overwrite"});
+    r = PatchskinIn(
+        d, {"sheet", (d / "f_####.png").string(), "--frames", bad, "--no-video", "--overwrite"});
     EXPECT_EQ(r.exit_code, 2) << "'" << bad << "'";
     EXPECT_NE(r.FirstErrLine().find("--frames"), std::string::npos) << "'" << bad << "': " << r.err;
   }
-  r = PatchskinIn(d, {"sheet", (d / "f_####.png").string(), "--frames", "0:3:3", "--no-video",
-                    "--overwrite"});
+  r = PatchskinIn(
+      d, {"sheet", (d / "f_####.png").string(), "--frames", "0:3:3", "--no-video", "--overwrite"});
   EXPECT_EQ(r.exit_code, 0) << r.err;
 }
 

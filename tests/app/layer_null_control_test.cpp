@@ -113,12 +113,15 @@ TEST(LayerNullControl, PatchesWithoutExamplesOrElasticRenderTheGlobalFrames) {
   for (const char* demo : {"biceps", "knee", "belly_jump"}) {
     SCOPED_TRACE(demo);
     Bodies b;
-    LoadBodies(demo, [](app::Rig& rig) {
-      for (app::RigPatch& p : rig.patches) {
-        p.examples.clear();
-        p.elastic.reset();
-      }
-    }, b);
+    LoadBodies(
+        demo,
+        [](app::Rig& rig) {
+          for (app::RigPatch& p : rig.patches) {
+            p.examples.clear();
+            p.elastic.reset();
+          }
+        },
+        b);
     if (HasFatalFailure()) return;
     ExpectIdenticalFrames(b);
   }
@@ -128,13 +131,16 @@ TEST(LayerNullControl, ExamplesWhoseEditsAreAllZeroRenderTheGlobalFrames) {
   for (const char* demo : {"biceps", "knee"}) {
     SCOPED_TRACE(demo);
     Bodies b;
-    LoadBodies(demo, [](app::Rig& rig) {
-      for (app::RigPatch& p : rig.patches) {
-        for (app::RigExample& e : p.examples) {
-          for (app::RigEdit& edit : e.edits) edit.move = glm::dvec3(0.0);
-        }
-      }
-    }, b);
+    LoadBodies(
+        demo,
+        [](app::Rig& rig) {
+          for (app::RigPatch& p : rig.patches) {
+            for (app::RigExample& e : p.examples) {
+              for (app::RigEdit& edit : e.edits) edit.move = glm::dvec3(0.0);
+            }
+          }
+        },
+        b);
     if (HasFatalFailure()) return;
     ExpectIdenticalFrames(b);
   }
@@ -168,7 +174,8 @@ std::vector<bool> MarkedPixels(const app::Character& ch, const app::DeformedFram
 
 TEST(LayerNullControl, ExamplesChangeOnlyThePixelsOfTheirPatchRegion) {
   Bodies b;
-  LoadBodies("biceps", [](app::Rig&) {}, b);
+  LoadBodies(
+      "biceps", [](app::Rig&) {}, b);
   if (HasFatalFailure()) return;
   const app::Character& ch = *b.character;
   // Seen from above, the biceps' front is the silhouette (as the golden frames).

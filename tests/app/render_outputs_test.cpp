@@ -53,8 +53,8 @@ void ExpectSameFrames(const fs::path& a, const fs::path& b) {
 TEST(RenderOutputs, SameBytesWithOneTwoAndEightThreads) {
   const fs::path d = TestDir();
   for (const char* t : {"1", "2", "8"}) {
-    const ProcessResult r =
-        RunPatchskin(DemoArgs(d / (std::string("threads_") + t), "0:5", {"--threads", t, "--sheet"}));
+    const ProcessResult r = RunPatchskin(
+        DemoArgs(d / (std::string("threads_") + t), "0:5", {"--threads", t, "--sheet"}));
     ASSERT_EQ(r.exit_code, 0) << r.err;
   }
   ASSERT_EQ(testsupport::FilesIn(d / "threads_1").size(), 7u);  // 6 frames and the contact sheet
@@ -83,8 +83,8 @@ TEST(RenderOutputs, RigWithPatchesGivesTheSameBytesWithOneTwoAndEightThreads) {
   for (const char* t : {"1", "2", "8"}) {
     const ProcessResult r =
         RunPatchskin({"render", rig.string(), "--threads", t, "--quiet", "--no-video", "--look-at",
-                   "patch:left_elbow", "--azimuth", "150", "--zoom", "1.2", "--out",
-                   (d / (std::string("threads_") + t) / "f_####.png").string()});
+                      "patch:left_elbow", "--azimuth", "150", "--zoom", "1.2", "--out",
+                      (d / (std::string("threads_") + t) / "f_####.png").string()});
     ASSERT_EQ(r.exit_code, 0) << r.err;
   }
   ASSERT_EQ(testsupport::FilesIn(d / "threads_1").size(), 9u);  // 8 frames and the contact sheet

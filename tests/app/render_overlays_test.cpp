@@ -81,7 +81,7 @@ TEST(RenderOverlays, TransparentBackgroundKeepsTheBodyAndGroundOpaque) {
   const fs::path d = TestDir();
   const std::string bend = testsupport::SampleDataPath("bend.bvh").string();
   auto r = RenderWith(d, {bend, "--frames", "30", "--size", "160x90", "--background", "transparent",
-                      "--camera", "fixed", "--out", (d / "t_####.png").string()});
+                          "--camera", "fixed", "--out", (d / "t_####.png").string()});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   auto image = render::ReadImage((d / "t_0030.png").string());
   ASSERT_TRUE(image.ok());
@@ -90,7 +90,7 @@ TEST(RenderOverlays, TransparentBackgroundKeepsTheBodyAndGroundOpaque) {
   EXPECT_EQ(image->at(80, 45).a, 1.0f);   // the body
   // JPEG has no alpha: refused before anything is written.
   r = RenderWith(d, {bend, "--frames", "30", "--background", "transparent", "--out",
-                 (d / "j/t_####.jpg").string()});
+                     (d / "j/t_####.jpg").string()});
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("--background"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(d / "j"));
@@ -102,7 +102,7 @@ TEST(RenderOverlays, LabelNoneFrameAndTimecodeChangeOnlyTheBottomLeft) {
   const std::string bend = testsupport::SampleDataPath("bend.bvh").string();
   for (const char* label : {"none", "frame", "timecode"}) {
     const auto r = RenderWith(d, {bend, "--frames", "45", "--size", "320x180", "--camera", "fixed",
-                              "--label", label, "--out", (d / label / "f_####.png").string()});
+                                  "--label", label, "--out", (d / label / "f_####.png").string()});
     ASSERT_EQ(r.exit_code, 0) << r.err;
   }
   const auto none = render::ReadImage((d / "none/f_0045.png").string());
@@ -121,7 +121,8 @@ TEST(RenderOverlays, LabelNoneFrameAndTimecodeChangeOnlyTheBottomLeft) {
     EXPECT_EQ(outside, 0);
   }
   EXPECT_NE(frame->rgba, timecode->rgba);
-  const auto bad = RenderWith(d, {bend, "--label", "seconds", "--out", (d / "bad/f_####.png").string()});
+  const auto bad =
+      RenderWith(d, {bend, "--label", "seconds", "--out", (d / "bad/f_####.png").string()});
   EXPECT_EQ(bad.exit_code, 2);
 }
 
@@ -132,7 +133,7 @@ TEST(RenderOverlays, DeltaColoursTheLayeredBodyAndDrawsItsScale) {
   const fs::path d = TestDir();
   const std::string rig = testsupport::SampleDataPath("elbow.json").string();
   auto r = RenderWith(d, {rig, "--frames", "60", "--size", "640x360", "--overlay", "delta",
-                      "--supersample", "1", "--out", (d / "f_####.png").string()});
+                          "--supersample", "1", "--out", (d / "f_####.png").string()});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   auto image = render::ReadImage((d / "f_0060.png").string());
   ASSERT_TRUE(image.ok());
@@ -153,8 +154,8 @@ TEST(RenderOverlays, DeltaColoursTheLayeredBodyAndDrawsItsScale) {
   EXPECT_NEAR(top.g, hot.g, 0.04f);
   EXPECT_NEAR(top.b, hot.b, 0.04f);
   // Without patches there is no layer to colour.
-  r = RenderWith(d, {testsupport::SampleDataPath("bend.bvh").string(), "--overlay", "delta", "--out",
-                 (d / "bad/f_####.png").string()});
+  r = RenderWith(d, {testsupport::SampleDataPath("bend.bvh").string(), "--overlay", "delta",
+                     "--out", (d / "bad/f_####.png").string()});
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("--overlay"), std::string::npos) << r.err;
 }

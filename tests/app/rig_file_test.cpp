@@ -337,10 +337,11 @@ TEST(RigFile, RenderCommandRendersTheSampleRigAsASplitFrame) {
   const fs::path dir = testsupport::TestOutputPath("rig_file/render/x").parent_path();
   fs::remove_all(dir);
   fs::create_directories(dir);
-  const testsupport::ProcessResult r = testsupport::RunPatchskinLine("render '" + testsupport::SampleDataPath("elbow_knee.json").string() +
-                              "' --frames 45:45 --no-video --no-sheet --quiet --out '" +
-                              (dir / "f_####.png").string() + "'",
-                          dir);
+  const testsupport::ProcessResult r = testsupport::RunPatchskinLine(
+      "render '" + testsupport::SampleDataPath("elbow_knee.json").string() +
+          "' --frames 45:45 --no-video --no-sheet --quiet --out '" + (dir / "f_####.png").string() +
+          "'",
+      dir);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto img = render::ReadImage((dir / "f_0045.png").string());
   ASSERT_TRUE(img.ok());
@@ -353,12 +354,14 @@ TEST(RigFile, RenderCommandReportsABadJointWithItsFieldPath) {
   fs::remove_all(dir);
   fs::create_directories(dir);
   const fs::path rig = dir / "bad.json";
-  std::ofstream(rig) << R"({"character": "mannequin", "motion": {"file": ")"
-                     << testsupport::SampleDataPath("bend.bvh").string()
-                     << R"("}, "patches": [{"name": "e", "region": {"joint": "Elbow", "radius": 9}}]})";
-  const testsupport::ProcessResult r = testsupport::RunPatchskinLine("render '" + rig.string() + "' --no-video --no-sheet --quiet --out '" +
-                              (dir / "f_####.png").string() + "'",
-                          dir);
+  std::ofstream(rig)
+      << R"({"character": "mannequin", "motion": {"file": ")"
+      << testsupport::SampleDataPath("bend.bvh").string()
+      << R"("}, "patches": [{"name": "e", "region": {"joint": "Elbow", "radius": 9}}]})";
+  const testsupport::ProcessResult r = testsupport::RunPatchskinLine(
+      "render '" + rig.string() + "' --no-video --no-sheet --quiet --out '" +
+          (dir / "f_####.png").string() + "'",
+      dir);
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("bad.json: patches[0].region.joint: error: expected a joint of "), std::string::npos)
       << r.err;

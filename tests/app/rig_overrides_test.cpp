@@ -49,7 +49,8 @@ std::string WriteRig(const fs::path& dir, const std::string& name, const json& r
   return path.string();
 }
 
-ProcessResult RenderRig(const fs::path& dir, const std::string& rig, std::vector<std::string> extra) {
+ProcessResult RenderRig(const fs::path& dir, const std::string& rig,
+                        std::vector<std::string> extra) {
   std::vector<std::string> args{"render", rig, "--quiet", "--no-video", "--no-sheet",
                                 "--supersample", "1"};
   args.insert(args.end(), extra.begin(), extra.end());
@@ -128,8 +129,8 @@ TEST(RigOverrides, SplitWins) {
   const fs::path d = TestDir();
   const std::string rig = WriteRig(d, "rig.json", WithElbowPatch(BaseRig("out/f_####.png")));
   ASSERT_EQ(RenderRig(d, rig, {"--size", "96x48", "--wipe"}).exit_code, 0);
-  const ProcessResult r =
-      RenderRig(d, rig, {"--size", "96x48", "--split", "ssd,dqs", "--out", (d / "cli/f_####.png").string()});
+  const ProcessResult r = RenderRig(
+      d, rig, {"--size", "96x48", "--split", "ssd,dqs", "--out", (d / "cli/f_####.png").string()});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto from_rig = render::ReadImage((d / "out/f_0031.png").string());
   const auto from_cli = render::ReadImage((d / "cli/f_0031.png").string());
@@ -154,10 +155,13 @@ TEST(RigOverrides, RigWithPatchesComparesSideBySide) {
   const fs::path d = TestDir();
   const std::string rig = WriteRig(d, "rig.json", WithElbowPatch(BaseRig("out/f_####.png")));
   ASSERT_EQ(RenderRig(d, rig, {"--size", "192x96"}).exit_code, 0);
-  ProcessResult r = RenderRig(d, rig, {"--size", "192x96", "--compare", "ssd,ssd + patches", "--out",
-                                    (d / "cli/f_####.png").string()});
+  ProcessResult r = RenderRig(d, rig,
+                              {"--size", "192x96", "--compare", "ssd,ssd + patches", "--out",
+                               (d / "cli/f_####.png").string()});
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  r = RenderRig(d, rig, {"--size", "192x96", "--compare", "ssd,ssd", "--out", (d / "same/f_####.png").string()});
+  r = RenderRig(
+      d, rig,
+      {"--size", "192x96", "--compare", "ssd,ssd", "--out", (d / "same/f_####.png").string()});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto from_rig = render::ReadImage((d / "out/f_0031.png").string());
   const auto from_cli = render::ReadImage((d / "cli/f_0031.png").string());
@@ -210,8 +214,10 @@ TEST(RigOverrides, ThreadsAreRead) {
   const ProcessResult bad = RenderRig(d, rig, {"--threads", "999"});
   EXPECT_EQ(bad.exit_code, 2);
   EXPECT_NE(bad.FirstErrLine().find("--threads"), std::string::npos) << bad.err;
-  ASSERT_EQ(RenderRig(d, rig, {"--threads", "1", "--out", (d / "t1/f_####.png").string()}).exit_code, 0);
-  ASSERT_EQ(RenderRig(d, rig, {"--threads", "2", "--out", (d / "t2/f_####.png").string()}).exit_code, 0);
+  ASSERT_EQ(
+      RenderRig(d, rig, {"--threads", "1", "--out", (d / "t1/f_####.png").string()}).exit_code, 0);
+  ASSERT_EQ(
+      RenderRig(d, rig, {"--threads", "2", "--out", (d / "t2/f_####.png").string()}).exit_code, 0);
   EXPECT_TRUE(Bytes(d / "t1/f_0031.png") == Bytes(d / "t2/f_0031.png"));
 }
 
@@ -223,8 +229,8 @@ TEST(RigOverrides, GlobalSwdRefusesExampleShapes) {
   const fs::path dir = TestDir();
   const std::string rig =
       (fs::path(TEST_DATA_DIR) / "../../samples/data/elbow.json").lexically_normal().string();
-  const ProcessResult r = RenderRig(dir, rig, {"--global", "swd", "--frames", "0:0", "--out",
-                                            (dir / "f_####.png").string()});
+  const ProcessResult r = RenderRig(
+      dir, rig, {"--global", "swd", "--frames", "0:0", "--out", (dir / "f_####.png").string()});
   EXPECT_EQ(r.exit_code, 2) << r.err;
   EXPECT_NE(r.err.find("elbow.json"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("patches[0].examples"), std::string::npos) << r.err;

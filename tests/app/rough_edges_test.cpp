@@ -43,7 +43,7 @@ std::vector<std::string> Names(const fs::path& folder) {
 TEST(RoughEdges, OddSizeRendersFramesAndVideo) {
   const fs::path out = TestDir() / "odd";
   const ProcessResult r = RunPatchskin({"render", "--size", "101x57", "--frames", "0:3", "--quiet",
-                                     "--out", (out / "f_####.png").string()});
+                                        "--out", (out / "f_####.png").string()});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
   EXPECT_TRUE(fs::exists(out / "preview.mp4"));
@@ -150,8 +150,8 @@ TEST(RoughEdges, ExportResumeWritesTheMissingFramesOnly) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(testsupport::SlurpFile(part / "m_0045.obj"), testsupport::SlurpFile(full / "m_0045.obj"));
 
-  const ProcessResult glb = RunPatchskin({"export", "--frames", "0:2", "--quiet", "--resume", "--out",
-                                       (TestDir() / "resume.glb").string()});
+  const ProcessResult glb = RunPatchskin({"export", "--frames", "0:2", "--quiet", "--resume",
+                                          "--out", (TestDir() / "resume.glb").string()});
   EXPECT_EQ(glb.exit_code, 2);
   EXPECT_NE(glb.err.find("--resume"), std::string::npos) << glb.err;
   EXPECT_FALSE(fs::exists(TestDir() / "resume.glb"));
@@ -161,7 +161,8 @@ TEST(RoughEdges, ExportResumeWritesTheMissingFramesOnly) {
 // described (its frames and mesh), not refused with "the file has no skin".
 TEST(RoughEdges, InspectDescribesAnExportedGlb) {
   const fs::path glb = TestDir() / "exported.glb";
-  const ProcessResult made = RunPatchskin({"export", "--frames", "0:5", "--quiet", "--out", glb.string()});
+  const ProcessResult made =
+      RunPatchskin({"export", "--frames", "0:5", "--quiet", "--out", glb.string()});
   ASSERT_EQ(made.exit_code, 0) << made.err;
   const ProcessResult r = RunPatchskin({"inspect", glb.string(), "--json"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
@@ -256,10 +257,10 @@ TEST(RoughEdges, TurntableOfARigHonoursItsOptions) {
   ASSERT_TRUE(fs::exists(rig)) << rig;
   for (const std::string frame : {"0", "40"}) {
     const fs::path out = TestDir() / ("f" + frame);
-    const ProcessResult r = RunPatchskin({"turntable", rig.string(), "--frames", frame,
-                                       "--turntable-frames", "3", "--size", "96x64", "--out",
-                                       (out / "t_####.png").string(), "--start-number", "1001",
-                                       "--quiet", "--no-video", "--no-sheet"});
+    const ProcessResult r =
+        RunPatchskin({"turntable", rig.string(), "--frames", frame, "--turntable-frames", "3",
+                      "--size", "96x64", "--out", (out / "t_####.png").string(), "--start-number",
+                      "1001", "--quiet", "--no-video", "--no-sheet"});
     ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_EQ(Names(out), (std::vector<std::string>{"t_1001.png", "t_1002.png", "t_1003.png"}));
     const mocap::Result<render::Image> img = render::ReadImage((out / "t_1001.png").string());
@@ -279,12 +280,14 @@ TEST(RoughEdges, TurntableOfARigHonoursItsOptions) {
 // --start-number 1001: motion frame 0 is file 1001 (render and export).
 TEST(RoughEdges, StartNumberNumbersTheFiles) {
   const ProcessResult r = RunPatchskin({"render", "--frames", "2:4", "--size", "64x36", "--quiet",
-                                     "--no-video", "--no-sheet", "--start-number", "1001", "--out",
-                                     (TestDir() / "r" / "f_####.png").string()});
+                                        "--no-video", "--no-sheet", "--start-number", "1001",
+                                        "--out", (TestDir() / "r" / "f_####.png").string()});
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_EQ(Names(TestDir() / "r"), (std::vector<std::string>{"f_1003.png", "f_1004.png", "f_1005.png"}));
-  const ProcessResult e = RunPatchskin({"export", "--frames", "0:1", "--quiet", "--start-number",
-                                     "1001", "--out", (TestDir() / "e" / "m_####.obj").string()});
+  EXPECT_EQ(Names(TestDir() / "r"),
+            (std::vector<std::string>{"f_1003.png", "f_1004.png", "f_1005.png"}));
+  const ProcessResult e =
+      RunPatchskin({"export", "--frames", "0:1", "--quiet", "--start-number", "1001", "--out",
+                    (TestDir() / "e" / "m_####.obj").string()});
   ASSERT_EQ(e.exit_code, 0) << e.err;
   EXPECT_EQ(Names(TestDir() / "e"), (std::vector<std::string>{"m_1001.obj", "m_1002.obj"}));
   EXPECT_EQ(RunPatchskin({"render", "--start-number", "-1"}).exit_code, 2);

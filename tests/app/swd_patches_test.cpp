@@ -28,8 +28,8 @@ namespace fs = std::filesystem;
 
 // The sample bend (elbows and knees from straight to 150 degrees) on the mannequin.
 app::Character BendCharacter() {
-  auto src = app::LoadMotionSource(
-      testsupport::SampleDataPath("bend.bvh").string(), {.y_up = true});
+  auto src =
+      app::LoadMotionSource(testsupport::SampleDataPath("bend.bvh").string(), {.y_up = true});
   EXPECT_TRUE(src.ok()) << src.error().ToString();
   auto c = app::MakeCharacter(std::move(*src));
   EXPECT_TRUE(c.ok()) << c.error().ToString();
@@ -113,8 +113,8 @@ TEST(SwdPatches, RenderCommandRendersTheSwdSampleRig) {
   fs::remove_all(dir);
   fs::create_directories(dir);
   const testsupport::ProcessResult r = testsupport::RunPatchskin(
-      {"render", testsupport::SampleDataPath("elbow_knee_swd.json").string(), "--frames", "45:45", "--no-video",
-       "--no-sheet", "--quiet", "--out", (dir / "f_####.png").string()},
+      {"render", testsupport::SampleDataPath("elbow_knee_swd.json").string(), "--frames", "45:45",
+       "--no-video", "--no-sheet", "--quiet", "--out", (dir / "f_####.png").string()},
       dir);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto img = render::ReadImage((dir / "f_0045.png").string());

@@ -76,7 +76,8 @@ void ExpectClosed(const deform::Mesh& m, const std::string& what) {
   EXPECT_EQ(bad, 0) << what << ": edges not shared by exactly two triangles";
 }
 
-// max_growth: bound on testsupport::MaxEdgeGrowthFraction at the first, middle and last frame (0: print only).
+// max_growth: bound on testsupport::MaxEdgeGrowthFraction at the first, middle and last frame (0:
+// print only).
 void CheckCharacter(const app::Character& c, const std::string& what, float max_growth) {
   {  // At the bind pose the rig rebuilds the mesh (ALGORITHMS.md 2.3).
     auto bind = app::BindModelFromJoint(c);

@@ -61,7 +61,8 @@ render::Image RenderDemo(const DemoCase& c) {
                                  .triangles = demo->character.mesh.bind.triangles};
     const render::Image half = render::Render(camera, {&mesh, 1}, {}, settings);
     for (int y = 0; y < kDemoHeight; ++y) {
-      for (int x = 0; x < kDemoWidth / 2; ++x) out.at(side * (kDemoWidth / 2) + x, y) = half.at(x, y);
+      for (int x = 0; x < kDemoWidth / 2; ++x)
+        out.at(side * (kDemoWidth / 2) + x, y) = half.at(x, y);
     }
   }
   for (int y = 0; y < kDemoHeight; ++y) out.at(kDemoWidth / 2, y) = glm::vec4(1.0f);  // divider

@@ -125,7 +125,8 @@ inline ProcessResult RunPatchskin(const std::vector<std::string>& args) {
 
 // Runs `patchskin ARGS` through /bin/sh, so `args` is one line that may quote
 // paths ('...'); stdout and stderr go to `log_dir`/{stdout,stderr}.txt.
-inline ProcessResult RunPatchskinLine(const std::string& args, const std::filesystem::path& log_dir) {
+inline ProcessResult RunPatchskinLine(const std::string& args,
+                                      const std::filesystem::path& log_dir) {
   return RunProgram("/bin/sh", {"-c", std::string("'") + PATCHSKIN_BINARY + "' " + args}, log_dir);
 }
 

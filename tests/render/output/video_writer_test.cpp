@@ -31,8 +31,8 @@ glm::vec4 Grey(int f) {
 // Writes kFrames flat grey frames with `codecs` and checks them read back.
 void RoundTrip(const std::vector<VideoCodec>& codecs, VideoCodec expected,
                const std::string& expected_ext) {
-  const fs::path dir =
-      testsupport::FreshOutputDir(std::string("video/") + VideoCodecName(expected) + "x" + expected_ext.substr(1));
+  const fs::path dir = testsupport::FreshOutputDir(
+      std::string("video/") + VideoCodecName(expected) + "x" + expected_ext.substr(1));
   VideoOptions options;
   options.codecs = codecs;
   auto video = VideoWriter::Open((dir / "preview.mp4").string(), kWidth, kHeight, options);

@@ -21,8 +21,8 @@
 namespace {
 
 using render::BackgroundFill;
-using testsupport::AtSample;
 using render::kTileSize;
+using testsupport::AtSample;
 
 struct Scene {
   int width, height, ss;  // output pixels, samples per axis

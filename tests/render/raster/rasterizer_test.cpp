@@ -17,10 +17,10 @@
 
 namespace {
 
-using testsupport::AtSample;
 using render::ClipMesh;
 using render::Rasterizer;
 using render::RasterSettings;
+using testsupport::AtSample;
 
 // Fragments per sample over all triangles (no depth test).
 std::vector<int> CountFragments(std::span<const ClipMesh> meshes, int width, int height, bool cull) {
