@@ -36,6 +36,7 @@
 #include "app/frame_render.h"
 #include "app/motion_source.h"
 #include "app/pipeline.h"
+#include "app/exit_code.h"
 #include "deform/patch/patch_binding.h"
 #include "deform/global/skinning_job.h"
 #include "mocap/bvh_reader.h"
@@ -212,15 +213,11 @@ nlohmann::json RowJson(const Row& r) {
   return j;
 }
 
-int Fail(const mocap::Error& e) {
-  std::fprintf(stderr, "%s\n", e.ToString().c_str());
-  return e.code == mocap::ErrorCode::kInternal ? 3 : 2;
-}
-
 }  // namespace
 
 int RunBench(const BenchOptions& o) {
-  if (o.threads < 0 || o.threads > 256) return Fail(ArgError("--threads", "expected 0..256"));
+  if (o.threads < 0 || o.threads > 256)
+    return ReportError(ArgError("--threads", "expected 0..256"));
 #ifndef NDEBUG
   std::fprintf(stderr,
                "bench: WARNING: this is not a Release build (%s, assertions on); its figures are "
@@ -258,7 +255,7 @@ int RunBench(const BenchOptions& o) {
   std::vector<Table1Row> table1;
   for (const bench::PatchCase& c : bench::kPatches) {
     mocap::Result<Table1Row> row = bench::MeasurePatch(c, budget);
-    if (!row.ok()) return Fail(row.error());
+    if (!row.ok()) return ReportError(row.error());
     table1.push_back(std::move(*row));
   }
   std::printf("%-30s %12s %12s %12s  %-10s %-4s %10s %9s  %s\n", "Table 1 (per patch)", "median",
@@ -273,8 +270,8 @@ int RunBench(const BenchOptions& o) {
   std::vector<Row> rows;
   const std::string generated = GeneratedBvh(o.quick ? 1200 : 12000);
   if (generated.empty()) {
-    return Fail(mocap::MakeError(mocap::ErrorCode::kInternal, {"bench", 0, 0, {}},
-                                 "could not generate the BVH workload"));
+    return ReportError(mocap::MakeError(mocap::ErrorCode::kInternal, {"bench", 0, 0, {}},
+                                        "could not generate the BVH workload"));
   }
   rows.push_back(BvhParseRow("bvh_parse_generated", generated, "generated walk, 120 fps", budget, failed));
   const std::string data_dir = o.data_dir.empty() ? PATCHSKIN_DATA_DIR : o.data_dir;
@@ -311,19 +308,19 @@ int RunBench(const BenchOptions& o) {
 
   // The demo body (the walk on the generated mannequin).
   mocap::Result<MotionSource> src = LoadBvhText(DemoBvhText(), "demo_walk.bvh", {.y_up = true});
-  if (!src.ok()) return Fail(src.error());
+  if (!src.ok()) return ReportError(src.error());
   mocap::Result<Character> character = MakeCharacter(std::move(*src));
-  if (!character.ok()) return Fail(character.error());
+  if (!character.ok()) return ReportError(character.error());
   const Character& ch = *character;
   const int e2e_frames = o.quick ? 4 : 24;
   mocap::Result<FramePlan> plan = PlanFrames(ch.motion, {.frames = "0:" + std::to_string(e2e_frames - 1)});
-  if (!plan.ok()) return Fail(plan.error());
+  if (!plan.ok()) return ReportError(plan.error());
   mocap::Result<FramePipeline> pipeline = FramePipeline::Create(ch, GlobalMethod::kSsd, threads);
-  if (!pipeline.ok()) return Fail(pipeline.error());
+  if (!pipeline.ok()) return ReportError(pipeline.error());
   mocap::Result<CameraPlan> cameras = CameraPlan::Create(*pipeline, *plan, "follow", 15.0f, {1280, 720});
-  if (!cameras.ok()) return Fail(cameras.error());
+  if (!cameras.ok()) return ReportError(cameras.error());
   DeformedFrame frame;
-  if (mocap::Status s = pipeline->Evaluate(0.0, frame); !s.ok()) return Fail(s.error());
+  if (mocap::Status s = pipeline->Evaluate(0.0, frame); !s.ok()) return ReportError(s.error());
   render::Renderer renderer, right_renderer;
   render::Image image, scratch;
   const auto draw_settings = [&](int w, int h, int ss, int nthreads) {
@@ -359,7 +356,7 @@ int RunBench(const BenchOptions& o) {
     for (int i = 0; i < n; ++i) {
       const double t = plan->frames[static_cast<std::size_t>(i % e2e_frames)].time_s;
       if (mocap::Status s = pipeline->Evaluate(t, posed[static_cast<std::size_t>(i)]); !s.ok())
-        return Fail(s.error());
+        return ReportError(s.error());
     }
     const auto render_all = [&](bool shadows) {
       render::RenderSettings s = draw_settings(1280, 720, 2, threads);
@@ -398,8 +395,8 @@ int RunBench(const BenchOptions& o) {
       std::filesystem::temp_directory_path() / ("patchskin_bench_" + std::to_string(getpid()));
   std::filesystem::create_directories(out_dir, ec);
   if (ec) {
-    return Fail(mocap::MakeError(mocap::ErrorCode::kIo, {out_dir.string(), 0, 0, {}},
-                                 "cannot create a temporary folder: " + ec.message()));
+    return ReportError(mocap::MakeError(mocap::ErrorCode::kIo, {out_dir.string(), 0, 0, {}},
+                                        "cannot create a temporary folder: " + ec.message()));
   }
   const render::RenderSettings e2e_settings = draw_settings(1280, 720, 2, threads);
   render::WriteOptions png;
@@ -425,9 +422,9 @@ int RunBench(const BenchOptions& o) {
         std::snprintf(name, sizeof(name), "frame_%04d.png", of.number);
         s = writer.Submit(image, (out_dir / name).string(), png);
       }
-      if (!s.ok()) return Fail(s.error());
+      if (!s.ok()) return ReportError(s.error());
     }
-    if (mocap::Status s = writer.Finish(); !s.ok()) return Fail(s.error());
+    if (mocap::Status s = writer.Finish(); !s.ok()) return ReportError(s.error());
     e2e.runs.push_back(e2e_frames / std::max(Now(Clock::kWall) - t0, 1e-9));
     e2e_cpu.runs.push_back(e2e_frames / std::max(Now(Clock::kProcess) - c0, 1e-9));
   }
@@ -484,7 +481,7 @@ int RunBench(const BenchOptions& o) {
   for (int i = 0; i < out_frames; ++i) {
     if (mocap::Status s = render_frame(render::AntiAlias::kSupersample)(i, rendered[static_cast<std::size_t>(i)]);
         !s.ok()) {
-      return Fail(s.error());
+      return ReportError(s.error());
     }
   }
   const std::string outputs_note = std::to_string(out_frames) + " demo frames, 1280x720, PNG level 1 + H.264 + sheet, " +
@@ -505,8 +502,8 @@ int RunBench(const BenchOptions& o) {
     const double t_ssaa = run_outputs(render_frame(render::AntiAlias::kSupersample));
     const double t_msaa = run_outputs(render_frame(render::AntiAlias::kMultisample));
     if (t_encode <= 0.0 || t_ssaa <= 0.0 || t_msaa <= 0.0) {
-      return Fail(mocap::MakeError(mocap::ErrorCode::kInternal, {"bench", 0, 0, {}},
-                                   "the default-render outputs failed"));
+      return ReportError(mocap::MakeError(mocap::ErrorCode::kInternal, {"bench", 0, 0, {}},
+                                          "the default-render outputs failed"));
     }
     encode_row.runs.push_back(out_frames / t_encode);
     ssaa_row.runs.push_back(out_frames / t_ssaa);
@@ -538,8 +535,8 @@ int RunBench(const BenchOptions& o) {
                   "getrusage ru_maxrss of this process"});
   bench::AddLongCaptureRows(o.quick, rows, &failed);
   if (failed) {
-    return Fail(mocap::MakeError(mocap::ErrorCode::kInternal, {"bench", 0, 0, {}},
-                                 "a measured operation failed"));
+    return ReportError(mocap::MakeError(mocap::ErrorCode::kInternal, {"bench", 0, 0, {}},
+                                        "a measured operation failed"));
   }
 
   std::printf("\n%-30s %12s %12s %12s  %-10s %-4s %10s %9s  %s\n", "figure", "median", "min", "max",
@@ -569,12 +566,13 @@ int RunBench(const BenchOptions& o) {
       std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
       out << j.dump(2) << "\n";
       if (!out) {
-        return Fail(mocap::MakeError(mocap::ErrorCode::kIo, {o.json, 0, 0, {}}, "cannot write the JSON file"));
+        return ReportError(mocap::MakeError(mocap::ErrorCode::kIo, {o.json, 0, 0, {}},
+                                            "cannot write the JSON file"));
       }
     }
     std::filesystem::rename(tmp, o.json, ec);
     if (ec) {
-      return Fail(mocap::MakeError(mocap::ErrorCode::kIo, {o.json, 0, 0, {}}, ec.message()));
+      return ReportError(mocap::MakeError(mocap::ErrorCode::kIo, {o.json, 0, 0, {}}, ec.message()));
     }
     std::printf("\njson: %s\n", o.json.c_str());
   }

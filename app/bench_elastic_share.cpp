@@ -37,7 +37,7 @@ constexpr const char* kTwoPatchRig = R"({
   ]
 })";
 
-bool Report(const mocap::Error& e, bool* failed) {
+bool ReportElasticShare(const mocap::Error& e, bool* failed) {
   std::fprintf(stderr, "bench: elastic share: %s\n", e.ToString().c_str());
   *failed = true;
   return false;
@@ -47,29 +47,30 @@ bool Report(const mocap::Error& e, bool* failed) {
 
 void AddElasticShareRow(const Budget& b, int frames, std::vector<Row>& rows, bool* failed) {
   mocap::Result<MotionSource> src = LoadBvhText(DemoBvhText(), "demo_walk.bvh", {.y_up = true});
-  if (!src.ok()) return void(Report(src.error(), failed));
+  if (!src.ok()) return void(ReportElasticShare(src.error(), failed));
   mocap::Result<Character> character = MakeCharacter(std::move(*src));
-  if (!character.ok()) return void(Report(character.error(), failed));
+  if (!character.ok()) return void(ReportElasticShare(character.error(), failed));
   const Character& ch = *character;
   mocap::Result<Rig> rig = ParseRig(kTwoPatchRig, "bench_two_elastic_patches.json");
-  if (!rig.ok()) return void(Report(rig.error(), failed));
+  if (!rig.ok()) return void(ReportElasticShare(rig.error(), failed));
   mocap::Result<FramePipeline> pipeline = FramePipeline::Create(ch, GlobalMethod::kSsd, 1);
-  if (!pipeline.ok()) return void(Report(pipeline.error(), failed));
+  if (!pipeline.ok()) return void(ReportElasticShare(pipeline.error(), failed));
   if (mocap::Status s = ApplyRigLayers(*rig, ch, *pipeline); !s.ok()) {
-    return void(Report(s.error(), failed));
+    return void(ReportElasticShare(s.error(), failed));
   }
   // The same two networks again, advanced on their own.
   mocap::Result<std::vector<deform::PatchSetup>> patches = BuildRigPatches(*rig, ch);
-  if (!patches.ok()) return void(Report(patches.error(), failed));
+  if (!patches.ok()) return void(ReportElasticShare(patches.error(), failed));
   mocap::Result<std::vector<ElasticPatchSpec>> specs = ResolveRigElastic(*rig, ch, *patches);
-  if (!specs.ok()) return void(Report(specs.error(), failed));
+  if (!specs.ok()) return void(ReportElasticShare(specs.error(), failed));
   mocap::Result<std::unique_ptr<ElasticLayer>> layer =
       ElasticLayer::Create(ch, *patches, std::move(*specs));
-  if (!layer.ok()) return void(Report(layer.error(), failed));
+  if (!layer.ok()) return void(ReportElasticShare(layer.error(), failed));
   if ((*layer)->num_patches() != 2) {
-    return void(Report(mocap::MakeError(mocap::ErrorCode::kInternal, {"bench", 0, 0, {}},
-                                        "expected two elastic patches"),
-                       failed));
+    return void(
+        ReportElasticShare(mocap::MakeError(mocap::ErrorCode::kInternal, {"bench", 0, 0, {}},
+                                            "expected two elastic patches"),
+                           failed));
   }
 
   // Joint matrices of every clip frame (the layer's driving rotations).
@@ -80,12 +81,13 @@ void AddElasticShareRow(const Budget& b, int frames, std::vector<Row>& rows, boo
                                                    .locals = locals, .model_from_joint = model}
                                .Run();
       !s) {
-    return void(Report(mocap::MakeError(mocap::ErrorCode::kInternal, {"bench", 0, 0, {}}, s.what),
-                       failed));
+    return void(ReportElasticShare(
+        mocap::MakeError(mocap::ErrorCode::kInternal, {"bench", 0, 0, {}}, s.what), failed));
   }
 
   DeformedFrame frame;
-  if (mocap::Status s = pipeline->Evaluate(0.0, frame); !s.ok()) return void(Report(s.error(), failed));
+  if (mocap::Status s = pipeline->Evaluate(0.0, frame); !s.ok())
+    return void(ReportElasticShare(s.error(), failed));
   EndToEndFrame end_to_end(ch, frame, "share");
   std::vector<std::vector<glm::vec3>> displacements(rig->patches.size());
   const double dt = 1.0 / 30.0;
@@ -112,7 +114,7 @@ void AddElasticShareRow(const Budget& b, int frames, std::vector<Row>& rows, boo
       }
       const double t2 = Now(Clock::kCpu);
       if (!s.ok()) {
-        Report(s.error(), failed);
+        ReportElasticShare(s.error(), failed);
         break;
       }
       frame_s += t1 - t0;

@@ -19,39 +19,19 @@ namespace fs = std::filesystem;
 constexpr std::uintmax_t kMaxManifestBytes = 16u << 20;
 constexpr std::size_t kMaxCases = 10000;
 
-struct Ctx {
-  std::string file;
-  mocap::Error Fail(const std::string& path, const std::string& message) const {
-    return mocap::MakeError(mocap::ErrorCode::kInvalidArgument, {file, 0, 0, path}, message);
-  }
-  mocap::Error Expected(const std::string& path, const std::string& what, const json& found) const {
-    return Fail(path, "expected " + what + ", found " + DescribeJson(found));
-  }
-};
-
 std::string Resolve(const std::string& manifest, const std::string& path) {
   const fs::path p(path);
   if (p.is_absolute()) return path;
   return (fs::path(manifest).parent_path() / p).lexically_normal().string();
 }
 
-std::optional<mocap::Error> CheckKeys(const Ctx& c, const json& obj, const std::string& path,
+std::optional<mocap::Error> CheckKeys(const JsonFile& c, const json& obj, const std::string& path,
                                       std::initializer_list<const char*> allowed) {
-  if (!obj.is_object()) return c.Expected(path.empty() ? "manifest" : path, "an object", obj);
-  for (const auto& [key, value] : obj.items()) {
-    bool known = false;
-    std::string list;
-    for (const char* a : allowed) {
-      known = known || key == a;
-      list += std::string(list.empty() ? "" : ", ") + a;
-    }
-    if (!known) return c.Fail(path.empty() ? key : path + "." + key, "unknown field (expected one of: " + list + ")");
-  }
-  return std::nullopt;
+  return c.Keys(obj, path, allowed, "manifest");
 }
 
-std::optional<mocap::Error> ParseThresholds(const Ctx& c, const json& v, const std::string& path,
-                                            render::IdiffThresholds& t) {
+std::optional<mocap::Error> ParseThresholds(const JsonFile& c, const json& v,
+                                            const std::string& path, render::IdiffThresholds& t) {
   if (auto e = CheckKeys(c, v, path,
                          {"fail", "failpercent", "hardfail", "warn", "warnpercent", "hardwarn",
                           "allowfailures"})) {
@@ -95,7 +75,7 @@ bool ValidName(const std::string& name) {
 }
 
 // The render command's words of a case, split on white space (a string) or as listed.
-std::optional<mocap::Error> OptionWords(const Ctx& c, const json& v, const std::string& path,
+std::optional<mocap::Error> OptionWords(const JsonFile& c, const json& v, const std::string& path,
                                         std::vector<std::string>& words) {
   if (v.is_string()) {
     std::istringstream in(v.get<std::string>());
@@ -111,7 +91,7 @@ std::optional<mocap::Error> OptionWords(const Ctx& c, const json& v, const std::
 }
 
 // Parses `words` with the render command's parser into `out`.
-std::optional<mocap::Error> ParseCaseOptions(const Ctx& c, const std::string& path,
+std::optional<mocap::Error> ParseCaseOptions(const JsonFile& c, const std::string& path,
                                              const std::string& input,
                                              const std::vector<std::string>& words,
                                              RenderOptions& out) {
@@ -126,7 +106,7 @@ std::optional<mocap::Error> ParseCaseOptions(const Ctx& c, const std::string& pa
   return std::nullopt;
 }
 
-std::optional<mocap::Error> ParseCase(const Ctx& c, const json& v, const std::string& path,
+std::optional<mocap::Error> ParseCase(const JsonFile& c, const json& v, const std::string& path,
                                       const render::IdiffThresholds& defaults, CheckCase& out) {
   if (auto e = CheckKeys(c, v, path, {"name", "input", "options", "frames", "thresholds"})) return e;
   if (!v.contains("name") || !v["name"].is_string() || !ValidName(v["name"].get<std::string>())) {
@@ -173,7 +153,7 @@ mocap::Error JsonError(const std::string& file, const std::string& text,
 }  // namespace
 
 mocap::Result<CheckManifest> ParseCheckManifest(const std::string& text, const std::string& file) {
-  const Ctx c{file};
+  const JsonFile c{file};
   json doc;
   try {
     doc = json::parse(text);

@@ -19,6 +19,7 @@
 #include "app/auto_rig.h"
 #include "app/rig_file.h"
 #include "app/rig_setup.h"
+#include "app/exit_code.h"
 #include "deform/io/file_output.h"
 #include "deform/io/gltf_export.h"
 #include "deform/io/obj_writer.h"
@@ -60,11 +61,6 @@ mocap::Result<ObjMaterials> WriteObjMaterialFiles(const deform::MeshMaterials& m
     return s.error();
   }
   return out;
-}
-
-int Fail(const mocap::Error& e) {
-  std::fprintf(stderr, "%s\n", e.ToString().c_str());
-  return e.code == mocap::ErrorCode::kInternal ? 3 : 2;
 }
 
 std::string Lower(std::string s) {
@@ -118,13 +114,13 @@ int RunExport(const ExportOptions& options) {
   if (!o.layer.empty()) {
     // --layer auto: the rig `patchskin rig auto` writes; the options given here stay.
     mocap::Result<Rig> made = AutoRigForCommand(o.layer, o.input, o.motion, o.body, o.up, o.quiet);
-    if (!made.ok()) return Fail(made.error());
+    if (!made.ok()) return ReportError(made.error());
     rig = std::move(*made);
     o.input = RigInputFile(*rig);
     if (!IsBuiltInBody(rig->character)) o.motion = rig->motion;
   } else if (Lower(std::filesystem::path(o.input).extension().string()) == ".json") {
     mocap::Result<Rig> loaded = LoadRig(o.input);
-    if (!loaded.ok()) return Fail(loaded.error());
+    if (!loaded.ok()) return ReportError(loaded.error());
     rig = std::move(*loaded);
     o.input = RigInputFile(*rig);
     if (!IsBuiltInBody(rig->character) && o.motion.empty()) {
@@ -141,20 +137,23 @@ int RunExport(const ExportOptions& options) {
 
   // --- Arguments -------------------------------------------------------------
   const mocap::Result<glm::ivec2> size = ParseSize(o.size);
-  if (!size.ok()) return Fail(size.error());
+  if (!size.ok()) return ReportError(size.error());
   if (o.camera != "follow" && o.camera != "fixed") {
-    return Fail(ArgError("--camera", "expected follow or fixed, found '" + o.camera + "'"));
+    return ReportError(ArgError("--camera", "expected follow or fixed, found '" + o.camera + "'"));
   }
-  if (o.threads < 0 || o.threads > 256) return Fail(ArgError("--threads", "expected 0..256"));
-  if (!(o.fps >= 0.0) || o.fps > 10000.0) return Fail(ArgError("--fps", "expected 0 < fps <= 10000"));
+  if (o.threads < 0 || o.threads > 256)
+    return ReportError(ArgError("--threads", "expected 0..256"));
+  if (!(o.fps >= 0.0) || o.fps > 10000.0)
+    return ReportError(ArgError("--fps", "expected 0 < fps <= 10000"));
   if (!(o.scale == 0.0f || (o.scale >= 1e-6f && o.scale <= 1e6f))) {
-    return Fail(ArgError("--scale", "expected 0 (detected units to metres) or a factor in 1e-6..1e6, found " +
-                                        std::to_string(o.scale)));
+    return ReportError(ArgError(
+        "--scale", "expected 0 (detected units to metres) or a factor in 1e-6..1e6, found " +
+                       std::to_string(o.scale)));
   }
   const mocap::Result<GlobalMethod> method = ParseGlobalMethod(o.global);
-  if (!method.ok()) return Fail(method.error());
+  if (!method.ok()) return ReportError(method.error());
   const mocap::Result<deform::GltfExportLayout> layout = ParseLayout(o.layout);
-  if (!layout.ok()) return Fail(layout.error());
+  if (!layout.ok()) return ReportError(layout.error());
 
   // --- Input (as render) --------------------------------------------------------
   const bool demo = o.input.empty();
@@ -162,13 +161,13 @@ int RunExport(const ExportOptions& options) {
                            : rig ? std::filesystem::path(rig->file).stem().string()
                                  : std::filesystem::path(o.input).stem().string();
   const mocap::Result<std::optional<mocap::UpAxis>> up = ParseUpAxis(o.up);
-  if (!up.ok()) return Fail(up.error());
+  if (!up.ok()) return ReportError(up.error());
   const mocap::Result<BodyKind> body = ParseBodyKind(o.body);
-  if (!body.ok()) return Fail(body.error());
+  if (!body.ok()) return ReportError(body.error());
   // A rig names its own body: its example edits may name that body's vertices.
   mocap::Result<Character> character = LoadCommandCharacter(
       o.input, o.motion, o.quiet, *up, o.joint_map, nullptr, rig ? RigBodyKind(*rig) : *body);
-  if (!character.ok()) return Fail(character.error());
+  if (!character.ok()) return ReportError(character.error());
   const Character& ch = *character;
   if (o.scale == 0.0f) {  // as inspect --scale 0: the detected units to metres
     const float metres = mocap::MetresPerUnit(ch.skeleton.info.detected_units);
@@ -181,34 +180,36 @@ int RunExport(const ExportOptions& options) {
   mocap::Result<FramePlan> plan = PlanFrames(
       ch.motion,
       {.frames = o.frames, .fps = o.fps, .start_number = o.start_number, .list_frames = false});
-  if (!plan.ok()) return Fail(plan.error());
+  if (!plan.ok()) return ReportError(plan.error());
 
   const std::string out = o.out.empty() ? "out/" + name + "_export/mesh_####.obj" : o.out;
   const std::string ext = Lower(std::filesystem::path(out).extension().string());
   const bool glb = ext == ".glb";
   if (!glb && ext != ".obj") {
-    return Fail(ArgError("--out", "expected a .obj pattern or a .glb file, found '" + out + "'"));
+    return ReportError(
+        ArgError("--out", "expected a .obj pattern or a .glb file, found '" + out + "'"));
   }
   if (glb && o.resume) {
-    return Fail(ArgError("--resume", "expected an OBJ sequence: a .glb is written whole at the end, "
-                                     "so an interrupted one has nothing to resume"));
+    return ReportError(ArgError("--resume",
+                                "expected an OBJ sequence: a .glb is written whole at the end, "
+                                "so an interrupted one has nothing to resume"));
   }
   if (!glb && !render::HasFramePlaceholder(out)) {
-    return Fail(ArgError("--out", "the OBJ pattern '" + out +
-                                      "' needs one frame placeholder such as #### or %04d"));
+    return ReportError(ArgError(
+        "--out", "the OBJ pattern '" + out + "' needs one frame placeholder such as #### or %04d"));
   }
   const std::filesystem::path out_dir =
       glb ? std::filesystem::path(out).parent_path()
           : std::filesystem::path(*render::ExpandFramePattern(out, 0)).parent_path();
-  if (mocap::Status s = PrepareOutputFolder(out_dir); !s) return Fail(s.error());
+  if (mocap::Status s = PrepareOutputFolder(out_dir); !s) return ReportError(s.error());
 
   // --- Pipeline and cameras ----------------------------------------------------------
   // The layered result: with a rig, every layer it asks for (render draws the
   // same pipeline, or its right half when the rig splits the view).
   mocap::Result<FramePipeline> pipeline = FramePipeline::Create(ch, *method, o.threads);
-  if (!pipeline.ok()) return Fail(pipeline.error());
+  if (!pipeline.ok()) return ReportError(pipeline.error());
   if (rig) {
-    if (mocap::Status s = ApplyRigLayers(*rig, ch, *pipeline); !s) return Fail(s.error());
+    if (mocap::Status s = ApplyRigLayers(*rig, ch, *pipeline); !s) return ReportError(s.error());
   }
   // The camera plan is built whether or not it is written: its framing
   // pre-pass evaluates the pipeline, as render's does before its frame loop,
@@ -216,7 +217,7 @@ int RunExport(const ExportOptions& options) {
   // the same sequence of evaluations here as there.
   mocap::Result<CameraPlan> camera_plan =
       CameraPlan::Create(*pipeline, *plan, o.camera, o.elevation_deg, *size);
-  if (!camera_plan.ok()) return Fail(camera_plan.error());
+  if (!camera_plan.ok()) return ReportError(camera_plan.error());
   const CameraPlan* cameras = o.with_camera ? &*camera_plan : nullptr;
   std::optional<deform::GltfSequenceWriter> gltf;
   const deform::Mesh& bind = ch.mesh.bind;
@@ -240,7 +241,7 @@ int RunExport(const ExportOptions& options) {
     mocap::Result<deform::GltfSequenceWriter> w = deform::GltfSequenceWriter::Create(
         bind.triangles, bind.colors, bind.num_vertices(), static_cast<int>(plan->count()), go,
         surface);
-    if (!w.ok()) return Fail(w.error());
+    if (!w.ok()) return ReportError(w.error());
     gltf.emplace(std::move(*w));
   }
 
@@ -255,7 +256,7 @@ int RunExport(const ExportOptions& options) {
   ObjMaterials obj_materials;
   if (!glb && !ch.mesh.materials.materials.empty()) {
     mocap::Result<ObjMaterials> written = WriteObjMaterialFiles(ch.mesh.materials, out_dir);
-    if (!written.ok()) return Fail(written.error());
+    if (!written.ok()) return ReportError(written.error());
     obj_materials = std::move(*written);
   }
   const std::string source = demo ? "demo_walk.bvh (built in)" : rig ? rig->file : o.input;
@@ -270,7 +271,7 @@ int RunExport(const ExportOptions& options) {
     const mocap::Status planned = guard.Plan(
         plan->count(),
         [&](std::size_t i) { return render::ExpandFramePattern(out, plan->At(i).number); }, {});
-    if (!planned.ok()) return Fail(planned.error());
+    if (!planned.ok()) return ReportError(planned.error());
   }
   int frames_done = 0;
   int last_done_number = -1;
@@ -278,7 +279,7 @@ int RunExport(const ExportOptions& options) {
     if (guard.interrupted()) break;
     const OutputFrame of = plan->At(index);
     mocap::Status s = pipeline->Evaluate(of.time_s, frame);
-    if (!s.ok()) return Fail(s.error());
+    if (!s.ok()) return ReportError(s.error());
     std::span<const glm::vec3> positions = frame.positions;
     if (o.scale != 1.0f) {
       scaled.resize(frame.positions.size());
@@ -292,7 +293,7 @@ int RunExport(const ExportOptions& options) {
       // one frame hands the next (the elastic layer).
     } else {
       const mocap::Result<std::string> path = render::ExpandFramePattern(out, of.number);
-      if (!path.ok()) return Fail(path.error());
+      if (!path.ok()) return ReportError(path.error());
       char comment[160];
       std::snprintf(comment, sizeof(comment), "frame %d, t = %.6f s, %s skinning", of.number,
                     of.time_s, GlobalMethodName(*method));
@@ -307,7 +308,7 @@ int RunExport(const ExportOptions& options) {
                                               : std::span<const std::int32_t>(ch.mesh.materials.triangle_material)},
                     *path);
     }
-    if (!s.ok()) return Fail(s.error());
+    if (!s.ok()) return ReportError(s.error());
     if (cameras) {
       char file[32];
       std::snprintf(file, sizeof(file), "camera_%04d.json", of.number);
@@ -319,12 +320,12 @@ int RunExport(const ExportOptions& options) {
       camera.far_plane *= o.scale;
       if (gltf) {  // the camera node: world position and world-from-view rotation
         const glm::quat rotation = glm::quat_cast(glm::transpose(glm::mat3(camera.ViewFromWorld())));
-        if (s = gltf->AddCameraFrame(camera.eye, rotation); !s.ok()) return Fail(s.error());
+        if (s = gltf->AddCameraFrame(camera.eye, rotation); !s.ok()) return ReportError(s.error());
       }
       s = deform::WriteFileAtomic((out_dir / file).string(),
                                   CameraJson(camera, *size, cameras->ground_y() * o.scale,
                                              of.number, of.time_s));
-      if (!s.ok()) return Fail(s.error());
+      if (!s.ok()) return ReportError(s.error());
     }
     progress.Step(of.number);
     ++frames_done;
@@ -341,7 +342,7 @@ int RunExport(const ExportOptions& options) {
     return guard.exit_code();
   }
   if (gltf) {
-    if (mocap::Status s = gltf->Finish(out); !s) return Fail(s.error());
+    if (mocap::Status s = gltf->Finish(out); !s) return ReportError(s.error());
   }
   progress.Finish();
   if (glb) {

@@ -14,6 +14,7 @@
 #include "app/frame_plan.h"
 #include "app/motion_source.h"
 #include "app/rig_file.h"
+#include "app/exit_code.h"
 #include "render/output/image_io.h"
 
 extern char** environ;
@@ -22,11 +23,6 @@ namespace app {
 namespace {
 
 namespace fs = std::filesystem;
-
-int Fail(const mocap::Error& e) {
-  std::fprintf(stderr, "%s\n", e.ToString().c_str());
-  return e.code == mocap::ErrorCode::kInternal ? 3 : 2;
-}
 
 // Single-quotes `s` for sh unless it only holds characters sh leaves alone.
 std::string Quote(const std::string& s) {
@@ -87,12 +83,14 @@ std::string FramesText(int first, int last, int step) {
 }  // namespace
 
 int RunFarm(const FarmOptions& o) {
-  if (o.chunk < 1 || o.chunk > 1000000) return Fail(ArgError("--chunk", "expected 1..1000000 frames per task"));
-  if (o.wait && !o.submit) return Fail(ArgError("--wait", "only with --submit"));
+  if (o.chunk < 1 || o.chunk > 1000000)
+    return ReportError(ArgError("--chunk", "expected 1..1000000 frames per task"));
+  if (o.wait && !o.submit) return ReportError(ArgError("--wait", "only with --submit"));
   for (const std::string& a : o.render_args) {
     for (const char* reserved : kReservedRenderOptions) {
       if (a == reserved || a.rfind(std::string(reserved) + "=", 0) == 0) {
-        return Fail(ArgError(a, "farm sets this render option itself; give it to farm (or leave it out)"));
+        return ReportError(
+            ArgError(a, "farm sets this render option itself; give it to farm (or leave it out)"));
       }
     }
   }
@@ -103,39 +101,40 @@ int RunFarm(const FarmOptions& o) {
   double fps = o.fps;
   if (fs::path(o.input).extension() == ".json") {
     mocap::Result<Rig> rig = LoadRig(o.input);
-    if (!rig.ok()) return Fail(rig.error());
+    if (!rig.ok()) return ReportError(rig.error());
     if (o.motion.empty()) motion_path = rig->motion.empty() ? rig->character : rig->motion;
     if (frames_text.empty()) frames_text = rig->render.frames;
     if (pattern.empty()) pattern = rig->render.output;
     if (fps <= 0.0) fps = rig->fps;
   }
-  if (!(fps >= 0.0) || fps > 10000.0) return Fail(ArgError("--fps", "expected 0 < fps <= 10000"));
+  if (!(fps >= 0.0) || fps > 10000.0)
+    return ReportError(ArgError("--fps", "expected 0 < fps <= 10000"));
   MotionSourceOptions load;
   load.y_up = true;
   mocap::Result<MotionSource> src = LoadMotionSource(motion_path, load);
-  if (!src.ok()) return Fail(src.error());
+  if (!src.ok()) return ReportError(src.error());
   mocap::Result<FramePlan> plan = PlanFrames(src->motion, {.frames = frames_text, .fps = fps});
-  if (!plan.ok()) return Fail(plan.error());
+  if (!plan.ok()) return ReportError(plan.error());
   const FrameRange range = plan->range;
   const int num_frames = static_cast<int>(plan->frames.size());
   const int num_tasks = (num_frames + o.chunk - 1) / o.chunk;
 
   if (pattern.empty()) pattern = "out/" + name + "/frame_####.png";
   if (!render::HasFramePlaceholder(pattern)) {
-    return Fail(ArgError("--out", "the pattern '" + pattern +
-                                      "' needs one frame placeholder such as #### or %04d"));
+    return ReportError(ArgError(
+        "--out", "the pattern '" + pattern + "' needs one frame placeholder such as #### or %04d"));
   }
   pattern = Absolute(pattern);
   const mocap::Result<std::string> first_frame = render::ExpandFramePattern(pattern, range.first);
-  if (!first_frame.ok()) return Fail(first_frame.error());
+  if (!first_frame.ok()) return ReportError(first_frame.error());
   const fs::path frames_dir = fs::path(*first_frame).parent_path();
   const fs::path script_dir = o.script_dir.empty() ? frames_dir / "slurm" : fs::path(Absolute(o.script_dir));
   const std::string job_name = o.job_name.empty() ? "patchskin-" + name : o.job_name;
   std::error_code ec;
   const std::string exe = fs::read_symlink("/proc/self/exe", ec).string();
   if (ec) {
-    return Fail(mocap::MakeError(mocap::ErrorCode::kInternal, {"/proc/self/exe", 0, 0, {}},
-                                 "cannot find the patchskin binary: " + ec.message()));
+    return ReportError(mocap::MakeError(mocap::ErrorCode::kInternal, {"/proc/self/exe", 0, 0, {}},
+                                        "cannot find the patchskin binary: " + ec.message()));
   }
   char rate[64];
   std::snprintf(rate, sizeof rate, "%.17g", 1.0 / plan->frame_time_s);
@@ -206,15 +205,15 @@ int RunFarm(const FarmOptions& o) {
 
   fs::create_directories(script_dir / "logs", ec);
   if (ec) {
-    return Fail(mocap::MakeError(mocap::ErrorCode::kIo, {script_dir.string(), 0, 0, {}},
-                                 "cannot create the script folder: " + ec.message()));
+    return ReportError(mocap::MakeError(mocap::ErrorCode::kIo, {script_dir.string(), 0, 0, {}},
+                                        "cannot create the script folder: " + ec.message()));
   }
   for (const auto& [file, text, executable] :
        {std::tuple{"render_array.sbatch", &scripts.render_array, false},
         std::tuple{"sheet.sbatch", &scripts.sheet, false},
         std::tuple{"submit.sh", &scripts.submit, true}}) {
     const mocap::Status s = WriteText(script_dir / file, *text, executable);
-    if (!s.ok()) return Fail(s.error());
+    if (!s.ok()) return ReportError(s.error());
   }
   const std::string submit_path = (script_dir / "submit.sh").string();
   if (!o.submit) {
@@ -232,7 +231,8 @@ int RunFarm(const FarmOptions& o) {
   argv.push_back(nullptr);
   pid_t pid = -1;
   if (posix_spawn(&pid, "/bin/sh", nullptr, nullptr, argv.data(), environ) != 0) {
-    return Fail(mocap::MakeError(mocap::ErrorCode::kIo, {submit_path, 0, 0, {}}, "cannot run /bin/sh"));
+    return ReportError(
+        mocap::MakeError(mocap::ErrorCode::kIo, {submit_path, 0, 0, {}}, "cannot run /bin/sh"));
   }
   int status = 0;
   while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {

@@ -23,6 +23,7 @@
 #include "app/rig_file.h"
 #include "app/rig_patches.h"
 #include "app/rig_setup.h"
+#include "app/exit_code.h"
 #include "render/output/async_writer.h"
 #include "render/camera.h"
 #include "render/output/contact_sheet.h"
@@ -156,11 +157,6 @@ std::string FrameLabel(const std::string& kind, int number, double frame_time_s)
   return text;
 }
 
-int Fail(const mocap::Error& e) {
-  std::fprintf(stderr, "%s\n", e.ToString().c_str());
-  return e.code == mocap::ErrorCode::kInternal ? 3 : 2;
-}
-
 // This process's peak resident memory in MB (VmHWM of /proc/self/status), 0 if unknown.
 double PeakResidentMb() {
   std::FILE* f = std::fopen("/proc/self/status", "r");
@@ -185,13 +181,13 @@ int RunRender(const RenderOptions& options) {
   if (!o.layer.empty()) {
     // --layer auto: the rig `patchskin rig auto` would write, used as if read.
     mocap::Result<Rig> made = AutoRigForCommand(o.layer, o.input, o.motion, o.body, o.up, o.quiet);
-    if (!made.ok()) return Fail(made.error());
+    if (!made.ok()) return ReportError(made.error());
     rig = std::move(*made);
     o.given.erase("--body");  // the rig names the body now
     o.body = "generated";
   } else if (std::filesystem::path(o.input).extension() == ".json") {
     mocap::Result<Rig> loaded = LoadRig(o.input);
-    if (!loaded.ok()) return Fail(loaded.error());
+    if (!loaded.ok()) return ReportError(loaded.error());
     rig = std::move(*loaded);
   }
   if (rig) {
@@ -224,45 +220,50 @@ int RunRender(const RenderOptions& options) {
 
   // --- Arguments -------------------------------------------------------------
   const mocap::Result<glm::ivec2> size = ParseSize(o.size);
-  if (!size.ok()) return Fail(size.error());
+  if (!size.ok()) return ReportError(size.error());
   if (o.supersample != 1 && o.supersample != 2 && o.supersample != 4) {
-    return Fail(ArgError("--supersample", "expected 1, 2 or 4, found " + std::to_string(o.supersample)));
+    return ReportError(
+        ArgError("--supersample", "expected 1, 2 or 4, found " + std::to_string(o.supersample)));
   }
   if (std::int64_t{size->x} * size->y * o.supersample * o.supersample > kMaxFrameSamples) {
-    return Fail(ArgError("--size", "expected at most " + std::to_string(kMaxFrameSamples) +
-                                       " samples per frame (width x height x supersample^2), found " +
-                                       o.size + " at supersample " + std::to_string(o.supersample)));
+    return ReportError(
+        ArgError("--size", "expected at most " + std::to_string(kMaxFrameSamples) +
+                               " samples per frame (width x height x supersample^2), found " +
+                               o.size + " at supersample " + std::to_string(o.supersample)));
   }
   if (o.aa != "ssaa" && o.aa != "msaa") {
-    return Fail(ArgError("--aa", "expected ssaa or msaa, found '" + o.aa + "'"));
+    return ReportError(ArgError("--aa", "expected ssaa or msaa, found '" + o.aa + "'"));
   }
   if (o.shadows != "on" && o.shadows != "off") {
-    return Fail(ArgError("--shadows", "expected on or off, found '" + o.shadows + "'"));
+    return ReportError(ArgError("--shadows", "expected on or off, found '" + o.shadows + "'"));
   }
   if (o.textures != "on" && o.textures != "off") {
-    return Fail(ArgError("--textures", "expected on or off, found '" + o.textures + "'"));
+    return ReportError(ArgError("--textures", "expected on or off, found '" + o.textures + "'"));
   }
   if (o.resolve != "box" && o.resolve != "tent") {
-    return Fail(ArgError("--resolve", "expected box or tent, found '" + o.resolve + "'"));
+    return ReportError(ArgError("--resolve", "expected box or tent, found '" + o.resolve + "'"));
   }
   if (o.resolve == "tent" && o.supersample > 1 &&
       std::int64_t{size->x} * size->y * o.supersample * o.supersample > kMaxTentSamples) {
-    return Fail(ArgError("--resolve", "a tent resolve keeps every sample: expected at most " +
-                                          std::to_string(kMaxTentSamples) +
-                                          " samples per frame, found " + o.size +
-                                          " at supersample " + std::to_string(o.supersample)));
+    return ReportError(
+        ArgError("--resolve", "a tent resolve keeps every sample: expected at most " +
+                                  std::to_string(kMaxTentSamples) + " samples per frame, found " +
+                                  o.size + " at supersample " + std::to_string(o.supersample)));
   }
   if (o.png_compression < 0 || o.png_compression > 9) {
-    return Fail(ArgError("--png-compression", "expected 0..9"));
+    return ReportError(ArgError("--png-compression", "expected 0..9"));
   }
   if (o.camera != "follow" && o.camera != "fixed" && o.camera != "turntable") {
-    return Fail(ArgError("--camera", "expected follow, fixed or turntable, found '" + o.camera + "'"));
+    return ReportError(
+        ArgError("--camera", "expected follow, fixed or turntable, found '" + o.camera + "'"));
   }
   if (o.turntable_frames < 1 || o.turntable_frames > 100000) {
-    return Fail(ArgError("--turntable-frames", "expected 1..100000"));
+    return ReportError(ArgError("--turntable-frames", "expected 1..100000"));
   }
-  if (o.threads < 0 || o.threads > 256) return Fail(ArgError("--threads", "expected 0..256"));
-  if (!(o.fps >= 0.0) || o.fps > 10000.0) return Fail(ArgError("--fps", "expected 0 < fps <= 10000"));
+  if (o.threads < 0 || o.threads > 256)
+    return ReportError(ArgError("--threads", "expected 0..256"));
+  if (!(o.fps >= 0.0) || o.fps > 10000.0)
+    return ReportError(ArgError("--fps", "expected 0 < fps <= 10000"));
   bool overlay_skeleton = false, overlay_wire = false, overlay_patches = false, overlay_delta = false;
   for (const std::string& item : SplitList(o.overlay)) {
     if (item == "skeleton") overlay_skeleton = true;
@@ -270,19 +271,22 @@ int RunRender(const RenderOptions& options) {
     else if (item == "patches") overlay_patches = true;
     else if (item == "delta") overlay_delta = true;
     else {
-      return Fail(ArgError("--overlay", "expected skeleton, wire, patches or delta, found '" + item + "'"));
+      return ReportError(
+          ArgError("--overlay", "expected skeleton, wire, patches or delta, found '" + item + "'"));
     }
   }
   if (o.label != "none" && o.label != "frame" && o.label != "timecode") {
-    return Fail(ArgError("--label", "expected none, frame or timecode, found '" + o.label + "'"));
+    return ReportError(
+        ArgError("--label", "expected none, frame or timecode, found '" + o.label + "'"));
   }
   if (o.background != "gradient" && o.background != "transparent") {
-    return Fail(ArgError("--background", "expected gradient or transparent, found '" + o.background + "'"));
+    return ReportError(
+        ArgError("--background", "expected gradient or transparent, found '" + o.background + "'"));
   }
   const mocap::Result<GlobalMethod> method = ParseGlobalMethod(o.global);
-  if (!method.ok()) return Fail(method.error());
+  if (!method.ok()) return ReportError(method.error());
   mocap::Result<TwoBodies> two = ChooseTwoBodies(o, rig ? &*rig : nullptr, *method);
-  if (!two.ok()) return Fail(two.error());
+  if (!two.ok()) return ReportError(two.error());
 
   // --- Body: a rig file names its body ("character"); a glTF body is the
   // character and the BVH input its --motion.
@@ -290,19 +294,23 @@ int RunRender(const RenderOptions& options) {
   const std::string body_ext = std::filesystem::path(o.body).extension().string();
   if (body_ext == ".glb" || body_ext == ".gltf") {
     if (rig || !o.motion.empty()) {
-      return Fail(ArgError("--body", "a glTF/GLB body takes a BVH INPUT as its motion; not with a rig file or --motion"));
+      return ReportError(ArgError(
+          "--body",
+          "a glTF/GLB body takes a BVH INPUT as its motion; not with a rig file or --motion"));
     }
     o.motion = o.input.empty() ? std::string() : o.input;
-    if (o.motion.empty()) return Fail(ArgError("--body", "a glTF/GLB body needs a BVH INPUT to drive it"));
+    if (o.motion.empty())
+      return ReportError(ArgError("--body", "a glTF/GLB body needs a BVH INPUT to drive it"));
     o.input = o.body;
   } else {
     const mocap::Result<BodyKind> kind = ParseBodyKind(o.body);
-    if (!kind.ok()) return Fail(kind.error());
+    if (!kind.ok()) return ReportError(kind.error());
     body_kind = rig ? RigBodyKind(*rig) : *kind;
     if (rig && o.given.count("--body") > 0 && *kind != body_kind) {
-      return Fail(ArgError("--body", "the rig file names its body (\"character\"); expected " +
-                                         std::string(body_kind == BodyKind::kTubes ? "tubes" : "generated") +
-                                         " or no --body with this rig"));
+      return ReportError(ArgError(
+          "--body", "the rig file names its body (\"character\"); expected " +
+                        std::string(body_kind == BodyKind::kTubes ? "tubes" : "generated") +
+                        " or no --body with this rig"));
     }
   }
 
@@ -312,10 +320,10 @@ int RunRender(const RenderOptions& options) {
                            : rig ? std::filesystem::path(rig->file).stem().string()
                                  : std::filesystem::path(o.input).stem().string();
   const mocap::Result<std::optional<mocap::UpAxis>> up = ParseUpAxis(o.up);
-  if (!up.ok()) return Fail(up.error());
+  if (!up.ok()) return ReportError(up.error());
   mocap::Result<Character> character =
       LoadCommandCharacter(o.input, o.motion, o.quiet, *up, o.joint_map, nullptr, body_kind);
-  if (!character.ok()) return Fail(character.error());
+  if (!character.ok()) return ReportError(character.error());
   const Character& ch = *character;
 
   const bool turntable = o.camera == "turntable";
@@ -328,9 +336,9 @@ int RunRender(const RenderOptions& options) {
       // The range came from the rig file: name it and its field, not --frames.
       mocap::Error e = plan.error();
       e.loc = {rig->file, 0, 0, "render.frames"};
-      return Fail(e);
+      return ReportError(e);
     }
-    return Fail(plan.error());
+    return ReportError(plan.error());
   }
   const double frame_time = plan->frame_time_s;
   // The output frames are computed one at a time (plan->At): a render of
@@ -340,14 +348,16 @@ int RunRender(const RenderOptions& options) {
   std::string pattern = o.out;
   if (pattern.empty()) pattern = "out/" + name + (turntable ? "_turntable" : "") + "/frame_####.png";
   if (!render::HasFramePlaceholder(pattern)) {
-    return Fail(ArgError("--out", "the pattern '" + pattern +
-                                      "' needs one frame placeholder such as #### or %04d"));
+    return ReportError(ArgError(
+        "--out", "the pattern '" + pattern + "' needs one frame placeholder such as #### or %04d"));
   }
   if (o.background == "transparent") {
     const mocap::Result<render::ImageFormat> format = render::ImageFormatFromPath(pattern);
     if (format.ok() && *format == render::ImageFormat::kJpeg) {
-      return Fail(ArgError("--background", "transparent needs frames with alpha (PNG, EXR or TIFF), "
-                                           "found the JPEG pattern '" + pattern + "'"));
+      return ReportError(ArgError("--background",
+                                  "transparent needs frames with alpha (PNG, EXR or TIFF), "
+                                  "found the JPEG pattern '" +
+                                      pattern + "'"));
     }
   }
   // Existing outputs are refused (or, with --resume, skipped) before anything renders.
@@ -357,13 +367,13 @@ int RunRender(const RenderOptions& options) {
       return render::ExpandFramePattern(pattern, plan->At(i).number);
     };
     const mocap::Result<std::string> first_path = frame_path(0);
-    if (!first_path.ok()) return Fail(first_path.error());
+    if (!first_path.ok()) return ReportError(first_path.error());
     const std::filesystem::path dir = std::filesystem::path(*first_path).parent_path();
     std::vector<std::string> others;
     if (!o.no_sheet) others.push_back((dir / "contact_sheet.png").string());
     if (!o.no_video) others.push_back((dir / "preview.mp4").string());
     const mocap::Status planned = guard.Plan(num_frames, frame_path, others);
-    if (!planned.ok()) return Fail(planned.error());
+    if (!planned.ok()) return ReportError(planned.error());
   }
 
   // --- Pipelines ---------------------------------------------------------------
@@ -373,11 +383,11 @@ int RunRender(const RenderOptions& options) {
   const BodySpec main_body = two->view != View::kOne ? two->sides[0]
                                                      : BodySpec{*method, has_layers};
   mocap::Result<FramePipeline> pipeline = FramePipeline::Create(ch, main_body.method, o.threads);
-  if (!pipeline.ok()) return Fail(pipeline.error());
+  if (!pipeline.ok()) return ReportError(pipeline.error());
   std::optional<FramePipeline> right_pipeline;
   if (two->view != View::kOne) {
     mocap::Result<FramePipeline> p = FramePipeline::Create(ch, two->sides[1].method, o.threads);
-    if (!p.ok()) return Fail(p.error());
+    if (!p.ok()) return ReportError(p.error());
     right_pipeline.emplace(std::move(*p));
   }
   const std::pair<FramePipeline*, bool> bodies[] = {
@@ -387,7 +397,8 @@ int RunRender(const RenderOptions& options) {
     if (body == nullptr || !layered) continue;
     // The layers (patches, example shapes, elastic), set up as `export` sets them up.
     std::vector<std::string> notes;
-    if (mocap::Status s = ApplyRigLayers(*rig, ch, *body, &notes); !s.ok()) return Fail(s.error());
+    if (mocap::Status s = ApplyRigLayers(*rig, ch, *body, &notes); !s.ok())
+      return ReportError(s.error());
     if (!o.quiet) {
       for (const std::string& note : notes) std::fprintf(stderr, "%s\n", note.c_str());
     }
@@ -399,13 +410,13 @@ int RunRender(const RenderOptions& options) {
   // layer coloured by its displacement from the same method alone, evaluated
   // by a global-only pipeline per such body.
   if ((overlay_patches || overlay_delta) && (!rig || rig->patches.empty())) {
-    return Fail(ArgError("--overlay", std::string(overlay_delta ? "delta" : "patches") +
-                                          " needs a rig file with patches as the input"));
+    return ReportError(ArgError("--overlay", std::string(overlay_delta ? "delta" : "patches") +
+                                                 " needs a rig file with patches as the input"));
   }
   std::vector<glm::vec3> tint;
   if (overlay_patches) {
     mocap::Result<std::vector<deform::PatchSetup>> patches = BuildRigPatches(*rig, ch);
-    if (!patches.ok()) return Fail(patches.error());
+    if (!patches.ok()) return ReportError(patches.error());
     tint = PatchTint(*patches, ch.mesh.bind.num_vertices(), ch.mesh.bind.colors);
   }
   struct DeltaBody {
@@ -418,7 +429,7 @@ int RunRender(const RenderOptions& options) {
     const FramePipeline* body = side == 0 ? &*pipeline : right_pipeline ? &*right_pipeline : nullptr;
     if (body == nullptr || body->num_patches() == 0) continue;
     mocap::Result<FramePipeline> base = FramePipeline::Create(ch, body->method(), o.threads);
-    if (!base.ok()) return Fail(base.error());
+    if (!base.ok()) return ReportError(base.error());
     delta[side].base.emplace(std::move(*base));
   }
 
@@ -428,12 +439,12 @@ int RunRender(const RenderOptions& options) {
   if (!o.framing.empty() && !turntable) {
     framing = PlanFrames(ch.motion, {.frames = o.framing, .fps = o.fps,
                                      .start_number = o.start_number, .list_frames = false});
-    if (!framing.ok()) return Fail(ArgError("--framing", framing.error().message));
+    if (!framing.ok()) return ReportError(ArgError("--framing", framing.error().message));
     if (plan->range.first < framing->range.first || plan->range.last > framing->range.last) {
-      return Fail(ArgError("--framing", "expected a range holding every output frame (" +
-                                            std::to_string(plan->range.first) + ".." +
-                                            std::to_string(plan->range.last) + "), found '" +
-                                            o.framing + "'"));
+      return ReportError(ArgError("--framing", "expected a range holding every output frame (" +
+                                                   std::to_string(plan->range.first) + ".." +
+                                                   std::to_string(plan->range.last) + "), found '" +
+                                                   o.framing + "'"));
     }
   }
   // Side by side, every body is framed in its own half of the frame.
@@ -447,18 +458,18 @@ int RunRender(const RenderOptions& options) {
   if (mocap::Status s = ResolveLookAt(o.look_at, rig ? &*rig : nullptr, ch, camera_spec); !s.ok()) {
     mocap::Error e = s.error();
     if (rig && options.given.count("--look-at") == 0) e.loc = {rig->file, 0, 0, "render.camera.look_at"};
-    return Fail(e);
+    return ReportError(e);
   }
   mocap::Result<CameraPlan> cameras = CameraPlan::Create(*pipeline, *framing, camera_spec, view_size);
-  if (!cameras.ok()) return Fail(cameras.error());
+  if (!cameras.ok()) return ReportError(cameras.error());
   const float ground_y = cameras->ground_y();
 
   // --- Outputs -------------------------------------------------------------------
   {
     const mocap::Result<std::string> first = render::ExpandFramePattern(pattern, plan->At(0).number);
-    if (!first.ok()) return Fail(first.error());
+    if (!first.ok()) return ReportError(first.error());
     const mocap::Status writable = PrepareOutputFolder(std::filesystem::path(*first).parent_path());
-    if (!writable.ok()) return Fail(writable.error());
+    if (!writable.ok()) return ReportError(writable.error());
   }
   const std::filesystem::path out_dir =
       std::filesystem::path(*render::ExpandFramePattern(pattern, 0)).parent_path();
@@ -492,7 +503,7 @@ int RunRender(const RenderOptions& options) {
   if (!o.no_sheet) {
     auto b = render::ContactSheetBuilder::Create(
         sheet_count, size->x, size->y, {.columns = render::ContactSheetColumns(sheet_count)});
-    if (!b.ok()) return Fail(b.error());
+    if (!b.ok()) return ReportError(b.error());
     sheet = std::move(*b);
   }
   std::unique_ptr<render::VideoWriter> video;
@@ -554,21 +565,21 @@ int RunRender(const RenderOptions& options) {
     // frame to frame (the elastic layer) must see every frame to give a
     // resumed range the same result.
     mocap::Status s = pipeline->Evaluate(of.time_s, frame);
-    if (!s.ok()) return Fail(s.error());
+    if (!s.ok()) return ReportError(s.error());
     if (right_pipeline) {
       s = right_pipeline->Evaluate(of.time_s, right_frame);
-      if (!s.ok()) return Fail(s.error());
+      if (!s.ok()) return ReportError(s.error());
     }
     if (guard.skip(i)) {
       // Resumed: the finished frame on disk feeds the sheet and the video.
       if (!sheet && !video) continue;
       const mocap::Result<std::string> done_path = render::ExpandFramePattern(pattern, of.number);
-      if (!done_path.ok()) return Fail(done_path.error());
+      if (!done_path.ok()) return ReportError(done_path.error());
       mocap::Result<render::Image> done = render::ReadImage(*done_path);
-      if (!done.ok()) return Fail(done.error());
+      if (!done.ok()) return ReportError(done.error());
       s = feed_async(i, of.number, std::make_shared<const render::Image>(std::move(*done)),
                      /*read_back=*/true);
-      if (!s.ok()) return Fail(s.error());
+      if (!s.ok()) return ReportError(s.error());
       continue;
     }
     const render::Camera camera = cameras->At(of);
@@ -578,7 +589,7 @@ int RunRender(const RenderOptions& options) {
     for (int b = 0; b < 2; ++b) {
       if (!delta[b].base) continue;
       s = delta[b].base->Evaluate(of.time_s, delta[b].base_frame);
-      if (!s.ok()) return Fail(s.error());
+      if (!s.ok()) return ReportError(s.error());
       const DeformedFrame& layered = b == 0 ? frame : right_frame;
       for (std::size_t v = 0; v < layered.positions.size(); ++v) {
         delta_scale = std::max(delta_scale,
@@ -612,17 +623,17 @@ int RunRender(const RenderOptions& options) {
                                 .textures = o.textures == "on"};
     s = DrawCharacterFrame(ch, frame, right_pipeline ? &right_frame : nullptr, camera, settings,
                            draw, renderer, right_renderer, right_image, image);
-    if (!s.ok()) return Fail(s.error());
+    if (!s.ok()) return ReportError(s.error());
     s = feed_async(i, of.number, std::make_shared<const render::Image>(image), /*read_back=*/false);
-    if (!s.ok()) return Fail(s.error());
+    if (!s.ok()) return ReportError(s.error());
     const mocap::Result<std::string> path = render::ExpandFramePattern(pattern, of.number);
-    if (!path.ok()) return Fail(path.error());
+    if (!path.ok()) return ReportError(path.error());
     write_options.frame = of.number;
     // The frame moves to the writer; the next one renders into the buffers
     // of one already written (when there is one), so no frame-sized buffer is
     // copied, allocated or first touched per frame.
     s = writer.Submit(std::move(image), *path, write_options);
-    if (!s.ok()) return Fail(s.error());
+    if (!s.ok()) return ReportError(s.error());
     image = writer.TakeSpareImage();
     ++frames_done;
     if (first_frame_s < 0.0) {
@@ -633,9 +644,9 @@ int RunRender(const RenderOptions& options) {
   }
   // Every frame handed to the writer is finished (so none is left half-written).
   mocap::Status s = writer.Finish();
-  if (!s.ok()) return Fail(s.error());
+  if (!s.ok()) return ReportError(s.error());
   s = side.Finish();
-  if (!s.ok()) return Fail(s.error());
+  if (!s.ok()) return ReportError(s.error());
   progress.Finish();
   if (guard.interrupted()) {
     // The sheet and the video would be partial: the video writer's destructor
@@ -665,12 +676,12 @@ int RunRender(const RenderOptions& options) {
   if (sheet) {
     const std::string sheet_path = (out_dir / "contact_sheet.png").string();
     s = render::WriteImage(sheet->sheet(), sheet_path, {});
-    if (!s.ok()) return Fail(s.error());
+    if (!s.ok()) return ReportError(s.error());
     std::printf("contact sheet: %s\n", sheet_path.c_str());
   }
   if (video) {
     s = video->Close();
-    if (!s.ok()) return Fail(s.error());
+    if (!s.ok()) return ReportError(s.error());
     std::printf("video:         %s (%s)\n", video->path().c_str(), render::VideoCodecName(video->codec()));
   }
   if (o.stats) {

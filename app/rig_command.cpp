@@ -5,16 +5,14 @@
 #include <fstream>
 
 #include "app/auto_rig.h"
+#include "app/exit_code.h"
 #include "app/rig_writer.h"
 
 namespace app {
 
 int RunRigAuto(const RigCommandOptions& o) {
   mocap::Result<AutoRig> made = MakeAutoRig(o.capture, o.body, o.up, o.quiet);
-  if (!made.ok()) {
-    std::fprintf(stderr, "%s\n", made.error().ToString().c_str());
-    return made.error().code == mocap::ErrorCode::kInternal ? 3 : 2;
-  }
+  if (!made.ok()) return ReportError(made.error());
   const std::string folder =
       o.out.empty() ? std::string(".") : std::filesystem::path(o.out).parent_path().string();
   mocap::Result<std::string> text = WriteRigJson(made->rig, folder);

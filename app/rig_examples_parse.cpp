@@ -28,37 +28,12 @@ constexpr double kMaxAngleDeg = 360.0;
 constexpr double kMinBrushRadius = 0.01;
 constexpr double kMaxBrushRadius = 2.0;
 
-struct Ctx {
-  std::string file;
-  mocap::Error Fail(const std::string& path, const std::string& message) const {
-    return mocap::MakeError(mocap::ErrorCode::kInvalidArgument, {file, 0, 0, path}, message);
-  }
-  mocap::Error Expected(const std::string& path, const std::string& what, const json& found) const {
-    return Fail(path, "expected " + what + ", found " + DescribeJson(found));
-  }
-  // `obj` must be an object whose keys are all in `allowed`.
-  std::optional<mocap::Error> Keys(const json& obj, const std::string& path,
-                                   std::initializer_list<const char*> allowed) const {
-    if (!obj.is_object()) return Expected(path, "an object", obj);
-    for (const auto& [key, value] : obj.items()) {
-      bool known = false;
-      std::string list;
-      for (const char* a : allowed) {
-        known = known || key == a;
-        list += std::string(list.empty() ? "" : ", ") + a;
-      }
-      if (!known) return Fail(path + "." + key, "unknown field (expected one of: " + list + ")");
-    }
-    return std::nullopt;
-  }
-};
-
 bool NumberIn(const json& v, double lo, double hi) {
   return v.is_number() && std::isfinite(v.get<double>()) && v.get<double>() >= lo &&
          v.get<double>() <= hi;
 }
 
-std::optional<mocap::Error> GetVec(const Ctx& c, const json& v, const std::string& path,
+std::optional<mocap::Error> GetVec(const JsonFile& c, const json& v, const std::string& path,
                                    std::size_t n, double lo, double hi, double* out) {
   std::ostringstream what;
   what << "an array of " << n << " numbers in " << lo << ".." << hi;
@@ -70,7 +45,7 @@ std::optional<mocap::Error> GetVec(const Ctx& c, const json& v, const std::strin
   return std::nullopt;
 }
 
-std::optional<mocap::Error> ParsePose(const Ctx& c, const json& v, const std::string& path,
+std::optional<mocap::Error> ParsePose(const JsonFile& c, const json& v, const std::string& path,
                                       RigExamplePose& pose) {
   if (auto e = c.Keys(v, path, {"frame", "joints"})) return e;
   if (v.contains("frame") == v.contains("joints")) {
@@ -99,7 +74,7 @@ std::optional<mocap::Error> ParsePose(const Ctx& c, const json& v, const std::st
   return std::nullopt;
 }
 
-std::optional<mocap::Error> ParseEdit(const Ctx& c, const json& v, const std::string& path,
+std::optional<mocap::Error> ParseEdit(const JsonFile& c, const json& v, const std::string& path,
                                       RigEdit& edit) {
   if (auto e = c.Keys(v, path, {"vertex", "point", "move", "frame", "radius"})) return e;
   edit.path = path;
@@ -139,8 +114,8 @@ std::optional<mocap::Error> ParseEdit(const Ctx& c, const json& v, const std::st
   return std::nullopt;
 }
 
-std::optional<mocap::Error> ParsePoseSpace(const Ctx& c, const json& v, const std::string& path,
-                                           RigPoseSpace& ps) {
+std::optional<mocap::Error> ParsePoseSpace(const JsonFile& c, const json& v,
+                                           const std::string& path, RigPoseSpace& ps) {
   if (auto e = c.Keys(v, path, {"features", "kernel", "kappa", "width", "joints"})) return e;
   auto choice = [&](const char* key, std::initializer_list<const char*> options,
                     std::string& out) -> std::optional<mocap::Error> {
@@ -199,7 +174,7 @@ namespace internal {
 
 std::optional<mocap::Error> ParsePatchExamples(const std::string& file, const json& patch,
                                                const std::string& path, RigPatch& out) {
-  const Ctx c{file};
+  const JsonFile c{file};
   if (patch.contains("pose_space")) {
     if (auto e = ParsePoseSpace(c, patch["pose_space"], path + ".pose_space", out.pose_space)) {
       return e;

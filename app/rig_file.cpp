@@ -20,38 +20,17 @@ namespace {
 using nlohmann::json;
 
 // Parsing context: the file name and the error to return.
-struct Ctx {
-  std::string file;
-  mocap::Error Fail(const std::string& path, const std::string& message,
-                    mocap::ErrorCode code = mocap::ErrorCode::kInvalidArgument) const {
-    return mocap::MakeError(code, {file, 0, 0, path}, message);
-  }
-  mocap::Error Expected(const std::string& path, const std::string& what, const json& found) const {
-    return Fail(path, "expected " + what + ", found " + DescribeJson(found));
-  }
-};
-
 std::string Join(const std::string& path, const std::string& key) {
   return path.empty() ? key : path + "." + key;
 }
 
 // Checks `obj` is an object with only `allowed` keys.
-std::optional<mocap::Error> CheckObject(const Ctx& c, const json& obj, const std::string& path,
+std::optional<mocap::Error> CheckObject(const JsonFile& c, const json& obj, const std::string& path,
                                         std::initializer_list<const char*> allowed) {
-  if (!obj.is_object()) return c.Expected(path.empty() ? "rig" : path, "an object", obj);
-  for (const auto& [key, value] : obj.items()) {
-    bool known = false;
-    for (const char* a : allowed) known = known || key == a;
-    if (!known) {
-      std::string list;
-      for (const char* a : allowed) list += std::string(list.empty() ? "" : ", ") + a;
-      return c.Fail(Join(path, key), "unknown field (expected one of: " + list + ")");
-    }
-  }
-  return std::nullopt;
+  return c.Keys(obj, path, allowed, "rig");
 }
 
-std::optional<mocap::Error> GetNumber(const Ctx& c, const json& v, const std::string& path,
+std::optional<mocap::Error> GetNumber(const JsonFile& c, const json& v, const std::string& path,
                                       double lo, double hi, double& out) {
   std::ostringstream range;
   range << "a number in " << lo << ".." << hi;
@@ -63,7 +42,7 @@ std::optional<mocap::Error> GetNumber(const Ctx& c, const json& v, const std::st
   return std::nullopt;
 }
 
-std::optional<mocap::Error> GetFloat(const Ctx& c, const json& v, const std::string& path,
+std::optional<mocap::Error> GetFloat(const JsonFile& c, const json& v, const std::string& path,
                                      double lo, double hi, float& out) {
   double d = 0.0;
   if (auto e = GetNumber(c, v, path, lo, hi, d)) return e;
@@ -71,15 +50,16 @@ std::optional<mocap::Error> GetFloat(const Ctx& c, const json& v, const std::str
   return std::nullopt;
 }
 
-std::optional<mocap::Error> GetString(const Ctx& c, const json& v, const std::string& path,
+std::optional<mocap::Error> GetString(const JsonFile& c, const json& v, const std::string& path,
                                       std::string& out) {
   if (!v.is_string() || v.get<std::string>().empty()) return c.Expected(path, "a non-empty string", v);
   out = v.get<std::string>();
   return std::nullopt;
 }
 
-std::optional<mocap::Error> GetChoice(const Ctx& c, const json& v, const std::string& path,
-                                      std::initializer_list<const char*> choices, std::string& out) {
+std::optional<mocap::Error> GetChoice(const JsonFile& c, const json& v, const std::string& path,
+                                      std::initializer_list<const char*> choices,
+                                      std::string& out) {
   std::string list;
   bool ok = false;
   for (const char* ch : choices) {
@@ -91,7 +71,7 @@ std::optional<mocap::Error> GetChoice(const Ctx& c, const json& v, const std::st
   return std::nullopt;
 }
 
-std::optional<mocap::Error> GetIntPair(const Ctx& c, const json& v, const std::string& path,
+std::optional<mocap::Error> GetIntPair(const JsonFile& c, const json& v, const std::string& path,
                                        int lo, int hi, glm::ivec2& out) {
   const std::string what =
       "an array of two integers in " + std::to_string(lo) + ".." + std::to_string(hi);
@@ -105,7 +85,7 @@ std::optional<mocap::Error> GetIntPair(const Ctx& c, const json& v, const std::s
 }
 
 template <int N>
-std::optional<mocap::Error> GetFloats(const Ctx& c, const json& v, const std::string& path,
+std::optional<mocap::Error> GetFloats(const JsonFile& c, const json& v, const std::string& path,
                                       double lo, double hi, glm::vec<N, float>& out) {
   std::ostringstream what;
   what << "an array of " << N << " numbers in " << lo << ".." << hi;
@@ -127,7 +107,7 @@ std::string Resolve(const std::string& rig_file, const std::string& path) {
   return (std::filesystem::path(rig_file).parent_path() / p).lexically_normal().string();
 }
 
-std::optional<mocap::Error> ParseRegion(const Ctx& c, const json& v, const std::string& path,
+std::optional<mocap::Error> ParseRegion(const JsonFile& c, const json& v, const std::string& path,
                                         RigRegion& r) {
   if (auto e = CheckObject(c, v, path, {"joint", "radius", "side", "half_angle_deg",
                                         "min_bone_weight", "vertices", "view", "rect"})) {
@@ -194,7 +174,7 @@ std::optional<mocap::Error> ParseRegion(const Ctx& c, const json& v, const std::
   return std::nullopt;
 }
 
-std::optional<mocap::Error> ParsePatch(const Ctx& c, const json& v, const std::string& path,
+std::optional<mocap::Error> ParsePatch(const JsonFile& c, const json& v, const std::string& path,
                                        RigPatch& p) {
   if (auto e = CheckObject(c, v, path, {"name", "region", "parametrization", "sampling", "grid",
                                         "border_width", "examples", "pose_space", "elastic"})) {
@@ -240,7 +220,7 @@ std::optional<mocap::Error> ParsePatch(const Ctx& c, const json& v, const std::s
 }
 
 // render.camera: a mode string, or an object of the mode and the view.
-std::optional<mocap::Error> ParseCamera(const Ctx& c, const json& v, RigRender& r) {
+std::optional<mocap::Error> ParseCamera(const JsonFile& c, const json& v, RigRender& r) {
   const std::initializer_list<const char*> modes = {"follow", "fixed", "turntable"};
   if (v.is_string()) return GetChoice(c, v, "render.camera", modes, r.camera);
   if (auto e = CheckObject(c, v, "render.camera",
@@ -271,7 +251,7 @@ std::optional<mocap::Error> ParseCamera(const Ctx& c, const json& v, RigRender& 
   return std::nullopt;
 }
 
-std::optional<mocap::Error> ParseRender(const Ctx& c, const json& v, RigRender& r) {
+std::optional<mocap::Error> ParseRender(const JsonFile& c, const json& v, RigRender& r) {
   if (auto e = CheckObject(c, v, "render",
                            {"size", "camera", "overlays", "split", "compare", "wipe", "output",
                             "frames"})) {
@@ -327,7 +307,7 @@ bool IsBuiltInBody(const std::string& character) {
 }
 
 mocap::Result<Rig> ParseRig(const std::string& text, const std::string& file) {
-  const Ctx c{file};
+  const JsonFile c{file};
   json doc;
   try {
     doc = json::parse(text);

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "app/frame_plan.h"
+#include "app/exit_code.h"
 #include "render/output/contact_sheet.h"
 #include "render/output/image_io.h"
 #include "render/output/video_writer.h"
@@ -18,11 +19,6 @@ namespace {
 constexpr int kMaxSheetFrames = 24;
 // Upper bound on frame numbers (ParseFrames needs a length).
 constexpr int kMaxFrameNumber = 10'000'000;
-
-int Fail(const mocap::Error& e) {
-  std::fprintf(stderr, "%s\n", e.ToString().c_str());
-  return e.code == mocap::ErrorCode::kInternal ? 3 : 2;
-}
 
 // True for "A:B" or "A:B:STEP" with every part a non-empty run of digits: a sheet
 // needs both ends of the range, which ParseFrames lets a render leave open.
@@ -47,14 +43,17 @@ bool IsClosedRange(const std::string& text) {
 
 int RunSheet(const SheetOptions& o) {
   if (!IsClosedRange(o.frames)) {
-    return Fail(ArgError("--frames", "expected A:B[:STEP] with both ends, found '" + o.frames + "'"));
+    return ReportError(
+        ArgError("--frames", "expected A:B[:STEP] with both ends, found '" + o.frames + "'"));
   }
   mocap::Result<FrameRange> range = ParseFrames(o.frames, kMaxFrameNumber);
-  if (!range.ok()) return Fail(range.error());
-  if (!(o.fps > 0.0) || o.fps > 10000.0) return Fail(ArgError("--fps", "expected 0 < fps <= 10000"));
+  if (!range.ok()) return ReportError(range.error());
+  if (!(o.fps > 0.0) || o.fps > 10000.0)
+    return ReportError(ArgError("--fps", "expected 0 < fps <= 10000"));
   if (!render::HasFramePlaceholder(o.pattern)) {
-    return Fail(ArgError("pattern", "the pattern '" + o.pattern +
-                                        "' needs one frame placeholder such as #### or %04d"));
+    return ReportError(ArgError(
+        "pattern",
+        "the pattern '" + o.pattern + "' needs one frame placeholder such as #### or %04d"));
   }
 
   // Every frame must exist before anything is written.
@@ -63,7 +62,7 @@ int RunSheet(const SheetOptions& o) {
   int missing = 0;
   for (int f = range->first; f <= range->last; f += range->step) {
     mocap::Result<std::string> path = render::ExpandFramePattern(o.pattern, f);
-    if (!path.ok()) return Fail(path.error());
+    if (!path.ok()) return ReportError(path.error());
     std::error_code ec;
     if (!std::filesystem::is_regular_file(*path, ec)) {
       if (missing++ == 0) first_missing = *path;
@@ -71,10 +70,10 @@ int RunSheet(const SheetOptions& o) {
     frames.emplace_back(f, std::move(*path));
   }
   if (missing > 0) {
-    return Fail(mocap::MakeError(mocap::ErrorCode::kIo, {first_missing, 0, 0, {}},
-                                 "frame missing (" + std::to_string(missing) + " of " +
-                                     std::to_string(frames.size()) +
-                                     " frames are missing; render them first)"));
+    return ReportError(mocap::MakeError(mocap::ErrorCode::kIo, {first_missing, 0, 0, {}},
+                                        "frame missing (" + std::to_string(missing) + " of " +
+                                            std::to_string(frames.size()) +
+                                            " frames are missing; render them first)"));
   }
   const std::filesystem::path dir = std::filesystem::path(frames.front().second).parent_path();
   const std::string sheet_path = (dir / "contact_sheet.png").string();
@@ -82,14 +81,14 @@ int RunSheet(const SheetOptions& o) {
   if (!o.overwrite) {
     for (const auto& [skip, path] : {std::pair{o.no_sheet, sheet_path}, std::pair{o.no_video, video_path}}) {
       if (!skip && std::filesystem::exists(path)) {
-        return Fail(mocap::MakeError(mocap::ErrorCode::kInvalidArgument, {path, 0, 0, {}},
-                                     "exists; pass --overwrite to replace it"));
+        return ReportError(mocap::MakeError(mocap::ErrorCode::kInvalidArgument, {path, 0, 0, {}},
+                                            "exists; pass --overwrite to replace it"));
       }
     }
   }
 
   mocap::Result<render::Image> first = render::ReadImage(frames.front().second);
-  if (!first.ok()) return Fail(first.error());
+  if (!first.ok()) return ReportError(first.error());
   const int width = first->width, height = first->height;
   const int n = static_cast<int>(frames.size());
   const int sheet_count = std::min(kMaxSheetFrames, n);
@@ -97,14 +96,14 @@ int RunSheet(const SheetOptions& o) {
   if (!o.no_sheet) {
     auto b = render::ContactSheetBuilder::Create(
         sheet_count, width, height, {.columns = render::ContactSheetColumns(sheet_count)});
-    if (!b.ok()) return Fail(b.error());
+    if (!b.ok()) return ReportError(b.error());
     sheet = std::move(*b);
   }
   std::unique_ptr<render::VideoWriter> video;
   if (!o.no_video) {
     auto v = render::VideoWriter::Open(video_path, width & ~1, height & ~1,
                                        {.fps = o.fps / range->step});
-    if (!v.ok()) return Fail(v.error());
+    if (!v.ok()) return ReportError(v.error());
     video = std::move(*v);
   }
   int next_sheet = 0;
@@ -115,32 +114,33 @@ int RunSheet(const SheetOptions& o) {
     if (!on_sheet && !video) continue;
     mocap::Result<render::Image> image =
         i == 0 ? std::move(first) : render::ReadImage(frames[static_cast<std::size_t>(i)].second);
-    if (!image.ok()) return Fail(image.error());
+    if (!image.ok()) return ReportError(image.error());
     if (image->width != width || image->height != height) {
-      return Fail(mocap::MakeError(
-          mocap::ErrorCode::kInvalidArgument, {frames[static_cast<std::size_t>(i)].second, 0, 0, {}},
-          "expected " + std::to_string(width) + "x" + std::to_string(height) +
-              " like the first frame, found " + std::to_string(image->width) + "x" +
-              std::to_string(image->height)));
+      return ReportError(
+          mocap::MakeError(mocap::ErrorCode::kInvalidArgument,
+                           {frames[static_cast<std::size_t>(i)].second, 0, 0, {}},
+                           "expected " + std::to_string(width) + "x" + std::to_string(height) +
+                               " like the first frame, found " + std::to_string(image->width) +
+                               "x" + std::to_string(image->height)));
     }
     if (on_sheet) {
       const mocap::Status s = sheet->Add(*image, frames[static_cast<std::size_t>(i)].first);
-      if (!s.ok()) return Fail(s.error());
+      if (!s.ok()) return ReportError(s.error());
       ++next_sheet;
     }
     if (video) {
       const mocap::Status s = video->AddFrame(*image);
-      if (!s.ok()) return Fail(s.error());
+      if (!s.ok()) return ReportError(s.error());
     }
   }
   if (sheet) {
     const mocap::Status s = render::WriteImage(sheet->sheet(), sheet_path, {});
-    if (!s.ok()) return Fail(s.error());
+    if (!s.ok()) return ReportError(s.error());
     if (!o.quiet) std::printf("contact sheet: %s\n", sheet_path.c_str());
   }
   if (video) {
     const mocap::Status s = video->Close();
-    if (!s.ok()) return Fail(s.error());
+    if (!s.ok()) return ReportError(s.error());
     if (!o.quiet) {
       std::printf("video:         %s (%s)\n", video->path().c_str(),
                   render::VideoCodecName(video->codec()));

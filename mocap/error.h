@@ -44,6 +44,9 @@ struct FileLoc {
   std::string ToString() const;
 };
 
+// The whole file, no position in it: errors about a file as a unit (I/O, size).
+inline FileLoc InFile(std::string file) { return {std::move(file), 0, 0, {}}; }
+
 struct Error {
   ErrorCode code = ErrorCode::kInternal;
   FileLoc loc;

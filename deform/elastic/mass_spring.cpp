@@ -1,4 +1,5 @@
 #include "deform/elastic/mass_spring.h"
+#include "deform/internal/checks.h"
 
 #include <algorithm>
 #include <cmath>
@@ -31,9 +32,7 @@ glm::vec3 Times(const float m[3][3], const glm::vec3& p) {
           m[2][0] * p.x + m[2][1] * p.y + m[2][2] * p.z};
 }
 
-bool Finite(const glm::vec3& v) {
-  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
-}
+using internal::Finite;
 
 bool Finite(const DrivingFrame& d) {
   const glm::quat& q = d.rotation;

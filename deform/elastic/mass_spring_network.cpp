@@ -10,6 +10,7 @@
 #include <opencv2/core.hpp>
 
 #include "deform/elastic/mass_spring.h"
+#include "deform/internal/checks.h"
 
 namespace deform {
 namespace {
@@ -23,11 +24,9 @@ constexpr double kStepRuleHardLimit = 2.5; // RK4 reaches 2.78 (real) / 2.83 (im
 constexpr int kMaxHalvings = 6;
 constexpr int kMaxGridSize = 16;
 
-bool Finite(const glm::vec3& v) {
-  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
-}
+using internal::Finite;
 
-Result<MassSpringNetwork> Invalid(const std::string& what) {
+Result<MassSpringNetwork> NetworkError(const std::string& what) {
   return MakeError(ErrorCode::kInvalidArgument, FileLoc{}, "mass-spring network: " + what);
 }
 
@@ -37,16 +36,16 @@ Result<MassSpringNetwork> BuildMassSpringNetwork(const MassSpringSetup& setup,
                                                  const MassSpringParams& params) {
   const int M = setup.rows, N = setup.cols;
   if (M < 3 || N < 3 || M > kMaxGridSize || N > kMaxGridSize) {
-    return Invalid("grid " + std::to_string(M) + " x " + std::to_string(N) +
-                   " outside 3..16 x 3..16 (a free interior needs 3 x 3)");
+    return NetworkError("grid " + std::to_string(M) + " x " + std::to_string(N) +
+                        " outside 3..16 x 3..16 (a free interior needs 3 x 3)");
   }
   const std::size_t num_points = static_cast<std::size_t>(M) * static_cast<std::size_t>(N);
   if (setup.rest_points.size() != num_points) {
-    return Invalid("expected " + std::to_string(num_points) + " rest points, found " +
-                   std::to_string(setup.rest_points.size()));
+    return NetworkError("expected " + std::to_string(num_points) + " rest points, found " +
+                        std::to_string(setup.rest_points.size()));
   }
   for (const glm::vec3& p : setup.rest_points)
-    if (!Finite(p)) return Invalid("non-finite rest control point");
+    if (!Finite(p)) return NetworkError("non-finite rest control point");
   const MassSpringParams& p = params;
   const bool ok = p.mass > 0 && p.frequency_hz > 0 && p.damping_ratio >= 0 &&
                   p.structural_ratio >= 0 && p.shear_ratio >= 0 && p.bending_ratio >= 0 &&
@@ -58,7 +57,7 @@ Result<MassSpringNetwork> BuildMassSpringNetwork(const MassSpringSetup& setup,
                   std::isfinite(p.mass) && std::isfinite(p.gain) && Finite(p.down) &&
                   glm::length(p.down) > 0.5f && setup.max_angular_speed_rad_s >= 0 &&
                   std::isfinite(setup.max_angular_speed_rad_s);
-  if (!ok) return Invalid("a parameter is out of range (see MassSpringParams)");
+  if (!ok) return NetworkError("a parameter is out of range (see MassSpringParams)");
 
   MassSpringNetwork net;
   net.rows = M;
@@ -115,13 +114,13 @@ Result<MassSpringNetwork> BuildMassSpringNetwork(const MassSpringSetup& setup,
   }
   const double mean_spacing = spacing_sum / spacing_count;
   if (net.params.max_displacement <= 0.0f) {
-    if (!(mean_spacing > 0.0)) return Invalid("rest control points coincide (zero spacing)");
+    if (!(mean_spacing > 0.0)) return NetworkError("rest control points coincide (zero spacing)");
     net.params.max_displacement = static_cast<float>(0.5 * mean_spacing);
   }
 
   cv::Mat eigenvalues, eigenvectors;  // descending; eigenvectors in rows
   try {
-    if (!cv::eigen(k1, eigenvalues, eigenvectors)) return Invalid("eigen solve failed");
+    if (!cv::eigen(k1, eigenvalues, eigenvectors)) return NetworkError("eigen solve failed");
   } catch (const cv::Exception& e) {
     return MakeError(ErrorCode::kInternal, FileLoc{}, std::string("cv::eigen: ") + e.what());
   }
@@ -192,7 +191,7 @@ Result<MassSpringNetwork> BuildMassSpringNetwork(const MassSpringSetup& setup,
                   "step rule: h (max(w_max, c_max/m) + 2|w|) = %.3f > %.1f even at h = %.6g s "
                   "(stiffness or damping too high)",
                   h * rate, kStepRuleHardLimit, h);
-    return Invalid(buf);
+    return NetworkError(buf);
   }
   net.time_step_s = h;
   return net;

@@ -1,4 +1,5 @@
 #include "deform/global/sweep.h"
+#include "deform/internal/checks.h"
 
 #include <algorithm>
 #include <cmath>
@@ -73,9 +74,7 @@ T RegionArcLength(const SweepChain& chain, const BasicSweepPose<T>& pose, int k)
   return sum / (T(3) * T(kIntervals));
 }
 
-bool Finite(const glm::vec3& v) {
-  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
-}
+using internal::Finite;
 
 }  // namespace
 

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "deform/global/sweep.h"
+#include "deform/internal/checks.h"
 
 namespace deform {
 namespace {
@@ -18,9 +19,7 @@ float Smoothstep(float x) {
   return y * y * (3.0f - 2.0f * y);
 }
 
-bool Finite(const glm::vec3& v) {
-  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
-}
+using internal::Finite;
 
 double PointSegmentDistance(const glm::dvec3& p, const glm::dvec3& a, const glm::dvec3& b) {
   const glm::dvec3 ab = b - a;

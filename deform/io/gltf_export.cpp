@@ -26,6 +26,7 @@
 #include <nlohmann/json.hpp>
 
 #include "deform/io/file_output.h"
+#include "deform/internal/checks.h"
 
 namespace deform {
 namespace {
@@ -45,16 +46,11 @@ constexpr std::size_t kCopyBlock = std::size_t{1} << 20;
 // A GLB's lengths are 32-bit.
 constexpr std::uint64_t kMaxGlbBytes = 0xFFFFFFFFu;
 
-mocap::Error Invalid(const std::string& what) {
+mocap::Error GlbError(const std::string& what) {
   return mocap::MakeError(mocap::ErrorCode::kInvalidArgument, {"glb", 0, 0, {}}, what);
 }
 
-bool AllFinite(std::span<const glm::vec3> v) {
-  for (const glm::vec3& p : v) {
-    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) return false;
-  }
-  return true;
-}
+using internal::AllFinite;
 
 std::string ErrnoText(int e) { return std::error_code(e, std::generic_category()).message(); }
 
@@ -458,54 +454,57 @@ mocap::Result<GltfSequenceWriter> GltfSequenceWriter::Create(std::span<const glm
                                                              int num_vertices, int num_frames,
                                                              const GltfExportOptions& options,
                                                              const GltfExportSurface& surface) {
-  if (num_vertices < 1) return Invalid("the mesh has no vertices");
+  if (num_vertices < 1) return GlbError("the mesh has no vertices");
   if (num_frames < 1 || num_frames > kMaxFrames) {
-    return Invalid("expected 1.." + std::to_string(kMaxFrames) + " frames, found " +
-                   std::to_string(num_frames));
+    return GlbError("expected 1.." + std::to_string(kMaxFrames) + " frames, found " +
+                    std::to_string(num_frames));
   }
   if (!(options.frame_time_s > 0.0) || !std::isfinite(options.frame_time_s)) {
-    return Invalid("the frame time must be a positive number of seconds");
+    return GlbError("the frame time must be a positive number of seconds");
   }
   if (const std::optional<GltfCameraLens>& lens = options.camera) {
     const bool ok = lens->yfov_rad > 0.0f && lens->yfov_rad < 3.14159f && lens->aspect > 0.0f &&
                     std::isfinite(lens->aspect) && lens->znear > 0.0f && lens->zfar > lens->znear &&
                     std::isfinite(lens->zfar);
-    if (!ok) return Invalid("camera lens: expected 0 < yfov < pi, aspect > 0 and 0 < znear < zfar");
+    if (!ok)
+      return GlbError("camera lens: expected 0 < yfov < pi, aspect > 0 and 0 < znear < zfar");
   }
   const auto nv = static_cast<std::size_t>(num_vertices);
   if (!colors.empty() && colors.size() != nv) {
-    return Invalid("colors must be empty or one per vertex");
+    return GlbError("colors must be empty or one per vertex");
   }
-  if (!AllFinite(colors)) return Invalid("colors must be finite");
+  if (!AllFinite(colors)) return GlbError("colors must be finite");
   for (std::size_t t = 0; t < triangles.size(); ++t) {
     const glm::uvec3& tri = triangles[t];
     if (tri.x >= nv || tri.y >= nv || tri.z >= nv) {
-      return Invalid("triangle " + std::to_string(t) + " has a vertex index outside 0.." +
-                     std::to_string(nv) + "-1");
+      return GlbError("triangle " + std::to_string(t) + " has a vertex index outside 0.." +
+                      std::to_string(nv) + "-1");
     }
   }
 
-  if (!surface.uvs.empty() && surface.uvs.size() != nv) return Invalid("uvs must be empty or one per vertex");
+  if (!surface.uvs.empty() && surface.uvs.size() != nv)
+    return GlbError("uvs must be empty or one per vertex");
   for (const glm::vec2& uv : surface.uvs) {
-    if (!std::isfinite(uv.x) || !std::isfinite(uv.y)) return Invalid("uvs must be finite");
+    if (!std::isfinite(uv.x) || !std::isfinite(uv.y)) return GlbError("uvs must be finite");
   }
   const MeshMaterials* materials = surface.materials;
   if (materials != nullptr) {
     const auto num_materials = static_cast<std::int32_t>(materials->materials.size());
     if (!materials->triangle_material.empty() && materials->triangle_material.size() != triangles.size()) {
-      return Invalid("triangle_material must be empty or one per triangle");
+      return GlbError("triangle_material must be empty or one per triangle");
     }
     for (const std::int32_t k : materials->triangle_material) {
-      if (k < -1 || k >= num_materials) return Invalid("triangle material " + std::to_string(k) + " out of range");
+      if (k < -1 || k >= num_materials)
+        return GlbError("triangle material " + std::to_string(k) + " out of range");
     }
     for (const Material& m : materials->materials) {
       if (m.texture < 0) continue;
       if (static_cast<std::size_t>(m.texture) >= materials->images.size() ||
           !materials->images[static_cast<std::size_t>(m.texture)] ||
           materials->images[static_cast<std::size_t>(m.texture)]->encoded.empty()) {
-        return Invalid("material '" + m.name + "': its texture has no encoded image to embed");
+        return GlbError("material '" + m.name + "': its texture has no encoded image to embed");
       }
-      if (surface.uvs.empty()) return Invalid("a textured material needs uvs");
+      if (surface.uvs.empty()) return GlbError("a textured material needs uvs");
     }
   }
 
@@ -565,17 +564,17 @@ mocap::Status GltfSequenceWriter::AddFrame(std::span<const glm::vec3> positions,
                                            std::span<const glm::vec3> normals) {
   Impl& m = *impl_;
   const auto nv = static_cast<std::size_t>(m.num_vertices);
-  if (m.finished) return Invalid("the file was already written");
+  if (m.finished) return GlbError("the file was already written");
   if (m.added >= m.num_frames) {
-    return Invalid("more frames than the " + std::to_string(m.num_frames) + " announced");
+    return GlbError("more frames than the " + std::to_string(m.num_frames) + " announced");
   }
   if (positions.size() != nv || normals.size() != nv) {
-    return Invalid("frame " + std::to_string(m.added) + ": expected " + std::to_string(nv) +
-                   " positions and normals, found " + std::to_string(positions.size()) + " and " +
-                   std::to_string(normals.size()));
+    return GlbError("frame " + std::to_string(m.added) + ": expected " + std::to_string(nv) +
+                    " positions and normals, found " + std::to_string(positions.size()) + " and " +
+                    std::to_string(normals.size()));
   }
   if (!AllFinite(positions) || !AllFinite(normals)) {
-    return Invalid("frame " + std::to_string(m.added) + ": positions and normals must be finite");
+    return GlbError("frame " + std::to_string(m.added) + ": positions and normals must be finite");
   }
   if (!m.write_error.empty()) {
     return mocap::MakeError(mocap::ErrorCode::kIo, {m.options.scratch_dir, 0, 0, {}}, m.write_error);
@@ -616,16 +615,19 @@ mocap::Status GltfSequenceWriter::AddFrame(std::span<const glm::vec3> positions,
 
 mocap::Status GltfSequenceWriter::AddCameraFrame(const glm::vec3& eye, const glm::quat& world_from_camera) {
   Impl& m = *impl_;
-  if (m.finished) return Invalid("the file was already written");
-  if (!m.options.camera) return Invalid("a camera pose without a camera lens in the options");
+  if (m.finished) return GlbError("the file was already written");
+  if (!m.options.camera) return GlbError("a camera pose without a camera lens in the options");
   const std::size_t poses = m.camera_translations.size() / 3;
   if (poses >= static_cast<std::size_t>(m.num_frames)) {
-    return Invalid("more camera poses than the " + std::to_string(m.num_frames) + " frames announced");
+    return GlbError("more camera poses than the " + std::to_string(m.num_frames) +
+                    " frames announced");
   }
   const glm::quat q = glm::normalize(world_from_camera);
   const bool finite = AllFinite(std::span<const glm::vec3>(&eye, 1)) && std::isfinite(q.x) && std::isfinite(q.y) &&
                       std::isfinite(q.z) && std::isfinite(q.w);
-  if (!finite) return Invalid("camera pose " + std::to_string(poses) + ": expected finite values and a non-zero rotation");
+  if (!finite)
+    return GlbError("camera pose " + std::to_string(poses) +
+                    ": expected finite values and a non-zero rotation");
   m.camera_translations.insert(m.camera_translations.end(), {eye.x, eye.y, eye.z});
   m.camera_rotations.insert(m.camera_rotations.end(), {q.x, q.y, q.z, q.w});
   return mocap::Status::Ok();
@@ -633,7 +635,7 @@ mocap::Status GltfSequenceWriter::AddCameraFrame(const glm::vec3& eye, const glm
 
 mocap::Status GltfSequenceWriter::Finish(const std::string& path) {
   Impl& m = *impl_;
-  if (m.finished) return Invalid("the file was already written");
+  if (m.finished) return GlbError("the file was already written");
   if (m.added != m.num_frames) {
     return mocap::MakeError(mocap::ErrorCode::kInvalidArgument, {path, 0, 0, {}},
                             "expected " + std::to_string(m.num_frames) + " frames, " +

@@ -47,7 +47,7 @@ void EvaluateWeights(const GltfWeightsChannel& channel, float t, std::span<float
   }
 }
 
-mocap::Error Invalid(const GltfModel& model, const std::string& what) {
+mocap::Error ModelError(const GltfModel& model, const std::string& what) {
   return mocap::MakeError(mocap::ErrorCode::kInvalidArgument,
                           {model.skeleton.info.source_file, 0, 0, {}}, what);
 }
@@ -91,7 +91,7 @@ mocap::Result<GltfMeshSampler> GltfMeshSampler::Create(const GltfModel& model) {
   if (model.morph.position_deltas.size() != expected ||
       (!model.morph.normal_deltas.empty() && model.morph.normal_deltas.size() != expected) ||
       model.morph.default_weights.size() != static_cast<std::size_t>(model.morph.num_targets)) {
-    return Invalid(model, "morph target arrays do not match the vertex and target counts");
+    return ModelError(model, "morph target arrays do not match the vertex and target counts");
   }
   return GltfMeshSampler(model);
 }
@@ -101,11 +101,11 @@ mocap::Status GltfMeshSampler::Sample(int animation, double t_s, std::span<glm::
   const GltfModel& m = *model_;
   const std::size_t nv = morphed_positions_.size();
   if (animation < -1 || animation >= static_cast<int>(m.animations.size())) {
-    return Invalid(m, "animation " + std::to_string(animation) + " requested, the model has " +
-                          std::to_string(m.animations.size()));
+    return ModelError(m, "animation " + std::to_string(animation) + " requested, the model has " +
+                             std::to_string(m.animations.size()));
   }
   if (positions.size() != nv || normals.size() != nv) {
-    return Invalid(m, "expected " + std::to_string(nv) + " positions and normals");
+    return ModelError(m, "expected " + std::to_string(nv) + " positions and normals");
   }
   // 1-2. Morph in bind space; targets with weight 0 add nothing and are skipped.
   SampleGltfMorphWeights(m, animation, t_s, weights_);

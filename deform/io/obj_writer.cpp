@@ -4,20 +4,16 @@
 #include <cmath>
 
 #include "deform/io/file_output.h"
+#include "deform/internal/checks.h"
 
 namespace deform {
 namespace {
 
-mocap::Error Invalid(const std::string& what) {
+mocap::Error ObjError(const std::string& what) {
   return mocap::MakeError(mocap::ErrorCode::kInvalidArgument, {"obj", 0, 0, {}}, what);
 }
 
-bool AllFinite(std::span<const glm::vec3> v) {
-  for (const glm::vec3& p : v) {
-    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) return false;
-  }
-  return true;
-}
+using internal::AllFinite;
 
 void AppendFloat(float value, std::string& out) {
   char buf[32];
@@ -51,40 +47,42 @@ bool HasSpace(const std::string& s) {
 mocap::Status AppendObj(const ObjFrame& frame, std::string& out) {
   const std::size_t nv = frame.positions.size();
   if (!frame.normals.empty() && frame.normals.size() != nv) {
-    return Invalid("normals must be empty or one per vertex: " + std::to_string(nv) +
-                   " positions, " + std::to_string(frame.normals.size()) + " normals");
+    return ObjError("normals must be empty or one per vertex: " + std::to_string(nv) +
+                    " positions, " + std::to_string(frame.normals.size()) + " normals");
   }
   if (!AllFinite(frame.positions) || !AllFinite(frame.normals)) {
-    return Invalid("positions and normals must be finite");
+    return ObjError("positions and normals must be finite");
   }
   for (std::size_t t = 0; t < frame.triangles.size(); ++t) {
     const glm::uvec3& tri = frame.triangles[t];
     if (tri.x >= nv || tri.y >= nv || tri.z >= nv) {
-      return Invalid("triangle " + std::to_string(t) + " has a vertex index outside 0.." +
-                     std::to_string(nv) + "-1");
+      return ObjError("triangle " + std::to_string(t) + " has a vertex index outside 0.." +
+                      std::to_string(nv) + "-1");
     }
   }
-  if (HasSpace(frame.object_name)) return Invalid("object name '" + frame.object_name + "' holds whitespace");
+  if (HasSpace(frame.object_name))
+    return ObjError("object name '" + frame.object_name + "' holds whitespace");
   if (HasSpace(frame.material_library)) {
-    return Invalid("material library '" + frame.material_library + "' holds whitespace");
+    return ObjError("material library '" + frame.material_library + "' holds whitespace");
   }
   for (const std::string& name : frame.material_names) {
-    if (name.empty() || HasSpace(name)) return Invalid("material name '" + name + "' is empty or holds whitespace");
+    if (name.empty() || HasSpace(name))
+      return ObjError("material name '" + name + "' is empty or holds whitespace");
   }
   if (!frame.uvs.empty() && frame.uvs.size() != nv) {
-    return Invalid("uvs must be empty or one per vertex: " + std::to_string(nv) + " positions, " +
-                   std::to_string(frame.uvs.size()) + " uvs");
+    return ObjError("uvs must be empty or one per vertex: " + std::to_string(nv) + " positions, " +
+                    std::to_string(frame.uvs.size()) + " uvs");
   }
   for (const glm::vec2& uv : frame.uvs) {
-    if (!std::isfinite(uv.x) || !std::isfinite(uv.y)) return Invalid("uvs must be finite");
+    if (!std::isfinite(uv.x) || !std::isfinite(uv.y)) return ObjError("uvs must be finite");
   }
   if (!frame.triangle_material.empty()) {
     if (frame.triangle_material.size() != frame.triangles.size()) {
-      return Invalid("triangle_material must be empty or one per triangle");
+      return ObjError("triangle_material must be empty or one per triangle");
     }
     for (const std::int32_t k : frame.triangle_material) {
       if (k < -1 || k >= static_cast<std::int32_t>(frame.material_names.size())) {
-        return Invalid("triangle material " + std::to_string(k) + " has no name");
+        return ObjError("triangle material " + std::to_string(k) + " has no name");
       }
     }
   }

@@ -1,4 +1,5 @@
 #include "deform/patch/bspline.h"
+#include "deform/internal/checks.h"
 
 #include <algorithm>
 #include <cmath>
@@ -10,9 +11,7 @@ namespace {
 using mocap::ErrorCode;
 using mocap::MakeError;
 
-mocap::Error ArgError(std::string message) {
-  return MakeError(ErrorCode::kInvalidArgument, mocap::FileLoc{}, std::move(message));
-}
+using internal::InvalidArgument;
 
 double Clamp01(double x) { return std::clamp(x, 0.0, 1.0); }
 
@@ -37,28 +36,28 @@ std::vector<double> MakeClampedUniformKnots(int num_control, int degree) {
 mocap::Status CheckKnots(std::span<const double> knots, int num_control, int degree,
                          const char* what) {
   if (degree < 1 || degree > kMaxSplineDegree) {
-    return ArgError(std::string(what) + ": expected degree in 1.." +
-                    std::to_string(kMaxSplineDegree) + ", found " + std::to_string(degree));
+    return InvalidArgument(std::string(what) + ": expected degree in 1.." +
+                           std::to_string(kMaxSplineDegree) + ", found " + std::to_string(degree));
   }
   if (num_control < degree + 1 || num_control > 255) {
-    return ArgError(std::string(what) + ": expected " + std::to_string(degree + 1) +
-                    "..255 control points, found " + std::to_string(num_control));
+    return InvalidArgument(std::string(what) + ": expected " + std::to_string(degree + 1) +
+                           "..255 control points, found " + std::to_string(num_control));
   }
   const size_t expected = static_cast<size_t>(num_control + degree + 1);
   if (knots.size() != expected) {
-    return ArgError(std::string(what) + ": expected " + std::to_string(expected) +
-                    " knots, found " + std::to_string(knots.size()));
+    return InvalidArgument(std::string(what) + ": expected " + std::to_string(expected) +
+                           " knots, found " + std::to_string(knots.size()));
   }
   for (size_t i = 0; i < knots.size(); ++i) {
-    if (!std::isfinite(knots[i])) return ArgError(std::string(what) + ": non-finite knot");
+    if (!std::isfinite(knots[i])) return InvalidArgument(std::string(what) + ": non-finite knot");
     if (i > 0 && knots[i] < knots[i - 1]) {
-      return ArgError(std::string(what) + ": knots decrease at index " + std::to_string(i));
+      return InvalidArgument(std::string(what) + ": knots decrease at index " + std::to_string(i));
     }
   }
   for (int i = 0; i <= degree; ++i) {
     if (knots[static_cast<size_t>(i)] != 0.0 || knots[expected - 1 - static_cast<size_t>(i)] != 1.0) {
-      return ArgError(std::string(what) + ": expected clamped knots (" +
-                      std::to_string(degree + 1) + " zeros and ones at the ends)");
+      return InvalidArgument(std::string(what) + ": expected clamped knots (" +
+                             std::to_string(degree + 1) + " zeros and ones at the ends)");
     }
   }
   // Interior multiplicity <= degree, so the surface stays continuous.
@@ -67,7 +66,7 @@ mocap::Status CheckKnots(std::span<const double> knots, int num_control, int deg
        ++i) {
     run = (knots[i] == knots[i - 1] && knots[i] != 0.0) ? run + 1 : 1;
     if (run > degree) {
-      return ArgError(std::string(what) + ": interior knot multiplicity exceeds the degree");
+      return InvalidArgument(std::string(what) + ": interior knot multiplicity exceeds the degree");
     }
   }
   return mocap::Status::Ok();
@@ -202,14 +201,14 @@ KnotInsertionMap KnotInsertionMap::After(const KnotInsertionMap& first) const {
 mocap::Result<KnotInsertionMap> InsertKnot(std::vector<double>& knots, int num_control,
                                            int degree, double ub) {
   if (!(ub > 0.0 && ub < 1.0)) {
-    return ArgError("knot insertion: expected a knot in (0,1), found " + std::to_string(ub));
+    return InvalidArgument("knot insertion: expected a knot in (0,1), found " + std::to_string(ub));
   }
   const int k = FindSpan(knots, num_control, degree, ub);
   int multiplicity = 0;
   for (double knot : knots) multiplicity += knot == ub ? 1 : 0;
   if (multiplicity + 1 > degree) {
-    return ArgError("knot insertion: multiplicity of " + std::to_string(ub) +
-                    " would exceed the degree " + std::to_string(degree));
+    return InvalidArgument("knot insertion: multiplicity of " + std::to_string(ub) +
+                           " would exceed the degree " + std::to_string(degree));
   }
   KnotInsertionMap map;
   map.num_old = num_control;
@@ -242,8 +241,8 @@ mocap::Result<BSplineSurface> BSplineSurface::Create(int degree_u, int degree_v,
   if (mocap::Status st = CheckKnots(knots_u, num_u, degree_u, "u knots"); !st) return st.error();
   if (mocap::Status st = CheckKnots(knots_v, num_v, degree_v, "v knots"); !st) return st.error();
   if (control.size() != static_cast<size_t>(num_u) * static_cast<size_t>(num_v)) {
-    return ArgError("expected " + std::to_string(num_u * num_v) + " control points, found " +
-                    std::to_string(control.size()));
+    return InvalidArgument("expected " + std::to_string(num_u * num_v) + " control points, found " +
+                           std::to_string(control.size()));
   }
   for (const glm::dvec3& q : control) {
     if (!std::isfinite(q.x) || !std::isfinite(q.y) || !std::isfinite(q.z)) {

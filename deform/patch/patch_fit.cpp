@@ -7,6 +7,7 @@
 #include <unordered_map>
 
 #include "deform/internal/dense_lu.h"
+#include "deform/internal/checks.h"
 
 namespace deform {
 namespace {
@@ -14,9 +15,7 @@ namespace {
 using mocap::ErrorCode;
 using mocap::MakeError;
 
-mocap::Error ArgError(std::string message) {
-  return MakeError(ErrorCode::kInvalidArgument, {}, std::move(message));
-}
+using internal::InvalidArgument;
 
 glm::dvec3 D(const glm::vec3& p) { return glm::dvec3(p); }
 
@@ -37,12 +36,13 @@ std::vector<glm::ivec3> RegionTriangles(std::span<const glm::uvec3> triangles,
 
 mocap::Status CheckRegion(std::span<const glm::vec3> positions, std::span<const int> region) {
   if (region.size() < 3) {
-    return ArgError("patch region: expected at least 3 vertices, found " + std::to_string(region.size()));
+    return InvalidArgument("patch region: expected at least 3 vertices, found " +
+                           std::to_string(region.size()));
   }
   for (int v : region) {
     if (v < 0 || static_cast<size_t>(v) >= positions.size()) {
-      return ArgError("patch region: vertex index " + std::to_string(v) + " out of range 0.." +
-                      std::to_string(positions.size()));
+      return InvalidArgument("patch region: vertex index " + std::to_string(v) +
+                             " out of range 0.." + std::to_string(positions.size()));
     }
   }
   return mocap::Status::Ok();
@@ -310,10 +310,11 @@ double ClosestInTriangle(const glm::dvec2& x, const glm::dvec2& a, const glm::dv
 }
 
 mocap::Status CheckParameterList(std::span<const double> xs, const char* what) {
-  if (xs.size() < 2) return ArgError(std::string(what) + ": expected at least 2 sample parameters");
+  if (xs.size() < 2)
+    return InvalidArgument(std::string(what) + ": expected at least 2 sample parameters");
   for (size_t i = 0; i < xs.size(); ++i) {
     if (!(xs[i] >= 0.0 && xs[i] <= 1.0) || (i > 0 && !(xs[i] > xs[i - 1]))) {
-      return ArgError(std::string(what) + ": sample parameters must increase within [0,1]");
+      return InvalidArgument(std::string(what) + ": sample parameters must increase within [0,1]");
     }
   }
   return mocap::Status::Ok();
@@ -373,7 +374,8 @@ mocap::Result<RegionParametrization> ParametrizeCylinder(
     std::span<const glm::uvec3> triangles, glm::dvec3 axis_origin, glm::dvec3 axis_direction,
     double max_span_deg) {
   if (mocap::Status st = CheckRegion(positions, region); !st) return st.error();
-  if (!(glm::length(axis_direction) > 0.0)) return ArgError("cylinder map: zero axis direction");
+  if (!(glm::length(axis_direction) > 0.0))
+    return InvalidArgument("cylinder map: zero axis direction");
   const std::vector<glm::ivec3> tris = RegionTriangles(triangles, region, positions.size());
   RegionParametrization param;
   param.kind = RegionParametrization::Kind::kCylinder;
@@ -385,7 +387,7 @@ mocap::Result<RegionParametrization> ParametrizeCylinder(
   glm::dvec3 radial = c - axis_origin;
   radial -= glm::dot(radial, a) * a;
   if (!(glm::length(radial) > 1e-12)) {
-    return ArgError("cylinder map: the region's centroid lies on the axis (a closed tube?)");
+    return InvalidArgument("cylinder map: the region's centroid lies on the axis (a closed tube?)");
   }
   const glm::dvec3 r0 = glm::normalize(radial);
   const glm::dvec3 b2 = glm::cross(a, r0);
@@ -423,7 +425,8 @@ mocap::Result<PatchSamples> SampleRegion(std::span<const glm::vec3> positions,
                                          SampleMode mode) {
   if (mocap::Status st = CheckParameterList(us, "sampling u"); !st) return st.error();
   if (mocap::Status st = CheckParameterList(vs, "sampling v"); !st) return st.error();
-  if (param.uv.size() != param.region.size()) return ArgError("sampling: parametrization has mismatched sizes");
+  if (param.uv.size() != param.region.size())
+    return InvalidArgument("sampling: parametrization has mismatched sizes");
   if (mocap::Status st = CheckRegion(positions, param.region); !st) return st.error();
   const std::vector<glm::ivec3> tris = RegionTriangles(triangles, param.region, positions.size());
   PatchSamples out;
@@ -487,8 +490,8 @@ mocap::Result<PatchSamples> SampleRegion(std::span<const glm::vec3> positions,
 mocap::Result<PatchSamples> SampleHandPicked(std::span<const glm::vec3> positions,
                                              std::span<const int> vertices, int num_s, int num_t) {
   if (num_s < 2 || num_t < 2 || vertices.size() != static_cast<size_t>(num_s) * static_cast<size_t>(num_t)) {
-    return ArgError("hand-picked samples: expected S x T >= 2 x 2 vertices, found " +
-                    std::to_string(vertices.size()));
+    return InvalidArgument("hand-picked samples: expected S x T >= 2 x 2 vertices, found " +
+                           std::to_string(vertices.size()));
   }
   if (mocap::Status st = CheckRegion(positions, vertices); !st) return st.error();
   PatchSamples out;
@@ -507,15 +510,15 @@ mocap::Result<PatchFit> FitSurface(const PatchSamples& samples, const FitOptions
   const int s = samples.num_s, t = samples.num_t, m = options.num_u, n = options.num_v;
   if (samples.points.size() != static_cast<size_t>(s) * static_cast<size_t>(t) ||
       samples.us.size() != static_cast<size_t>(s) || samples.vs.size() != static_cast<size_t>(t)) {
-    return ArgError("patch fit: samples have mismatched sizes");
+    return InvalidArgument("patch fit: samples have mismatched sizes");
   }
   if (m < 4 || n < 4 || m > s || n > t) {
-    return ArgError("patch fit: expected 4 <= M <= S and 4 <= N <= T, found M x N = " +
-                    std::to_string(m) + " x " + std::to_string(n) + ", S x T = " +
-                    std::to_string(s) + " x " + std::to_string(t) +
-                    " (sample more points, or fit coarser and refine knots)");
+    return InvalidArgument(
+        "patch fit: expected 4 <= M <= S and 4 <= N <= T, found M x N = " + std::to_string(m) +
+        " x " + std::to_string(n) + ", S x T = " + std::to_string(s) + " x " + std::to_string(t) +
+        " (sample more points, or fit coarser and refine knots)");
   }
-  if (!(options.smoothing >= 0.0)) return ArgError("patch fit: smoothing must be >= 0");
+  if (!(options.smoothing >= 0.0)) return InvalidArgument("patch fit: smoothing must be >= 0");
   PatchFit fit;
   switch (options.parameterization) {
     case FitParameterization::kSampleGrid:

@@ -5,13 +5,12 @@
 #include <string>
 
 #include "deform/global/skinning_job.h"
+#include "deform/internal/checks.h"
 
 namespace deform {
 namespace {
 
-mocap::Error Invalid(std::string message) {
-  return mocap::MakeError(mocap::ErrorCode::kInvalidArgument, {}, std::move(message));
-}
+using internal::InvalidArgument;
 
 // The region's own parameters in binding order are not needed: BindPatch takes
 // them in region order.
@@ -140,16 +139,17 @@ std::vector<float> BorderWeights(const PatchBinding& binding,
 mocap::Result<PatchSetup> BuildPatchSetup(const SkinnedMesh& mesh, std::span<const int> region,
                                           const PatchOptions& options) {
   if (options.grid_u < 4 || options.grid_v < 4 || options.grid_u > 64 || options.grid_v > 64) {
-    return Invalid("patch grid must be 4..64 control points each way, found " +
-                   std::to_string(options.grid_u) + "x" + std::to_string(options.grid_v));
+    return InvalidArgument("patch grid must be 4..64 control points each way, found " +
+                           std::to_string(options.grid_u) + "x" + std::to_string(options.grid_v));
   }
   if (options.samples_u < options.grid_u || options.samples_v < options.grid_v ||
       options.samples_u > 256 || options.samples_v > 256) {
-    return Invalid("patch sampling must be at least the grid and at most 256 each way, found " +
-                   std::to_string(options.samples_u) + "x" + std::to_string(options.samples_v));
+    return InvalidArgument(
+        "patch sampling must be at least the grid and at most 256 each way, found " +
+        std::to_string(options.samples_u) + "x" + std::to_string(options.samples_v));
   }
   if (!(options.border_width >= 0.0f && options.border_width <= 0.5f)) {
-    return Invalid("patch border width must be in [0, 0.5] (parameter units)");
+    return InvalidArgument("patch border width must be in [0, 0.5] (parameter units)");
   }
   PatchSetup out;
   out.region.assign(region.begin(), region.end());
@@ -232,31 +232,33 @@ mocap::Status ApplyPatchLayer(std::span<const PatchSetup> patches,
                               PatchLayerScratch& scratch, std::span<glm::vec3> positions,
                               std::span<const std::span<const glm::vec3>> reference) {
   if (carried.size() != patches.size()) {
-    return Invalid("patch layer: one carried control grid per patch is required");
+    return InvalidArgument("patch layer: one carried control grid per patch is required");
   }
   if (!reference.empty() && reference.size() != patches.size()) {
-    return Invalid("patch layer: reference grids must be empty or one per patch");
+    return InvalidArgument("patch layer: reference grids must be empty or one per patch");
   }
   if (!displacements.empty() && displacements.size() != patches.size()) {
-    return Invalid("patch layer: displacements must be empty or one per patch");
+    return InvalidArgument("patch layer: displacements must be empty or one per patch");
   }
   const std::size_t nv = positions.size();
   for (std::size_t k = 0; k < patches.size(); ++k) {
     const PatchSetup& p = patches[k];
     if (carried[k].size() != p.rest_control.size()) {
-      return Invalid("patch layer: carried control grid " + std::to_string(k) +
-                     " is not #M x #N");
+      return InvalidArgument("patch layer: carried control grid " + std::to_string(k) +
+                             " is not #M x #N");
     }
     if (!displacements.empty() && !displacements[k].empty() &&
         displacements[k].size() != p.rest_control.size()) {
-      return Invalid("patch layer: displacement " + std::to_string(k) + " is not #M x #N");
+      return InvalidArgument("patch layer: displacement " + std::to_string(k) + " is not #M x #N");
     }
     if (!reference.empty() && reference[k].size() != p.rest_control.size()) {
-      return Invalid("patch layer: reference grid " + std::to_string(k) + " is not #M x #N");
+      return InvalidArgument("patch layer: reference grid " + std::to_string(k) +
+                             " is not #M x #N");
     }
     for (const int v : p.bound.binding.vertex) {
       if (v < 0 || static_cast<std::size_t>(v) >= nv) {
-        return Invalid("patch layer: patch " + std::to_string(k) + " binds a vertex past #V");
+        return InvalidArgument("patch layer: patch " + std::to_string(k) +
+                               " binds a vertex past #V");
       }
     }
   }
@@ -276,7 +278,7 @@ mocap::Status ApplyPatchLayer(std::span<const PatchSetup> patches,
     const mocap::JobStatus s =
         PatchRebuildJob{.control = q, .bindings = p.bound.binding.view(), .positions = rebuilt}
             .Run();
-    if (!s) return Invalid(std::string("patch layer: rebuild refused: ") + s.what);
+    if (!s) return InvalidArgument(std::string("patch layer: rebuild refused: ") + s.what);
     // Relative: the rebuild of the reference grid stands in for G, so only what
     // the displacements change reaches the mesh (the same grid gives exactly 0).
     const std::span<glm::vec3> base(scratch.reference_rebuilt.data(), reference.empty() ? 0 : nb);
@@ -284,7 +286,7 @@ mocap::Status ApplyPatchLayer(std::span<const PatchSetup> patches,
       const mocap::JobStatus r = PatchRebuildJob{
           .control = reference[k], .bindings = p.bound.binding.view(), .positions = base}
                                      .Run();
-      if (!r) return Invalid(std::string("patch layer: rebuild refused: ") + r.what);
+      if (!r) return InvalidArgument(std::string("patch layer: rebuild refused: ") + r.what);
     }
     for (std::size_t r = 0; r < nb; ++r) {
       const auto v = static_cast<std::size_t>(p.bound.binding.vertex[r]);

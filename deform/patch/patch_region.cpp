@@ -1,4 +1,5 @@
 #include "deform/patch/patch_region.h"
+#include "deform/internal/checks.h"
 
 #include <algorithm>
 #include <cmath>
@@ -7,31 +8,29 @@
 namespace deform {
 namespace {
 
-mocap::Error Invalid(std::string message) {
-  return mocap::MakeError(mocap::ErrorCode::kInvalidArgument, {}, std::move(message));
-}
+using internal::InvalidArgument;
 
 }  // namespace
 
 mocap::Result<std::vector<int>> SelectJointRegion(const SkinnedMesh& mesh,
                                                   const JointRegionQuery& query) {
-  if (query.bone_joints.empty()) return Invalid("joint region: no bone joints given");
+  if (query.bone_joints.empty()) return InvalidArgument("joint region: no bone joints given");
   if (!(query.radius > 0.0f) || !std::isfinite(query.radius)) {
-    return Invalid("joint region: radius must be positive and finite, found " +
-                   std::to_string(query.radius));
+    return InvalidArgument("joint region: radius must be positive and finite, found " +
+                           std::to_string(query.radius));
   }
   if (!(query.min_bone_weight > 0.0f && query.min_bone_weight <= 1.0f)) {
-    return Invalid("joint region: min bone weight must be in (0, 1]");
+    return InvalidArgument("joint region: min bone weight must be in (0, 1]");
   }
   if (!(query.half_angle_deg > 0.0f && query.half_angle_deg <= 180.0f)) {
-    return Invalid("joint region: half angle must be in (0, 180] degrees");
+    return InvalidArgument("joint region: half angle must be in (0, 180] degrees");
   }
   const Mesh& bind = mesh.bind;
   const int nv = bind.num_vertices();
   const int k = mesh.weights.influences;
   if (k < 1 || mesh.weights.num_vertices() != nv ||
       mesh.weights.joints.size() != mesh.weights.weights.size()) {
-    return Invalid("joint region: skin weights do not match the mesh");
+    return InvalidArgument("joint region: skin weights do not match the mesh");
   }
   // Which skin joints are the region's bones.
   std::vector<char> is_bone(mesh.skin_joints.size(), 0);
@@ -74,18 +73,18 @@ mocap::Result<std::vector<int>> SelectJointRegion(const SkinnedMesh& mesh,
 
 mocap::Result<std::vector<int>> CheckVertexRegion(std::span<const int> vertices,
                                                   int num_vertices) {
-  if (vertices.empty()) return Invalid("vertex region: the list is empty");
+  if (vertices.empty()) return InvalidArgument("vertex region: the list is empty");
   std::vector<char> seen(static_cast<std::size_t>(std::max(0, num_vertices)), 0);
   for (std::size_t i = 0; i < vertices.size(); ++i) {
     const int v = vertices[i];
     if (v < 0 || v >= num_vertices) {
-      return Invalid("vertex region: vertex " + std::to_string(i) + " (index " +
-                     std::to_string(v) + ") is outside the " + std::to_string(num_vertices) +
-                     " vertices");
+      return InvalidArgument("vertex region: vertex " + std::to_string(i) + " (index " +
+                             std::to_string(v) + ") is outside the " +
+                             std::to_string(num_vertices) + " vertices");
     }
     if (seen[static_cast<std::size_t>(v)]) {
-      return Invalid("vertex region: vertex " + std::to_string(i) + " (index " +
-                     std::to_string(v) + ") appears twice");
+      return InvalidArgument("vertex region: vertex " + std::to_string(i) + " (index " +
+                             std::to_string(v) + ") appears twice");
     }
     seen[static_cast<std::size_t>(v)] = 1;
   }

@@ -9,19 +9,16 @@
 #include <Eigen/SparseCholesky>
 
 #include "deform/shapes/internal/control_grid.h"
+#include "deform/internal/checks.h"
 
 namespace deform {
 namespace {
 
 using Triplet = Eigen::Triplet<double>;
 
-mocap::Error Invalid(std::string message) {
-  return mocap::MakeError(mocap::ErrorCode::kInvalidArgument, {}, std::move(message));
-}
+using internal::InvalidArgument;
 
-bool Finite(const glm::dvec3& v) {
-  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
-}
+using internal::Finite;
 
 // The 16 (or (p+1)(q+1)) nonzero weights of s(u,v) with their control indices.
 struct SparseRow {
@@ -89,26 +86,26 @@ mocap::Result<ManipulationResult> SolveBrushStrokes(const BSplineSurface& surfac
                                                     const BrushOptions& options) {
   const int nu = surface.num_u(), nv = surface.num_v();
   const auto num_c = static_cast<std::size_t>(nu) * static_cast<std::size_t>(nv);
-  if (strokes.empty()) return Invalid("expected at least one brush stroke, found none");
+  if (strokes.empty()) return InvalidArgument("expected at least one brush stroke, found none");
   for (std::size_t k = 0; k < strokes.size(); ++k) {
     const BrushStroke& b = strokes[k];
     const std::string which = "stroke " + std::to_string(k) + ": ";
     if (!(b.u >= 0.0 && b.u <= 1.0 && b.v >= 0.0 && b.v <= 1.0)) {
-      return Invalid(which + "expected a centre (u, v) in [0,1]^2");
+      return InvalidArgument(which + "expected a centre (u, v) in [0,1]^2");
     }
     if (!(b.radius >= 0.0) || !std::isfinite(b.radius)) {
-      return Invalid(which + "expected a finite radius >= 0");
+      return InvalidArgument(which + "expected a finite radius >= 0");
     }
-    if (!Finite(b.delta)) return Invalid(which + "expected a finite move");
+    if (!Finite(b.delta)) return InvalidArgument(which + "expected a finite move");
   }
-  if (!(options.smoothness >= 0.0)) return Invalid("expected smoothness >= 0");
+  if (!(options.smoothness >= 0.0)) return InvalidArgument("expected smoothness >= 0");
   if (!options.free_mask.empty() && options.free_mask.size() != num_c) {
-    return Invalid("expected a free mask of " + std::to_string(num_c) + " entries, found " +
-                   std::to_string(options.free_mask.size()));
+    return InvalidArgument("expected a free mask of " + std::to_string(num_c) + " entries, found " +
+                           std::to_string(options.free_mask.size()));
   }
   std::vector<int> free_index;
   const int nf = internal::FreeIndex(nu, nv, options.free_mask, free_index);
-  if (nf == 0) return Invalid("expected at least one free control point, found none");
+  if (nf == 0) return InvalidArgument("expected at least one free control point, found none");
 
   // Field fit over an su x sv grid covering the whole domain, weight 1/S each.
   const int su = std::max(options.min_samples, 4 * nu);

@@ -12,6 +12,7 @@
 #include "deform/patch/fold_measure.h"
 #include "deform/shapes/direct_manipulation.h"
 #include "deform/shapes/internal/control_grid.h"
+#include "deform/internal/checks.h"
 
 namespace deform {
 namespace {
@@ -20,9 +21,7 @@ using mocap::ErrorCode;
 using Triplet = Eigen::Triplet<double>;
 using SparseMatrix = Eigen::SparseMatrix<double>;
 
-mocap::Error Invalid(std::string message) {
-  return mocap::MakeError(ErrorCode::kInvalidArgument, {}, std::move(message));
-}
+using internal::InvalidArgument;
 
 // One bound vertex's linearisation: its free control points and weights.
 struct BoundRow {
@@ -121,19 +120,21 @@ mocap::Result<CorrectedExample> CorrectExample(const PatchSetup& patch, const Sk
   const std::size_t num_skin = mesh.skin_joints.size();
   if (pose.model_from_bind.size() != num_skin ||
       (!pose.dq_palette.empty() && pose.dq_palette.size() != num_skin)) {
-    return Invalid("example pose: expected palettes of " + std::to_string(num_skin) +
-                   " skin joints, found " + std::to_string(pose.model_from_bind.size()));
+    return InvalidArgument("example pose: expected palettes of " + std::to_string(num_skin) +
+                           " skin joints, found " + std::to_string(pose.model_from_bind.size()));
   }
-  if (options.iterations < 1 || options.iterations > 20) return Invalid("expected 1..20 iterations");
-  if (patch.region.empty() || patch.num_bound() == 0) return Invalid("the patch binds no vertex");
+  if (options.iterations < 1 || options.iterations > 20)
+    return InvalidArgument("expected 1..20 iterations");
+  if (patch.region.empty() || patch.num_bound() == 0)
+    return InvalidArgument("the patch binds no vertex");
   const int nc = patch.num_control();
   const int nu = patch.fit.surface.num_u(), nv = patch.fit.surface.num_v();
   if (!options.free_mask.empty() && options.free_mask.size() != static_cast<std::size_t>(nc)) {
-    return Invalid("expected a free mask of " + std::to_string(nc) + " entries");
+    return InvalidArgument("expected a free mask of " + std::to_string(nc) + " entries");
   }
   std::vector<int> free_index;
   const int nf = internal::FreeIndex(nu, nv, options.free_mask, free_index);
-  if (nf == 0) return Invalid("expected at least one free control point, found none");
+  if (nf == 0) return InvalidArgument("expected at least one free control point, found none");
 
   // G: skinned vertices and carried control points at the pose.
   const auto num_v = static_cast<std::size_t>(mesh.bind.num_vertices());
@@ -151,7 +152,7 @@ mocap::Result<CorrectedExample> CorrectExample(const PatchSetup& patch, const Sk
                    .rest_positions = mesh.bind.positions, .rest_normals = {},
                    .positions = skinned, .normals = {}}
                 .Run();
-  if (!s) return Invalid(s.what);
+  if (!s) return InvalidArgument(s.what);
   std::vector<glm::vec3> carried(static_cast<std::size_t>(nc));
   s = CarryControlPointsJob{.patch = &patch,
                             .model_from_bind = pose.dq_palette.empty()
@@ -160,7 +161,7 @@ mocap::Result<CorrectedExample> CorrectExample(const PatchSetup& patch, const Sk
                             .dq_palette = pose.dq_palette,
                             .control = carried}
           .Run();
-  if (!s) return Invalid(s.what);
+  if (!s) return InvalidArgument(s.what);
   BSplineSurface base = patch.fit.surface;
   for (int c = 0; c < nc; ++c) {
     base.mutable_control()[static_cast<std::size_t>(c)] = glm::dvec3(carried[static_cast<std::size_t>(c)]);
@@ -185,7 +186,8 @@ mocap::Result<CorrectedExample> CorrectExample(const PatchSetup& patch, const Sk
   // The driving bone: its palette matrix and joint centre.
   CorrectedExample out;
   out.driving_skin_joint = DrivingSkinJoint(patch, static_cast<int>(num_skin));
-  if (out.driving_skin_joint < 0) return Invalid("no skin joint weights the patch's control points");
+  if (out.driving_skin_joint < 0)
+    return InvalidArgument("no skin joint weights the patch's control points");
   const auto drv = static_cast<std::size_t>(out.driving_skin_joint);
   const glm::dmat4 carry(pose.model_from_bind[drv]);
   const glm::dvec3 centre_bind(glm::inverse(glm::dmat4(mesh.joint_from_bind[drv]))[3]);
@@ -260,7 +262,8 @@ mocap::Result<CorrectedExample> CorrectExample(const PatchSetup& patch, const Sk
       }
       const Eigen::MatrixXd z = ldlt.solve(g);
       const double gz = (g.array() * z.array()).sum();
-      if (!(gz > 0.0)) return Invalid("the region's volume does not depend on its free control points");
+      if (!(gz > 0.0))
+        return InvalidArgument("the region's volume does not depend on its free control points");
       add_step(z * (miss / gz));
     }
     out.report.after = RegionVolume(x, mesh.bind.triangles, tris, centre);
@@ -269,7 +272,7 @@ mocap::Result<CorrectedExample> CorrectExample(const PatchSetup& patch, const Sk
   out.shape.world_delta = delta;
   std::vector<glm::quat> rotations(static_cast<std::size_t>(nc));
   s = PatchControlRotations(patch, pose, rotations);
-  if (!s) return Invalid(s.what);
+  if (!s) return InvalidArgument(s.what);
   out.shape.displacement.resize(static_cast<std::size_t>(nc));
   const std::vector<glm::vec3> zero(static_cast<std::size_t>(nc), glm::vec3(0.0f));
   s = StoreExampleDisplacement(rotations, zero, out.shape.world_delta, out.shape.displacement);

@@ -1,4 +1,5 @@
 #include "deform/shapes/direct_manipulation.h"
+#include "deform/internal/checks.h"
 
 #include <algorithm>
 #include <cstddef>
@@ -54,9 +55,7 @@ cv::Mat FreeLaplacian(int m, int n, const std::vector<int>& free_index) {
   return lap;
 }
 
-mocap::Error Invalid(std::string message) {
-  return mocap::MakeError(ErrorCode::kInvalidArgument, {}, std::move(message));
-}
+using internal::InvalidArgument;
 
 // 3x3 determinant helper in double.
 double Det(const glm::dmat3& m) { return glm::determinant(m); }
@@ -131,21 +130,22 @@ mocap::Result<ManipulationResult> SolvePointConstraints(
     const BSplineSurface& surface, std::span<const PointConstraint> constraints,
     const ManipulationOptions& options) {
   const size_t num_c = NumControl(surface);
-  if (constraints.empty()) return Invalid("expected at least one constraint, found none");
+  if (constraints.empty()) return InvalidArgument("expected at least one constraint, found none");
   for (size_t r = 0; r < constraints.size(); ++r) {
     const PointConstraint& k = constraints[r];
     if (!(k.u >= 0.0 && k.u <= 1.0 && k.v >= 0.0 && k.v <= 1.0)) {
-      return Invalid("constraint " + std::to_string(r) + ": expected (u,v) in [0,1]^2, found (" +
-                     std::to_string(k.u) + ", " + std::to_string(k.v) + ")");
+      return InvalidArgument("constraint " + std::to_string(r) +
+                             ": expected (u,v) in [0,1]^2, found (" + std::to_string(k.u) + ", " +
+                             std::to_string(k.v) + ")");
     }
     if (!std::isfinite(k.target.x) || !std::isfinite(k.target.y) || !std::isfinite(k.target.z)) {
-      return Invalid("constraint " + std::to_string(r) + ": expected a finite target");
+      return InvalidArgument("constraint " + std::to_string(r) + ": expected a finite target");
     }
   }
-  if (!(options.laplacian_mu >= 0.0)) return Invalid("expected laplacian_mu >= 0");
+  if (!(options.laplacian_mu >= 0.0)) return InvalidArgument("expected laplacian_mu >= 0");
   if (!options.free_mask.empty() && options.free_mask.size() != num_c) {
-    return Invalid("expected a free mask of " + std::to_string(num_c) + " entries, found " +
-                   std::to_string(options.free_mask.size()));
+    return InvalidArgument("expected a free mask of " + std::to_string(num_c) + " entries, found " +
+                           std::to_string(options.free_mask.size()));
   }
   const std::vector<std::uint8_t> mask = options.free_mask.empty()
                                              ? InteriorMask(surface.num_u(), surface.num_v())
@@ -159,7 +159,7 @@ mocap::Result<ManipulationResult> SolvePointConstraints(
     }
   }
   if (free_list.empty())
-    return Invalid("expected at least one free control point, the mask has none");
+    return InvalidArgument("expected at least one free control point, the mask has none");
 
   const int nc = static_cast<int>(constraints.size());
   const int nf = static_cast<int>(free_list.size());
@@ -242,8 +242,8 @@ mocap::Result<ManipulationResult> MoveBoundVertices(const BSplineSurface& surfac
                                                     const ManipulationOptions& options,
                                                     int iterations,
                                                     std::span<const PointConstraint> keep) {
-  if (edits.empty()) return Invalid("expected at least one vertex edit, found none");
-  if (iterations < 0 || iterations > 100) return Invalid("expected 0..100 iterations");
+  if (edits.empty()) return InvalidArgument("expected at least one vertex edit, found none");
+  if (iterations < 0 || iterations > 100) return InvalidArgument("expected 0..100 iterations");
   BSplineSurface moved = surface;
   const size_t num_c = NumControl(surface);
   std::vector<glm::dvec3> goal(edits.size());

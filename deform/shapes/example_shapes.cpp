@@ -8,6 +8,7 @@
 #include <glm/gtc/quaternion.hpp>
 
 #include "deform/shapes/polar_rotation.h"
+#include "deform/internal/checks.h"
 
 namespace deform {
 namespace {
@@ -18,10 +19,7 @@ mocap::Error EditError(const ExampleEdit& e, const std::string& message) {
   return mocap::MakeError(ErrorCode::kInvalidArgument, e.loc, message);
 }
 
-
-bool Finite(const glm::dvec3& v) {
-  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
-}
+using internal::Finite;
 
 // Rotation part of a palette matrix, in double.
 glm::dmat3 Rotation3(const glm::mat4& m) { return glm::dmat3(glm::mat3(m)); }

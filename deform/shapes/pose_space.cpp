@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "mocap/joint_angles.h"
+#include "deform/internal/checks.h"
 
 namespace deform {
 namespace {
@@ -30,9 +31,7 @@ int EulerCount(const mocap::Skeleton& skeleton, int joint) {
   return n;
 }
 
-mocap::Error Invalid(mocap::FileLoc loc, std::string message) {
-  return mocap::MakeError(ErrorCode::kInvalidArgument, std::move(loc), std::move(message));
-}
+using internal::InvalidArgument;
 
 // The kernel phi(r) for width sig, in double (fit) or float (per frame).
 template <typename T>
@@ -101,41 +100,41 @@ int PoseFeatureDimension(const mocap::Skeleton& skeleton, const PoseFeatureSpec&
 }
 
 mocap::Status CheckPoseFeatureSpec(const mocap::Skeleton& skeleton, const PoseFeatureSpec& spec) {
-  if (spec.joints.empty()) return Invalid({}, "expected at least one pose joint, found none");
+  if (spec.joints.empty()) return InvalidArgument("expected at least one pose joint, found none");
   for (size_t k = 0; k < spec.joints.size(); ++k) {
     const PoseFeatureJoint& j = spec.joints[k];
     const std::string where = "pose joint " + std::to_string(k);
     if (j.joint < 0 || j.joint >= skeleton.num_joints()) {
-      return Invalid({}, where + ": expected a joint index below " +
+      return InvalidArgument(where + ": expected a joint index below " +
                              std::to_string(skeleton.num_joints()) + ", found " +
                              std::to_string(j.joint));
     }
     const std::string& name = skeleton.names[static_cast<size_t>(j.joint)];
     if (skeleton.parents[static_cast<size_t>(j.joint)] == mocap::kNoParent) {
-      return Invalid({},
-                     where + ": '" + name + "' is a root; expected a joint that bends the patch");
+      return InvalidArgument(where + ": '" + name +
+                             "' is a root; expected a joint that bends the patch");
     }
     for (size_t o = 0; o < k; ++o) {
       if (spec.joints[o].joint == j.joint)
-        return Invalid({}, where + ": '" + name + "' is listed twice");
+        return InvalidArgument(where + ": '" + name + "' is listed twice");
     }
     if (!std::isfinite(j.weight) || j.weight <= 0.0f) {
-      return Invalid({}, where + ": expected a finite weight > 0 for '" + name + "'");
+      return InvalidArgument(where + ": expected a finite weight > 0 for '" + name + "'");
     }
     if (spec.kind == PoseFeatureKind::kEuler && j.weight != 1.0f) {
-      return Invalid({}, where +
+      return InvalidArgument(where +
                              ": Euler features wrap at 2 pi and take no weight; use the "
                              "rotation-vector features to weight '" +
                              name + "'");
     }
     if (spec.kind == PoseFeatureKind::kSwingTwist &&
         std::abs(glm::length(j.twist_axis) - 1.0f) > 1e-3f) {
-      return Invalid({}, where + ": expected a unit twist axis for '" + name + "'");
+      return InvalidArgument(where + ": expected a unit twist axis for '" + name + "'");
     }
   }
   const int dim = PoseFeatureDimension(skeleton, spec);
   if (dim < 1 || dim > kMaxPoseFeatures) {
-    return Invalid({}, "expected 1.." + std::to_string(kMaxPoseFeatures) +
+    return InvalidArgument("expected 1.." + std::to_string(kMaxPoseFeatures) +
                            " pose features, found " + std::to_string(dim) +
                            " (Euler joints without rotation channels add none)");
   }
@@ -146,16 +145,17 @@ mocap::Status ComputePoseFeatures(const mocap::Skeleton& skeleton, const PoseFea
                                   std::span<const mocap::JointTransform> locals,
                                   std::span<float> out) {
   if (locals.size() != static_cast<size_t>(skeleton.num_joints())) {
-    return Invalid({}, "expected " + std::to_string(skeleton.num_joints()) + " local transforms");
+    return InvalidArgument("expected " + std::to_string(skeleton.num_joints()) +
+                           " local transforms");
   }
   if (out.size() != static_cast<size_t>(PoseFeatureDimension(skeleton, spec))) {
-    return Invalid({}, "feature output has the wrong size");
+    return InvalidArgument("feature output has the wrong size");
   }
   size_t at = 0;
   constexpr float kDegToRad = std::numbers::pi_v<float> / 180.0f;
   for (const PoseFeatureJoint& j : spec.joints) {
     if (j.joint < 0 || j.joint >= skeleton.num_joints())
-      return Invalid({}, "pose joint out of range");
+      return InvalidArgument("pose joint out of range");
     const glm::quat rest = skeleton.rest_rotations[static_cast<size_t>(j.joint)];
     const glm::quat local = locals[static_cast<size_t>(j.joint)].rotation;
     switch (spec.kind) {
@@ -186,7 +186,7 @@ mocap::Result<std::vector<float>> PoseFeaturesAtFrame(const mocap::Skeleton& ske
                                                       const mocap::Motion& motion, int frame,
                                                       const PoseFeatureSpec& spec) {
   if (frame < 0 || frame >= motion.num_frames) {
-    return Invalid({}, "expected a frame in 0.." + std::to_string(motion.num_frames - 1) +
+    return InvalidArgument("expected a frame in 0.." + std::to_string(motion.num_frames - 1) +
                            ", found " + std::to_string(frame));
   }
   std::vector<mocap::JointTransform> locals(static_cast<size_t>(skeleton.num_joints()));
@@ -194,7 +194,7 @@ mocap::Result<std::vector<float>> PoseFeaturesAtFrame(const mocap::Skeleton& ske
       .skeleton = &skeleton, .frame_values = motion.frame(frame), .locals = locals};
   const JobStatus status = job.Run();
   if (!status.ok())
-    return Invalid({}, std::string("motion does not fit the skeleton: ") + status.what);
+    return InvalidArgument(std::string("motion does not fit the skeleton: ") + status.what);
   std::vector<float> features(static_cast<size_t>(PoseFeatureDimension(skeleton, spec)));
   mocap::Status s = ComputePoseFeatures(skeleton, spec, locals, features);
   if (!s.ok()) return s.error();
@@ -238,32 +238,34 @@ int AddOrUpdateExample(std::vector<PoseExample>& examples, PoseExample example,
 mocap::Result<RbfModel> RbfPoseSpace::Fit(std::span<const PoseExample> examples, int dimension,
                                           int num_control, const RbfOptions& options) {
   if (dimension < 1 || dimension > kMaxPoseFeatures) {
-    return Invalid({}, "expected 1.." + std::to_string(kMaxPoseFeatures) +
+    return InvalidArgument("expected 1.." + std::to_string(kMaxPoseFeatures) +
                            " pose features, found " + std::to_string(dimension));
   }
-  if (num_control < 1) return Invalid({}, "expected at least one control point");
+  if (num_control < 1) return InvalidArgument("expected at least one control point");
   if (!(options.kappa > 0.0) || !(options.width >= 0.0) || !(options.duplicate_tol >= 0.0) ||
       !(options.smoothing >= 0.0)) {
-    return Invalid({}, "expected kappa > 0 and width, duplicate_tol, smoothing >= 0");
+    return InvalidArgument("expected kappa > 0 and width, duplicate_tol, smoothing >= 0");
   }
   for (size_t e = 0; e < examples.size(); ++e) {
     const PoseExample& ex = examples[e];
     if (ex.features.size() != static_cast<size_t>(dimension)) {
-      return Invalid(ex.loc, ExampleLabel(ex, e) + ": expected " + std::to_string(dimension) +
-                                 " pose features, found " + std::to_string(ex.features.size()));
+      return InvalidArgument(ex.loc, ExampleLabel(ex, e) + ": expected " +
+                                         std::to_string(dimension) + " pose features, found " +
+                                         std::to_string(ex.features.size()));
     }
     if (ex.displacement.size() != static_cast<size_t>(num_control)) {
-      return Invalid(ex.loc, ExampleLabel(ex, e) + ": expected " + std::to_string(num_control) +
-                                 " control-point displacements, found " +
-                                 std::to_string(ex.displacement.size()));
+      return InvalidArgument(ex.loc, ExampleLabel(ex, e) + ": expected " +
+                                         std::to_string(num_control) +
+                                         " control-point displacements, found " +
+                                         std::to_string(ex.displacement.size()));
     }
     for (float f : ex.features) {
       if (!std::isfinite(f))
-        return Invalid(ex.loc, ExampleLabel(ex, e) + ": non-finite pose feature");
+        return InvalidArgument(ex.loc, ExampleLabel(ex, e) + ": non-finite pose feature");
     }
     for (const glm::vec3& d : ex.displacement) {
       if (!std::isfinite(d.x) || !std::isfinite(d.y) || !std::isfinite(d.z)) {
-        return Invalid(ex.loc, ExampleLabel(ex, e) + ": non-finite displacement");
+        return InvalidArgument(ex.loc, ExampleLabel(ex, e) + ": non-finite displacement");
       }
     }
   }
@@ -282,7 +284,7 @@ mocap::Result<RbfModel> RbfPoseSpace::Fit(std::span<const PoseExample> examples,
         msg << ExampleLabel(examples[a], a) << " duplicates " << ExampleLabel(examples[b], b)
             << ": their poses are " << dist << " apart, below the duplicate tolerance "
             << options.duplicate_tol << "; merge them or edit one pose";
-        return Invalid(examples[a].loc, msg.str());
+        return InvalidArgument(examples[a].loc, msg.str());
       }
     }
   }
@@ -391,9 +393,9 @@ mocap::Result<RbfModel> RbfPoseSpace::Fit(std::span<const PoseExample> examples,
     cv::SVD svd(sys, cv::SVD::FULL_UV);
     const double s_max = svd.w.at<double>(0), s_min = svd.w.at<double>(n - 1);
     if (!(s_min > 1e-15 * s_max)) {
-      return Invalid({},
-                     "the pose-space system is singular (condition number above 1e15); "
-                     "spread the example poses or change the kernel width");
+      return InvalidArgument(
+          "the pose-space system is singular (condition number above 1e15); "
+          "spread the example poses or change the kernel width");
     }
     model.condition = s_max / s_min;
     if (model.condition > options.warn_condition) {

@@ -4,17 +4,6 @@
 #include <utility>
 
 namespace render {
-namespace {
-
-// A whole-file location (no line): FileLoc has more fields than a designated
-// initializer should name here.
-mocap::FileLoc LocOf(const std::string& file) {
-  mocap::FileLoc loc;
-  loc.file = file;
-  return loc;
-}
-
-}  // namespace
 
 AsyncImageWriter::AsyncImageWriter(AsyncWriterOptions options) : options_(options) {
   options_.num_workers = std::max(options_.num_workers, 1);
@@ -28,7 +17,7 @@ AsyncImageWriter::~AsyncImageWriter() { (void)Finish(); }
 Status AsyncImageWriter::Submit(Image image, std::string path, WriteOptions options) {
   std::unique_lock<std::mutex> lock(mutex_);
   if (finished_) {
-    return mocap::MakeError(mocap::ErrorCode::kInvalidArgument, LocOf(path),
+    return mocap::MakeError(mocap::ErrorCode::kInvalidArgument, mocap::InFile(path),
                             "frame submitted after the writer finished");
   }
   slot_free_.wait(lock, [&] { return in_flight_ < options_.max_in_flight || first_error_; });

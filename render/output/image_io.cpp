@@ -25,14 +25,6 @@ using mocap::ErrorCode;
 using mocap::FileLoc;
 using mocap::MakeError;
 
-// A whole-file location (no line): FileLoc has more fields than a designated
-// initializer should name here.
-mocap::FileLoc LocOf(const std::string& file) {
-  mocap::FileLoc loc;
-  loc.file = file;
-  return loc;
-}
-
 constexpr const char* kSoftware = "patchskin " PATCHSKIN_VERSION;
 
 // Decision thresholds for 8-bit encoding: code c is chosen for linear values in
@@ -78,12 +70,12 @@ Status CheckImage(const Image& image, const std::string& path) {
   const auto pixels = static_cast<std::size_t>(std::max(image.width, 0)) *
                       static_cast<std::size_t>(std::max(image.height, 0));
   if (image.width <= 0 || image.height <= 0) {
-    return MakeError(ErrorCode::kInvalidArgument, LocOf(path),
+    return MakeError(ErrorCode::kInvalidArgument, mocap::InFile(path),
                      "cannot write an empty image (" + std::to_string(image.width) + "x" +
                          std::to_string(image.height) + ")");
   }
   if (image.rgba.size() != pixels || (!image.depth.empty() && image.depth.size() != pixels)) {
-    return MakeError(ErrorCode::kInvalidArgument, LocOf(path),
+    return MakeError(ErrorCode::kInvalidArgument, mocap::InFile(path),
                      "image buffers do not match its size " + std::to_string(image.width) + "x" +
                          std::to_string(image.height));
   }
@@ -92,7 +84,7 @@ Status CheckImage(const Image& image, const std::string& path) {
 
 Status CheckOptions(const WriteOptions& o, const std::string& path) {
   auto bad = [&](const std::string& what) {
-    return Status(MakeError(ErrorCode::kInvalidArgument, LocOf(path), what));
+    return Status(MakeError(ErrorCode::kInvalidArgument, mocap::InFile(path), what));
   };
   if (o.png_compression < 0 || o.png_compression > 9) {
     return bad("PNG compression must be 0..9, found " + std::to_string(o.png_compression));
@@ -255,7 +247,7 @@ const char* OiioFormatName(ImageFormat format) {
 }
 
 Status IoError(const std::string& path, const std::string& what) {
-  return MakeError(ErrorCode::kIo, LocOf(path), what);
+  return MakeError(ErrorCode::kIo, mocap::InFile(path), what);
 }
 
 }  // namespace
@@ -279,9 +271,9 @@ Result<ImageFormat> ImageFormatFromPath(const std::string& path) {
   if (ext == ".exr") return ImageFormat::kExr;
   if (ext == ".tif" || ext == ".tiff") return ImageFormat::kTiff;
   if (ext == ".jpg" || ext == ".jpeg") return ImageFormat::kJpeg;
-  return MakeError(ErrorCode::kUnsupported, LocOf(path),
-                   "expected an image extension .png, .exr, .tif, .tiff, .jpg or .jpeg, found '" +
-                       ext + "'");
+  return MakeError(
+      ErrorCode::kUnsupported, mocap::InFile(path),
+      "expected an image extension .png, .exr, .tif, .tiff, .jpg or .jpeg, found '" + ext + "'");
 }
 
 float LinearToSrgb(float linear) {
@@ -337,7 +329,7 @@ Status WriteImage(const Image& image, const std::string& path, const WriteOption
 }
 
 Result<Image> ReadImage(const std::string& path, ReadInfo* info) {
-  const FileLoc loc = LocOf(path);
+  const FileLoc loc = mocap::InFile(path);
   if (!std::filesystem::is_regular_file(path)) {
     return MakeError(ErrorCode::kIo, loc, "no such image file");
   }
@@ -466,9 +458,10 @@ bool HasFramePlaceholder(const std::string& pattern) {
 Result<std::string> ExpandFramePattern(const std::string& pattern, int frame) {
   const std::vector<Placeholder> found = FindPlaceholders(pattern);
   if (found.size() != 1) {
-    return MakeError(ErrorCode::kInvalidArgument, LocOf(pattern),
+    return MakeError(ErrorCode::kInvalidArgument, mocap::InFile(pattern),
                      "expected exactly one frame placeholder ('####' or '%04d') in the output "
-                     "pattern, found " + std::to_string(found.size()));
+                     "pattern, found " +
+                         std::to_string(found.size()));
   }
   char digits[128];
   std::snprintf(digits, sizeof(digits), "%0*d", found[0].width, frame);

@@ -19,10 +19,6 @@ using mocap::ErrorCode;
 
 constexpr int kMaxTextureSide = 8192;  // 8192^2 texels: 768 MiB of linear floats
 
-mocap::Error Fail(ErrorCode code, const std::string& file, const std::string& field, std::string message) {
-  return mocap::MakeError(code, {file, 0, 0, field}, std::move(message));
-}
-
 // The 8-bit sRGB codes in linear light (decoding an image maps each texel once).
 const std::array<float, 256>& Srgb8ToLinear() {
   static const std::array<float, 256> table = [] {
@@ -57,9 +53,9 @@ mocap::Result<TextureImage> DecodeTextureImage(std::span<const unsigned char> by
   if (bytes.size() >= 4 && std::memcmp(bytes.data(), kPng, 4) == 0) name = "texture.png";
   if (bytes.size() >= 3 && std::memcmp(bytes.data(), kJpeg, 3) == 0) name = "texture.jpg";
   if (name == nullptr) {
-    return Fail(ErrorCode::kUnsupported, file, field,
-                "image is neither PNG nor JPEG (" + std::to_string(bytes.size()) + " bytes, MIME type '" +
-                    mime_type + "')");
+    return GltfError(file, ErrorCode::kUnsupported, field,
+                     "image is neither PNG nor JPEG (" + std::to_string(bytes.size()) +
+                         " bytes, MIME type '" + mime_type + "')");
   }
   OIIO::Filesystem::IOMemReader reader(bytes.data(), bytes.size());
   OIIO::ImageSpec config;
@@ -68,14 +64,16 @@ mocap::Result<TextureImage> DecodeTextureImage(std::span<const unsigned char> by
   config.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &proxy);
   auto in = OIIO::ImageInput::open(name, &config, &reader);
   if (!in) {
-    return Fail(ErrorCode::kSyntax, file, field, "cannot decode the image: " + OIIO::geterror());
+    return GltfError(file, ErrorCode::kSyntax, field,
+                     "cannot decode the image: " + OIIO::geterror());
   }
   const OIIO::ImageSpec& spec = in->spec();
   if (spec.width < 1 || spec.height < 1 || spec.width > kMaxTextureSide || spec.height > kMaxTextureSide ||
       spec.nchannels < 1 || spec.nchannels > 4) {
-    return Fail(ErrorCode::kLimitExceeded, file, field,
-                "image of " + std::to_string(spec.width) + " x " + std::to_string(spec.height) + " x " +
-                    std::to_string(spec.nchannels) + " is outside 1..8192 texels a side, 1..4 channels");
+    return GltfError(file, ErrorCode::kLimitExceeded, field,
+                     "image of " + std::to_string(spec.width) + " x " +
+                         std::to_string(spec.height) + " x " + std::to_string(spec.nchannels) +
+                         " is outside 1..8192 texels a side, 1..4 channels");
   }
   const auto texels = static_cast<std::size_t>(spec.width) * static_cast<std::size_t>(spec.height);
   const auto channels = static_cast<std::size_t>(spec.nchannels);
@@ -88,7 +86,8 @@ mocap::Result<TextureImage> DecodeTextureImage(std::span<const unsigned char> by
   if (spec.format == OIIO::TypeDesc::UINT8) {
     std::vector<unsigned char> raw(texels * channels);
     if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::UINT8, raw.data())) {
-      return Fail(ErrorCode::kSyntax, file, field, "cannot decode the image: " + in->geterror());
+      return GltfError(file, ErrorCode::kSyntax, field,
+                       "cannot decode the image: " + in->geterror());
     }
     const std::array<float, 256>& lut = Srgb8ToLinear();
     for (std::size_t t = 0; t < texels; ++t)
@@ -96,7 +95,8 @@ mocap::Result<TextureImage> DecodeTextureImage(std::span<const unsigned char> by
   } else {
     std::vector<float> raw(texels * channels);
     if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, raw.data())) {
-      return Fail(ErrorCode::kSyntax, file, field, "cannot decode the image: " + in->geterror());
+      return GltfError(file, ErrorCode::kSyntax, field,
+                       "cannot decode the image: " + in->geterror());
     }
     for (std::size_t t = 0; t < texels; ++t)
       for (std::size_t c = 0; c < 3; ++c) out.rgb[t * 3 + c] = SrgbToLinear(raw[t * channels + source_channel(c)]);
@@ -112,8 +112,8 @@ GltfMaterialReader::GltfMaterialReader(const tinygltf::Model& model, const std::
 mocap::Result<int> GltfMaterialReader::Image(int image, std::vector<mocap::Warning>& warnings) {
   const std::string at = Indexed("images", image);
   if (image < 0 || image >= static_cast<int>(m_.images.size())) {
-    return Fail(ErrorCode::kNotFound, path_, at, "image out of range (the file has " +
-                                                      std::to_string(m_.images.size()) + ")");
+    return GltfError(path_, ErrorCode::kNotFound, at,
+                     "image out of range (the file has " + std::to_string(m_.images.size()) + ")");
   }
   int& slot = image_slot_[static_cast<std::size_t>(image)];
   if (slot != -1) return slot;
@@ -122,15 +122,15 @@ mocap::Result<int> GltfMaterialReader::Image(int image, std::vector<mocap::Warni
   if (src.bufferView >= 0) {
     // Bounds of the view and its buffer, checked before reading (tinygltf does not).
     if (src.bufferView >= static_cast<int>(m_.bufferViews.size())) {
-      return Fail(ErrorCode::kNotFound, path_, at + ".bufferView",
-                  "buffer view " + std::to_string(src.bufferView) + " out of range");
+      return GltfError(path_, ErrorCode::kNotFound, at + ".bufferView",
+                       "buffer view " + std::to_string(src.bufferView) + " out of range");
     }
     const tinygltf::BufferView& view = m_.bufferViews[static_cast<std::size_t>(src.bufferView)];
     if (view.buffer < 0 || view.buffer >= static_cast<int>(m_.buffers.size()) ||
         view.byteOffset > m_.buffers[static_cast<std::size_t>(view.buffer)].data.size() ||
         view.byteLength > m_.buffers[static_cast<std::size_t>(view.buffer)].data.size() - view.byteOffset) {
-      return Fail(ErrorCode::kCountMismatch, path_, Indexed("bufferViews", src.bufferView),
-                  "the image's bytes lie outside its buffer");
+      return GltfError(path_, ErrorCode::kCountMismatch, Indexed("bufferViews", src.bufferView),
+                       "the image's bytes lie outside its buffer");
     }
     bytes = std::span<const unsigned char>(m_.buffers[static_cast<std::size_t>(view.buffer)].data)
                 .subspan(view.byteOffset, view.byteLength);
@@ -156,9 +156,9 @@ mocap::Result<Material> GltfMaterialReader::Read(int index, bool has_uvs, const 
   if (index < 0) return out;
   const std::string at = Indexed("materials", index);
   if (index >= static_cast<int>(m_.materials.size())) {
-    return Fail(ErrorCode::kNotFound, path_, primitive_field + ".material",
-                "material " + std::to_string(index) + " out of range (the file has " +
-                    std::to_string(m_.materials.size()) + ")");
+    return GltfError(path_, ErrorCode::kNotFound, primitive_field + ".material",
+                     "material " + std::to_string(index) + " out of range (the file has " +
+                         std::to_string(m_.materials.size()) + ")");
   }
   const tinygltf::Material& src = m_.materials[static_cast<std::size_t>(index)];
   out.name = src.name;
@@ -168,9 +168,9 @@ mocap::Result<Material> GltfMaterialReader::Read(int index, bool has_uvs, const 
   if (info.index < 0) return out;
   const std::string tat = at + ".pbrMetallicRoughness.baseColorTexture";
   if (info.index >= static_cast<int>(m_.textures.size())) {
-    return Fail(ErrorCode::kNotFound, path_, tat + ".index",
-                "texture " + std::to_string(info.index) + " out of range (the file has " +
-                    std::to_string(m_.textures.size()) + ")");
+    return GltfError(path_, ErrorCode::kNotFound, tat + ".index",
+                     "texture " + std::to_string(info.index) + " out of range (the file has " +
+                         std::to_string(m_.textures.size()) + ")");
   }
   if (info.texCoord != 0) {
     warnings.push_back({{path_, 0, 0, tat + ".texCoord"}, "only TEXCOORD_0 is imported; texture left out"});
@@ -193,8 +193,8 @@ mocap::Result<Material> GltfMaterialReader::Read(int index, bool has_uvs, const 
   out.texture = *slot;
   if (texture.sampler >= 0) {
     if (texture.sampler >= static_cast<int>(m_.samplers.size())) {
-      return Fail(ErrorCode::kNotFound, path_, Indexed("textures", info.index) + ".sampler",
-                  "sampler " + std::to_string(texture.sampler) + " out of range");
+      return GltfError(path_, ErrorCode::kNotFound, Indexed("textures", info.index) + ".sampler",
+                       "sampler " + std::to_string(texture.sampler) + " out of range");
     }
     const tinygltf::Sampler& s = m_.samplers[static_cast<std::size_t>(texture.sampler)];
     out.wrap_s = WrapOf(s.wrapS);

@@ -13,10 +13,6 @@ namespace {
 using mocap::ErrorCode;
 using mocap::Result;
 
-mocap::Error Fail(const std::string& path, ErrorCode code, std::string field, std::string message) {
-  return mocap::MakeError(code, {path, 0, 0, std::move(field)}, std::move(message));
-}
-
 }  // namespace
 
 Result<PrimitiveTargets> ReadPrimitiveTargets(const tinygltf::Model& m, const std::string& path, int mesh,
@@ -29,9 +25,10 @@ Result<PrimitiveTargets> ReadPrimitiveTargets(const tinygltf::Model& m, const st
   if (p.targets.empty()) return out;
   const std::size_t k_count = p.targets.size();
   if (num_vertices != 0 && k_count > max_values / num_vertices) {
-    return Fail(path, ErrorCode::kLimitExceeded, at,
-                std::to_string(k_count) + " targets x " + std::to_string(num_vertices) +
-                    " vertices exceed the limit of " + std::to_string(max_values) + " morph deltas");
+    return GltfError(path, ErrorCode::kLimitExceeded, at,
+                     std::to_string(k_count) + " targets x " + std::to_string(num_vertices) +
+                         " vertices exceed the limit of " + std::to_string(max_values) +
+                         " morph deltas");
   }
   out.num_targets = static_cast<int>(k_count);
   out.positions.assign(k_count * num_vertices, glm::vec3(0.0f));
@@ -45,9 +42,10 @@ Result<PrimitiveTargets> ReadPrimitiveTargets(const tinygltf::Model& m, const st
       const std::string field = tat + "." + name;
       if (accessor >= 0 && accessor < static_cast<int>(m.accessors.size()) &&
           m.accessors[static_cast<std::size_t>(accessor)].count != num_vertices) {
-        return Fail(path, ErrorCode::kCountMismatch, Indexed("accessors", accessor) + ".count",
-                    "expected " + std::to_string(num_vertices) + " (the POSITION count) for " + field +
-                        ", found " + std::to_string(m.accessors[static_cast<std::size_t>(accessor)].count));
+        return GltfError(path, ErrorCode::kCountMismatch, Indexed("accessors", accessor) + ".count",
+                         "expected " + std::to_string(num_vertices) + " (the POSITION count) for " +
+                             field + ", found " +
+                             std::to_string(m.accessors[static_cast<std::size_t>(accessor)].count));
       }
       auto values = ReadFloatsAllowingSparse(m, path, accessor, field, TINYGLTF_TYPE_VEC3,
                                              {TINYGLTF_COMPONENT_TYPE_FLOAT}, false);
@@ -69,13 +67,14 @@ Result<std::vector<float>> ReadDefaultWeights(const tinygltf::Model& m, const st
   std::vector<float> out(static_cast<std::size_t>(num_targets), 0.0f);
   if (w.empty()) return out;
   if (w.size() != out.size()) {
-    return Fail(path, ErrorCode::kCountMismatch, at,
-                "expected " + std::to_string(num_targets) + " weights (one per morph target), found " +
-                    std::to_string(w.size()));
+    return GltfError(path, ErrorCode::kCountMismatch, at,
+                     "expected " + std::to_string(num_targets) +
+                         " weights (one per morph target), found " + std::to_string(w.size()));
   }
   for (std::size_t k = 0; k < w.size(); ++k) {
     if (!(std::abs(w[k]) <= std::numeric_limits<float>::max())) {
-      return Fail(path, ErrorCode::kNonFinite, at, "weight " + std::to_string(k) + " is not finite");
+      return GltfError(path, ErrorCode::kNonFinite, at,
+                       "weight " + std::to_string(k) + " is not finite");
     }
     out[k] = static_cast<float>(w[k]);
   }
@@ -96,8 +95,8 @@ Result<GltfWeightsChannel> ReadWeightsSampler(const tinygltf::Model& m, const st
   } else if (s.interpolation == "CUBICSPLINE") {
     out.interpolation = GltfInterpolation::kCubicSpline;
   } else {
-    return Fail(path, ErrorCode::kUnsupported, sat + ".interpolation",
-                "unknown interpolation '" + s.interpolation + "'");
+    return GltfError(path, ErrorCode::kUnsupported, sat + ".interpolation",
+                     "unknown interpolation '" + s.interpolation + "'");
   }
   auto in_view = CheckedView(m, path, s.input, sat + ".input", TINYGLTF_TYPE_SCALAR,
                              {TINYGLTF_COMPONENT_TYPE_FLOAT});
@@ -110,20 +109,22 @@ Result<GltfWeightsChannel> ReadWeightsSampler(const tinygltf::Model& m, const st
   const std::size_t keys = in_view->count;
   const std::size_t per_key =
       (out.interpolation == GltfInterpolation::kCubicSpline ? 3 : 1) * static_cast<std::size_t>(num_targets);
-  if (keys == 0) return Fail(path, ErrorCode::kCountMismatch, Indexed("accessors", s.input) + ".count", "no keys");
+  if (keys == 0)
+    return GltfError(path, ErrorCode::kCountMismatch, Indexed("accessors", s.input) + ".count",
+                     "no keys");
   if (out_view->count / per_key != keys || out_view->count % per_key != 0) {
-    return Fail(path, ErrorCode::kCountMismatch, Indexed("accessors", s.output) + ".count",
-                "expected " + std::to_string(keys) + " keys x " + std::to_string(per_key) +
-                    " weights = " + std::to_string(keys * per_key) + " outputs, found " +
-                    std::to_string(out_view->count));
+    return GltfError(path, ErrorCode::kCountMismatch, Indexed("accessors", s.output) + ".count",
+                     "expected " + std::to_string(keys) + " keys x " + std::to_string(per_key) +
+                         " weights = " + std::to_string(keys * per_key) + " outputs, found " +
+                         std::to_string(out_view->count));
   }
   auto times = ReadFloats(*in_view, false, path);
   if (!times.ok()) return std::move(times).error();
   for (std::size_t k = 0; k < keys; ++k) {
     if ((*times)[k] < 0.0f || (k > 0 && (*times)[k] < (*times)[k - 1])) {
-      return Fail(path, ErrorCode::kBadNumber, Indexed("accessors", s.input),
-                  "key times must be >= 0 and non-decreasing; element " + std::to_string(k) + " is " +
-                      std::to_string((*times)[k]));
+      return GltfError(path, ErrorCode::kBadNumber, Indexed("accessors", s.input),
+                       "key times must be >= 0 and non-decreasing; element " + std::to_string(k) +
+                           " is " + std::to_string((*times)[k]));
     }
   }
   auto values = ReadFloats(*out_view, true, path);

@@ -10,10 +10,6 @@ namespace {
 using mocap::ErrorCode;
 using mocap::Result;
 
-mocap::Error Fail(const std::string& path, ErrorCode code, std::string field, std::string message) {
-  return mocap::MakeError(code, {path, 0, 0, std::move(field)}, std::move(message));
-}
-
 // The byte range [offset, offset + (count-1)*stride + element) of a buffer
 // view, checked against the view and the view against its buffer. `at` names
 // the object holding the offset (an accessor or its sparse part).
@@ -21,37 +17,38 @@ Result<AccessorView> CheckedRange(const tinygltf::Model& m, const std::string& p
                                   std::size_t offset, std::size_t count, int components,
                                   int component_type, const std::string& at) {
   if (buffer_view < 0 || buffer_view >= static_cast<int>(m.bufferViews.size())) {
-    return Fail(path, ErrorCode::kNotFound, at + ".bufferView",
-                "buffer view " + std::to_string(buffer_view) + " out of range");
+    return GltfError(path, ErrorCode::kNotFound, at + ".bufferView",
+                     "buffer view " + std::to_string(buffer_view) + " out of range");
   }
   const tinygltf::BufferView& bv = m.bufferViews[static_cast<std::size_t>(buffer_view)];
   const std::string bv_at = Indexed("bufferViews", buffer_view);
   if (bv.buffer < 0 || bv.buffer >= static_cast<int>(m.buffers.size())) {
-    return Fail(path, ErrorCode::kNotFound, bv_at + ".buffer",
-                "buffer " + std::to_string(bv.buffer) + " out of range");
+    return GltfError(path, ErrorCode::kNotFound, bv_at + ".buffer",
+                     "buffer " + std::to_string(bv.buffer) + " out of range");
   }
   const std::vector<unsigned char>& buffer = m.buffers[static_cast<std::size_t>(bv.buffer)].data;
   if (bv.byteOffset > buffer.size() || bv.byteLength > buffer.size() - bv.byteOffset) {
-    return Fail(path, ErrorCode::kCountMismatch, bv_at + ".byteLength",
-                "view of " + std::to_string(bv.byteLength) + " bytes at offset " +
-                    std::to_string(bv.byteOffset) + " runs past the " + std::to_string(buffer.size()) +
-                    " bytes of its buffer");
+    return GltfError(path, ErrorCode::kCountMismatch, bv_at + ".byteLength",
+                     "view of " + std::to_string(bv.byteLength) + " bytes at offset " +
+                         std::to_string(bv.byteOffset) + " runs past the " +
+                         std::to_string(buffer.size()) + " bytes of its buffer");
   }
   const std::size_t element = static_cast<std::size_t>(components * ComponentBytes(component_type));
   const std::size_t stride = bv.byteStride == 0 ? element : bv.byteStride;
   if (stride < element || stride > 252) {
-    return Fail(path, ErrorCode::kCountMismatch, bv_at + ".byteStride",
-                "stride " + std::to_string(stride) + " must be in " + std::to_string(element) + "..252");
+    return GltfError(
+        path, ErrorCode::kCountMismatch, bv_at + ".byteStride",
+        "stride " + std::to_string(stride) + " must be in " + std::to_string(element) + "..252");
   }
   const std::size_t available = bv.byteLength;
   const bool fits = offset <= available &&
                     (count == 0 || (count - 1 <= available / stride &&
                                     (count - 1) * stride + element <= available - offset));
   if (!fits) {
-    return Fail(path, ErrorCode::kCountMismatch, at + ".count",
-                std::to_string(count) + " elements of " + std::to_string(element) + " bytes at offset " +
-                    std::to_string(offset) + " do not fit in the " + std::to_string(available) +
-                    " bytes of " + bv_at);
+    return GltfError(path, ErrorCode::kCountMismatch, at + ".count",
+                     std::to_string(count) + " elements of " + std::to_string(element) +
+                         " bytes at offset " + std::to_string(offset) + " do not fit in the " +
+                         std::to_string(available) + " bytes of " + bv_at);
   }
   AccessorView v;
   v.data = buffer.data() + bv.byteOffset + offset;
@@ -67,26 +64,32 @@ Result<const tinygltf::Accessor*> CheckedAccessor(const tinygltf::Model& m, cons
                                                   int index, const std::string& user, int type,
                                                   std::initializer_list<int> component_types) {
   if (index < 0 || index >= static_cast<int>(m.accessors.size())) {
-    return Fail(path, ErrorCode::kNotFound, user,
-                "accessor index " + std::to_string(index) + " out of range (" +
-                    std::to_string(m.accessors.size()) + " accessors)");
+    return GltfError(path, ErrorCode::kNotFound, user,
+                     "accessor index " + std::to_string(index) + " out of range (" +
+                         std::to_string(m.accessors.size()) + " accessors)");
   }
   const tinygltf::Accessor& a = m.accessors[static_cast<std::size_t>(index)];
   const std::string at = Indexed("accessors", index);
   if (a.type != type) {
-    return Fail(path, ErrorCode::kUnsupported, at + ".type",
-                std::string("expected ") + GltfTypeName(type) + " for " + user + ", found " +
-                    GltfTypeName(a.type));
+    return GltfError(path, ErrorCode::kUnsupported, at + ".type",
+                     std::string("expected ") + GltfTypeName(type) + " for " + user + ", found " +
+                         GltfTypeName(a.type));
   }
   if (std::find(component_types.begin(), component_types.end(), a.componentType) ==
       component_types.end()) {
-    return Fail(path, ErrorCode::kUnsupported, at + ".componentType",
-                "component type " + std::to_string(a.componentType) + " not allowed for " + user);
+    return GltfError(
+        path, ErrorCode::kUnsupported, at + ".componentType",
+        "component type " + std::to_string(a.componentType) + " not allowed for " + user);
   }
   return &a;
 }
 
 }  // namespace
+
+mocap::Error GltfError(const std::string& path, mocap::ErrorCode code, std::string field,
+                       std::string message) {
+  return mocap::MakeError(code, {path, 0, 0, std::move(field)}, std::move(message));
+}
 
 std::string Indexed(const char* array, int i) { return std::string(array) + "[" + std::to_string(i) + "]"; }
 
@@ -115,7 +118,8 @@ Result<AccessorView> CheckedView(const tinygltf::Model& m, const std::string& pa
   const tinygltf::Accessor& a = **accessor;
   const std::string at = Indexed("accessors", index);
   if (a.sparse.isSparse) {
-    return Fail(path, ErrorCode::kUnsupported, at + ".sparse", "sparse accessors are not supported for " + user);
+    return GltfError(path, ErrorCode::kUnsupported, at + ".sparse",
+                     "sparse accessors are not supported for " + user);
   }
   const int components = tinygltf::GetNumComponentsInType(static_cast<std::uint32_t>(a.type));
   auto v = CheckedRange(m, path, a.bufferView, a.byteOffset, a.count, components, a.componentType, at);
@@ -148,20 +152,21 @@ Result<std::vector<float>> ReadFloatsAllowingSparse(const tinygltf::Model& m, co
 
   const std::string sat = at + ".sparse";
   if (a.sparse.count < 1 || static_cast<std::size_t>(a.sparse.count) > a.count) {
-    return Fail(path, ErrorCode::kCountMismatch, sat + ".count",
-                "expected 1.." + std::to_string(a.count) + " replaced elements, found " +
-                    std::to_string(a.sparse.count));
+    return GltfError(path, ErrorCode::kCountMismatch, sat + ".count",
+                     "expected 1.." + std::to_string(a.count) + " replaced elements, found " +
+                         std::to_string(a.sparse.count));
   }
   const auto n = static_cast<std::size_t>(a.sparse.count);
   const int index_type = a.sparse.indices.componentType;
   if (index_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
       index_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
       index_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT) {
-    return Fail(path, ErrorCode::kUnsupported, sat + ".indices.componentType",
-                "expected an unsigned byte, short or int type, found " + std::to_string(index_type));
+    return GltfError(
+        path, ErrorCode::kUnsupported, sat + ".indices.componentType",
+        "expected an unsigned byte, short or int type, found " + std::to_string(index_type));
   }
   if (a.sparse.indices.byteOffset < 0 || a.sparse.values.byteOffset < 0) {
-    return Fail(path, ErrorCode::kCountMismatch, sat, "negative byteOffset");
+    return GltfError(path, ErrorCode::kCountMismatch, sat, "negative byteOffset");
   }
   auto iv = CheckedRange(m, path, a.sparse.indices.bufferView,
                          static_cast<std::size_t>(a.sparse.indices.byteOffset), n, 1, index_type,
@@ -172,9 +177,10 @@ Result<std::vector<float>> ReadFloatsAllowingSparse(const tinygltf::Model& m, co
   if (!indices.ok()) return std::move(indices).error();
   for (std::size_t k = 1; k < n; ++k) {
     if ((*indices)[k] <= (*indices)[k - 1]) {
-      return Fail(path, ErrorCode::kBadNumber, sat + ".indices",
-                  "indices must increase strictly; element " + std::to_string(k) + " is " +
-                      std::to_string((*indices)[k]) + " after " + std::to_string((*indices)[k - 1]));
+      return GltfError(path, ErrorCode::kBadNumber, sat + ".indices",
+                       "indices must increase strictly; element " + std::to_string(k) + " is " +
+                           std::to_string((*indices)[k]) + " after " +
+                           std::to_string((*indices)[k - 1]));
     }
   }
   auto vv = CheckedRange(m, path, a.sparse.values.bufferView,

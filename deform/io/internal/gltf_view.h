@@ -19,6 +19,10 @@ class Model;
 
 namespace deform::internal {
 
+// The error of a glTF reader: `message` about `field` of the file at `path`.
+mocap::Error GltfError(const std::string& path, mocap::ErrorCode code, std::string field,
+                       std::string message);
+
 // "accessors[3]"-style field names.
 std::string Indexed(const char* array, int index);
 

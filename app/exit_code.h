@@ -1,0 +1,17 @@
+#pragma once
+// The exit code of a command that failed (the rule is in app/command_line.h):
+// 3 for an internal error, 2 for everything else (bad input, unwritable output).
+
+#include <cstdio>
+
+#include "mocap/error.h"
+
+namespace app {
+
+// Prints `e` ("file:line:column: message") to stderr and returns its exit code.
+inline int ReportError(const mocap::Error& e) {
+  std::fprintf(stderr, "%s\n", e.ToString().c_str());
+  return e.code == mocap::ErrorCode::kInternal ? 3 : 2;
+}
+
+}  // namespace app
