@@ -303,7 +303,7 @@ void PlaceNonHumanoid(const mocap::Skeleton& s, std::span<const glm::mat4> bind,
                       const std::string& why, AutoRig& out) {
   out.notes.push_back("not a humanoid (" + why +
                       "): skipped elbows, biceps, shoulders, knees, hips and jowl");
-  mocap::Result<deform::BodyChains> chains = deform::BuildBodyChains(s, bind, kMinBranchExtent);
+  base::Result<deform::BodyChains> chains = deform::BuildBodyChains(s, bind, kMinBranchExtent);
   if (!chains.ok() || chains->chains.empty() ||
       chains->chains.front().kind != deform::BodyChainKind::kSpine) {
     out.notes.push_back("belly: skipped (no spine chain)");
@@ -371,7 +371,7 @@ void KeepBuildable(const Character& character, AutoRig& out) {
   for (RigPatch& p : out.rig.patches) {
     Rig one = out.rig;
     one.patches = {p};
-    mocap::Result<std::vector<deform::PatchSetup>> built = BuildRigPatches(one, character);
+    base::Result<std::vector<deform::PatchSetup>> built = BuildRigPatches(one, character);
     if (!built.ok()) {
       RigPatch looser = p;
       looser.region.radius = Round2(1.5f * p.region.radius);
@@ -426,9 +426,9 @@ void KeepBuildable(const Character& character, AutoRig& out) {
 
 }  // namespace
 
-mocap::Result<AutoRig> BuildAutoRig(const Character& character, const std::string& character_name,
-                                    const std::string& motion_file, const std::string& label) {
-  mocap::Result<std::vector<glm::mat4>> bind = BindModelFromJoint(character);
+base::Result<AutoRig> BuildAutoRig(const Character& character, const std::string& character_name,
+                                   const std::string& motion_file, const std::string& label) {
+  base::Result<std::vector<glm::mat4>> bind = BindModelFromJoint(character);
   if (!bind.ok()) return std::move(bind).error();
   AutoRig out;
   out.rig.file = label;
@@ -436,7 +436,7 @@ mocap::Result<AutoRig> BuildAutoRig(const Character& character, const std::strin
   out.rig.motion = motion_file;
   out.rig.render.size = {1280, 720};
   const mocap::Skeleton& s = character.skeleton;
-  mocap::Result<deform::Humanoid> h = deform::FindHumanoid(s, *bind);
+  base::Result<deform::Humanoid> h = deform::FindHumanoid(s, *bind);
   std::string why = h.ok() ? UprightProblem(*h) : h.error().message;
   if (!why.empty()) {
     PlaceNonHumanoid(s, *bind, why, out);
@@ -450,49 +450,50 @@ mocap::Result<AutoRig> BuildAutoRig(const Character& character, const std::strin
   return out;
 }
 
-mocap::Result<AutoRig> MakeAutoRig(const std::string& capture, const std::string& body,
-                                   const std::string& up, bool quiet) {
-  const mocap::Result<std::optional<mocap::UpAxis>> up_axis = ParseUpAxis(up);
+base::Result<AutoRig> MakeAutoRig(const std::string& capture, const std::string& body,
+                                  const std::string& up, bool quiet) {
+  const base::Result<std::optional<mocap::UpAxis>> up_axis = ParseUpAxis(up);
   if (!up_axis.ok()) return up_axis.error();
   const std::string ext = std::filesystem::path(body).extension().string();
   const bool gltf = ext == ".glb" || ext == ".gltf";
   BodyKind kind = BodyKind::kGenerated;
   if (!gltf) {
-    mocap::Result<BodyKind> parsed = ParseBodyKind(body);
+    base::Result<BodyKind> parsed = ParseBodyKind(body);
     if (!parsed.ok()) return parsed.error();
     kind = *parsed;
   }
-  mocap::Result<Character> ch = gltf ? LoadCommandCharacter(body, capture, quiet, *up_axis)
-                                     : LoadCommandCharacter(capture, "", quiet, *up_axis, {},
-                                                            nullptr, kind);
+  base::Result<Character> ch =
+      gltf ? LoadCommandCharacter(body, capture, quiet, *up_axis)
+           : LoadCommandCharacter(capture, "", quiet, *up_axis, {}, nullptr, kind);
   if (!ch.ok()) return std::move(ch).error();
   const std::string name = gltf ? body : kind == BodyKind::kTubes ? "tubes" : "generated";
-  mocap::Result<AutoRig> made = BuildAutoRig(*ch, name, capture, capture);
+  base::Result<AutoRig> made = BuildAutoRig(*ch, name, capture, capture);
   // An up axis given for the capture is part of the rig: the rig is read the same way again.
   if (made.ok() && *up_axis) made->rig.up = *up_axis == mocap::UpAxis::kZ ? "z" : "y";
   return made;
 }
 
-mocap::Result<Rig> AutoRigForCommand(const std::string& layer, const std::string& input,
-                                     const std::string& motion, const std::string& body,
-                                     const std::string& up, bool quiet) {
+base::Result<Rig> AutoRigForCommand(const std::string& layer, const std::string& input,
+                                    const std::string& motion, const std::string& body,
+                                    const std::string& up, bool quiet) {
   if (layer != "auto") {
-    return mocap::MakeError(mocap::ErrorCode::kInvalidArgument, {"--layer", 0, 0, {}},
-                            "expected auto, found '" + layer + "'");
+    return base::MakeError(base::ErrorCode::kInvalidArgument, {"--layer", 0, 0, {}},
+                           "expected auto, found '" + layer + "'");
   }
   if (std::filesystem::path(input).extension() == ".json") {
-    return mocap::MakeError(mocap::ErrorCode::kInvalidArgument, {"--layer", 0, 0, {}},
-                            "expected a capture (BVH) as the input, found the rig file " + input +
-                                " (a rig names its own patches)");
+    return base::MakeError(base::ErrorCode::kInvalidArgument, {"--layer", 0, 0, {}},
+                           "expected a capture (BVH) as the input, found the rig file " + input +
+                               " (a rig names its own patches)");
   }
   const std::string ext = std::filesystem::path(input).extension().string();
   if (motion.empty() && (ext == ".glb" || ext == ".gltf")) {
-    return mocap::MakeError(mocap::ErrorCode::kInvalidArgument, {"--layer", 0, 0, {}},
-                            "expected a BVH capture: give the glTF character's motion with "
-                            "--motion, or the capture as the input with --body " + input);
+    return base::MakeError(base::ErrorCode::kInvalidArgument, {"--layer", 0, 0, {}},
+                           "expected a BVH capture: give the glTF character's motion with "
+                           "--motion, or the capture as the input with --body " +
+                               input);
   }
   const std::string& capture = motion.empty() ? input : motion;
-  mocap::Result<AutoRig> made = MakeAutoRig(capture, motion.empty() ? body : input, up, quiet);
+  base::Result<AutoRig> made = MakeAutoRig(capture, motion.empty() ? body : input, up, quiet);
   if (!made.ok()) return std::move(made).error();
   if (!quiet) {
     const std::string name = capture.empty() ? "demo" : capture;

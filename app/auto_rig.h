@@ -35,7 +35,7 @@
 
 #include "app/pipeline.h"
 #include "app/rig_file.h"
-#include "mocap/error.h"
+#include "base/error.h"
 
 namespace app {
 
@@ -49,15 +49,15 @@ struct AutoRig {
 // `character_name`: "generated", "tubes" or the glTF path (Rig::character);
 // `motion_file`: the capture (Rig::motion); `label` names the rig in messages
 // and output folders (Rig::file). Errors: BindModelFromJoint's.
-mocap::Result<AutoRig> BuildAutoRig(const Character& character, const std::string& character_name,
-                                    const std::string& motion_file, const std::string& label);
+base::Result<AutoRig> BuildAutoRig(const Character& character, const std::string& character_name,
+                                   const std::string& motion_file, const std::string& label);
 
 // Loads the character as `render` does (a BVH on the `body` built-in body, or
 // the glTF `body` driven by the BVH `capture`) and builds its rig. `up`: the
 // BVH's up axis as --up gives it (empty = detected). Errors: the loader's,
 // kInvalidArgument naming --body for an unknown body.
-mocap::Result<AutoRig> MakeAutoRig(const std::string& capture, const std::string& body,
-                                   const std::string& up, bool quiet);
+base::Result<AutoRig> MakeAutoRig(const std::string& capture, const std::string& body,
+                                  const std::string& up, bool quiet);
 
 // What `--layer LAYER` on render/turntable/export does with a command's input:
 // "auto" makes the rig (MakeAutoRig) and prints its notes to stderr unless
@@ -65,8 +65,8 @@ mocap::Result<AutoRig> MakeAutoRig(const std::string& capture, const std::string
 // body `body` (built-in or a glTF character), or, with `motion` set, the BVH
 // `motion` driving the glTF `input`. kInvalidArgument naming --layer for any
 // other value, a rig file as the input, or a glTF input without --motion.
-mocap::Result<Rig> AutoRigForCommand(const std::string& layer, const std::string& input,
-                                     const std::string& motion, const std::string& body,
-                                     const std::string& up, bool quiet);
+base::Result<Rig> AutoRigForCommand(const std::string& layer, const std::string& input,
+                                    const std::string& motion, const std::string& body,
+                                    const std::string& up, bool quiet);
 
 }  // namespace app

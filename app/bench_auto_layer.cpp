@@ -13,7 +13,7 @@
 namespace app::bench {
 namespace {
 
-bool ReportAutoLayer(const mocap::Error& e, bool* failed) {
+bool ReportAutoLayer(const base::Error& e, bool* failed) {
   std::fprintf(stderr, "bench: auto layer: %s\n", e.ToString().c_str());
   *failed = true;
   return false;
@@ -22,12 +22,12 @@ bool ReportAutoLayer(const mocap::Error& e, bool* failed) {
 }  // namespace
 
 void AddAutoLayerRows(const Budget& b, int frames, std::vector<Row>& rows, bool* failed) {
-  mocap::Result<MotionSource> src = LoadBvhText(DemoBvhText(), "demo_walk.bvh", {.y_up = true});
+  base::Result<MotionSource> src = LoadBvhText(DemoBvhText(), "demo_walk.bvh", {.y_up = true});
   if (!src.ok()) return void(ReportAutoLayer(src.error(), failed));
-  mocap::Result<Character> character = MakeCharacter(std::move(*src), {}, BodyKind::kGenerated);
+  base::Result<Character> character = MakeCharacter(std::move(*src), {}, BodyKind::kGenerated);
   if (!character.ok()) return void(ReportAutoLayer(character.error(), failed));
   const Character& ch = *character;
-  mocap::Result<FramePipeline> global = FramePipeline::Create(ch, GlobalMethod::kSsd, 1);
+  base::Result<FramePipeline> global = FramePipeline::Create(ch, GlobalMethod::kSsd, 1);
   if (!global.ok()) return void(ReportAutoLayer(global.error(), failed));
 
   Row setup{"auto_layer_setup_s", "s", Clock::kCpu, {}, 1.0, "limit",
@@ -37,11 +37,11 @@ void AddAutoLayerRows(const Budget& b, int frames, std::vector<Row>& rows, bool*
   std::size_t patches = 0;
   for (int r = 0; r < b.runs; ++r) {
     const double t0 = Now(Clock::kCpu);
-    mocap::Result<AutoRig> made = BuildAutoRig(ch, "generated", "demo_walk.bvh", "demo");
+    base::Result<AutoRig> made = BuildAutoRig(ch, "generated", "demo_walk.bvh", "demo");
     if (!made.ok()) return void(ReportAutoLayer(made.error(), failed));
-    mocap::Result<FramePipeline> p = FramePipeline::Create(ch, GlobalMethod::kSsd, 1);
+    base::Result<FramePipeline> p = FramePipeline::Create(ch, GlobalMethod::kSsd, 1);
     if (!p.ok()) return void(ReportAutoLayer(p.error(), failed));
-    if (mocap::Status s = ApplyRigLayers(made->rig, ch, *p); !s.ok()) {
+    if (base::Status s = ApplyRigLayers(made->rig, ch, *p); !s.ok()) {
       return void(ReportAutoLayer(s.error(), failed));
     }
     setup.runs.push_back(Now(Clock::kCpu) - t0);
@@ -52,7 +52,7 @@ void AddAutoLayerRows(const Budget& b, int frames, std::vector<Row>& rows, bool*
   setup.note += ", " + std::to_string(patches) + " patches";
 
   DeformedFrame frame;
-  if (mocap::Status s = global->Evaluate(0.0, frame); !s.ok())
+  if (base::Status s = global->Evaluate(0.0, frame); !s.ok())
     return void(ReportAutoLayer(s.error(), failed));
   EndToEndFrame end_to_end(ch, frame, "auto");
   // CPU seconds of `frames` end-to-end frames of `pipeline`, from the start of the clip.
@@ -60,7 +60,7 @@ void AddAutoLayerRows(const Budget& b, int frames, std::vector<Row>& rows, bool*
     const double t0 = Now(Clock::kCpu);
     for (int f = 0; f < frames && !*failed; ++f) {
       const double time_s = f / 30.0;
-      mocap::Status s = pipeline.Evaluate(time_s, frame);
+      base::Status s = pipeline.Evaluate(time_s, frame);
       if (s.ok()) s = end_to_end.Draw(frame, f);
       if (!s.ok()) ReportAutoLayer(s.error(), failed);
     }

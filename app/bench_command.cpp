@@ -37,6 +37,7 @@
 #include "app/motion_source.h"
 #include "app/pipeline.h"
 #include "app/exit_code.h"
+#include "base/parallel.h"
 #include "deform/patch/patch_binding.h"
 #include "deform/global/skinning_job.h"
 #include "mocap/bvh_reader.h"
@@ -74,9 +75,9 @@ std::string GeneratedBvh(int frames) {
   mocap::WalkOptions walk;
   walk.frame_time_s = 1.0 / 120.0;
   walk.num_cycles = std::max(1, frames / 120);
-  const mocap::Result<mocap::Motion> motion = mocap::MakeWalkMotion(skel, walk);
+  const base::Result<mocap::Motion> motion = mocap::MakeWalkMotion(skel, walk);
   if (!motion.ok()) return {};
-  mocap::Result<std::string> text = mocap::FormatBvh(skel, *motion);
+  base::Result<std::string> text = mocap::FormatBvh(skel, *motion);
   return text.ok() ? std::move(*text) : std::string();
 }
 
@@ -229,7 +230,7 @@ int RunBench(const BenchOptions& o) {
   const bool release = true;
 #endif
   const Budget budget = o.quick ? Budget{3, 0.02} : Budget{7, 0.3};
-  const int threads = o.threads > 0 ? o.threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  const int threads = base::ResolveThreads(o.threads);
   bool failed = false;
 
   // --- Header -----------------------------------------------------------------
@@ -254,7 +255,7 @@ int RunBench(const BenchOptions& o) {
   // --- Table 1 --------------------------------------------------------------------
   std::vector<Table1Row> table1;
   for (const bench::PatchCase& c : bench::kPatches) {
-    mocap::Result<Table1Row> row = bench::MeasurePatch(c, budget);
+    base::Result<Table1Row> row = bench::MeasurePatch(c, budget);
     if (!row.ok()) return ReportError(row.error());
     table1.push_back(std::move(*row));
   }
@@ -270,8 +271,8 @@ int RunBench(const BenchOptions& o) {
   std::vector<Row> rows;
   const std::string generated = GeneratedBvh(o.quick ? 1200 : 12000);
   if (generated.empty()) {
-    return ReportError(mocap::MakeError(mocap::ErrorCode::kInternal, {"bench", 0, 0, {}},
-                                        "could not generate the BVH workload"));
+    return ReportError(base::MakeError(base::ErrorCode::kInternal, {"bench", 0, 0, {}},
+                                       "could not generate the BVH workload"));
   }
   rows.push_back(BvhParseRow("bvh_parse_generated", generated, "generated walk, 120 fps", budget, failed));
   const std::string data_dir = o.data_dir.empty() ? PATCHSKIN_DATA_DIR : o.data_dir;
@@ -307,20 +308,22 @@ int RunBench(const BenchOptions& o) {
                   "", "two halves on two threads"});
 
   // The demo body (the walk on the generated mannequin).
-  mocap::Result<MotionSource> src = LoadBvhText(DemoBvhText(), "demo_walk.bvh", {.y_up = true});
+  base::Result<MotionSource> src = LoadBvhText(DemoBvhText(), "demo_walk.bvh", {.y_up = true});
   if (!src.ok()) return ReportError(src.error());
-  mocap::Result<Character> character = MakeCharacter(std::move(*src));
+  base::Result<Character> character = MakeCharacter(std::move(*src));
   if (!character.ok()) return ReportError(character.error());
   const Character& ch = *character;
   const int e2e_frames = o.quick ? 4 : 24;
-  mocap::Result<FramePlan> plan = PlanFrames(ch.motion, {.frames = "0:" + std::to_string(e2e_frames - 1)});
+  base::Result<FramePlan> plan =
+      PlanFrames(ch.motion, {.frames = "0:" + std::to_string(e2e_frames - 1)});
   if (!plan.ok()) return ReportError(plan.error());
-  mocap::Result<FramePipeline> pipeline = FramePipeline::Create(ch, GlobalMethod::kSsd, threads);
+  base::Result<FramePipeline> pipeline = FramePipeline::Create(ch, GlobalMethod::kSsd, threads);
   if (!pipeline.ok()) return ReportError(pipeline.error());
-  mocap::Result<CameraPlan> cameras = CameraPlan::Create(*pipeline, *plan, "follow", 15.0f, {1280, 720});
+  base::Result<CameraPlan> cameras =
+      CameraPlan::Create(*pipeline, *plan, "follow", 15.0f, {1280, 720});
   if (!cameras.ok()) return ReportError(cameras.error());
   DeformedFrame frame;
-  if (mocap::Status s = pipeline->Evaluate(0.0, frame); !s.ok()) return ReportError(s.error());
+  if (base::Status s = pipeline->Evaluate(0.0, frame); !s.ok()) return ReportError(s.error());
   render::Renderer renderer, right_renderer;
   render::Image image, scratch;
   const auto draw_settings = [&](int w, int h, int ss, int nthreads) {
@@ -355,7 +358,7 @@ int RunBench(const BenchOptions& o) {
     std::vector<DeformedFrame> posed(static_cast<std::size_t>(n));
     for (int i = 0; i < n; ++i) {
       const double t = plan->frames[static_cast<std::size_t>(i % e2e_frames)].time_s;
-      if (mocap::Status s = pipeline->Evaluate(t, posed[static_cast<std::size_t>(i)]); !s.ok())
+      if (base::Status s = pipeline->Evaluate(t, posed[static_cast<std::size_t>(i)]); !s.ok())
         return ReportError(s.error());
     }
     const auto render_all = [&](bool shadows) {
@@ -395,8 +398,8 @@ int RunBench(const BenchOptions& o) {
       std::filesystem::temp_directory_path() / ("patchskin_bench_" + std::to_string(getpid()));
   std::filesystem::create_directories(out_dir, ec);
   if (ec) {
-    return ReportError(mocap::MakeError(mocap::ErrorCode::kIo, {out_dir.string(), 0, 0, {}},
-                                        "cannot create a temporary folder: " + ec.message()));
+    return ReportError(base::MakeError(base::ErrorCode::kIo, {out_dir.string(), 0, 0, {}},
+                                       "cannot create a temporary folder: " + ec.message()));
   }
   const render::RenderSettings e2e_settings = draw_settings(1280, 720, 2, threads);
   render::WriteOptions png;
@@ -410,7 +413,7 @@ int RunBench(const BenchOptions& o) {
     const double t0 = Now(Clock::kWall), c0 = Now(Clock::kProcess);
     render::AsyncImageWriter writer({.num_workers = 2, .max_in_flight = 4});
     for (const OutputFrame& of : plan->frames) {
-      mocap::Status s = pipeline->Evaluate(of.time_s, frame);
+      base::Status s = pipeline->Evaluate(of.time_s, frame);
       if (s.ok()) {
         FrameDrawOptions draw;
         draw.frame_number = of.number;
@@ -424,7 +427,7 @@ int RunBench(const BenchOptions& o) {
       }
       if (!s.ok()) return ReportError(s.error());
     }
-    if (mocap::Status s = writer.Finish(); !s.ok()) return ReportError(s.error());
+    if (base::Status s = writer.Finish(); !s.ok()) return ReportError(s.error());
     e2e.runs.push_back(e2e_frames / std::max(Now(Clock::kWall) - t0, 1e-9));
     e2e_cpu.runs.push_back(e2e_frames / std::max(Now(Clock::kProcess) - c0, 1e-9));
   }
@@ -434,7 +437,7 @@ int RunBench(const BenchOptions& o) {
   // fills frame i: either rendered now, or copied from frames rendered before
   // (encode only). Returns the wall-clock seconds, or < 0 on a failure.
   const int out_frames = o.quick ? 4 : 12;
-  const auto run_outputs = [&](const std::function<mocap::Status(int, render::Image&)>& next) {
+  const auto run_outputs = [&](const std::function<base::Status(int, render::Image&)>& next) {
     const double t0 = Now(Clock::kWall);
     render::AsyncImageWriter writer({.num_workers = 2, .max_in_flight = 4});
     auto sheet = render::ContactSheetBuilder::Create(
@@ -444,30 +447,31 @@ int RunBench(const BenchOptions& o) {
     render::SerialTaskQueue side({.max_queued = 2});
     render::Image img;
     for (int i = 0; i < out_frames; ++i) {
-      mocap::Status s = next(i, img);
+      base::Status s = next(i, img);
       char name[32];
       std::snprintf(name, sizeof(name), "frame_%04d.png", i);
       if (s.ok()) s = writer.Submit(img, (out_dir / name).string(), png);
       if (s.ok()) {
         auto copy = std::make_shared<const render::Image>(img);
         s = side.Submit([&, i, copy] {
-          const mocap::Result<render::Image> stored =
+          const base::Result<render::Image> stored =
               render::AsStored(*copy, render::ImageFormat::kPng, png);
-          if (!stored.ok()) return mocap::Status(stored.error());
-          if (mocap::Status st = (*sheet)->Add(*stored, i); !st.ok()) return st;
+          if (!stored.ok()) return base::Status(stored.error());
+          if (base::Status st = (*sheet)->Add(*stored, i); !st.ok()) return st;
           return (*video)->AddFrame(*copy);
         });
       }
       if (!s.ok()) return -1.0;
     }
     if (!side.Finish().ok() || !writer.Finish().ok() || !(*video)->Close().ok()) return -1.0;
-    if (!render::WriteImage((*sheet)->sheet(), (out_dir / "sheet.png").string(), {}).ok()) return -1.0;
+    if (!render::WriteImage((*sheet)->sheet(), (out_dir / "sheet.png").string(), {}).ok())
+      return -1.0;
     return Now(Clock::kWall) - t0;
   };
   const auto render_frame = [&](render::AntiAlias aa) {
     return [&, aa](int i, render::Image& img) {
       const OutputFrame& of = plan->frames[static_cast<std::size_t>(i % e2e_frames)];
-      mocap::Status s = pipeline->Evaluate(of.time_s, frame);
+      base::Status s = pipeline->Evaluate(of.time_s, frame);
       if (!s.ok()) return s;
       render::RenderSettings settings = e2e_settings;
       settings.antialias = aa;
@@ -479,7 +483,8 @@ int RunBench(const BenchOptions& o) {
   };
   std::vector<render::Image> rendered(static_cast<std::size_t>(out_frames));
   for (int i = 0; i < out_frames; ++i) {
-    if (mocap::Status s = render_frame(render::AntiAlias::kSupersample)(i, rendered[static_cast<std::size_t>(i)]);
+    if (base::Status s =
+            render_frame(render::AntiAlias::kSupersample)(i, rendered[static_cast<std::size_t>(i)]);
         !s.ok()) {
       return ReportError(s.error());
     }
@@ -497,13 +502,13 @@ int RunBench(const BenchOptions& o) {
   for (int r = 0; r < (o.quick ? 1 : 5); ++r) {
     const double t_encode = run_outputs([&](int i, render::Image& img) {
       img = rendered[static_cast<std::size_t>(i)];
-      return mocap::Status::Ok();
+      return base::Status::Ok();
     });
     const double t_ssaa = run_outputs(render_frame(render::AntiAlias::kSupersample));
     const double t_msaa = run_outputs(render_frame(render::AntiAlias::kMultisample));
     if (t_encode <= 0.0 || t_ssaa <= 0.0 || t_msaa <= 0.0) {
-      return ReportError(mocap::MakeError(mocap::ErrorCode::kInternal, {"bench", 0, 0, {}},
-                                          "the default-render outputs failed"));
+      return ReportError(base::MakeError(base::ErrorCode::kInternal, {"bench", 0, 0, {}},
+                                         "the default-render outputs failed"));
     }
     encode_row.runs.push_back(out_frames / t_encode);
     ssaa_row.runs.push_back(out_frames / t_ssaa);
@@ -535,8 +540,8 @@ int RunBench(const BenchOptions& o) {
                   "getrusage ru_maxrss of this process"});
   bench::AddLongCaptureRows(o.quick, rows, &failed);
   if (failed) {
-    return ReportError(mocap::MakeError(mocap::ErrorCode::kInternal, {"bench", 0, 0, {}},
-                                        "a measured operation failed"));
+    return ReportError(base::MakeError(base::ErrorCode::kInternal, {"bench", 0, 0, {}},
+                                       "a measured operation failed"));
   }
 
   std::printf("\n%-30s %12s %12s %12s  %-10s %-4s %10s %9s  %s\n", "figure", "median", "min", "max",
@@ -566,13 +571,13 @@ int RunBench(const BenchOptions& o) {
       std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
       out << j.dump(2) << "\n";
       if (!out) {
-        return ReportError(mocap::MakeError(mocap::ErrorCode::kIo, {o.json, 0, 0, {}},
-                                            "cannot write the JSON file"));
+        return ReportError(base::MakeError(base::ErrorCode::kIo, {o.json, 0, 0, {}},
+                                           "cannot write the JSON file"));
       }
     }
     std::filesystem::rename(tmp, o.json, ec);
     if (ec) {
-      return ReportError(mocap::MakeError(mocap::ErrorCode::kIo, {o.json, 0, 0, {}}, ec.message()));
+      return ReportError(base::MakeError(base::ErrorCode::kIo, {o.json, 0, 0, {}}, ec.message()));
     }
     std::printf("\njson: %s\n", o.json.c_str());
   }

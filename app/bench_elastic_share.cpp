@@ -37,7 +37,7 @@ constexpr const char* kTwoPatchRig = R"({
   ]
 })";
 
-bool ReportElasticShare(const mocap::Error& e, bool* failed) {
+bool ReportElasticShare(const base::Error& e, bool* failed) {
   std::fprintf(stderr, "bench: elastic share: %s\n", e.ToString().c_str());
   *failed = true;
   return false;
@@ -46,47 +46,48 @@ bool ReportElasticShare(const mocap::Error& e, bool* failed) {
 }  // namespace
 
 void AddElasticShareRow(const Budget& b, int frames, std::vector<Row>& rows, bool* failed) {
-  mocap::Result<MotionSource> src = LoadBvhText(DemoBvhText(), "demo_walk.bvh", {.y_up = true});
+  base::Result<MotionSource> src = LoadBvhText(DemoBvhText(), "demo_walk.bvh", {.y_up = true});
   if (!src.ok()) return void(ReportElasticShare(src.error(), failed));
-  mocap::Result<Character> character = MakeCharacter(std::move(*src));
+  base::Result<Character> character = MakeCharacter(std::move(*src));
   if (!character.ok()) return void(ReportElasticShare(character.error(), failed));
   const Character& ch = *character;
-  mocap::Result<Rig> rig = ParseRig(kTwoPatchRig, "bench_two_elastic_patches.json");
+  base::Result<Rig> rig = ParseRig(kTwoPatchRig, "bench_two_elastic_patches.json");
   if (!rig.ok()) return void(ReportElasticShare(rig.error(), failed));
-  mocap::Result<FramePipeline> pipeline = FramePipeline::Create(ch, GlobalMethod::kSsd, 1);
+  base::Result<FramePipeline> pipeline = FramePipeline::Create(ch, GlobalMethod::kSsd, 1);
   if (!pipeline.ok()) return void(ReportElasticShare(pipeline.error(), failed));
-  if (mocap::Status s = ApplyRigLayers(*rig, ch, *pipeline); !s.ok()) {
+  if (base::Status s = ApplyRigLayers(*rig, ch, *pipeline); !s.ok()) {
     return void(ReportElasticShare(s.error(), failed));
   }
   // The same two networks again, advanced on their own.
-  mocap::Result<std::vector<deform::PatchSetup>> patches = BuildRigPatches(*rig, ch);
+  base::Result<std::vector<deform::PatchSetup>> patches = BuildRigPatches(*rig, ch);
   if (!patches.ok()) return void(ReportElasticShare(patches.error(), failed));
-  mocap::Result<std::vector<ElasticPatchSpec>> specs = ResolveRigElastic(*rig, ch, *patches);
+  base::Result<std::vector<ElasticPatchSpec>> specs = ResolveRigElastic(*rig, ch, *patches);
   if (!specs.ok()) return void(ReportElasticShare(specs.error(), failed));
-  mocap::Result<std::unique_ptr<ElasticLayer>> layer =
+  base::Result<std::unique_ptr<ElasticLayer>> layer =
       ElasticLayer::Create(ch, *patches, std::move(*specs));
   if (!layer.ok()) return void(ReportElasticShare(layer.error(), failed));
   if ((*layer)->num_patches() != 2) {
-    return void(
-        ReportElasticShare(mocap::MakeError(mocap::ErrorCode::kInternal, {"bench", 0, 0, {}},
-                                            "expected two elastic patches"),
-                           failed));
+    return void(ReportElasticShare(base::MakeError(base::ErrorCode::kInternal, {"bench", 0, 0, {}},
+                                                   "expected two elastic patches"),
+                                   failed));
   }
 
   // Joint matrices of every clip frame (the layer's driving rotations).
   const std::size_t nj = static_cast<std::size_t>(ch.skeleton.num_joints());
   std::vector<mocap::JointTransform> locals(nj);
   std::vector<glm::mat4> model(static_cast<std::size_t>(ch.motion.num_frames) * nj);
-  if (mocap::JobStatus s = mocap::ModelMatricesJob{.skeleton = &ch.skeleton, .motion = &ch.motion,
-                                                   .locals = locals, .model_from_joint = model}
-                               .Run();
+  if (base::JobStatus s = mocap::ModelMatricesJob{.skeleton = &ch.skeleton,
+                                                  .motion = &ch.motion,
+                                                  .locals = locals,
+                                                  .model_from_joint = model}
+                              .Run();
       !s) {
     return void(ReportElasticShare(
-        mocap::MakeError(mocap::ErrorCode::kInternal, {"bench", 0, 0, {}}, s.what), failed));
+        base::MakeError(base::ErrorCode::kInternal, {"bench", 0, 0, {}}, s.what), failed));
   }
 
   DeformedFrame frame;
-  if (mocap::Status s = pipeline->Evaluate(0.0, frame); !s.ok())
+  if (base::Status s = pipeline->Evaluate(0.0, frame); !s.ok())
     return void(ReportElasticShare(s.error(), failed));
   EndToEndFrame end_to_end(ch, frame, "share");
   std::vector<std::vector<glm::vec3>> displacements(rig->patches.size());
@@ -103,7 +104,7 @@ void AddElasticShareRow(const Budget& b, int frames, std::vector<Row>& rows, boo
       if (f * dt > ch.motion.duration_s()) f = 0;  // a restart re-simulates from t = 0
       const double time_s = f * dt;
       const double t0 = Now(Clock::kCpu);
-      mocap::Status s = pipeline->Evaluate(time_s, frame);
+      base::Status s = pipeline->Evaluate(time_s, frame);
       if (s.ok()) s = end_to_end.Draw(frame, f);
       const double t1 = Now(Clock::kCpu);
       std::size_t clip = static_cast<std::size_t>(std::lround(time_s / clip_dt));

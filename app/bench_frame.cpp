@@ -26,11 +26,11 @@ EndToEndFrame::~EndToEndFrame() {
   std::filesystem::remove(path_, ec);
 }
 
-mocap::Status EndToEndFrame::Draw(const DeformedFrame& frame, int number) {
+base::Status EndToEndFrame::Draw(const DeformedFrame& frame, int number) {
   FrameDrawOptions draw;
   draw.frame_number = number;
-  mocap::Status s = DrawCharacterFrame(character_, frame, nullptr, camera_, settings_, draw, renderer_,
-                                       unused_, scratch_, image_);
+  base::Status s = DrawCharacterFrame(character_, frame, nullptr, camera_, settings_, draw,
+                                      renderer_, unused_, scratch_, image_);
   if (!s.ok()) return s;
   return render::WriteImage(image_, path_, png_);
 }

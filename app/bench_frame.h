@@ -9,7 +9,7 @@
 #include <string>
 
 #include "app/pipeline.h"
-#include "mocap/error.h"
+#include "base/error.h"
 #include "render/camera.h"
 #include "render/output/image_io.h"
 #include "render/renderer.h"
@@ -25,7 +25,7 @@ class EndToEndFrame {
   EndToEndFrame& operator=(const EndToEndFrame&) = delete;
 
   // Draws `frame` (labelled `number`) and writes it. Errors: the renderer's or the writer's.
-  mocap::Status Draw(const DeformedFrame& frame, int number);
+  base::Status Draw(const DeformedFrame& frame, int number);
 
  private:
   const Character& character_;

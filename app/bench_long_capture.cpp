@@ -26,7 +26,7 @@ int WriteCapture(const fs::path& path, int frames) {
   mocap::WalkOptions walk;
   walk.frame_time_s = 1.0 / 120.0;
   walk.num_cycles = frames / 120 + 1;  // one cycle per second: 120 frames
-  mocap::Result<mocap::Motion> motion = mocap::MakeWalkMotion(skeleton, walk);
+  base::Result<mocap::Motion> motion = mocap::MakeWalkMotion(skeleton, walk);
   if (!motion.ok() || motion->num_frames < frames) return 0;
   motion->num_frames = frames;
   motion->values.resize(static_cast<std::size_t>(frames) *

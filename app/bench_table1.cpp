@@ -43,7 +43,7 @@ struct BoundPatch {
   deform::PatchBinding binding;
 };
 
-mocap::Result<BoundPatch> FitAndBind(const PatchCase& c) {
+base::Result<BoundPatch> FitAndBind(const PatchCase& c) {
   const deform::Mesh mesh = Tube(c.around, c.along);
   std::vector<int> region(mesh.positions.size());
   for (std::size_t i = 0; i < region.size(); ++i) region[i] = static_cast<int>(i);
@@ -66,7 +66,7 @@ mocap::Result<BoundPatch> FitAndBind(const PatchCase& c) {
 }
 
 // 5 example poses (6 features: two rotation vectors) with random displacements.
-mocap::Result<deform::RbfModel> FitRbf(int num_control) {
+base::Result<deform::RbfModel> FitRbf(int num_control) {
   std::mt19937 rng(1);
   std::uniform_real_distribution<float> uni(-1.0f, 1.0f);
   std::vector<deform::PoseExample> examples;
@@ -80,11 +80,10 @@ mocap::Result<deform::RbfModel> FitRbf(int num_control) {
   return deform::RbfPoseSpace::Fit(examples, 6, num_control);
 }
 
-
 }  // namespace
 
-mocap::Result<Table1Row> MeasurePatch(const PatchCase& c, const Budget& b) {
-  mocap::Result<BoundPatch> p = FitAndBind(c);
+base::Result<Table1Row> MeasurePatch(const PatchCase& c, const Budget& b) {
+  base::Result<BoundPatch> p = FitAndBind(c);
   if (!p.ok()) return p.error();
   const auto count = static_cast<std::size_t>(c.m * c.n);
   std::vector<glm::vec3> control = deform::ControlPointsAsFloat(p->surface);
@@ -154,8 +153,8 @@ mocap::Result<Table1Row> MeasurePatch(const PatchCase& c, const Budget& b) {
     row.total.runs.push_back(1.0 / (1.0 / row.update.runs[r] + 1.0 / row.rebuild.runs[r]));
   }
   if (failed) {
-    return mocap::MakeError(mocap::ErrorCode::kInternal, {"bench", 0, 0, {}},
-                            std::string("a job refused to run in the ") + c.name + " workload");
+    return base::MakeError(base::ErrorCode::kInternal, {"bench", 0, 0, {}},
+                           std::string("a job refused to run in the ") + c.name + " workload");
   }
   return row;
 }

@@ -8,7 +8,7 @@
 // bound as the rig's patches are (deform/patch/patch_fit.h, deform/patch/patch_binding.h).
 
 #include "app/bench_timing.h"
-#include "mocap/error.h"
+#include "base/error.h"
 
 namespace app::bench {
 
@@ -37,6 +37,6 @@ struct Table1Row {
 // Fits and binds the patch of `c`, then measures its update and rebuild
 // `b.runs` times. Errors: the fitting and binding errors; kInternal when a job
 // refuses to run.
-mocap::Result<Table1Row> MeasurePatch(const PatchCase& c, const Budget& b);
+base::Result<Table1Row> MeasurePatch(const PatchCase& c, const Budget& b);
 
 }  // namespace app::bench

@@ -16,21 +16,23 @@ namespace {
 constexpr std::uintmax_t kMaxJointMapBytes = 1u << 20;
 }  // namespace
 
-mocap::Result<deform::JointMapEntries> ReadJointMap(const std::string& path) {
-  const mocap::FileLoc loc{path, 0, 0, {}};
+base::Result<deform::JointMapEntries> ReadJointMap(const std::string& path) {
+  const base::FileLoc loc{path, 0, 0, {}};
   std::error_code ec;
   const std::uintmax_t bytes = std::filesystem::file_size(path, ec);
   if (ec || !std::filesystem::is_regular_file(path, ec)) {
-    return mocap::MakeError(mocap::ErrorCode::kIo, loc, "expected a joint map file (JSON), found none");
+    return base::MakeError(base::ErrorCode::kIo, loc,
+                           "expected a joint map file (JSON), found none");
   }
   if (bytes > kMaxJointMapBytes) {
-    return mocap::MakeError(mocap::ErrorCode::kLimitExceeded, loc,
-                            "expected a joint map of at most 1 MiB, found " + std::to_string(bytes) + " bytes");
+    return base::MakeError(
+        base::ErrorCode::kLimitExceeded, loc,
+        "expected a joint map of at most 1 MiB, found " + std::to_string(bytes) + " bytes");
   }
   std::ifstream in(path, std::ios::binary);
   std::string text(static_cast<std::size_t>(bytes), '\0');
   in.read(text.data(), static_cast<std::streamsize>(text.size()));
-  if (!in) return mocap::MakeError(mocap::ErrorCode::kIo, loc, "cannot read the joint map");
+  if (!in) return base::MakeError(base::ErrorCode::kIo, loc, "cannot read the joint map");
   nlohmann::json doc;
   try {
     doc = nlohmann::json::parse(text);
@@ -45,51 +47,53 @@ mocap::Result<deform::JointMapEntries> ReadJointMap(const std::string& path) {
     std::string what = e.what();
     const auto cut = what.rfind(": ");
     if (cut != std::string::npos) what = what.substr(cut + 2);
-    return mocap::MakeError(mocap::ErrorCode::kSyntax, {path, at ? line : 0, at ? column : 0, {}},
-                            "invalid JSON in the joint map: " + what);
+    return base::MakeError(base::ErrorCode::kSyntax, {path, at ? line : 0, at ? column : 0, {}},
+                           "invalid JSON in the joint map: " + what);
   }
   if (!doc.is_object()) {
-    return mocap::MakeError(mocap::ErrorCode::kInvalidArgument, loc,
-                            "expected a joint map object {\"glTF joint\": \"BVH joint\", ...}, found " +
-                                std::string(doc.type_name()));
+    return base::MakeError(
+        base::ErrorCode::kInvalidArgument, loc,
+        "expected a joint map object {\"glTF joint\": \"BVH joint\", ...}, found " +
+            std::string(doc.type_name()));
   }
   deform::JointMapEntries out;
   for (const auto& [key, value] : doc.items()) {
     if (!value.is_string() && !value.is_null()) {
-      return mocap::MakeError(mocap::ErrorCode::kInvalidArgument, loc,
-                              "expected a BVH joint name or null for \"" + key + "\", found " +
-                                  std::string(value.type_name()));
+      return base::MakeError(base::ErrorCode::kInvalidArgument, loc,
+                             "expected a BVH joint name or null for \"" + key + "\", found " +
+                                 std::string(value.type_name()));
     }
     out.emplace_back(key, value.is_string() ? value.get<std::string>() : std::string());
   }
   return out;
 }
 
-mocap::Result<Character> MakeRetargetedCharacter(MotionSource&& character, MotionSource&& motion,
-                                                 const std::string& joint_map_file,
-                                                 RetargetReport* report) {
+base::Result<Character> MakeRetargetedCharacter(MotionSource&& character, MotionSource&& motion,
+                                                const std::string& joint_map_file,
+                                                RetargetReport* report) {
   const std::string model_file = character.skeleton.info.source_file;
   const std::string motion_file = motion.skeleton.info.source_file;
   if (!character.gltf) {
-    return mocap::MakeError(mocap::ErrorCode::kInvalidArgument, {model_file, 0, 0, {}},
-                            "expected a glTF or GLB character to drive with a separate motion, "
-                            "found a " + character.format + " file");
+    return base::MakeError(base::ErrorCode::kInvalidArgument, {model_file, 0, 0, {}},
+                           "expected a glTF or GLB character to drive with a separate motion, "
+                           "found a " +
+                               character.format + " file");
   }
   if (motion.format != "bvh") {
-    return mocap::MakeError(mocap::ErrorCode::kInvalidArgument, {motion_file, 0, 0, {}},
-                            "expected a BVH motion, found a " + motion.format + " file");
+    return base::MakeError(base::ErrorCode::kInvalidArgument, {motion_file, 0, 0, {}},
+                           "expected a BVH motion, found a " + motion.format + " file");
   }
   deform::JointMapEntries overrides;
   if (!joint_map_file.empty()) {
-    mocap::Result<deform::JointMapEntries> read = ReadJointMap(joint_map_file);
+    base::Result<deform::JointMapEntries> read = ReadJointMap(joint_map_file);
     if (!read.ok()) return std::move(read).error();
     overrides = std::move(*read);
   }
-  mocap::Result<deform::HumanoidMatch> match =
+  base::Result<deform::HumanoidMatch> match =
       deform::MatchHumanoids(character.skeleton, motion.skeleton, motion.motion, overrides,
                              model_file, motion_file, joint_map_file);
   if (!match.ok()) return std::move(match).error();
-  mocap::Result<mocap::RetargetedMotion> retargeted = mocap::ApplyRetargetPlan(
+  base::Result<mocap::RetargetedMotion> retargeted = mocap::ApplyRetargetPlan(
       character.skeleton, motion.skeleton, motion.motion, match->plan, motion_file);
   if (!retargeted.ok()) return std::move(retargeted).error();
   if (report != nullptr) {
@@ -104,26 +108,25 @@ mocap::Result<Character> MakeRetargetedCharacter(MotionSource&& character, Motio
                                   b >= 0 ? motion.skeleton.names[static_cast<std::size_t>(b)] : "");
     }
   }
-  for (mocap::Warning& w : match->warnings) retargeted->warnings.push_back(std::move(w));
+  for (base::Warning& w : match->warnings) retargeted->warnings.push_back(std::move(w));
   character.skeleton = std::move(retargeted->skeleton);
   character.motion = std::move(retargeted->motion);
-  for (mocap::Warning& w : motion.warnings) character.warnings.push_back(std::move(w));
-  for (mocap::Warning& w : retargeted->warnings) character.warnings.push_back(std::move(w));
+  for (base::Warning& w : motion.warnings) character.warnings.push_back(std::move(w));
+  for (base::Warning& w : retargeted->warnings) character.warnings.push_back(std::move(w));
   return MakeCharacter(std::move(character));
 }
 
-mocap::Result<Character> LoadCommandCharacter(const std::string& input, const std::string& motion,
-                                              bool quiet, std::optional<mocap::UpAxis> up,
-                                              const std::string& joint_map_file,
-                                              RetargetReport* report, BodyKind body) {
+base::Result<Character> LoadCommandCharacter(const std::string& input, const std::string& motion,
+                                             bool quiet, std::optional<mocap::UpAxis> up,
+                                             const std::string& joint_map_file,
+                                             RetargetReport* report, BodyKind body) {
   MotionSourceOptions load;
   load.y_up = true;  // frames are rendered Y-up with the ground at the feet
   load.up = up;
-  mocap::Result<MotionSource> src = input.empty()
-                                        ? LoadBvhText(DemoBvhText(), "demo_walk.bvh", load)
-                                        : LoadMotionSource(input, load);
+  base::Result<MotionSource> src = input.empty() ? LoadBvhText(DemoBvhText(), "demo_walk.bvh", load)
+                                                 : LoadMotionSource(input, load);
   if (!src.ok()) return std::move(src).error();
-  const auto print = [quiet](const std::vector<mocap::Warning>& warnings, std::size_t from) {
+  const auto print = [quiet](const std::vector<base::Warning>& warnings, std::size_t from) {
     if (quiet) return;
     for (std::size_t i = from; i < warnings.size(); ++i) {
       std::fprintf(stderr, "%s\n", warnings[i].ToString().c_str());
@@ -131,14 +134,16 @@ mocap::Result<Character> LoadCommandCharacter(const std::string& input, const st
   };
   print(src->warnings, 0);
   if (motion.empty() && !joint_map_file.empty()) {
-    return mocap::MakeError(mocap::ErrorCode::kInvalidArgument, {joint_map_file, 0, 0, {}},
-                            "expected a BVH motion (--motion) for the joint map to apply to, found none");
+    return base::MakeError(
+        base::ErrorCode::kInvalidArgument, {joint_map_file, 0, 0, {}},
+        "expected a BVH motion (--motion) for the joint map to apply to, found none");
   }
   if (motion.empty()) return MakeCharacter(std::move(*src), {}, body);
-  mocap::Result<MotionSource> bvh = LoadMotionSource(motion, load);
+  base::Result<MotionSource> bvh = LoadMotionSource(motion, load);
   if (!bvh.ok()) return std::move(bvh).error();
   const std::size_t printed = src->warnings.size();  // the glTF's, printed above
-  mocap::Result<Character> character = MakeRetargetedCharacter(std::move(*src), std::move(*bvh), joint_map_file, report);
+  base::Result<Character> character =
+      MakeRetargetedCharacter(std::move(*src), std::move(*bvh), joint_map_file, report);
   if (character.ok()) print(character->warnings, printed);
   return character;
 }

@@ -14,7 +14,7 @@
 #include "app/motion_source.h"
 #include "app/pipeline.h"
 #include "deform/body/humanoid_map.h"
-#include "mocap/error.h"
+#include "base/error.h"
 
 namespace app {
 
@@ -35,15 +35,15 @@ struct RetargetReport {
   std::string target_root, source_root;
   std::vector<std::pair<std::string, std::string>> joints;  // every glTF joint -> BVH joint or ""
 };
-mocap::Result<Character> MakeRetargetedCharacter(MotionSource&& character, MotionSource&& motion,
-                                                 const std::string& joint_map_file = {},
-                                                 RetargetReport* report = nullptr);
+base::Result<Character> MakeRetargetedCharacter(MotionSource&& character, MotionSource&& motion,
+                                                const std::string& joint_map_file = {},
+                                                RetargetReport* report = nullptr);
 
 // Reads a joint map: one JSON object whose keys are joints of the character and
 // whose values are joints of the motion (a string) or null (left at rest).
 // Errors: kIo (missing, unreadable, over 1 MiB), kSyntax with line and column for
 // invalid JSON, kInvalidArgument for a value that is not a string or null.
-mocap::Result<deform::JointMapEntries> ReadJointMap(const std::string& path);
+base::Result<deform::JointMapEntries> ReadJointMap(const std::string& path);
 
 // The character a command evaluates, loaded as `render` and `export` load it:
 // `input` (a BVH, glTF or GLB path; empty = the built-in demo walk) read Y-up,
@@ -52,10 +52,10 @@ mocap::Result<deform::JointMapEntries> ReadJointMap(const std::string& path);
 // stderr unless `quiet`. A BVH gets the body `body` (MakeCharacter). Errors: those of
 // LoadMotionSource and the makers. `up` (--up) gives the BVH's up axis instead of
 // detecting it.
-mocap::Result<Character> LoadCommandCharacter(const std::string& input, const std::string& motion,
-                                              bool quiet, std::optional<mocap::UpAxis> up = {},
-                                              const std::string& joint_map_file = {},
-                                              RetargetReport* report = nullptr,
-                                              BodyKind body = BodyKind::kTubes);
+base::Result<Character> LoadCommandCharacter(const std::string& input, const std::string& motion,
+                                             bool quiet, std::optional<mocap::UpAxis> up = {},
+                                             const std::string& joint_map_file = {},
+                                             RetargetReport* report = nullptr,
+                                             BodyKind body = BodyKind::kTubes);
 
 }  // namespace app

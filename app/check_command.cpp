@@ -18,7 +18,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-int Error(const mocap::Error& e) {
+int Error(const base::Error& e) {
   std::fprintf(stderr, "%s\n", e.ToString().c_str());
   return kCheckError;
 }
@@ -101,12 +101,12 @@ int FrameSeverity(const FrameCheck& f) {
 // Writes the amplified |new - reference| of a frame (colour, sRGB values),
 // scaled so the largest difference is near white (x1 .. x1000).
 void WriteDiff(FrameCheck& f, const fs::path& dir) {
-  mocap::Result<render::Image> a = render::ReadImage(f.new_path);
-  mocap::Result<render::Image> b = render::ReadImage(f.ref_path);
+  base::Result<render::Image> a = render::ReadImage(f.new_path);
+  base::Result<render::Image> b = render::ReadImage(f.ref_path);
   if (!a.ok() || !b.ok()) return;
   const double max_error = f.result ? f.result->max_error : 0.0;
   f.diff_scale = static_cast<float>(std::clamp(max_error > 0.0 ? 1.0 / max_error : 1.0, 1.0, 1000.0));
-  mocap::Result<render::Image> diff = render::MakeDiffImage(*a, *b, f.diff_scale);
+  base::Result<render::Image> diff = render::MakeDiffImage(*a, *b, f.diff_scale);
   if (!diff.ok()) return;
   char name[32];
   std::snprintf(name, sizeof(name), "diff_%04d.png", f.number);
@@ -173,7 +173,7 @@ void CompareCase(const fs::path& new_dir, const fs::path& ref_dir, CaseCheck& c)
     if (!fs::exists(f.ref_path, ec)) {
       f.missing = true;
     } else {
-      mocap::Result<render::FileCompareResult> r =
+      base::Result<render::FileCompareResult> r =
           render::CompareImageFiles(f.new_path, f.ref_path, c.thresholds);
       if (!r.ok()) {
         c.status = CaseStatus::kError;
@@ -203,7 +203,7 @@ void CompareCase(const fs::path& new_dir, const fs::path& ref_dir, CaseCheck& c)
 }
 
 // Copies the case's new frames over its references (each atomically).
-mocap::Status UpdateReferences(const fs::path& ref_dir, CaseCheck& c) {
+base::Status UpdateReferences(const fs::path& ref_dir, CaseCheck& c) {
   std::error_code ec;
   fs::create_directories(ref_dir, ec);
   for (const FrameCheck& f : c.frames) {
@@ -214,13 +214,13 @@ mocap::Status UpdateReferences(const fs::path& ref_dir, CaseCheck& c) {
     if (!ec) fs::rename(temp, target, ec);
     if (ec) {
       fs::remove(temp, ec);
-      return mocap::MakeError(mocap::ErrorCode::kIo, {target.string(), 0, 0, {}},
-                              "cannot write the reference: " + ec.message());
+      return base::MakeError(base::ErrorCode::kIo, {target.string(), 0, 0, {}},
+                             "cannot write the reference: " + ec.message());
     }
     ++(existed ? c.replaced : c.added);
   }
   c.updated = true;
-  return mocap::Status::Ok();
+  return base::Status::Ok();
 }
 
 // Renders one case into `new_dir` with the render command; false on failure
@@ -264,7 +264,7 @@ void PrintCaseLine(const CaseCheck& c, std::size_t name_width) {
 }  // namespace
 
 int RunCheck(const CheckOptions& options) {
-  mocap::Result<CheckManifest> manifest = LoadCheckManifest(options.manifest);
+  base::Result<CheckManifest> manifest = LoadCheckManifest(options.manifest);
   if (!manifest.ok()) return Error(manifest.error());
   const fs::path out = options.out.empty()
                            ? fs::path("out/check") / fs::path(options.manifest).stem()
@@ -287,7 +287,7 @@ int RunCheck(const CheckOptions& options) {
     if (RenderCase(cs, new_dir, options.threads, c)) CompareCase(new_dir, ref_dir, c);
     const bool differs = c.status != CaseStatus::kPass && c.status != CaseStatus::kError;
     if (c.status != CaseStatus::kError && (options.update_all || (options.update && differs))) {
-      if (mocap::Status s = UpdateReferences(ref_dir, c); !s.ok()) {
+      if (base::Status s = UpdateReferences(ref_dir, c); !s.ok()) {
         c.status = CaseStatus::kError;
         c.error = s.error().ToString();
         c.summary = "cannot update the references: " + c.error;
@@ -314,10 +314,10 @@ int RunCheck(const CheckOptions& options) {
   if (updated > 0) std::printf("; %d updated in %s", updated, run.references.c_str());
   std::printf("\n");
   const std::string html = options.html.empty() ? (out / "report.html").string() : options.html;
-  if (mocap::Status s = WriteCheckHtml(run, html); !s.ok()) return Error(s.error());
+  if (base::Status s = WriteCheckHtml(run, html); !s.ok()) return Error(s.error());
   std::printf("report: %s\n", html.c_str());
   if (!options.junit.empty()) {
-    if (mocap::Status s = WriteCheckJUnit(run, options.junit); !s.ok()) return Error(s.error());
+    if (base::Status s = WriteCheckJUnit(run, options.junit); !s.ok()) return Error(s.error());
     std::printf("junit:  %s\n", options.junit.c_str());
   }
   return exit_code;

@@ -25,19 +25,19 @@ std::string Resolve(const std::string& manifest, const std::string& path) {
   return (fs::path(manifest).parent_path() / p).lexically_normal().string();
 }
 
-std::optional<mocap::Error> CheckKeys(const JsonFile& c, const json& obj, const std::string& path,
-                                      std::initializer_list<const char*> allowed) {
+std::optional<base::Error> CheckKeys(const JsonFile& c, const json& obj, const std::string& path,
+                                     std::initializer_list<const char*> allowed) {
   return c.Keys(obj, path, allowed, "manifest");
 }
 
-std::optional<mocap::Error> ParseThresholds(const JsonFile& c, const json& v,
-                                            const std::string& path, render::IdiffThresholds& t) {
+std::optional<base::Error> ParseThresholds(const JsonFile& c, const json& v,
+                                           const std::string& path, render::IdiffThresholds& t) {
   if (auto e = CheckKeys(c, v, path,
                          {"fail", "failpercent", "hardfail", "warn", "warnpercent", "hardwarn",
                           "allowfailures"})) {
     return e;
   }
-  const auto number = [&](const char* key, float& out, double hi) -> std::optional<mocap::Error> {
+  const auto number = [&](const char* key, float& out, double hi) -> std::optional<base::Error> {
     if (!v.contains(key)) return std::nullopt;
     const json& x = v[key];
     if (!x.is_number() || !(x.get<double>() >= 0.0) || x.get<double>() > hi) {
@@ -75,8 +75,8 @@ bool ValidName(const std::string& name) {
 }
 
 // The render command's words of a case, split on white space (a string) or as listed.
-std::optional<mocap::Error> OptionWords(const JsonFile& c, const json& v, const std::string& path,
-                                        std::vector<std::string>& words) {
+std::optional<base::Error> OptionWords(const JsonFile& c, const json& v, const std::string& path,
+                                       std::vector<std::string>& words) {
   if (v.is_string()) {
     std::istringstream in(v.get<std::string>());
     for (std::string w; in >> w;) words.push_back(w);
@@ -91,10 +91,10 @@ std::optional<mocap::Error> OptionWords(const JsonFile& c, const json& v, const 
 }
 
 // Parses `words` with the render command's parser into `out`.
-std::optional<mocap::Error> ParseCaseOptions(const JsonFile& c, const std::string& path,
-                                             const std::string& input,
-                                             const std::vector<std::string>& words,
-                                             RenderOptions& out) {
+std::optional<base::Error> ParseCaseOptions(const JsonFile& c, const std::string& path,
+                                            const std::string& input,
+                                            const std::vector<std::string>& words,
+                                            RenderOptions& out) {
   if (std::optional<std::string> bad = app::ParseRenderWords(input, words, out))
     return c.Fail(path, *bad);
   for (const char* refused : {"--out", "--frames", "--overwrite", "--resume", "--stats", "--help"}) {
@@ -106,8 +106,8 @@ std::optional<mocap::Error> ParseCaseOptions(const JsonFile& c, const std::strin
   return std::nullopt;
 }
 
-std::optional<mocap::Error> ParseCase(const JsonFile& c, const json& v, const std::string& path,
-                                      const render::IdiffThresholds& defaults, CheckCase& out) {
+std::optional<base::Error> ParseCase(const JsonFile& c, const json& v, const std::string& path,
+                                     const render::IdiffThresholds& defaults, CheckCase& out) {
   if (auto e = CheckKeys(c, v, path, {"name", "input", "options", "frames", "thresholds"})) return e;
   if (!v.contains("name") || !v["name"].is_string() || !ValidName(v["name"].get<std::string>())) {
     return c.Expected(path + ".name", "a name of letters, digits, '_', '-' and '.'",
@@ -136,8 +136,8 @@ std::optional<mocap::Error> ParseCase(const JsonFile& c, const json& v, const st
   return std::nullopt;
 }
 
-mocap::Error JsonError(const std::string& file, const std::string& text,
-                       const json::exception& e, std::size_t byte) {
+base::Error JsonError(const std::string& file, const std::string& text, const json::exception& e,
+                      std::size_t byte) {
   int line = 1, column = 1;
   for (std::size_t i = 0; i + 1 < byte && i < text.size(); ++i) {
     if (text[i] == '\n') ++line, column = 1;
@@ -146,13 +146,14 @@ mocap::Error JsonError(const std::string& file, const std::string& text,
   std::string what = e.what();
   const auto bracket = what.find("] ");
   if (bracket != std::string::npos) what = what.substr(bracket + 2);
-  return mocap::MakeError(mocap::ErrorCode::kSyntax, {file, byte > 0 ? line : 0, byte > 0 ? column : 0, {}},
-                          "invalid JSON: " + what);
+  return base::MakeError(base::ErrorCode::kSyntax,
+                         {file, byte > 0 ? line : 0, byte > 0 ? column : 0, {}},
+                         "invalid JSON: " + what);
 }
 
 }  // namespace
 
-mocap::Result<CheckManifest> ParseCheckManifest(const std::string& text, const std::string& file) {
+base::Result<CheckManifest> ParseCheckManifest(const std::string& text, const std::string& file) {
   const JsonFile c{file};
   json doc;
   try {
@@ -195,20 +196,23 @@ mocap::Result<CheckManifest> ParseCheckManifest(const std::string& text, const s
   return m;
 }
 
-mocap::Result<CheckManifest> LoadCheckManifest(const std::string& path) {
-  const mocap::FileLoc loc{path, 0, 0, {}};
+base::Result<CheckManifest> LoadCheckManifest(const std::string& path) {
+  const base::FileLoc loc{path, 0, 0, {}};
   std::error_code ec;
-  if (!fs::is_regular_file(path, ec)) return mocap::MakeError(mocap::ErrorCode::kIo, loc, "no such manifest file");
+  if (!fs::is_regular_file(path, ec))
+    return base::MakeError(base::ErrorCode::kIo, loc, "no such manifest file");
   const std::uintmax_t bytes = fs::file_size(path, ec);
-  if (ec) return mocap::MakeError(mocap::ErrorCode::kIo, loc, "cannot read the manifest: " + ec.message());
+  if (ec)
+    return base::MakeError(base::ErrorCode::kIo, loc, "cannot read the manifest: " + ec.message());
   if (bytes > kMaxManifestBytes) {
-    return mocap::MakeError(mocap::ErrorCode::kLimitExceeded, loc,
-                            "expected a manifest of at most 16 MiB, found " + std::to_string(bytes) + " bytes");
+    return base::MakeError(
+        base::ErrorCode::kLimitExceeded, loc,
+        "expected a manifest of at most 16 MiB, found " + std::to_string(bytes) + " bytes");
   }
   std::ifstream in(path, std::ios::binary);
   std::string text(static_cast<std::size_t>(bytes), '\0');
   in.read(text.data(), static_cast<std::streamsize>(text.size()));
-  if (!in) return mocap::MakeError(mocap::ErrorCode::kIo, loc, "cannot read the manifest");
+  if (!in) return base::MakeError(base::ErrorCode::kIo, loc, "cannot read the manifest");
   return ParseCheckManifest(text, path);
 }
 

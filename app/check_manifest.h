@@ -27,7 +27,7 @@
 #include <vector>
 
 #include "app/render_command.h"
-#include "mocap/error.h"
+#include "base/error.h"
 #include "render/output/image_file_compare.h"
 
 namespace app {
@@ -45,8 +45,8 @@ struct CheckManifest {
   std::vector<CheckCase> cases;
 };
 
-[[nodiscard]] mocap::Result<CheckManifest> ParseCheckManifest(const std::string& text,
-                                                              const std::string& file);
-[[nodiscard]] mocap::Result<CheckManifest> LoadCheckManifest(const std::string& path);
+[[nodiscard]] base::Result<CheckManifest> ParseCheckManifest(const std::string& text,
+                                                             const std::string& file);
+[[nodiscard]] base::Result<CheckManifest> LoadCheckManifest(const std::string& path);
 
 }  // namespace app

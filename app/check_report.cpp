@@ -60,8 +60,8 @@ std::string DataUri(const std::string& path) {
 }
 
 // Writes `text` to `path` under a temporary name, then renames it.
-mocap::Status WriteAtomically(const std::string& path, const std::string& text) {
-  const mocap::FileLoc loc{path, 0, 0, {}};
+base::Status WriteAtomically(const std::string& path, const std::string& text) {
+  const base::FileLoc loc{path, 0, 0, {}};
   std::error_code ec;
   const fs::path dir = fs::path(path).parent_path();
   if (!dir.empty()) fs::create_directories(dir, ec);
@@ -71,15 +71,15 @@ mocap::Status WriteAtomically(const std::string& path, const std::string& text) 
     out << text;
     if (!out.flush()) {
       fs::remove(temp, ec);
-      return mocap::MakeError(mocap::ErrorCode::kIo, loc, "cannot write the file");
+      return base::MakeError(base::ErrorCode::kIo, loc, "cannot write the file");
     }
   }
   fs::rename(temp, path, ec);
   if (ec) {
     fs::remove(temp, ec);
-    return mocap::MakeError(mocap::ErrorCode::kIo, loc, "cannot write the file: " + ec.message());
+    return base::MakeError(base::ErrorCode::kIo, loc, "cannot write the file: " + ec.message());
   }
-  return mocap::Status::Ok();
+  return base::Status::Ok();
 }
 
 std::string Num(double v) {
@@ -231,7 +231,7 @@ std::vector<std::size_t> ReportOrder(const CheckRun& run) {
   return order;
 }
 
-mocap::Status WriteCheckHtml(const CheckRun& run, const std::string& path) {
+base::Status WriteCheckHtml(const CheckRun& run, const std::string& path) {
   int counts[5] = {0, 0, 0, 0, 0};
   for (const CaseCheck& c : run.cases) ++counts[static_cast<int>(c.status)];
   std::ostringstream s;
@@ -246,7 +246,7 @@ mocap::Status WriteCheckHtml(const CheckRun& run, const std::string& path) {
   return WriteAtomically(path, s.str());
 }
 
-mocap::Status WriteCheckJUnit(const CheckRun& run, const std::string& path) {
+base::Status WriteCheckJUnit(const CheckRun& run, const std::string& path) {
   int failures = 0, errors = 0;
   for (const CaseCheck& c : run.cases) {
     if (c.status == CaseStatus::kError) ++errors;

@@ -19,7 +19,7 @@
 #include <string>
 #include <vector>
 
-#include "mocap/error.h"
+#include "base/error.h"
 #include "render/output/image_file_compare.h"
 
 namespace app {
@@ -60,7 +60,7 @@ struct CheckRun {
 // Cases in report order (severity, then manifest order), as indices.
 std::vector<std::size_t> ReportOrder(const CheckRun& run);
 
-[[nodiscard]] mocap::Status WriteCheckHtml(const CheckRun& run, const std::string& path);
-[[nodiscard]] mocap::Status WriteCheckJUnit(const CheckRun& run, const std::string& path);
+[[nodiscard]] base::Status WriteCheckHtml(const CheckRun& run, const std::string& path);
+[[nodiscard]] base::Status WriteCheckJUnit(const CheckRun& run, const std::string& path);
 
 }  // namespace app

@@ -70,19 +70,20 @@ void PrintReport(const CompareCommandOptions& o, const render::FileCompareResult
 // Writes |A - B| amplified, for people to look at (colour only).
 int WriteDiff(const CompareCommandOptions& o) {
   render::ReadInfo info_a, info_b;
-  mocap::Result<render::Image> a = render::ReadImage(o.image_a, &info_a);
+  base::Result<render::Image> a = render::ReadImage(o.image_a, &info_a);
   if (!a.ok()) return Error(a.error().ToString());
-  mocap::Result<render::Image> b = render::ReadImage(o.image_b, &info_b);
+  base::Result<render::Image> b = render::ReadImage(o.image_b, &info_b);
   if (!b.ok()) return Error(b.error().ToString());
   const render::CompareSpace space = info_a.srgb_encoded || info_b.srgb_encoded
                                          ? render::CompareSpace::kSrgbEncoded
                                          : render::CompareSpace::kLinear;
-  mocap::Result<render::Image> diff = render::MakeDiffImage(*a, *b, o.diff_scale, space);
+  base::Result<render::Image> diff = render::MakeDiffImage(*a, *b, o.diff_scale, space);
   if (!diff.ok()) {
     std::printf("  no difference image: %s\n", diff.error().message.c_str());
     return kComparePass;
   }
-  if (mocap::Status s = render::WriteImage(*diff, o.diff_path); !s) return Error(s.error().ToString());
+  if (base::Status s = render::WriteImage(*diff, o.diff_path); !s)
+    return Error(s.error().ToString());
   std::printf("  difference image: %s (x%g)\n", o.diff_path.c_str(), static_cast<double>(o.diff_scale));
   return kComparePass;
 }
@@ -116,7 +117,7 @@ int RunCompareCommand(const CompareCommandOptions& o) {
                                   .allow_failures = o.allow_failures};
   std::printf("Comparing \"%s\" and \"%s\"\n", o.image_a.c_str(), o.image_b.c_str());
   std::fflush(stdout);
-  mocap::Result<render::FileCompareResult> r = render::CompareImageFiles(o.image_a, o.image_b, t);
+  base::Result<render::FileCompareResult> r = render::CompareImageFiles(o.image_a, o.image_b, t);
   if (!r.ok()) return Error(r.error().ToString());
   PrintReport(o, *r);
   if (!o.diff_path.empty()) {

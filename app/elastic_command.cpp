@@ -16,31 +16,38 @@
 namespace app {
 namespace {
 
-int Fail(const mocap::Error& e, int code) {
+int Fail(const base::Error& e, int code) {
   std::fprintf(stderr, "%s\n", e.ToString().c_str());
   return code;
 }
 
 // Per-frame kinematics of every joint, low-passed first when cutoff_hz > 0.
-mocap::Result<std::vector<mocap::JointKinematics>> Kinematics(const mocap::Skeleton& skel,
-                                                              const mocap::Motion& motion,
-                                                              double cutoff_hz) {
+base::Result<std::vector<mocap::JointKinematics>> Kinematics(const mocap::Skeleton& skel,
+                                                             const mocap::Motion& motion,
+                                                             double cutoff_hz) {
   if (cutoff_hz <= 0.0) return mocap::ComputeKinematics(skel, motion);
   const std::size_t nj = static_cast<std::size_t>(skel.num_joints());
   const std::size_t nf = static_cast<std::size_t>(motion.num_frames);
   std::vector<mocap::JointTransform> locals(nj);
   std::vector<glm::mat4> raw(nj * nf), smooth(nj * nf);
   std::vector<mocap::JointKinematics> kin(nj * nf);
-  const mocap::JobStatus s1 = mocap::ModelMatricesJob{
-      .skeleton = &skel, .motion = &motion, .locals = locals, .model_from_joint = raw}.Run();
-  const mocap::JobStatus s2 = mocap::SmoothTrajectoriesJob{
-      .model_from_joint = raw, .num_joints = skel.num_joints(),
-      .frame_time_s = motion.frame_time_s, .cutoff_hz = cutoff_hz, .output = smooth}.Run();
-  const mocap::JobStatus s3 = mocap::KinematicsJob{
-      .model_from_joint = smooth, .num_joints = skel.num_joints(),
-      .frame_time_s = motion.frame_time_s, .output = kin}.Run();
-  for (const mocap::JobStatus& s : {s1, s2, s3}) {
-    if (!s) return mocap::MakeError(mocap::ErrorCode::kInvalidArgument, mocap::FileLoc(), s.what);
+  const base::JobStatus s1 =
+      mocap::ModelMatricesJob{
+          .skeleton = &skel, .motion = &motion, .locals = locals, .model_from_joint = raw}
+          .Run();
+  const base::JobStatus s2 = mocap::SmoothTrajectoriesJob{.model_from_joint = raw,
+                                                          .num_joints = skel.num_joints(),
+                                                          .frame_time_s = motion.frame_time_s,
+                                                          .cutoff_hz = cutoff_hz,
+                                                          .output = smooth}
+                                 .Run();
+  const base::JobStatus s3 = mocap::KinematicsJob{.model_from_joint = smooth,
+                                                  .num_joints = skel.num_joints(),
+                                                  .frame_time_s = motion.frame_time_s,
+                                                  .output = kin}
+                                 .Run();
+  for (const base::JobStatus& s : {s1, s2, s3}) {
+    if (!s) return base::MakeError(base::ErrorCode::kInvalidArgument, base::FileLoc(), s.what);
   }
   return kin;
 }
@@ -70,16 +77,16 @@ int RunElastic(const ElasticOptions& o) {
     if (upm <= 0.0f) upm = 1.0f;
     source = o.file;
   }
-  mocap::FileLoc loc;
+  base::FileLoc loc;
   loc.file = o.file.empty() ? "elastic" : o.file;
   const int joint = skel.FindJoint(o.joint);
   if (joint < 0) {
-    return Fail(mocap::MakeError(mocap::ErrorCode::kNotFound, loc,
-                                 "no joint named '" + o.joint + "'"), 2);
+    return Fail(
+        base::MakeError(base::ErrorCode::kNotFound, loc, "no joint named '" + o.joint + "'"), 2);
   }
   if (motion.num_frames < 2) {
-    return Fail(mocap::MakeError(mocap::ErrorCode::kInvalidArgument, loc,
-                                 "expected at least 2 frames"), 2);
+    return Fail(
+        base::MakeError(base::ErrorCode::kInvalidArgument, loc, "expected at least 2 frames"), 2);
   }
   auto kin = Kinematics(skel, motion, o.cutoff_hz);
   if (!kin.ok()) return Fail(kin.error(), 2);
@@ -131,8 +138,8 @@ int RunElastic(const ElasticOptions& o) {
         .network = &*net, .state = &state, .time_s = t, .kinematics = *kin,
         .num_joints = skel.num_joints(), .joint = joint, .frame_time_s = motion.frame_time_s,
         .displacements = disp};
-    if (const mocap::JobStatus s = job.Run(); !s) {
-      return Fail(mocap::MakeError(mocap::ErrorCode::kInternal, loc, s.what), 3);
+    if (const base::JobStatus s = job.Run(); !s) {
+      return Fail(base::MakeError(base::ErrorCode::kInternal, loc, s.what), 3);
     }
     const glm::vec3 a = (*kin)[static_cast<std::size_t>(f) * nj + static_cast<std::size_t>(joint)]
                             .local_linear_acceleration;
@@ -151,7 +158,7 @@ int RunElastic(const ElasticOptions& o) {
     std::error_code ec;
     std::filesystem::create_directories(out.parent_path(), ec);
   }
-  if (const mocap::Status s = render::WriteImage(*image, o.out); !s) return Fail(s.error(), 2);
+  if (const base::Status s = render::WriteImage(*image, o.out); !s) return Fail(s.error(), 2);
   const deform::MassSpringCounters& c = state.counters();
   std::printf("%d frames, h = %.6g s, %lld steps, peak |e| %.3f cm (e_max %.3f cm)\n",
               motion.num_frames, net->time_step_s, static_cast<long long>(c.steps), peak,

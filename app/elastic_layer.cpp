@@ -10,12 +10,11 @@
 namespace app {
 namespace {
 
-mocap::Error ElasticError(const Character& c, int patch, const std::string& field,
-                          const std::string& message,
-                          mocap::ErrorCode code = mocap::ErrorCode::kInvalidArgument) {
-  return mocap::MakeError(code,
-                          {c.source, 0, 0, "patches[" + std::to_string(patch) + "].elastic" + field},
-                          message);
+base::Error ElasticError(const Character& c, int patch, const std::string& field,
+                         const std::string& message,
+                         base::ErrorCode code = base::ErrorCode::kInvalidArgument) {
+  return base::MakeError(
+      code, {c.source, 0, 0, "patches[" + std::to_string(patch) + "].elastic" + field}, message);
 }
 
 // Rotation part of a joint matrix with any scale removed.
@@ -43,7 +42,7 @@ int DominantJoint(const Character& c, const deform::PatchSetup& patch) {
 
 }  // namespace
 
-mocap::Result<std::vector<mocap::JointKinematics>> DrivingKinematics(
+base::Result<std::vector<mocap::JointKinematics>> DrivingKinematics(
     const mocap::Skeleton& skeleton, const mocap::Motion& motion, double cutoff_hz,
     const glm::mat4& model_from_root) {
   const std::size_t nj = static_cast<std::size_t>(skeleton.num_joints());
@@ -51,7 +50,7 @@ mocap::Result<std::vector<mocap::JointKinematics>> DrivingKinematics(
   std::vector<mocap::JointTransform> locals(nj);
   std::vector<glm::mat4> raw(nj * nf);
   std::vector<mocap::JointKinematics> kin(nj * nf);
-  std::vector<mocap::JobStatus> statuses;
+  std::vector<base::JobStatus> statuses;
   statuses.push_back(mocap::ModelMatricesJob{.skeleton = &skeleton, .motion = &motion,
                                              .model_from_root = model_from_root,
                                              .locals = locals, .model_from_joint = raw}
@@ -73,22 +72,22 @@ mocap::Result<std::vector<mocap::JointKinematics>> DrivingKinematics(
                                             .output = kin}
                            .Run());
   }
-  for (const mocap::JobStatus& s : statuses) {
+  for (const base::JobStatus& s : statuses) {
     if (!s) {
-      return mocap::MakeError(mocap::ErrorCode::kInvalidArgument,
-                              {skeleton.info.source_file, 0, 0, {}},
-                              std::string("joint kinematics: ") + s.what);
+      return base::MakeError(base::ErrorCode::kInvalidArgument,
+                             {skeleton.info.source_file, 0, 0, {}},
+                             std::string("joint kinematics: ") + s.what);
     }
   }
   return kin;
 }
 
-mocap::Result<std::vector<mocap::JointKinematics>> DrivingKinematicsOf(
+base::Result<std::vector<mocap::JointKinematics>> DrivingKinematicsOf(
     const mocap::Skeleton& skeleton, const mocap::Motion& motion, std::span<const int> joints,
     double cutoff_hz, const glm::mat4& model_from_root) {
   const auto fail = [&](const std::string& what) {
-    return mocap::MakeError(mocap::ErrorCode::kInvalidArgument,
-                            {skeleton.info.source_file, 0, 0, {}}, "joint kinematics: " + what);
+    return base::MakeError(base::ErrorCode::kInvalidArgument, {skeleton.info.source_file, 0, 0, {}},
+                           "joint kinematics: " + what);
   };
   const std::size_t nj = static_cast<std::size_t>(skeleton.num_joints());
   const std::size_t nd = joints.size();
@@ -113,13 +112,13 @@ mocap::Result<std::vector<mocap::JointKinematics>> DrivingKinematicsOf(
   for (std::size_t first = 0; first < nf; first += kChunkFrames) {
     const std::size_t count = std::min(kChunkFrames, nf - first);
     const std::span<glm::mat4> out = std::span(chunk).first(count * nj);
-    const mocap::JobStatus s = mocap::ModelMatricesJob{.skeleton = &skeleton,
-                                                       .motion = &motion,
-                                                       .first_frame = static_cast<int>(first),
-                                                       .model_from_root = model_from_root,
-                                                       .locals = locals,
-                                                       .model_from_joint = out}
-                                   .Run();
+    const base::JobStatus s = mocap::ModelMatricesJob{.skeleton = &skeleton,
+                                                      .motion = &motion,
+                                                      .first_frame = static_cast<int>(first),
+                                                      .model_from_root = model_from_root,
+                                                      .locals = locals,
+                                                      .model_from_joint = out}
+                                  .Run();
     if (!s) return fail(s.what);
     for (std::size_t k = 0; k < count; ++k) {
       for (std::size_t d = 0; d < nd; ++d) {
@@ -132,26 +131,26 @@ mocap::Result<std::vector<mocap::JointKinematics>> DrivingKinematicsOf(
   const int num_columns = static_cast<int>(nd);
   if (cutoff_hz > 0.0) {
     std::vector<glm::mat4> smooth(nd * nf);
-    const mocap::JobStatus s = mocap::SmoothTrajectoriesJob{.model_from_joint = raw,
-                                                            .num_joints = num_columns,
-                                                            .frame_time_s = motion.frame_time_s,
-                                                            .cutoff_hz = cutoff_hz,
-                                                            .output = smooth}
-                                   .Run();
+    const base::JobStatus s = mocap::SmoothTrajectoriesJob{.model_from_joint = raw,
+                                                           .num_joints = num_columns,
+                                                           .frame_time_s = motion.frame_time_s,
+                                                           .cutoff_hz = cutoff_hz,
+                                                           .output = smooth}
+                                  .Run();
     if (!s) return fail(s.what);
     raw = std::move(smooth);  // frees the unsmoothed columns before kin is allocated
   }
   std::vector<mocap::JointKinematics> kin(nd * nf);
-  const mocap::JobStatus s = mocap::KinematicsJob{.model_from_joint = raw,
-                                                  .num_joints = num_columns,
-                                                  .frame_time_s = motion.frame_time_s,
-                                                  .output = kin}
-                                 .Run();
+  const base::JobStatus s = mocap::KinematicsJob{.model_from_joint = raw,
+                                                 .num_joints = num_columns,
+                                                 .frame_time_s = motion.frame_time_s,
+                                                 .output = kin}
+                                .Run();
   if (!s) return fail(s.what);
   return kin;
 }
 
-mocap::Result<std::vector<ElasticPatchSpec>> ResolveRigElastic(
+base::Result<std::vector<ElasticPatchSpec>> ResolveRigElastic(
     const Rig& rig, const Character& character, std::span<const deform::PatchSetup> patches) {
   std::vector<ElasticPatchSpec> specs;
   for (std::size_t i = 0; i < rig.patches.size() && i < patches.size(); ++i) {
@@ -174,9 +173,9 @@ mocap::Result<std::vector<ElasticPatchSpec>> ResolveRigElastic(
     } else {
       spec.joint = character.skeleton.FindJoint(name);
       if (spec.joint < 0) {
-        return mocap::MakeError(mocap::ErrorCode::kNotFound, {rig.file, 0, 0, field},
-                                "expected a joint of " + character.source + ", found \"" + name +
-                                    "\"");
+        return base::MakeError(
+            base::ErrorCode::kNotFound, {rig.file, 0, 0, field},
+            "expected a joint of " + character.source + ", found \"" + name + "\"");
       }
     }
     specs.push_back(spec);
@@ -184,7 +183,7 @@ mocap::Result<std::vector<ElasticPatchSpec>> ResolveRigElastic(
   return specs;
 }
 
-mocap::Result<std::unique_ptr<ElasticLayer>> ElasticLayer::Create(
+base::Result<std::unique_ptr<ElasticLayer>> ElasticLayer::Create(
     const Character& c, std::span<const deform::PatchSetup> patches,
     std::vector<ElasticPatchSpec> specs) {
   auto layer = std::unique_ptr<ElasticLayer>(new ElasticLayer());
@@ -194,7 +193,7 @@ mocap::Result<std::unique_ptr<ElasticLayer>> ElasticLayer::Create(
   if (c.motion.num_frames < 1 || !(c.motion.frame_time_s > 0.0)) {
     return ElasticError(c, specs.front().patch, "", "expected a motion with frames to drive it");
   }
-  mocap::Result<std::vector<glm::mat4>> bind = BindModelFromJoint(c);
+  base::Result<std::vector<glm::mat4>> bind = BindModelFromJoint(c);
   if (!bind.ok()) return std::move(bind).error();
   const std::size_t nj = static_cast<std::size_t>(c.skeleton.num_joints());
   // One compact kinematics table per distinct cutoff, with a column per
@@ -252,7 +251,7 @@ mocap::Result<std::unique_ptr<ElasticLayer>> ElasticLayer::Create(
          .bind_rotation = bind_rotation, .max_angular_speed_rad_s = max_w},
         spec.params);
     if (!network.ok()) {
-      mocap::Error e = std::move(network).error();
+      base::Error e = std::move(network).error();
       e.loc.file = c.source;
       e.loc.field_path = "patches[" + std::to_string(spec.patch) + "].elastic";
       return e;
@@ -266,11 +265,11 @@ mocap::Result<std::unique_ptr<ElasticLayer>> ElasticLayer::Create(
   return layer;
 }
 
-mocap::Status ElasticLayer::RunAll(double time_s) {
+base::Status ElasticLayer::RunAll(double time_s) {
   const Character& c = *character_;
   for (Patch& p : patches_) {
     const Kinematics& table = kinematics_[static_cast<std::size_t>(p.kinematics)];
-    const mocap::JobStatus s =
+    const base::JobStatus s =
         deform::MassSpringStepJob{.network = &p.network,
                                   .state = &p.state,
                                   .time_s = time_s,
@@ -281,16 +280,16 @@ mocap::Status ElasticLayer::RunAll(double time_s) {
                                   .displacements = p.local}
             .Run();
     if (!s) {
-      return mocap::MakeError(mocap::ErrorCode::kInternal, {c.source, 0, 0, {}},
-                              std::string("elastic layer refused to run: ") + s.what);
+      return base::MakeError(base::ErrorCode::kInternal, {c.source, 0, 0, {}},
+                             std::string("elastic layer refused to run: ") + s.what);
     }
   }
-  return mocap::Status::Ok();
+  return base::Status::Ok();
 }
 
-mocap::Status ElasticLayer::Advance(double time_s, std::span<const glm::mat4> model_from_joint,
-                                    std::vector<std::vector<glm::vec3>>& displacements) {
-  if (patches_.empty()) return mocap::Status::Ok();
+base::Status ElasticLayer::Advance(double time_s, std::span<const glm::mat4> model_from_joint,
+                                   std::vector<std::vector<glm::vec3>>& displacements) {
+  if (patches_.empty()) return base::Status::Ok();
   constexpr double kEps = 1e-9;
   time_s = std::clamp(time_s, 0.0, duration_s_);
   if (!started_ || time_s < time_s_ - kEps) {
@@ -299,7 +298,7 @@ mocap::Status ElasticLayer::Advance(double time_s, std::span<const glm::mat4> mo
       p.state.Reset();
       p.baseline = p.state.counters();
     }
-    if (mocap::Status s = RunAll(0.0); !s.ok()) return s;
+    if (base::Status s = RunAll(0.0); !s.ok()) return s;
     started_ = true;
     time_s_ = 0.0;
   }
@@ -307,7 +306,7 @@ mocap::Status ElasticLayer::Advance(double time_s, std::span<const glm::mat4> mo
   // the state, does not depend on where the pieces end.
   while (time_s_ < time_s - kEps) {
     const double t = std::min(time_s, time_s_ + piece_s_);
-    if (mocap::Status s = RunAll(t); !s.ok()) return s;
+    if (base::Status s = RunAll(t); !s.ok()) return s;
     time_s_ = t;
   }
   for (Patch& p : patches_) {
@@ -321,7 +320,7 @@ mocap::Status ElasticLayer::Advance(double time_s, std::span<const glm::mat4> mo
     }
     p.displacement = largest;
   }
-  return mocap::Status::Ok();
+  return base::Status::Ok();
 }
 
 std::vector<ElasticPatchReport> ElasticLayer::Report() const {

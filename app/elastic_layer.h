@@ -23,7 +23,7 @@
 
 #include "deform/elastic/mass_spring.h"
 #include "deform/patch/patch_layer.h"
-#include "mocap/error.h"
+#include "base/error.h"
 #include "mocap/kinematics.h"
 
 namespace app {
@@ -44,7 +44,7 @@ struct ElasticPatchSpec {
 // `elastic.joint`, else the region's joint, else the joint with the largest
 // total skin weight on the patch's control points. Errors (kNotFound) name
 // "patches[i].elastic.joint".
-mocap::Result<std::vector<ElasticPatchSpec>> ResolveRigElastic(
+base::Result<std::vector<ElasticPatchSpec>> ResolveRigElastic(
     const Rig& rig, const Character& character, std::span<const deform::PatchSetup> patches);
 
 // What one elastic patch did, for reports and tests.
@@ -66,7 +66,7 @@ class ElasticLayer {
   // Errors: kInvalidArgument for a motion without frames, a patch index out of
   // range, a grid beyond 16 x 16 or parameters the network refuses (with
   // "patches[i].elastic" as the field path).
-  static mocap::Result<std::unique_ptr<ElasticLayer>> Create(
+  static base::Result<std::unique_ptr<ElasticLayer>> Create(
       const Character& character, std::span<const deform::PatchSetup> patches,
       std::vector<ElasticPatchSpec> specs);
 
@@ -74,8 +74,8 @@ class ElasticLayer {
   // elastic patch's displacement in model space, R_drv(t) e (#M x #N), into
   // displacements[spec.patch] (resized; the other entries are untouched).
   // model_from_joint: this frame's #J joint matrices (R_drv from them).
-  mocap::Status Advance(double time_s, std::span<const glm::mat4> model_from_joint,
-                        std::vector<std::vector<glm::vec3>>& displacements);
+  base::Status Advance(double time_s, std::span<const glm::mat4> model_from_joint,
+                       std::vector<std::vector<glm::vec3>>& displacements);
 
   std::vector<ElasticPatchReport> Report() const;
   int num_patches() const { return static_cast<int>(patches_.size()); }
@@ -97,7 +97,7 @@ class ElasticLayer {
     std::vector<int> joints;                     // #D distinct skeleton joints
     std::vector<mocap::JointKinematics> frames;  // #F x #D, column d = joints[d]
   };
-  mocap::Status RunAll(double time_s);
+  base::Status RunAll(double time_s);
 
   const Character* character_ = nullptr;
   std::vector<Patch> patches_;
@@ -112,7 +112,7 @@ class ElasticLayer {
 // joint paths low-passed at cutoff_hz first when it is > 0
 // (mocap::SmoothTrajectoriesJob), as the elastic layer and `patchskin elastic`
 // drive their networks.
-mocap::Result<std::vector<mocap::JointKinematics>> DrivingKinematics(
+base::Result<std::vector<mocap::JointKinematics>> DrivingKinematics(
     const mocap::Skeleton& skeleton, const mocap::Motion& motion, double cutoff_hz,
     const glm::mat4& model_from_root = glm::mat4(1.0f));
 
@@ -125,7 +125,7 @@ mocap::Result<std::vector<mocap::JointKinematics>> DrivingKinematics(
 // constant, instead of #F x #J x 252 B. Errors (kInvalidArgument) as
 // DrivingKinematics, and for a joint list that is empty, repeats a joint or
 // holds one out of range.
-mocap::Result<std::vector<mocap::JointKinematics>> DrivingKinematicsOf(
+base::Result<std::vector<mocap::JointKinematics>> DrivingKinematicsOf(
     const mocap::Skeleton& skeleton, const mocap::Motion& motion, std::span<const int> joints,
     double cutoff_hz, const glm::mat4& model_from_root = glm::mat4(1.0f));
 

@@ -4,14 +4,14 @@
 
 #include <cstdio>
 
-#include "mocap/error.h"
+#include "base/error.h"
 
 namespace app {
 
 // Prints `e` ("file:line:column: message") to stderr and returns its exit code.
-inline int ReportError(const mocap::Error& e) {
+inline int ReportError(const base::Error& e) {
   std::fprintf(stderr, "%s\n", e.ToString().c_str());
-  return e.code == mocap::ErrorCode::kInternal ? 3 : 2;
+  return e.code == base::ErrorCode::kInternal ? 3 : 2;
 }
 
 }  // namespace app

@@ -37,8 +37,8 @@ struct ObjMaterials {
 
 // materials.mtl and each texture's image as read (texture_K.png / .jpg) in
 // `folder`: map_Kd names the image, Kd the base colour factor.
-mocap::Result<ObjMaterials> WriteObjMaterialFiles(const deform::MeshMaterials& materials,
-                                                  const std::filesystem::path& folder) {
+base::Result<ObjMaterials> WriteObjMaterialFiles(const deform::MeshMaterials& materials,
+                                                 const std::filesystem::path& folder) {
   ObjMaterials out;
   out.library = "materials.mtl";
   std::vector<glm::vec3> diffuse;
@@ -53,11 +53,14 @@ mocap::Result<ObjMaterials> WriteObjMaterialFiles(const deform::MeshMaterials& m
       const deform::TextureImage& image = *materials.images[static_cast<std::size_t>(m.texture)];
       file = "texture_" + std::to_string(m.texture) + (image.mime_type == "image/jpeg" ? ".jpg" : ".png");
       const std::string_view bytes(reinterpret_cast<const char*>(image.encoded.data()), image.encoded.size());
-      if (mocap::Status s = deform::WriteFileAtomic((folder / file).string(), bytes); !s) return s.error();
+      if (base::Status s = deform::WriteFileAtomic((folder / file).string(), bytes); !s)
+        return s.error();
     }
     files.push_back(file);
   }
-  if (mocap::Status s = deform::WriteObjMaterials((folder / out.library).string(), out.names, diffuse, files); !s) {
+  if (base::Status s =
+          deform::WriteObjMaterials((folder / out.library).string(), out.names, diffuse, files);
+      !s) {
     return s.error();
   }
   return out;
@@ -78,7 +81,7 @@ nlohmann::json ColumnMajor(const glm::mat4& m) {
   return a;
 }
 
-mocap::Result<deform::GltfExportLayout> ParseLayout(const std::string& text) {
+base::Result<deform::GltfExportLayout> ParseLayout(const std::string& text) {
   if (text == "auto") return deform::GltfExportLayout::kAuto;
   if (text == "morph") return deform::GltfExportLayout::kMorphTargets;
   if (text == "baked") return deform::GltfExportLayout::kBakedMeshes;
@@ -113,13 +116,13 @@ int RunExport(const ExportOptions& options) {
   std::optional<Rig> rig;
   if (!o.layer.empty()) {
     // --layer auto: the rig `patchskin rig auto` writes; the options given here stay.
-    mocap::Result<Rig> made = AutoRigForCommand(o.layer, o.input, o.motion, o.body, o.up, o.quiet);
+    base::Result<Rig> made = AutoRigForCommand(o.layer, o.input, o.motion, o.body, o.up, o.quiet);
     if (!made.ok()) return ReportError(made.error());
     rig = std::move(*made);
     o.input = RigInputFile(*rig);
     if (!IsBuiltInBody(rig->character)) o.motion = rig->motion;
   } else if (Lower(std::filesystem::path(o.input).extension().string()) == ".json") {
-    mocap::Result<Rig> loaded = LoadRig(o.input);
+    base::Result<Rig> loaded = LoadRig(o.input);
     if (!loaded.ok()) return ReportError(loaded.error());
     rig = std::move(*loaded);
     o.input = RigInputFile(*rig);
@@ -136,7 +139,7 @@ int RunExport(const ExportOptions& options) {
   }
 
   // --- Arguments -------------------------------------------------------------
-  const mocap::Result<glm::ivec2> size = ParseSize(o.size);
+  const base::Result<glm::ivec2> size = ParseSize(o.size);
   if (!size.ok()) return ReportError(size.error());
   if (o.camera != "follow" && o.camera != "fixed") {
     return ReportError(ArgError("--camera", "expected follow or fixed, found '" + o.camera + "'"));
@@ -150,9 +153,9 @@ int RunExport(const ExportOptions& options) {
         "--scale", "expected 0 (detected units to metres) or a factor in 1e-6..1e6, found " +
                        std::to_string(o.scale)));
   }
-  const mocap::Result<GlobalMethod> method = ParseGlobalMethod(o.global);
+  const base::Result<GlobalMethod> method = ParseGlobalMethod(o.global);
   if (!method.ok()) return ReportError(method.error());
-  const mocap::Result<deform::GltfExportLayout> layout = ParseLayout(o.layout);
+  const base::Result<deform::GltfExportLayout> layout = ParseLayout(o.layout);
   if (!layout.ok()) return ReportError(layout.error());
 
   // --- Input (as render) --------------------------------------------------------
@@ -160,12 +163,12 @@ int RunExport(const ExportOptions& options) {
   const std::string name = demo  ? "demo"
                            : rig ? std::filesystem::path(rig->file).stem().string()
                                  : std::filesystem::path(o.input).stem().string();
-  const mocap::Result<std::optional<mocap::UpAxis>> up = ParseUpAxis(o.up);
+  const base::Result<std::optional<mocap::UpAxis>> up = ParseUpAxis(o.up);
   if (!up.ok()) return ReportError(up.error());
-  const mocap::Result<BodyKind> body = ParseBodyKind(o.body);
+  const base::Result<BodyKind> body = ParseBodyKind(o.body);
   if (!body.ok()) return ReportError(body.error());
   // A rig names its own body: its example edits may name that body's vertices.
-  mocap::Result<Character> character = LoadCommandCharacter(
+  base::Result<Character> character = LoadCommandCharacter(
       o.input, o.motion, o.quiet, *up, o.joint_map, nullptr, rig ? RigBodyKind(*rig) : *body);
   if (!character.ok()) return ReportError(character.error());
   const Character& ch = *character;
@@ -177,7 +180,7 @@ int RunExport(const ExportOptions& options) {
     }
     o.scale = metres > 0.0f ? metres : 1.0f;
   }
-  mocap::Result<FramePlan> plan = PlanFrames(
+  base::Result<FramePlan> plan = PlanFrames(
       ch.motion,
       {.frames = o.frames, .fps = o.fps, .start_number = o.start_number, .list_frames = false});
   if (!plan.ok()) return ReportError(plan.error());
@@ -201,21 +204,21 @@ int RunExport(const ExportOptions& options) {
   const std::filesystem::path out_dir =
       glb ? std::filesystem::path(out).parent_path()
           : std::filesystem::path(*render::ExpandFramePattern(out, 0)).parent_path();
-  if (mocap::Status s = PrepareOutputFolder(out_dir); !s) return ReportError(s.error());
+  if (base::Status s = PrepareOutputFolder(out_dir); !s) return ReportError(s.error());
 
   // --- Pipeline and cameras ----------------------------------------------------------
   // The layered result: with a rig, every layer it asks for (render draws the
   // same pipeline, or its right half when the rig splits the view).
-  mocap::Result<FramePipeline> pipeline = FramePipeline::Create(ch, *method, o.threads);
+  base::Result<FramePipeline> pipeline = FramePipeline::Create(ch, *method, o.threads);
   if (!pipeline.ok()) return ReportError(pipeline.error());
   if (rig) {
-    if (mocap::Status s = ApplyRigLayers(*rig, ch, *pipeline); !s) return ReportError(s.error());
+    if (base::Status s = ApplyRigLayers(*rig, ch, *pipeline); !s) return ReportError(s.error());
   }
   // The camera plan is built whether or not it is written: its framing
   // pre-pass evaluates the pipeline, as render's does before its frame loop,
   // so a pipeline that carries state between frames (the elastic layer) sees
   // the same sequence of evaluations here as there.
-  mocap::Result<CameraPlan> camera_plan =
+  base::Result<CameraPlan> camera_plan =
       CameraPlan::Create(*pipeline, *plan, o.camera, o.elevation_deg, *size);
   if (!camera_plan.ok()) return ReportError(camera_plan.error());
   const CameraPlan* cameras = o.with_camera ? &*camera_plan : nullptr;
@@ -238,9 +241,9 @@ int RunExport(const ExportOptions& options) {
     const deform::MeshMaterials& materials = ch.mesh.materials;
     const deform::GltfExportSurface surface{
         .uvs = bind.uvs, .materials = materials.materials.empty() ? nullptr : &materials};
-    mocap::Result<deform::GltfSequenceWriter> w = deform::GltfSequenceWriter::Create(
-        bind.triangles, bind.colors, bind.num_vertices(), static_cast<int>(plan->count()), go,
-        surface);
+    base::Result<deform::GltfSequenceWriter> w =
+        deform::GltfSequenceWriter::Create(bind.triangles, bind.colors, bind.num_vertices(),
+                                           static_cast<int>(plan->count()), go, surface);
     if (!w.ok()) return ReportError(w.error());
     gltf.emplace(std::move(*w));
   }
@@ -255,7 +258,7 @@ int RunExport(const ExportOptions& options) {
   deform::ObjSequenceWriter obj;
   ObjMaterials obj_materials;
   if (!glb && !ch.mesh.materials.materials.empty()) {
-    mocap::Result<ObjMaterials> written = WriteObjMaterialFiles(ch.mesh.materials, out_dir);
+    base::Result<ObjMaterials> written = WriteObjMaterialFiles(ch.mesh.materials, out_dir);
     if (!written.ok()) return ReportError(written.error());
     obj_materials = std::move(*written);
   }
@@ -268,7 +271,7 @@ int RunExport(const ExportOptions& options) {
   // are kept (files appear only whole, renamed into place).
   OutputGuard guard({.overwrite = true, .resume = o.resume});
   if (!glb) {
-    const mocap::Status planned = guard.Plan(
+    const base::Status planned = guard.Plan(
         plan->count(),
         [&](std::size_t i) { return render::ExpandFramePattern(out, plan->At(i).number); }, {});
     if (!planned.ok()) return ReportError(planned.error());
@@ -278,7 +281,7 @@ int RunExport(const ExportOptions& options) {
   for (std::size_t index = 0; index < plan->count(); ++index) {
     if (guard.interrupted()) break;
     const OutputFrame of = plan->At(index);
-    mocap::Status s = pipeline->Evaluate(of.time_s, frame);
+    base::Status s = pipeline->Evaluate(of.time_s, frame);
     if (!s.ok()) return ReportError(s.error());
     std::span<const glm::vec3> positions = frame.positions;
     if (o.scale != 1.0f) {
@@ -292,7 +295,7 @@ int RunExport(const ExportOptions& options) {
       // Written by an earlier run: evaluated above all the same, for the state
       // one frame hands the next (the elastic layer).
     } else {
-      const mocap::Result<std::string> path = render::ExpandFramePattern(out, of.number);
+      const base::Result<std::string> path = render::ExpandFramePattern(out, of.number);
       if (!path.ok()) return ReportError(path.error());
       char comment[160];
       std::snprintf(comment, sizeof(comment), "frame %d, t = %.6f s, %s skinning", of.number,
@@ -342,7 +345,7 @@ int RunExport(const ExportOptions& options) {
     return guard.exit_code();
   }
   if (gltf) {
-    if (mocap::Status s = gltf->Finish(out); !s) return ReportError(s.error());
+    if (base::Status s = gltf->Finish(out); !s) return ReportError(s.error());
   }
   progress.Finish();
   if (glb) {

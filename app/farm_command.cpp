@@ -44,7 +44,7 @@ std::string Absolute(const std::string& path) {
 }
 
 // Writes `text` to `path` under a temporary name, then renames it.
-mocap::Status WriteText(const fs::path& path, const std::string& text, bool executable) {
+base::Status WriteText(const fs::path& path, const std::string& text, bool executable) {
   // Appended piecewise: GCC 12 warns falsely (-Wrestrict) on "." + string.
   std::string name = ".";
   name += path.filename().string();
@@ -54,7 +54,8 @@ mocap::Status WriteText(const fs::path& path, const std::string& text, bool exec
     std::ofstream out(tmp, std::ios::binary);
     out << text;
     if (!out.flush()) {
-      return mocap::MakeError(mocap::ErrorCode::kIo, {path.string(), 0, 0, {}}, "cannot write the file");
+      return base::MakeError(base::ErrorCode::kIo, {path.string(), 0, 0, {}},
+                             "cannot write the file");
     }
   }
   std::error_code ec;
@@ -65,10 +66,10 @@ mocap::Status WriteText(const fs::path& path, const std::string& text, bool exec
   fs::rename(tmp, path, ec);
   if (ec) {
     fs::remove(tmp, ec);
-    return mocap::MakeError(mocap::ErrorCode::kIo, {path.string(), 0, 0, {}},
-                            "cannot write the file: " + ec.message());
+    return base::MakeError(base::ErrorCode::kIo, {path.string(), 0, 0, {}},
+                           "cannot write the file: " + ec.message());
   }
-  return mocap::Status::Ok();
+  return base::Status::Ok();
 }
 
 // Options farm sets on every render call itself.
@@ -100,7 +101,7 @@ int RunFarm(const FarmOptions& o) {
   std::string frames_text = o.frames, pattern = o.out, name = fs::path(o.input).stem().string();
   double fps = o.fps;
   if (fs::path(o.input).extension() == ".json") {
-    mocap::Result<Rig> rig = LoadRig(o.input);
+    base::Result<Rig> rig = LoadRig(o.input);
     if (!rig.ok()) return ReportError(rig.error());
     if (o.motion.empty()) motion_path = rig->motion.empty() ? rig->character : rig->motion;
     if (frames_text.empty()) frames_text = rig->render.frames;
@@ -111,9 +112,9 @@ int RunFarm(const FarmOptions& o) {
     return ReportError(ArgError("--fps", "expected 0 < fps <= 10000"));
   MotionSourceOptions load;
   load.y_up = true;
-  mocap::Result<MotionSource> src = LoadMotionSource(motion_path, load);
+  base::Result<MotionSource> src = LoadMotionSource(motion_path, load);
   if (!src.ok()) return ReportError(src.error());
-  mocap::Result<FramePlan> plan = PlanFrames(src->motion, {.frames = frames_text, .fps = fps});
+  base::Result<FramePlan> plan = PlanFrames(src->motion, {.frames = frames_text, .fps = fps});
   if (!plan.ok()) return ReportError(plan.error());
   const FrameRange range = plan->range;
   const int num_frames = static_cast<int>(plan->frames.size());
@@ -125,7 +126,7 @@ int RunFarm(const FarmOptions& o) {
         "--out", "the pattern '" + pattern + "' needs one frame placeholder such as #### or %04d"));
   }
   pattern = Absolute(pattern);
-  const mocap::Result<std::string> first_frame = render::ExpandFramePattern(pattern, range.first);
+  const base::Result<std::string> first_frame = render::ExpandFramePattern(pattern, range.first);
   if (!first_frame.ok()) return ReportError(first_frame.error());
   const fs::path frames_dir = fs::path(*first_frame).parent_path();
   const fs::path script_dir = o.script_dir.empty() ? frames_dir / "slurm" : fs::path(Absolute(o.script_dir));
@@ -133,8 +134,8 @@ int RunFarm(const FarmOptions& o) {
   std::error_code ec;
   const std::string exe = fs::read_symlink("/proc/self/exe", ec).string();
   if (ec) {
-    return ReportError(mocap::MakeError(mocap::ErrorCode::kInternal, {"/proc/self/exe", 0, 0, {}},
-                                        "cannot find the patchskin binary: " + ec.message()));
+    return ReportError(base::MakeError(base::ErrorCode::kInternal, {"/proc/self/exe", 0, 0, {}},
+                                       "cannot find the patchskin binary: " + ec.message()));
   }
   char rate[64];
   std::snprintf(rate, sizeof rate, "%.17g", 1.0 / plan->frame_time_s);
@@ -205,14 +206,14 @@ int RunFarm(const FarmOptions& o) {
 
   fs::create_directories(script_dir / "logs", ec);
   if (ec) {
-    return ReportError(mocap::MakeError(mocap::ErrorCode::kIo, {script_dir.string(), 0, 0, {}},
-                                        "cannot create the script folder: " + ec.message()));
+    return ReportError(base::MakeError(base::ErrorCode::kIo, {script_dir.string(), 0, 0, {}},
+                                       "cannot create the script folder: " + ec.message()));
   }
   for (const auto& [file, text, executable] :
        {std::tuple{"render_array.sbatch", &scripts.render_array, false},
         std::tuple{"sheet.sbatch", &scripts.sheet, false},
         std::tuple{"submit.sh", &scripts.submit, true}}) {
-    const mocap::Status s = WriteText(script_dir / file, *text, executable);
+    const base::Status s = WriteText(script_dir / file, *text, executable);
     if (!s.ok()) return ReportError(s.error());
   }
   const std::string submit_path = (script_dir / "submit.sh").string();
@@ -232,7 +233,7 @@ int RunFarm(const FarmOptions& o) {
   pid_t pid = -1;
   if (posix_spawn(&pid, "/bin/sh", nullptr, nullptr, argv.data(), environ) != 0) {
     return ReportError(
-        mocap::MakeError(mocap::ErrorCode::kIo, {submit_path, 0, 0, {}}, "cannot run /bin/sh"));
+        base::MakeError(base::ErrorCode::kIo, {submit_path, 0, 0, {}}, "cannot run /bin/sh"));
   }
   int status = 0;
   while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
@@ -251,7 +252,7 @@ int RunFarm(const FarmOptions& o) {
   int missing = 0;
   std::string first_missing;
   for (const OutputFrame& f : plan->frames) {
-    const mocap::Result<std::string> p = render::ExpandFramePattern(pattern, f.number);
+    const base::Result<std::string> p = render::ExpandFramePattern(pattern, f.number);
     if (p.ok() && fs::is_regular_file(*p, ec)) continue;
     if (missing++ == 0) first_missing = p.ok() ? *p : pattern;
   }

@@ -8,17 +8,17 @@
 #include <optional>
 #include <sstream>
 
-#include "mocap/check.h"
+#include "base/check.h"
 
 namespace app {
 
 constexpr int kMaxImageSide = 16384;
 
-mocap::Error ArgError(const std::string& option, const std::string& message) {
-  return mocap::MakeError(mocap::ErrorCode::kInvalidArgument, {option, 0, 0, {}}, message);
+base::Error ArgError(const std::string& option, const std::string& message) {
+  return base::MakeError(base::ErrorCode::kInvalidArgument, {option, 0, 0, {}}, message);
 }
 
-mocap::Result<glm::ivec2> ParseSize(const std::string& text) {
+base::Result<glm::ivec2> ParseSize(const std::string& text) {
   int w = 0, h = 0;
   char x = 0, extra = 0;
   std::istringstream in(text);
@@ -32,14 +32,14 @@ mocap::Result<glm::ivec2> ParseSize(const std::string& text) {
   return glm::ivec2(w, h);
 }
 
-mocap::Result<std::optional<mocap::UpAxis>> ParseUpAxis(const std::string& text) {
+base::Result<std::optional<mocap::UpAxis>> ParseUpAxis(const std::string& text) {
   if (text.empty()) return std::optional<mocap::UpAxis>();
   if (text == "y" || text == "Y") return std::optional<mocap::UpAxis>(mocap::UpAxis::kY);
   if (text == "z" || text == "Z") return std::optional<mocap::UpAxis>(mocap::UpAxis::kZ);
   return ArgError("--up", "expected y or z, found '" + text + "'");
 }
 
-mocap::Result<FrameRange> ParseFrames(const std::string& text, int num_frames) {
+base::Result<FrameRange> ParseFrames(const std::string& text, int num_frames) {
   FrameRange r{0, num_frames - 1, 1};
   if (text.empty()) return r;
   std::vector<std::string> parts;
@@ -72,7 +72,7 @@ mocap::Result<FrameRange> ParseFrames(const std::string& text, int num_frames) {
   return r;
 }
 
-mocap::Result<FramePlan> PlanFrames(const mocap::Motion& motion, const FramePlanOptions& o) {
+base::Result<FramePlan> PlanFrames(const mocap::Motion& motion, const FramePlanOptions& o) {
   FramePlan plan;
   plan.frame_time_s = o.fps > 0.0 ? 1.0 / o.fps
                                   : (motion.frame_time_s > 0 ? motion.frame_time_s : 1.0 / 30.0);
@@ -80,7 +80,7 @@ mocap::Result<FramePlan> PlanFrames(const mocap::Motion& motion, const FramePlan
       motion.num_frames > 0
           ? static_cast<int>(std::floor(motion.duration_s() / plan.frame_time_s + 1e-9)) + 1
           : 1;
-  mocap::Result<FrameRange> range = ParseFrames(o.frames, plan.motion_frames);
+  base::Result<FrameRange> range = ParseFrames(o.frames, plan.motion_frames);
   if (!range.ok()) return range.error();
   plan.range = *range;
   plan.turntable = o.turntable;
@@ -113,9 +113,9 @@ OutputFrame FramePlan::At(std::size_t i) const {
   return {start_number + f, f * frame_time_s, f};
 }
 
-mocap::Result<CameraPlan> CameraPlan::Create(FramePipeline& pipeline, const FramePlan& plan,
-                                             const std::string& mode, float elevation_deg,
-                                             glm::ivec2 size) {
+base::Result<CameraPlan> CameraPlan::Create(FramePipeline& pipeline, const FramePlan& plan,
+                                            const std::string& mode, float elevation_deg,
+                                            glm::ivec2 size) {
   CameraSpec spec;
   spec.mode = mode;
   spec.elevation_deg = elevation_deg;
@@ -160,8 +160,8 @@ void ApplyDistance(const CameraSpec& spec, float body_extent, render::Camera& c)
 
 }  // namespace
 
-mocap::Result<CameraPlan> CameraPlan::Create(FramePipeline& pipeline, const FramePlan& plan,
-                                             const CameraSpec& spec, glm::ivec2 size) {
+base::Result<CameraPlan> CameraPlan::Create(FramePipeline& pipeline, const FramePlan& plan,
+                                            const CameraSpec& spec, glm::ivec2 size) {
   const std::string& mode = spec.mode;
   const float elevation_deg = spec.elevation_deg;
   if (spec.azimuth_deg && !(std::abs(*spec.azimuth_deg) <= 3600.0f)) {
@@ -199,7 +199,7 @@ mocap::Result<CameraPlan> CameraPlan::Create(FramePipeline& pipeline, const Fram
   cp.look_region_ = spec.look_region;
   const bool look = spec.look_joint >= 0 || !spec.look_region.empty();
   cp.frame_time_s_ = plan.frame_time_s;
-  mocap::Result<FramePipeline> tracker =
+  base::Result<FramePipeline> tracker =
       FramePipeline::Create(pipeline.character(), GlobalMethod::kSsd, pipeline.threads());
   if (!tracker.ok()) return std::move(tracker).error();
   cp.tracker_ = std::make_unique<FramePipeline>(std::move(*tracker));
@@ -216,7 +216,7 @@ mocap::Result<CameraPlan> CameraPlan::Create(FramePipeline& pipeline, const Fram
   const std::int64_t samples = std::min<std::int64_t>(kFramingSamples, last + 1);
   for (std::int64_t i = 0; i < samples; ++i) {
     const std::int64_t f = samples > 1 ? last * i / (samples - 1) : 0;
-    const mocap::Status s = cp.tracker_->Evaluate(static_cast<double>(f) * plan.frame_time_s, frame);
+    const base::Status s = cp.tracker_->Evaluate(static_cast<double>(f) * plan.frame_time_s, frame);
     if (!s.ok()) return s.error();
     all_bounds.Extend(frame.bounds.min);
     all_bounds.Extend(frame.bounds.max);
@@ -240,7 +240,7 @@ mocap::Result<CameraPlan> CameraPlan::Create(FramePipeline& pipeline, const Fram
   const float aspect = static_cast<float>(size.x) / static_cast<float>(size.y);
   const glm::vec3 view_dir = ViewDirection(spec);
   if (mode == "turntable") {
-    const mocap::Status s = cp.tracker_->Evaluate(plan.At(0).time_s, frame);
+    const base::Status s = cp.tracker_->Evaluate(plan.At(0).time_s, frame);
     if (!s.ok()) return s.error();
     deform::Bounds box = frame.bounds;
     if (look) {
@@ -359,7 +359,7 @@ render::Camera CameraPlan::At(const OutputFrame& frame) const {
   for (int g = centre_base_ + static_cast<int>(centres_.size()); g <= f; ++g) {
     // Evaluate() only fails on sizes, which Create() already checked with
     // the same pipeline.
-    const mocap::Status s = tracker_->Evaluate(g * frame_time_s_, scratch_);
+    const base::Status s = tracker_->Evaluate(g * frame_time_s_, scratch_);
     PATCHSKIN_CHECK(s.ok());
     centres_.push_back(LookPoint(scratch_));
     boxes_.push_back(scratch_.bounds);

@@ -12,7 +12,7 @@
 #include <glm/glm.hpp>
 
 #include "app/pipeline.h"
-#include "mocap/error.h"
+#include "base/error.h"
 #include "mocap/motion.h"
 #include "mocap/skeleton.h"
 #include "render/camera.h"
@@ -25,13 +25,13 @@ inline constexpr float kFovYDeg = 35.0f;
 inline constexpr float kMaxElevationDeg = 89.0f;
 
 // kInvalidArgument naming the command-line option, e.g. "--frames: error: ...".
-mocap::Error ArgError(const std::string& option, const std::string& message);
+base::Error ArgError(const std::string& option, const std::string& message);
 
 // "WxH" with both sides in 16..16384.
-mocap::Result<glm::ivec2> ParseSize(const std::string& text);
+base::Result<glm::ivec2> ParseSize(const std::string& text);
 
 // --up: "y" or "z" (either case) -> that axis; "" -> empty (detect it).
-mocap::Result<std::optional<mocap::UpAxis>> ParseUpAxis(const std::string& text);
+base::Result<std::optional<mocap::UpAxis>> ParseUpAxis(const std::string& text);
 
 // Output frames first..last (inclusive) every step.
 struct FrameRange {
@@ -42,7 +42,7 @@ struct FrameRange {
 
 // "A:B[:STEP]" (A or B may be empty: 0 / the last frame; "A" alone is one
 // frame) within 0..num_frames-1; empty text = all frames.
-mocap::Result<FrameRange> ParseFrames(const std::string& text, int num_frames);
+base::Result<FrameRange> ParseFrames(const std::string& text, int num_frames);
 
 // Everything about one output frame that a frame loop needs.
 struct OutputFrame {
@@ -86,7 +86,7 @@ struct FramePlan {
 inline constexpr int kMaxStartNumber = 100'000'000;
 
 // Errors: kInvalidArgument from ParseFrames, or --start-number outside 0..kMaxStartNumber.
-mocap::Result<FramePlan> PlanFrames(const mocap::Motion& motion, const FramePlanOptions& options);
+base::Result<FramePlan> PlanFrames(const mocap::Motion& motion, const FramePlanOptions& options);
 
 // Where the camera looks from and what it frames (render --camera, --azimuth,
 // --elevation, --distance, --zoom, --look-at; a rig's render.camera object).
@@ -142,13 +142,13 @@ class CameraPlan {
   // `pipeline` only supplies the character and thread count; it must outlive
   // nothing here (the character must outlive the CameraPlan).
   // Errors: kInvalidArgument (mode), and the pipeline's errors.
-  static mocap::Result<CameraPlan> Create(FramePipeline& pipeline, const FramePlan& plan,
-                                          const std::string& mode, float elevation_deg,
-                                          glm::ivec2 size);
+  static base::Result<CameraPlan> Create(FramePipeline& pipeline, const FramePlan& plan,
+                                         const std::string& mode, float elevation_deg,
+                                         glm::ivec2 size);
   // The same with every camera setting (CameraSpec); kInvalidArgument naming
   // --azimuth, --distance, --zoom or --look-at for values out of range.
-  static mocap::Result<CameraPlan> Create(FramePipeline& pipeline, const FramePlan& plan,
-                                          const CameraSpec& spec, glm::ivec2 size);
+  static base::Result<CameraPlan> Create(FramePipeline& pipeline, const FramePlan& plan,
+                                         const CameraSpec& spec, glm::ivec2 size);
 
   // The camera of `frame` (one of the plan's frames). Follow: evaluates the
   // frames of its window not seen yet, so ascending frames cost one body

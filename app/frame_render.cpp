@@ -73,10 +73,10 @@ void DrawColorBar(float scale, render::Image& image) {
   render::DrawText({.text = "|d|", .origin_px = {x0 - 10, y0 - 8}, .scale = size}, image);
 }
 
-mocap::Status DrawOne(const Character& ch, const DeformedFrame& f, const render::Camera& camera,
-                      const render::RenderSettings& settings, const FrameDrawOptions& o,
-                      const std::string& label, int label_x, bool frame_label,
-                      std::span<const glm::vec3> colors, render::Renderer& r, render::Image& into) {
+base::Status DrawOne(const Character& ch, const DeformedFrame& f, const render::Camera& camera,
+                     const render::RenderSettings& settings, const FrameDrawOptions& o,
+                     const std::string& label, int label_x, bool frame_label,
+                     std::span<const glm::vec3> colors, render::Renderer& r, render::Image& into) {
   const deform::Mesh& bind = ch.mesh.bind;
   render::SceneMesh body{.positions = f.positions, .normals = f.normals,
                          .triangles = bind.triangles,
@@ -104,25 +104,25 @@ mocap::Status DrawOne(const Character& ch, const DeformedFrame& f, const render:
     const double scale = std::min(0.8, 0.8 * room / (15.0 * static_cast<double>(label.size())));
     overlays.text.push_back({.text = label, .origin_px = {label_x, 30}, .scale = std::max(scale, 0.3)});
   }
-  const mocap::JobStatus js = r.Render(camera, {&body, 1}, overlays, settings, into);
+  const base::JobStatus js = r.Render(camera, {&body, 1}, overlays, settings, into);
   if (!js) {
-    return mocap::MakeError(mocap::ErrorCode::kInternal, {ch.source, 0, 0, {}},
-                            std::string("renderer refused the frame: ") + js.what);
+    return base::MakeError(base::ErrorCode::kInternal, {ch.source, 0, 0, {}},
+                           std::string("renderer refused the frame: ") + js.what);
   }
-  return mocap::Status::Ok();
+  return base::Status::Ok();
 }
 
 }  // namespace
 
-mocap::Status DrawCharacterFrame(const Character& character, const DeformedFrame& frame,
-                                 const DeformedFrame* right, const render::Camera& camera,
-                                 const render::RenderSettings& settings,
-                                 const FrameDrawOptions& options, render::Renderer& renderer,
-                                 render::Renderer& right_renderer, render::Image& scratch,
-                                 render::Image& into) {
+base::Status DrawCharacterFrame(const Character& character, const DeformedFrame& frame,
+                                const DeformedFrame* right, const render::Camera& camera,
+                                const render::RenderSettings& settings,
+                                const FrameDrawOptions& options, render::Renderer& renderer,
+                                render::Renderer& right_renderer, render::Image& scratch,
+                                render::Image& into) {
   if (right == nullptr) {
-    mocap::Status s = DrawOne(character, frame, camera, settings, options, "", 0, true,
-                              options.left_colors, renderer, into);
+    base::Status s = DrawOne(character, frame, camera, settings, options, "", 0, true,
+                             options.left_colors, renderer, into);
     if (s.ok() && options.color_bar_scale > 0.0f) DrawColorBar(options.color_bar_scale, into);
     return s;
   }
@@ -130,8 +130,8 @@ mocap::Status DrawCharacterFrame(const Character& character, const DeformedFrame
     // Each body whole in its own half: two renders of half the width, pasted.
     render::RenderSettings half = settings;
     half.width = settings.width / 2;
-    mocap::Status s = DrawOne(character, frame, camera, half, options, options.left_label, 10,
-                              true, options.left_colors, renderer, scratch);
+    base::Status s = DrawOne(character, frame, camera, half, options, options.left_label, 10, true,
+                             options.left_colors, renderer, scratch);
     if (!s.ok()) return s;
     if (into.width != settings.width || into.height != settings.height) {
       into = render::Image(settings.width, settings.height);
@@ -145,17 +145,17 @@ mocap::Status DrawCharacterFrame(const Character& character, const DeformedFrame
     PasteHalf(scratch, settings.width / 2, into);
     DrawDivider(into);
     if (options.color_bar_scale > 0.0f) DrawColorBar(options.color_bar_scale, into);
-    return mocap::Status::Ok();
+    return base::Status::Ok();
   }
-  mocap::Status s = DrawOne(character, frame, camera, settings, options, options.left_label, 10,
-                            true, options.left_colors, renderer, into);
+  base::Status s = DrawOne(character, frame, camera, settings, options, options.left_label, 10,
+                           true, options.left_colors, renderer, into);
   if (!s.ok()) return s;
   s = DrawOne(character, *right, camera, settings, options, options.right_label,
               settings.width / 2 + 10, true, options.right_colors, right_renderer, scratch);
   if (!s.ok()) return s;
   ComposeSplit(scratch, into);
   if (options.color_bar_scale > 0.0f) DrawColorBar(options.color_bar_scale, into);
-  return mocap::Status::Ok();
+  return base::Status::Ok();
 }
 
 std::shared_ptr<const CharacterTextures> BuildCharacterTextures(const deform::SkinnedMesh& mesh) {

@@ -14,7 +14,7 @@
 
 #include "app/pipeline.h"
 #include "deform/patch/patch_layer.h"
-#include "mocap/error.h"
+#include "base/error.h"
 #include "render/camera.h"
 #include "render/image.h"
 #include "render/renderer.h"
@@ -78,11 +78,11 @@ float NiceScale(float value);
 // `right` is set, `frame` and `right` side by side or as a wipe, with a
 // divider. `right_renderer` and `scratch` are only used for two bodies.
 // Errors: kInternal when the renderer refuses the frame.
-mocap::Status DrawCharacterFrame(const Character& character, const DeformedFrame& frame,
-                                 const DeformedFrame* right, const render::Camera& camera,
-                                 const render::RenderSettings& settings,
-                                 const FrameDrawOptions& options, render::Renderer& renderer,
-                                 render::Renderer& right_renderer, render::Image& scratch,
-                                 render::Image& into);
+base::Status DrawCharacterFrame(const Character& character, const DeformedFrame& frame,
+                                const DeformedFrame* right, const render::Camera& camera,
+                                const render::RenderSettings& settings,
+                                const FrameDrawOptions& options, render::Renderer& renderer,
+                                render::Renderer& right_renderer, render::Image& scratch,
+                                render::Image& into);
 
 }  // namespace app

@@ -55,10 +55,10 @@ int YRotationChannel(const mocap::Skeleton& s, const char* joint) {
 }
 
 // Standing (the jump's first frame) with a head shake; see the file comment.
-mocap::Result<mocap::Motion> MakeHeadShake(const mocap::Skeleton& skeleton) {
+base::Result<mocap::Motion> MakeHeadShake(const mocap::Skeleton& skeleton) {
   mocap::JumpOptions jump;
   jump.frame_time_s = 1.0 / 60.0;
-  mocap::Result<mocap::Motion> stand = mocap::MakeJumpMotion(skeleton, jump);
+  base::Result<mocap::Motion> stand = mocap::MakeJumpMotion(skeleton, jump);
   if (!stand.ok()) return stand;
   mocap::Motion m = std::move(*stand);
   m.values.resize(static_cast<std::size_t>(m.num_channels));  // frame 0 only
@@ -66,8 +66,8 @@ mocap::Result<mocap::Motion> MakeHeadShake(const mocap::Skeleton& skeleton) {
   HoldLastFrame(m, 0.5 + 1.0 + kStillAfterS);
   const int neck = YRotationChannel(skeleton, "Neck"), head = YRotationChannel(skeleton, "Head");
   if (neck < 0 || head < 0) {
-    return mocap::MakeError(mocap::ErrorCode::kNotFound, {"synthetic", 0, 0, {}},
-                            "expected Neck and Head joints with Y rotation channels");
+    return base::MakeError(base::ErrorCode::kNotFound, {"synthetic", 0, 0, {}},
+                           "expected Neck and Head joints with Y rotation channels");
   }
   for (int f = 0; f < m.num_frames; ++f) {
     const double t = f * m.frame_time_s - 0.5;
@@ -92,7 +92,7 @@ int main(int argc, char** argv) {
   const mocap::Skeleton skeleton = mocap::MakeHumanoidSkeleton();
   mocap::WalkOptions walk;
   walk.num_cycles = 3;
-  mocap::Result<mocap::Motion> motion = mocap::MakeWalkMotion(skeleton, walk);
+  base::Result<mocap::Motion> motion = mocap::MakeWalkMotion(skeleton, walk);
   if (mode == "--bend") motion = mocap::MakeBendRamp(skeleton, 150.0f, 2.0);
   if (mode == "--shoulder") motion = mocap::MakeShoulderSweep(skeleton);
   if (mode == "--hip") motion = mocap::MakeHipSwing(skeleton);
@@ -105,7 +105,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "%s\n", motion.error().ToString().c_str());
     return 2;
   }
-  const mocap::Status s = mocap::WriteBvhFile(argv[argc - 1], skeleton, *motion);
+  const base::Status s = mocap::WriteBvhFile(argv[argc - 1], skeleton, *motion);
   if (!s.ok()) {
     std::fprintf(stderr, "%s\n", s.error().ToString().c_str());
     return 2;

@@ -173,28 +173,28 @@ void PrintJson(const MotionSource& src, const InspectOptions& options) {
 
 // Collapse and candy-wrapper figures of SSD, DQS and SWD on the file's body.
 int PrintArtifacts(MotionSource&& src, const std::string& file) {
-  mocap::Result<Character> ch = MakeCharacter(std::move(src));
+  base::Result<Character> ch = MakeCharacter(std::move(src));
   if (!ch.ok()) {
     std::fprintf(stderr, "%s\n", ch.error().ToString().c_str());
     return 2;
   }
-  mocap::Result<std::vector<glm::mat4>> bind = BindModelFromJoint(*ch);
-  mocap::Result<deform::SwdRig> rig =
+  base::Result<std::vector<glm::mat4>> bind = BindModelFromJoint(*ch);
+  base::Result<deform::SwdRig> rig =
       bind.ok() ? deform::BuildSwdRig(ch->skeleton, *bind, ch->mesh.bind,
                                       {.vertex_chains = ch->mesh.body_chain_coords})
-                : mocap::Result<deform::SwdRig>(bind.error());
+                : base::Result<deform::SwdRig>(bind.error());
   if (!rig.ok()) {
-    mocap::Error e = std::move(rig).error();
+    base::Error e = std::move(rig).error();
     if (e.loc.file.empty()) e.loc.file = file;
     std::fprintf(stderr, "%s\n", e.ToString().c_str());
     return 2;
   }
   const std::vector<double> bends = {90.0, 120.0, 150.0};
   const std::vector<double> twists = {90.0, 180.0};
-  mocap::Result<std::vector<deform::LimbArtifacts>> figures =
+  base::Result<std::vector<deform::LimbArtifacts>> figures =
       deform::MeasureLimbArtifacts(ch->skeleton, *bind, ch->mesh, *rig, bends, twists);
   if (!figures.ok()) {
-    mocap::Error e = std::move(figures).error();
+    base::Error e = std::move(figures).error();
     if (e.loc.file.empty()) e.loc.file = file;
     std::fprintf(stderr, "%s\n", e.ToString().c_str());
     return 2;
@@ -222,13 +222,13 @@ int PrintArtifacts(MotionSource&& src, const std::string& file) {
 // `inspect MODEL --motion X.bvh`: how the motion's joints drive the character's.
 int PrintRetarget(const InspectOptions& options) {
   RetargetReport r;
-  const mocap::Result<std::optional<mocap::UpAxis>> up = ParseUpAxis(options.up);
+  const base::Result<std::optional<mocap::UpAxis>> up = ParseUpAxis(options.up);
   if (!up.ok()) {
     std::fprintf(stderr, "%s\n", up.error().ToString().c_str());
     return 2;
   }
-  mocap::Result<Character> ch = LoadCommandCharacter(options.file, options.motion,
-                                                     /*quiet=*/false, *up, options.joint_map, &r);
+  base::Result<Character> ch = LoadCommandCharacter(options.file, options.motion,
+                                                    /*quiet=*/false, *up, options.joint_map, &r);
   if (!ch.ok()) {
     std::fprintf(stderr, "%s\n", ch.error().ToString().c_str());
     return 2;
@@ -273,7 +273,7 @@ int RunInspect(const InspectOptions& options) {
   MotionSourceOptions load;
   load.scale = options.scale;
   load.y_up = options.y_up;
-  const mocap::Result<std::optional<mocap::UpAxis>> up = ParseUpAxis(options.up);
+  const base::Result<std::optional<mocap::UpAxis>> up = ParseUpAxis(options.up);
   if (!up.ok()) {
     std::fprintf(stderr, "%s\n", up.error().ToString().c_str());
     return 2;
@@ -282,12 +282,12 @@ int RunInspect(const InspectOptions& options) {
   load.add_position_to_offset = options.add_position_to_offset;
   load.allow_short_motion = options.allow_short;
   load.require_skin = false;  // inspect describes any glTF, an exported (skinless) .glb too
-  mocap::Result<MotionSource> src = LoadMotionSource(options.file, load);
+  base::Result<MotionSource> src = LoadMotionSource(options.file, load);
   if (!src.ok()) {
     std::fprintf(stderr, "%s\n", src.error().ToString().c_str());
     return 2;
   }
-  for (const mocap::Warning& w : src->warnings) std::fprintf(stderr, "%s\n", w.ToString().c_str());
+  for (const base::Warning& w : src->warnings) std::fprintf(stderr, "%s\n", w.ToString().c_str());
   if (options.frame) {
     const int last = src->motion.num_frames - 1;
     if (*options.frame < 0 || *options.frame > std::max(last, 0)) {

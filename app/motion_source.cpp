@@ -40,36 +40,36 @@ MotionSource FromBvh(mocap::BvhFile&& file) {
 
 }  // namespace
 
-mocap::Result<MotionSource> LoadBvhText(std::string_view text, const std::string& name,
-                                        const MotionSourceOptions& options) {
-  mocap::Result<mocap::BvhFile> file = mocap::ParseBvh(text, name, BvhOptions(options));
+base::Result<MotionSource> LoadBvhText(std::string_view text, const std::string& name,
+                                       const MotionSourceOptions& options) {
+  base::Result<mocap::BvhFile> file = mocap::ParseBvh(text, name, BvhOptions(options));
   if (!file.ok()) return std::move(file).error();
   return FromBvh(std::move(*file));
 }
 
-mocap::Result<MotionSource> LoadMotionSource(const std::string& path,
-                                             const MotionSourceOptions& options) {
-  const mocap::FileLoc loc{path, 0, 0, {}};
+base::Result<MotionSource> LoadMotionSource(const std::string& path,
+                                            const MotionSourceOptions& options) {
+  const base::FileLoc loc{path, 0, 0, {}};
   std::error_code ec;
   const auto status = std::filesystem::status(path, ec);
   if (ec || !std::filesystem::exists(status)) {
-    return mocap::MakeError(mocap::ErrorCode::kIo, loc, "no such file");
+    return base::MakeError(base::ErrorCode::kIo, loc, "no such file");
   }
   if (std::filesystem::is_directory(status)) {
-    return mocap::MakeError(mocap::ErrorCode::kIo, loc,
-                            "expected a BVH, glTF or GLB file, found a directory");
+    return base::MakeError(base::ErrorCode::kIo, loc,
+                           "expected a BVH, glTF or GLB file, found a directory");
   }
   const std::string ext = LowerExtension(path);
   MotionSource out;
   if (ext == ".bvh") {
-    mocap::Result<mocap::BvhFile> file = mocap::ReadBvhFile(path, BvhOptions(options));
+    base::Result<mocap::BvhFile> file = mocap::ReadBvhFile(path, BvhOptions(options));
     if (!file.ok()) return std::move(file).error();
     return FromBvh(std::move(*file));
   }
   if (ext == ".gltf" || ext == ".glb") {
     deform::GltfReadOptions read;
     read.require_skin = options.require_skin;
-    mocap::Result<deform::GltfModel> model = deform::ReadGltf(path, read);
+    base::Result<deform::GltfModel> model = deform::ReadGltf(path, read);
     if (!model.ok()) return std::move(model).error();
     out.format = ext.substr(1);
     out.warnings = model->warnings;
@@ -80,12 +80,12 @@ mocap::Result<MotionSource> LoadMotionSource(const std::string& path,
     } else {
       if (options.animation < 0 ||
           options.animation >= static_cast<int>(model->animations.size())) {
-        return mocap::MakeError(mocap::ErrorCode::kInvalidArgument, loc,
-                                "animation " + std::to_string(options.animation) +
-                                    " does not exist (the file has " +
-                                    std::to_string(model->animations.size()) + ")");
+        return base::MakeError(base::ErrorCode::kInvalidArgument, loc,
+                               "animation " + std::to_string(options.animation) +
+                                   " does not exist (the file has " +
+                                   std::to_string(model->animations.size()) + ")");
       }
-      mocap::Result<mocap::Motion> motion =
+      base::Result<mocap::Motion> motion =
           deform::AnimationToMotion(*model, options.animation, options.frame_time_s);
       if (!motion.ok()) return std::move(motion).error();
       out.motion = std::move(*motion);
@@ -96,8 +96,8 @@ mocap::Result<MotionSource> LoadMotionSource(const std::string& path,
     out.gltf = std::move(*model);
     return out;
   }
-  return mocap::MakeError(mocap::ErrorCode::kUnsupported, loc,
-                          "expected a .bvh, .gltf or .glb file, found extension '" + ext + "'");
+  return base::MakeError(base::ErrorCode::kUnsupported, loc,
+                         "expected a .bvh, .gltf or .glb file, found extension '" + ext + "'");
 }
 
 }  // namespace app

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "deform/io/gltf_import.h"
-#include "mocap/error.h"
+#include "base/error.h"
 #include "mocap/motion.h"
 #include "mocap/skeleton.h"
 
@@ -31,7 +31,7 @@ struct MotionSource {
   std::string format;                  // "bvh", "gltf" or "glb"
   mocap::Skeleton skeleton;
   mocap::Motion motion;
-  std::vector<mocap::Warning> warnings;
+  std::vector<base::Warning> warnings;
   std::optional<deform::GltfModel> gltf;  // the character, for glTF inputs
   int mesh_vertices = 0;
   int mesh_triangles = 0;
@@ -39,11 +39,11 @@ struct MotionSource {
 
 // Reads `path`. Errors (kIo for a missing file or a directory, kUnsupported for
 // an unknown extension, anything the readers report) name the file.
-mocap::Result<MotionSource> LoadMotionSource(const std::string& path,
-                                             const MotionSourceOptions& options);
+base::Result<MotionSource> LoadMotionSource(const std::string& path,
+                                            const MotionSourceOptions& options);
 
 // Parses BVH text held in memory (the built-in demo); `name` labels messages.
-mocap::Result<MotionSource> LoadBvhText(std::string_view text, const std::string& name,
-                                        const MotionSourceOptions& options);
+base::Result<MotionSource> LoadBvhText(std::string_view text, const std::string& name,
+                                       const MotionSourceOptions& options);
 
 }  // namespace app

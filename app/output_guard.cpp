@@ -50,18 +50,18 @@ struct OutputGuard::SavedHandlers {
   struct sigaction term_action {};
 };
 
-mocap::Status CheckRigOutputPattern(const std::string& pattern, const mocap::FileLoc& where) {
-  const auto refuse = [&](const std::string& why) -> mocap::Status {
-    return mocap::MakeError(mocap::ErrorCode::kInvalidArgument, where,
-                            "expected a relative path inside the rig's output folder, found '" +
-                                pattern + "' (" + why + ")");
+base::Status CheckRigOutputPattern(const std::string& pattern, const base::FileLoc& where) {
+  const auto refuse = [&](const std::string& why) -> base::Status {
+    return base::MakeError(base::ErrorCode::kInvalidArgument, where,
+                           "expected a relative path inside the rig's output folder, found '" +
+                               pattern + "' (" + why + ")");
   };
   if (pattern.empty()) return refuse("empty");
   if (pattern.front() == '/' || pattern.front() == '\\') return refuse("an absolute path");
   if (pattern.size() >= 2 && pattern[1] == ':') return refuse("a drive letter");
   if (pattern.front() == '~') return refuse("a home-folder path");
   if (HasDotDot(pattern)) return refuse("a '..' component");
-  return mocap::Status::Ok();
+  return base::Status::Ok();
 }
 
 OutputGuard::OutputGuard(OutputGuardOptions options)
@@ -81,59 +81,58 @@ OutputGuard::~OutputGuard() {
   delete saved_;
 }
 
-mocap::Status OutputGuard::Plan(const std::vector<std::string>& frame_paths,
-                                const std::vector<std::string>& other_paths) {
+base::Status OutputGuard::Plan(const std::vector<std::string>& frame_paths,
+                               const std::vector<std::string>& other_paths) {
   return Plan(
       frame_paths.size(),
-      [&frame_paths](std::size_t i) -> mocap::Result<std::string> { return frame_paths[i]; },
+      [&frame_paths](std::size_t i) -> base::Result<std::string> { return frame_paths[i]; },
       other_paths);
 }
 
-mocap::Status OutputGuard::Plan(
-    std::size_t num_frames,
-    const std::function<mocap::Result<std::string>(std::size_t)>& frame_path,
+base::Status OutputGuard::Plan(
+    std::size_t num_frames, const std::function<base::Result<std::string>(std::size_t)>& frame_path,
     const std::vector<std::string>& other_paths) {
   skip_.assign(num_frames, false);
   num_skipped_ = 0;
   int existing = 0;
   std::string first_existing;
-  const auto check = [&](const std::string& path, bool is_frame, std::size_t i) -> mocap::Status {
+  const auto check = [&](const std::string& path, bool is_frame, std::size_t i) -> base::Status {
     std::error_code ec;
     const auto status = std::filesystem::symlink_status(path, ec);
-    if (ec || !std::filesystem::exists(status)) return mocap::Status::Ok();
+    if (ec || !std::filesystem::exists(status)) return base::Status::Ok();
     if (!std::filesystem::is_regular_file(status)) {
-      return mocap::MakeError(mocap::ErrorCode::kIo, {path, 0, 0, {}},
-                              "expected an image file or nothing at this output path, found "
-                              "something else (a folder or a link)");
+      return base::MakeError(base::ErrorCode::kIo, {path, 0, 0, {}},
+                             "expected an image file or nothing at this output path, found "
+                             "something else (a folder or a link)");
     }
     if (is_frame && options_.resume) {
       skip_[i] = true;
       ++num_skipped_;
-      return mocap::Status::Ok();
+      return base::Status::Ok();
     }
     if (first_existing.empty()) first_existing = path;
     ++existing;
-    return mocap::Status::Ok();
+    return base::Status::Ok();
   };
   for (std::size_t i = 0; i < num_frames; ++i) {
-    mocap::Result<std::string> path = frame_path(i);
+    base::Result<std::string> path = frame_path(i);
     if (!path.ok()) return path.error();
-    if (mocap::Status s = check(*path, true, i); !s) return s;
+    if (base::Status s = check(*path, true, i); !s) return s;
   }
   if (!options_.resume) {
     for (const std::string& p : other_paths) {
-      if (mocap::Status s = check(p, false, 0); !s) return s;
+      if (base::Status s = check(p, false, 0); !s) return s;
     }
   }
   if (existing > 0 && !options_.overwrite) {
-    return mocap::MakeError(
-        mocap::ErrorCode::kInvalidArgument, {first_existing, 0, 0, {}},
+    return base::MakeError(
+        base::ErrorCode::kInvalidArgument, {first_existing, 0, 0, {}},
         "output file exists (" + std::to_string(existing) + " of this render's " +
             std::to_string(num_frames + other_paths.size()) +
             " outputs do); expected a free output path: pass --overwrite to replace them or "
             "--resume to render only the missing frames");
   }
-  return mocap::Status::Ok();
+  return base::Status::Ok();
 }
 
 bool OutputGuard::interrupted() const { return g_signal != 0; }
@@ -160,17 +159,17 @@ const char* OutputGuard::signal_name() const {
   return signal_number() == 0 ? "no signal" : SignalName(signal_number());
 }
 
-mocap::Status PrepareOutputFolder(const std::filesystem::path& dir) {
+base::Status PrepareOutputFolder(const std::filesystem::path& dir) {
   const std::filesystem::path folder = dir.empty() ? std::filesystem::path(".") : dir;
-  const mocap::FileLoc loc{folder.string(), 0, 0, {}};
+  const base::FileLoc loc{folder.string(), 0, 0, {}};
   std::error_code ec;
   std::filesystem::create_directories(folder, ec);
   if (ec) {
     const std::string reason = ec == std::errc::permission_denied ? "permission denied: "
                                : ec == std::errc::read_only_file_system ? "read-only file system: "
                                                                         : "";
-    return mocap::MakeError(mocap::ErrorCode::kIo, loc,
-                            reason + "cannot create the output folder: " + ec.message());
+    return base::MakeError(base::ErrorCode::kIo, loc,
+                           reason + "cannot create the output folder: " + ec.message());
   }
   const std::string probe = (folder / (".patchskin-probe-" + std::to_string(::getpid()))).string();
   const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
@@ -179,12 +178,12 @@ mocap::Status PrepareOutputFolder(const std::filesystem::path& dir) {
     const std::string reason = err == EACCES || err == EPERM ? "permission denied"
                                : err == EROFS                ? "read-only file system"
                                                              : std::strerror(err);
-    return mocap::MakeError(mocap::ErrorCode::kIo, loc,
-                            reason + ": cannot write in the output folder");
+    return base::MakeError(base::ErrorCode::kIo, loc,
+                           reason + ": cannot write in the output folder");
   }
   ::close(fd);
   ::unlink(probe.c_str());
-  return mocap::Status::Ok();
+  return base::Status::Ok();
 }
 
 void OutputGuard::SimulateSignal(int signal) { g_signal = signal; }

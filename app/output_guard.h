@@ -26,7 +26,7 @@
 #include <string_view>
 #include <vector>
 
-#include "mocap/error.h"
+#include "base/error.h"
 
 namespace app {
 
@@ -35,8 +35,8 @@ namespace app {
 // rig file and field, e.g. {"walk.rig.json", 0, 0, "render.output"}.
 // kInvalidArgument: "expected a relative path inside the rig's output folder,
 // found '../x/####.png' (a '..' component)".
-[[nodiscard]] mocap::Status CheckRigOutputPattern(const std::string& pattern,
-                                                  const mocap::FileLoc& where);
+[[nodiscard]] base::Status CheckRigOutputPattern(const std::string& pattern,
+                                                 const base::FileLoc& where);
 
 // Creates `dir` (and its parents) when missing and checks that a file can be
 // created in it, by creating and removing an empty hidden one, so a render or
@@ -44,7 +44,7 @@ namespace app {
 // cannot write in the output folder" naming the folder (or "cannot create the
 // output folder: ..." with the system's reason). An empty `dir` is the
 // current folder.
-[[nodiscard]] mocap::Status PrepareOutputFolder(const std::filesystem::path& dir);
+[[nodiscard]] base::Status PrepareOutputFolder(const std::filesystem::path& dir);
 
 struct OutputGuardOptions {
   bool overwrite = false;  // --overwrite: replace existing outputs
@@ -68,14 +68,14 @@ class OutputGuard {
   // and the two options, when outputs exist without --overwrite / --resume;
   // kIo when a path exists but is not a regular file (a folder named like a
   // frame). Call before rendering anything.
-  [[nodiscard]] mocap::Status Plan(const std::vector<std::string>& frame_paths,
-                                   const std::vector<std::string>& other_paths);
+  [[nodiscard]] base::Status Plan(const std::vector<std::string>& frame_paths,
+                                  const std::vector<std::string>& other_paths);
   // The same for `num_frames` frames whose paths frame_path(i) gives one at a
   // time (an error from it is returned as is), so a render of ~430,000 frames
   // holds no list of their names: memory is one bit per frame.
-  [[nodiscard]] mocap::Status Plan(
+  [[nodiscard]] base::Status Plan(
       std::size_t num_frames,
-      const std::function<mocap::Result<std::string>(std::size_t)>& frame_path,
+      const std::function<base::Result<std::string>(std::size_t)>& frame_path,
       const std::vector<std::string>& other_paths);
 
   // After Plan: true when frame i (index into frame_paths) is already done

@@ -5,10 +5,10 @@
 #include <limits>
 #include <optional>
 #include <string>
-#include <thread>
 
 #include "app/frame_render.h"
 #include "app/motion_source.h"
+#include "base/parallel.h"
 #include "deform/body/bind_pose.h"
 #include "deform/body/generated_body.h"
 #include "deform/global/dqs_job.h"
@@ -34,15 +34,12 @@ void ParallelRanges(int n, int threads, Fn&& fn) {
     fn(0, 0, n);
     return;
   }
-  std::vector<std::thread> workers;
   const int chunk = (n + threads - 1) / threads;
-  for (int t = 1; t < threads; ++t) {
+  base::RunOnThreads(threads, [&](int t) {
     const int begin = std::min(n, t * chunk);
     const int end = std::min(n, begin + chunk);
-    if (begin < end) workers.emplace_back([&fn, t, begin, end] { fn(t, begin, end); });
-  }
-  fn(0, 0, std::min(n, chunk));
-  for (std::thread& w : workers) w.join();
+    if (begin < end) fn(t, begin, end);
+  });
 }
 
 template <typename T>
@@ -72,9 +69,9 @@ Job WithVertexRange(Job job, const deform::SkinnedMesh& mesh, int begin, int end
   return job;
 }
 
-mocap::Error JobError(const Character& c, const mocap::JobStatus& s, const char* stage) {
-  return mocap::MakeError(mocap::ErrorCode::kInternal, {c.source, 0, 0, {}},
-                          std::string(stage) + " refused to run: " + s.what);
+base::Error JobError(const Character& c, const base::JobStatus& s, const char* stage) {
+  return base::MakeError(base::ErrorCode::kInternal, {c.source, 0, 0, {}},
+                         std::string(stage) + " refused to run: " + s.what);
 }
 
 // Unit normals of the global result, as every variant gets them: the skinned
@@ -118,15 +115,15 @@ const char* GlobalMethodName(GlobalMethod method) {
   return "?";
 }
 
-mocap::Result<GlobalMethod> ParseGlobalMethod(const std::string& name) {
+base::Result<GlobalMethod> ParseGlobalMethod(const std::string& name) {
   if (name == "ssd" || name == "lbs") return GlobalMethod::kSsd;
   if (name == "dqs") return GlobalMethod::kDqs;
   if (name == "swd") return GlobalMethod::kSwd;
-  return mocap::MakeError(mocap::ErrorCode::kInvalidArgument, {"--global", 0, 0, {}},
-                          "expected ssd, dqs or swd, found '" + name + "'");
+  return base::MakeError(base::ErrorCode::kInvalidArgument, {"--global", 0, 0, {}},
+                         "expected ssd, dqs or swd, found '" + name + "'");
 }
 
-mocap::Result<std::vector<glm::mat4>> BindModelFromJoint(const Character& c) {
+base::Result<std::vector<glm::mat4>> BindModelFromJoint(const Character& c) {
   const auto nj = static_cast<std::size_t>(c.skeleton.num_joints());
   std::vector<mocap::JointTransform> locals(nj);
   std::vector<glm::mat4> model(nj);
@@ -134,8 +131,9 @@ mocap::Result<std::vector<glm::mat4>> BindModelFromJoint(const Character& c) {
   if (c.bound_at_first_frame && c.motion.num_frames > 0) {
     (void)mocap::LocalPoseJob{&c.skeleton, c.motion.frame(0), locals}.Run();
   }
-  const mocap::JobStatus s =
-      mocap::LocalToModelJob{.parents = c.skeleton.parents, .locals = locals, .model_from_joint = model}
+  const base::JobStatus s =
+      mocap::LocalToModelJob{
+          .parents = c.skeleton.parents, .locals = locals, .model_from_joint = model}
           .Run();
   if (!s) return JobError(c, s, "local-to-model");
   // A skinned mesh's own bind matrices win over the rest pose (glTF).
@@ -146,15 +144,15 @@ mocap::Result<std::vector<glm::mat4>> BindModelFromJoint(const Character& c) {
   return model;
 }
 
-mocap::Result<BodyKind> ParseBodyKind(const std::string& name) {
+base::Result<BodyKind> ParseBodyKind(const std::string& name) {
   if (name == "tubes") return BodyKind::kTubes;
   if (name == "generated") return BodyKind::kGenerated;
-  return mocap::MakeError(mocap::ErrorCode::kInvalidArgument, {"--body", 0, 0, {}},
-                          "expected generated, tubes or a glTF/GLB file, found '" + name + "'");
+  return base::MakeError(base::ErrorCode::kInvalidArgument, {"--body", 0, 0, {}},
+                         "expected generated, tubes or a glTF/GLB file, found '" + name + "'");
 }
 
-mocap::Result<Character> MakeCharacter(MotionSource&& source,
-                                       const deform::MannequinOptions& mannequin, BodyKind kind) {
+base::Result<Character> MakeCharacter(MotionSource&& source,
+                                      const deform::MannequinOptions& mannequin, BodyKind kind) {
   Character c;
   c.source = source.gltf ? source.gltf->skeleton.info.source_file : source.skeleton.info.source_file;
   c.skeleton = std::move(source.skeleton);
@@ -170,7 +168,7 @@ mocap::Result<Character> MakeCharacter(MotionSource&& source,
   // A rest pose far lower than the first frame's is not a body pose (limbs
   // folded or lying flat): build and bind the body at frame 0 instead. Without a
   // body in either pose BuildMannequin below reports why.
-  mocap::Result<deform::BindPoseChoice> pose =
+  base::Result<deform::BindPoseChoice> pose =
       deform::ChooseBindPose(c.skeleton, c.motion, mannequin.min_branch_extent);
   c.bound_at_first_frame = pose.ok() && pose->frame == 0;
   // One welded skin fuses whatever touches in its bind pose: a rest pose much taller
@@ -181,14 +179,14 @@ mocap::Result<Character> MakeCharacter(MotionSource&& source,
     const float first = mocap::FirstFrameHeight(c.skeleton, c.motion, c.skeleton.info.up_axis);
     c.bound_at_first_frame = first > 0.0f && rest > 1.15f * first;
   }
-  mocap::Result<std::vector<glm::mat4>> model = BindModelFromJoint(c);
+  base::Result<std::vector<glm::mat4>> model = BindModelFromJoint(c);
   if (!model.ok()) return std::move(model).error();
-  mocap::Result<deform::SkinnedMesh> body =
+  base::Result<deform::SkinnedMesh> body =
       kind == BodyKind::kGenerated
           ? deform::BuildGeneratedBodyCached(c.skeleton, *model, {}, deform::BodyCacheFolder())
           : deform::BuildMannequin(c.skeleton, *model, mannequin);
   if (!body.ok()) {
-    mocap::Error e = std::move(body).error();
+    base::Error e = std::move(body).error();
     if (e.loc.file.empty()) e.loc.file = c.source;
     return e;
   }
@@ -243,7 +241,7 @@ int FramePipeline::threads() const { return impl_->threads; }
 
 int FramePipeline::num_patches() const { return static_cast<int>(impl_->patches.size()); }
 
-mocap::Status FramePipeline::SetPatches(std::vector<deform::PatchSetup> patches) {
+base::Status FramePipeline::SetPatches(std::vector<deform::PatchSetup> patches) {
   Impl& m = *impl_;
   std::vector<std::vector<deform::SweepVertexBinding>> swd_control;
   if (m.method == GlobalMethod::kSwd) {
@@ -261,10 +259,10 @@ mocap::Status FramePipeline::SetPatches(std::vector<deform::PatchSetup> patches)
           if (glm::dot(d, d) < best) best = glm::dot(d, d), guides[i] = v;
         }
       }
-      mocap::Result<std::vector<deform::SweepVertexBinding>> bound =
+      base::Result<std::vector<deform::SweepVertexBinding>> bound =
           deform::BindPointsLikeVertices(*m.swd_rig, patch.rest_control, guides);
       if (!bound.ok()) {
-        mocap::Error e = std::move(bound).error();
+        base::Error e = std::move(bound).error();
         e.loc.file = m.character->source;
         e.message = "patch " + std::to_string(p) + ": " + e.message;
         return e;
@@ -293,28 +291,29 @@ mocap::Status FramePipeline::SetPatches(std::vector<deform::PatchSetup> patches)
   m.displacement.assign(m.patches.size(), {});
   m.displacement_views.assign(m.patches.size(), {});
   m.pose_spaces.clear();
-  return mocap::Status::Ok();
+  return base::Status::Ok();
 }
 
-mocap::Status FramePipeline::SetElastic(std::vector<ElasticPatchSpec> specs) {
+base::Status FramePipeline::SetElastic(std::vector<ElasticPatchSpec> specs) {
   Impl& m = *impl_;
   auto layer = ElasticLayer::Create(*m.character, m.patches, std::move(specs));
   if (!layer.ok()) return std::move(layer).error();
   m.elastic = std::move(*layer);
-  return mocap::Status::Ok();
+  return base::Status::Ok();
 }
 
 std::vector<ElasticPatchReport> FramePipeline::elastic_report() const {
   return impl_->elastic ? impl_->elastic->Report() : std::vector<ElasticPatchReport>();
 }
 
-mocap::Status FramePipeline::SetPoseSpaces(std::vector<deform::PatchPoseSpace> spaces) {
+base::Status FramePipeline::SetPoseSpaces(std::vector<deform::PatchPoseSpace> spaces) {
   Impl& m = *impl_;
-  const mocap::FileLoc loc{m.character->source, 0, 0, {}};
+  const base::FileLoc loc{m.character->source, 0, 0, {}};
   if (!spaces.empty() && spaces.size() != m.patches.size()) {
-    return mocap::MakeError(mocap::ErrorCode::kInvalidArgument, loc,
-                            "expected one pose space per patch (" + std::to_string(m.patches.size()) +
-                                "), found " + std::to_string(spaces.size()));
+    return base::MakeError(base::ErrorCode::kInvalidArgument, loc,
+                           "expected one pose space per patch (" +
+                               std::to_string(m.patches.size()) + "), found " +
+                               std::to_string(spaces.size()));
   }
   std::size_t max_x = 0, max_c = 0;
   for (std::size_t p = 0; p < spaces.size(); ++p) {
@@ -322,15 +321,15 @@ mocap::Status FramePipeline::SetPoseSpaces(std::vector<deform::PatchPoseSpace> s
     if (m.method == GlobalMethod::kSwd) {
       // The frames A that carry dS (ALGORITHMS.md 4.3) are defined here for
       // SSD and DQS only; refuse rather than drop the examples silently.
-      return mocap::MakeError(mocap::ErrorCode::kUnsupported, loc,
-                              "example shapes need global ssd or dqs (not available with swd yet)");
+      return base::MakeError(base::ErrorCode::kUnsupported, loc,
+                             "example shapes need global ssd or dqs (not available with swd yet)");
     }
     const deform::RbfModel& model = spaces[p].model;
     const int dim = deform::PoseFeatureDimension(m.character->skeleton, spaces[p].features);
     if (model.dimension != dim || model.num_values != 3 * m.patches[p].num_control()) {
-      return mocap::MakeError(mocap::ErrorCode::kInvalidArgument, loc,
-                              "pose space " + std::to_string(p) +
-                                  " does not fit its patch (features or control points)");
+      return base::MakeError(base::ErrorCode::kInvalidArgument, loc,
+                             "pose space " + std::to_string(p) +
+                                 " does not fit its patch (features or control points)");
     }
     max_x = std::max(max_x, static_cast<std::size_t>(dim));
     max_c = std::max(max_c, m.patches[p].rest_control.size());
@@ -339,11 +338,11 @@ mocap::Status FramePipeline::SetPoseSpaces(std::vector<deform::PatchPoseSpace> s
   m.pose_features.resize(max_x);
   m.pose_ds.resize(max_c);
   m.pose_rotations.resize(max_c);
-  return mocap::Status::Ok();
+  return base::Status::Ok();
 }
 
 // Q = G + A dS(theta) for patch p, in place on its carried control points.
-mocap::JobStatus FramePipeline::AddExampleShapes(Impl& m, std::size_t p) {
+base::JobStatus FramePipeline::AddExampleShapes(Impl& m, std::size_t p) {
   const deform::PatchPoseSpace& space = m.pose_spaces[p];
   const std::size_t nc = m.patches[p].rest_control.size();
   const std::span<float> features =
@@ -351,9 +350,9 @@ mocap::JobStatus FramePipeline::AddExampleShapes(Impl& m, std::size_t p) {
   const std::span<glm::vec3> ds = std::span<glm::vec3>(m.pose_ds).first(nc);
   const std::span<glm::quat> rotations = std::span<glm::quat>(m.pose_rotations).first(nc);
   if (!deform::ComputePoseFeatures(m.character->skeleton, space.features, m.locals, features).ok()) {
-    return {mocap::JobStatus::kSizeMismatch, "pose features"};
+    return {base::JobStatus::kSizeMismatch, "pose features"};
   }
-  mocap::JobStatus s =
+  base::JobStatus s =
       deform::PoseSpaceJob{.model = &space.model, .features = features, .displacement = ds}.Run();
   if (!s) return s;
   const bool dqs = m.method == GlobalMethod::kDqs;
@@ -369,16 +368,16 @@ mocap::JobStatus FramePipeline::AddExampleShapes(Impl& m, std::size_t p) {
       .Run();
 }
 
-mocap::Result<FramePipeline> FramePipeline::Create(const Character& character, GlobalMethod method,
-                                                   int threads) {
-  const mocap::Status weights = deform::CheckSkinWeights(
+base::Result<FramePipeline> FramePipeline::Create(const Character& character, GlobalMethod method,
+                                                  int threads) {
+  const base::Status weights = deform::CheckSkinWeights(
       character.mesh.weights, static_cast<int>(character.mesh.skin_joints.size()),
       character.mesh.bind.num_vertices());
   if (!weights.ok()) return weights.error();
   auto impl = std::make_unique<Impl>();
   impl->character = &character;
   impl->method = method;
-  impl->threads = threads > 0 ? threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  impl->threads = base::ResolveThreads(threads);
   const auto nj = static_cast<std::size_t>(character.skeleton.num_joints());
   impl->locals.resize(nj);
   impl->scratch.resize(nj);
@@ -386,13 +385,13 @@ mocap::Result<FramePipeline> FramePipeline::Create(const Character& character, G
   impl->palette.resize(character.mesh.skin_joints.size());
   impl->dq_palette.resize(character.mesh.skin_joints.size());
   if (method == GlobalMethod::kSwd) {
-    mocap::Result<std::vector<glm::mat4>> bind = BindModelFromJoint(character);
+    base::Result<std::vector<glm::mat4>> bind = BindModelFromJoint(character);
     if (!bind.ok()) return std::move(bind).error();
-    mocap::Result<deform::SwdRig> rig = deform::BuildSwdRig(
-        character.skeleton, *bind, character.mesh.bind,
-        {.vertex_chains = character.mesh.body_chain_coords});
+    base::Result<deform::SwdRig> rig =
+        deform::BuildSwdRig(character.skeleton, *bind, character.mesh.bind,
+                            {.vertex_chains = character.mesh.body_chain_coords});
     if (!rig.ok()) {
-      mocap::Error e = std::move(rig).error();
+      base::Error e = std::move(rig).error();
       if (e.loc.file.empty()) e.loc.file = character.source;
       return e;
     }
@@ -403,23 +402,26 @@ mocap::Result<FramePipeline> FramePipeline::Create(const Character& character, G
   return FramePipeline(std::move(impl));
 }
 
-mocap::Status FramePipeline::Evaluate(double time_s, DeformedFrame& out) {
+base::Status FramePipeline::Evaluate(double time_s, DeformedFrame& out) {
   Impl& m = *impl_;
   const Character& c = *m.character;
   const deform::SkinnedMesh& mesh = c.mesh;
   if (c.motion.num_frames > 0) {
-    const mocap::JobStatus s = mocap::SampleLocalsJob{.skeleton = &c.skeleton, .motion = &c.motion,
-                                                      .time_s = time_s, .scratch = m.scratch,
-                                                      .locals = m.locals}
-                                   .Run();
+    const base::JobStatus s = mocap::SampleLocalsJob{.skeleton = &c.skeleton,
+                                                     .motion = &c.motion,
+                                                     .time_s = time_s,
+                                                     .scratch = m.scratch,
+                                                     .locals = m.locals}
+                                  .Run();
     if (!s) return JobError(c, s, "sampling");
   } else {
     mocap::RestPose(c.skeleton, m.locals);
   }
-  mocap::JobStatus s = mocap::LocalToModelJob{.parents = c.skeleton.parents, .locals = m.locals,
-                                              .model_from_root = c.world_from_model,
-                                              .model_from_joint = m.model_from_joint}
-                           .Run();
+  base::JobStatus s = mocap::LocalToModelJob{.parents = c.skeleton.parents,
+                                             .locals = m.locals,
+                                             .model_from_root = c.world_from_model,
+                                             .model_from_joint = m.model_from_joint}
+                          .Run();
   if (!s) return JobError(c, s, "local-to-model");
   s = deform::BuildSkinningPalette(m.model_from_joint, mesh, m.palette);
   if (!s) return JobError(c, s, "palette");
@@ -432,9 +434,9 @@ mocap::Status FramePipeline::Evaluate(double time_s, DeformedFrame& out) {
     s = deform::BuildDualQuatPalette(m.palette, m.dq_palette);
     if (!s) return JobError(c, s, "dual quaternion palette");
   }
-  std::array<mocap::JobStatus, kMaxThreads> results{};
+  std::array<base::JobStatus, kMaxThreads> results{};
   ParallelRanges(nv, m.threads, [&](int chunk, int begin, int end) {
-    mocap::JobStatus r;
+    base::JobStatus r;
     if (m.method == GlobalMethod::kSwd) {
       const int nj = static_cast<int>(m.model_from_joint.size());
       r = deform::SwdRigJob{.rig = &*m.swd_rig,
@@ -458,7 +460,7 @@ mocap::Status FramePipeline::Evaluate(double time_s, DeformedFrame& out) {
     }
     results[static_cast<std::size_t>(chunk)] = r;
   });
-  for (const mocap::JobStatus& r : results) {
+  for (const base::JobStatus& r : results) {
     if (!r) return JobError(c, r, GlobalMethodName(m.method));
   }
   if (!m.patches.empty()) {
@@ -507,13 +509,13 @@ mocap::Status FramePipeline::Evaluate(double time_s, DeformedFrame& out) {
     std::span<const std::span<const glm::vec3>> displacements;
     if (m.elastic) {
       // dE: the mass-spring networks advanced to this frame's time (state carried).
-      const mocap::Status advanced = m.elastic->Advance(time_s, m.model_from_joint, m.displacement);
+      const base::Status advanced = m.elastic->Advance(time_s, m.model_from_joint, m.displacement);
       if (!advanced.ok()) return advanced;
       for (std::size_t p = 0; p < m.patches.size(); ++p) m.displacement_views[p] = m.displacement[p];
       displacements = m.displacement_views;
     }
     std::copy(out.positions.begin(), out.positions.end(), m.global_positions.begin());
-    const mocap::Status layered =
+    const base::Status layered =
         deform::ApplyPatchLayer(m.patches, m.carried_views, displacements, m.patch_scratch,
                                 out.positions, m.reference_views);
     if (!layered.ok()) return layered;
@@ -532,7 +534,7 @@ mocap::Status FramePipeline::Evaluate(double time_s, DeformedFrame& out) {
     out.joint_positions[j] = glm::vec3(m.model_from_joint[j][3]);
   }
   out.bounds = deform::ComputeBounds(out.positions);
-  return mocap::Status::Ok();
+  return base::Status::Ok();
 }
 
 }  // namespace app

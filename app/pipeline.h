@@ -24,7 +24,7 @@
 #include "deform/body/mannequin.h"
 #include "deform/mesh.h"
 #include "deform/patch/patch_layer.h"
-#include "mocap/error.h"
+#include "base/error.h"
 #include "mocap/motion.h"
 #include "mocap/skeleton.h"
 
@@ -36,7 +36,7 @@ struct CharacterTextures;  // app/frame_render.h
 enum class GlobalMethod { kSsd, kDqs, kSwd };
 const char* GlobalMethodName(GlobalMethod method);
 // "ssd", "dqs", "swd" (also "lbs" for ssd); kInvalidArgument otherwise.
-mocap::Result<GlobalMethod> ParseGlobalMethod(const std::string& name);
+base::Result<GlobalMethod> ParseGlobalMethod(const std::string& name);
 
 // What gets deformed: a skeleton, its motion, and a skinned mesh bound to it
 // (the glTF's own mesh, or a mannequin generated from a BVH skeleton).
@@ -50,7 +50,7 @@ struct Character {
   bool closed_surface = false;         // the bind mesh is closed and outward (deform::IsClosedOutward)
   bool bound_at_first_frame = false;   // BVH: the rest pose was not a body pose, so the
                                        // mannequin was built and bound at frame 0
-  std::vector<mocap::Warning> warnings;
+  std::vector<base::Warning> warnings;
   // The renderer's mip pyramids of mesh.materials' textures, built once (null: untextured).
   std::shared_ptr<const CharacterTextures> textures;
 };
@@ -66,16 +66,16 @@ struct Character {
 // skin with bone-heat weights, read from the body cache when it was built before).
 enum class BodyKind { kTubes, kGenerated };
 // "tubes" or "generated"; kInvalidArgument (naming --body) otherwise.
-mocap::Result<BodyKind> ParseBodyKind(const std::string& name);
+base::Result<BodyKind> ParseBodyKind(const std::string& name);
 
-mocap::Result<Character> MakeCharacter(MotionSource&& source,
-                                       const deform::MannequinOptions& mannequin = {},
-                                       BodyKind body = BodyKind::kTubes);
+base::Result<Character> MakeCharacter(MotionSource&& source,
+                                      const deform::MannequinOptions& mannequin = {},
+                                      BodyKind body = BodyKind::kTubes);
 
 // The model-space joint matrices (#J) of the pose the character's mesh was made
 // in: the rest pose, or frame 0 when bound_at_first_frame; a skinned mesh's own
 // bind matrices replace those of its skin joints.
-mocap::Result<std::vector<glm::mat4>> BindModelFromJoint(const Character& character);
+base::Result<std::vector<glm::mat4>> BindModelFromJoint(const Character& character);
 
 // One evaluated frame, in world space.
 struct DeformedFrame {
@@ -94,12 +94,12 @@ class FramePipeline {
   ~FramePipeline();
 
   // Precomputes what the method needs (palettes, SWD bindings).
-  static mocap::Result<FramePipeline> Create(const Character& character, GlobalMethod method,
-                                             int threads);
+  static base::Result<FramePipeline> Create(const Character& character, GlobalMethod method,
+                                            int threads);
 
   // Deforms the character at `time_s` seconds from the motion's first frame
   // (clamped to the motion). Never allocates after the first call.
-  mocap::Status Evaluate(double time_s, DeformedFrame& out);
+  base::Status Evaluate(double time_s, DeformedFrame& out);
 
   GlobalMethod method() const;
   // The character this pipeline deforms (the one given to Create) and its
@@ -117,7 +117,7 @@ class FramePipeline {
   // Patches must be built on this character's bind mesh. With SWD every control
   // point is bound to the sweeps of its nearest region vertex
   // (deform::BindPointsLikeVertices) and carried by deform::SwdJob.
-  mocap::Status SetPatches(std::vector<deform::PatchSetup> patches);
+  base::Status SetPatches(std::vector<deform::PatchSetup> patches);
   int num_patches() const;
 
   // Adds example shapes to the patches (ALGORITHMS.md 0 step 2, 4.3, 5): per
@@ -127,21 +127,21 @@ class FramePipeline {
   // SetPatches (inactive entries: no examples); kInvalidArgument otherwise or
   // when a model's size disagrees with its patch; kUnsupported with SWD (its
   // control-point frames A are not defined yet). Empty clears them.
-  mocap::Status SetPoseSpaces(std::vector<deform::PatchPoseSpace> spaces);
+  base::Status SetPoseSpaces(std::vector<deform::PatchPoseSpace> spaces);
   // Adds the elastic layer dE (ALGORITHMS.md 6, app/elastic_layer.h) to some of
   // the patches set by SetPatches (call it after them): each frame, before the
   // rebuild, the carried control points of patch spec.patch get R_drv e. The
   // state is carried across Evaluate calls; an earlier time than the last one
   // re-simulates from the motion's start, so any frame order gives the same
   // frames. Errors: those of ElasticLayer::Create.
-  mocap::Status SetElastic(std::vector<ElasticPatchSpec> specs);
+  base::Status SetElastic(std::vector<ElasticPatchSpec> specs);
   // One report per elastic patch (empty without them), as of the last Evaluate.
   std::vector<ElasticPatchReport> elastic_report() const;
 
  private:
   struct Impl;
   explicit FramePipeline(std::unique_ptr<Impl> impl);
-  static mocap::JobStatus AddExampleShapes(Impl& m, std::size_t patch);
+  static base::JobStatus AddExampleShapes(Impl& m, std::size_t patch);
   std::unique_ptr<Impl> impl_;
 };
 

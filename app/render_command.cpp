@@ -64,7 +64,7 @@ struct BodySpec {
 };
 
 // "ssd", "dqs+patches", "swd + patches": a method and whether the patch layer is on.
-mocap::Result<BodySpec> ParseBodySpec(std::string text, const std::string& option) {
+base::Result<BodySpec> ParseBodySpec(std::string text, const std::string& option) {
   std::erase(text, ' ');
   BodySpec spec;
   const std::string suffix = "+patches";
@@ -72,7 +72,7 @@ mocap::Result<BodySpec> ParseBodySpec(std::string text, const std::string& optio
     spec.patches = true;
     text.resize(text.size() - suffix.size());
   }
-  mocap::Result<GlobalMethod> method = ParseGlobalMethod(text);
+  base::Result<GlobalMethod> method = ParseGlobalMethod(text);
   if (!method.ok()) {
     return ArgError(option, "expected ssd, dqs or swd, optionally with +patches, found '" + text + "'");
   }
@@ -91,7 +91,8 @@ struct TwoBodies {
 // render settings (a rig with patches compares its global method alone with
 // the same method and its patches, side by side, unless it asks for a wipe
 // or "split": false), else one body.
-mocap::Result<TwoBodies> ChooseTwoBodies(const RenderOptions& o, const Rig* rig, GlobalMethod global) {
+base::Result<TwoBodies> ChooseTwoBodies(const RenderOptions& o, const Rig* rig,
+                                        GlobalMethod global) {
   const bool has_layers = rig != nullptr && !rig->patches.empty();
   TwoBodies two;
   std::string pair_text, option = "--compare";
@@ -116,13 +117,13 @@ mocap::Result<TwoBodies> ChooseTwoBodies(const RenderOptions& o, const Rig* rig,
                       : std::vector<std::string>{"ssd", global == GlobalMethod::kSsd ? "dqs" : g};
   }
   // Errors name the option, or the rig file and its field.
-  const auto fail = [&](mocap::Error e) {
+  const auto fail = [&](base::Error e) {
     if (option == "render.compare") e.loc = {rig->file, 0, 0, option};
     return e;
   };
   if (pair.size() != 2) return fail(ArgError(option, "expected A,B such as ssd,ssd+patches"));
   for (int i = 0; i < 2; ++i) {
-    mocap::Result<BodySpec> side = ParseBodySpec(pair[static_cast<std::size_t>(i)], option);
+    base::Result<BodySpec> side = ParseBodySpec(pair[static_cast<std::size_t>(i)], option);
     if (!side.ok()) return fail(std::move(side).error());
     if (side->patches && !has_layers) {
       return fail(ArgError(option, "'" + pair[static_cast<std::size_t>(i)] +
@@ -180,13 +181,13 @@ int RunRender(const RenderOptions& options) {
   std::optional<Rig> rig;
   if (!o.layer.empty()) {
     // --layer auto: the rig `patchskin rig auto` would write, used as if read.
-    mocap::Result<Rig> made = AutoRigForCommand(o.layer, o.input, o.motion, o.body, o.up, o.quiet);
+    base::Result<Rig> made = AutoRigForCommand(o.layer, o.input, o.motion, o.body, o.up, o.quiet);
     if (!made.ok()) return ReportError(made.error());
     rig = std::move(*made);
     o.given.erase("--body");  // the rig names the body now
     o.body = "generated";
   } else if (std::filesystem::path(o.input).extension() == ".json") {
-    mocap::Result<Rig> loaded = LoadRig(o.input);
+    base::Result<Rig> loaded = LoadRig(o.input);
     if (!loaded.ok()) return ReportError(loaded.error());
     rig = std::move(*loaded);
   }
@@ -219,7 +220,7 @@ int RunRender(const RenderOptions& options) {
   }
 
   // --- Arguments -------------------------------------------------------------
-  const mocap::Result<glm::ivec2> size = ParseSize(o.size);
+  const base::Result<glm::ivec2> size = ParseSize(o.size);
   if (!size.ok()) return ReportError(size.error());
   if (o.supersample != 1 && o.supersample != 2 && o.supersample != 4) {
     return ReportError(
@@ -283,9 +284,9 @@ int RunRender(const RenderOptions& options) {
     return ReportError(
         ArgError("--background", "expected gradient or transparent, found '" + o.background + "'"));
   }
-  const mocap::Result<GlobalMethod> method = ParseGlobalMethod(o.global);
+  const base::Result<GlobalMethod> method = ParseGlobalMethod(o.global);
   if (!method.ok()) return ReportError(method.error());
-  mocap::Result<TwoBodies> two = ChooseTwoBodies(o, rig ? &*rig : nullptr, *method);
+  base::Result<TwoBodies> two = ChooseTwoBodies(o, rig ? &*rig : nullptr, *method);
   if (!two.ok()) return ReportError(two.error());
 
   // --- Body: a rig file names its body ("character"); a glTF body is the
@@ -303,7 +304,7 @@ int RunRender(const RenderOptions& options) {
       return ReportError(ArgError("--body", "a glTF/GLB body needs a BVH INPUT to drive it"));
     o.input = o.body;
   } else {
-    const mocap::Result<BodyKind> kind = ParseBodyKind(o.body);
+    const base::Result<BodyKind> kind = ParseBodyKind(o.body);
     if (!kind.ok()) return ReportError(kind.error());
     body_kind = rig ? RigBodyKind(*rig) : *kind;
     if (rig && o.given.count("--body") > 0 && *kind != body_kind) {
@@ -319,22 +320,24 @@ int RunRender(const RenderOptions& options) {
   const std::string name = demo  ? "demo"
                            : rig ? std::filesystem::path(rig->file).stem().string()
                                  : std::filesystem::path(o.input).stem().string();
-  const mocap::Result<std::optional<mocap::UpAxis>> up = ParseUpAxis(o.up);
+  const base::Result<std::optional<mocap::UpAxis>> up = ParseUpAxis(o.up);
   if (!up.ok()) return ReportError(up.error());
-  mocap::Result<Character> character =
+  base::Result<Character> character =
       LoadCommandCharacter(o.input, o.motion, o.quiet, *up, o.joint_map, nullptr, body_kind);
   if (!character.ok()) return ReportError(character.error());
   const Character& ch = *character;
 
   const bool turntable = o.camera == "turntable";
-  mocap::Result<FramePlan> plan = PlanFrames(
-      ch.motion, {.frames = o.frames, .fps = o.fps, .turntable = turntable,
-                  .turntable_frames = o.turntable_frames, .start_number = o.start_number,
-                  .list_frames = false});
+  base::Result<FramePlan> plan = PlanFrames(ch.motion, {.frames = o.frames,
+                                                        .fps = o.fps,
+                                                        .turntable = turntable,
+                                                        .turntable_frames = o.turntable_frames,
+                                                        .start_number = o.start_number,
+                                                        .list_frames = false});
   if (!plan.ok()) {
     if (rig && options.frames.empty() && !rig->render.frames.empty()) {
       // The range came from the rig file: name it and its field, not --frames.
-      mocap::Error e = plan.error();
+      base::Error e = plan.error();
       e.loc = {rig->file, 0, 0, "render.frames"};
       return ReportError(e);
     }
@@ -352,7 +355,7 @@ int RunRender(const RenderOptions& options) {
         "--out", "the pattern '" + pattern + "' needs one frame placeholder such as #### or %04d"));
   }
   if (o.background == "transparent") {
-    const mocap::Result<render::ImageFormat> format = render::ImageFormatFromPath(pattern);
+    const base::Result<render::ImageFormat> format = render::ImageFormatFromPath(pattern);
     if (format.ok() && *format == render::ImageFormat::kJpeg) {
       return ReportError(ArgError("--background",
                                   "transparent needs frames with alpha (PNG, EXR or TIFF), "
@@ -366,13 +369,13 @@ int RunRender(const RenderOptions& options) {
     const auto frame_path = [&pattern, &plan](std::size_t i) {
       return render::ExpandFramePattern(pattern, plan->At(i).number);
     };
-    const mocap::Result<std::string> first_path = frame_path(0);
+    const base::Result<std::string> first_path = frame_path(0);
     if (!first_path.ok()) return ReportError(first_path.error());
     const std::filesystem::path dir = std::filesystem::path(*first_path).parent_path();
     std::vector<std::string> others;
     if (!o.no_sheet) others.push_back((dir / "contact_sheet.png").string());
     if (!o.no_video) others.push_back((dir / "preview.mp4").string());
-    const mocap::Status planned = guard.Plan(num_frames, frame_path, others);
+    const base::Status planned = guard.Plan(num_frames, frame_path, others);
     if (!planned.ok()) return ReportError(planned.error());
   }
 
@@ -382,11 +385,11 @@ int RunRender(const RenderOptions& options) {
   const bool has_layers = rig && !rig->patches.empty();
   const BodySpec main_body = two->view != View::kOne ? two->sides[0]
                                                      : BodySpec{*method, has_layers};
-  mocap::Result<FramePipeline> pipeline = FramePipeline::Create(ch, main_body.method, o.threads);
+  base::Result<FramePipeline> pipeline = FramePipeline::Create(ch, main_body.method, o.threads);
   if (!pipeline.ok()) return ReportError(pipeline.error());
   std::optional<FramePipeline> right_pipeline;
   if (two->view != View::kOne) {
-    mocap::Result<FramePipeline> p = FramePipeline::Create(ch, two->sides[1].method, o.threads);
+    base::Result<FramePipeline> p = FramePipeline::Create(ch, two->sides[1].method, o.threads);
     if (!p.ok()) return ReportError(p.error());
     right_pipeline.emplace(std::move(*p));
   }
@@ -397,7 +400,7 @@ int RunRender(const RenderOptions& options) {
     if (body == nullptr || !layered) continue;
     // The layers (patches, example shapes, elastic), set up as `export` sets them up.
     std::vector<std::string> notes;
-    if (mocap::Status s = ApplyRigLayers(*rig, ch, *body, &notes); !s.ok())
+    if (base::Status s = ApplyRigLayers(*rig, ch, *body, &notes); !s.ok())
       return ReportError(s.error());
     if (!o.quiet) {
       for (const std::string& note : notes) std::fprintf(stderr, "%s\n", note.c_str());
@@ -415,7 +418,7 @@ int RunRender(const RenderOptions& options) {
   }
   std::vector<glm::vec3> tint;
   if (overlay_patches) {
-    mocap::Result<std::vector<deform::PatchSetup>> patches = BuildRigPatches(*rig, ch);
+    base::Result<std::vector<deform::PatchSetup>> patches = BuildRigPatches(*rig, ch);
     if (!patches.ok()) return ReportError(patches.error());
     tint = PatchTint(*patches, ch.mesh.bind.num_vertices(), ch.mesh.bind.colors);
   }
@@ -428,14 +431,14 @@ int RunRender(const RenderOptions& options) {
   for (int side = 0; side < 2 && overlay_delta; ++side) {
     const FramePipeline* body = side == 0 ? &*pipeline : right_pipeline ? &*right_pipeline : nullptr;
     if (body == nullptr || body->num_patches() == 0) continue;
-    mocap::Result<FramePipeline> base = FramePipeline::Create(ch, body->method(), o.threads);
+    base::Result<FramePipeline> base = FramePipeline::Create(ch, body->method(), o.threads);
     if (!base.ok()) return ReportError(base.error());
     delta[side].base.emplace(std::move(*base));
   }
 
   // --- Framing (app/frame_plan.h) ------------------------------------------------
   DeformedFrame frame, right_frame;
-  mocap::Result<FramePlan> framing = plan;
+  base::Result<FramePlan> framing = plan;
   if (!o.framing.empty() && !turntable) {
     framing = PlanFrames(ch.motion, {.frames = o.framing, .fps = o.fps,
                                      .start_number = o.start_number, .list_frames = false});
@@ -455,20 +458,21 @@ int RunRender(const RenderOptions& options) {
   camera_spec.azimuth_deg = o.azimuth_deg;
   camera_spec.distance = o.distance;
   camera_spec.zoom = o.zoom;
-  if (mocap::Status s = ResolveLookAt(o.look_at, rig ? &*rig : nullptr, ch, camera_spec); !s.ok()) {
-    mocap::Error e = s.error();
+  if (base::Status s = ResolveLookAt(o.look_at, rig ? &*rig : nullptr, ch, camera_spec); !s.ok()) {
+    base::Error e = s.error();
     if (rig && options.given.count("--look-at") == 0) e.loc = {rig->file, 0, 0, "render.camera.look_at"};
     return ReportError(e);
   }
-  mocap::Result<CameraPlan> cameras = CameraPlan::Create(*pipeline, *framing, camera_spec, view_size);
+  base::Result<CameraPlan> cameras =
+      CameraPlan::Create(*pipeline, *framing, camera_spec, view_size);
   if (!cameras.ok()) return ReportError(cameras.error());
   const float ground_y = cameras->ground_y();
 
   // --- Outputs -------------------------------------------------------------------
   {
-    const mocap::Result<std::string> first = render::ExpandFramePattern(pattern, plan->At(0).number);
+    const base::Result<std::string> first = render::ExpandFramePattern(pattern, plan->At(0).number);
     if (!first.ok()) return ReportError(first.error());
-    const mocap::Status writable = PrepareOutputFolder(std::filesystem::path(*first).parent_path());
+    const base::Status writable = PrepareOutputFolder(std::filesystem::path(*first).parent_path());
     if (!writable.ok()) return ReportError(writable.error());
   }
   const std::filesystem::path out_dir =
@@ -488,7 +492,7 @@ int RunRender(const RenderOptions& options) {
   // Only EXR frames store depth (their Z channel); the renderer still keeps it
   // internally while it draws depth-tested overlays.
   {
-    const mocap::Result<render::ImageFormat> format = render::ImageFormatFromPath(pattern);
+    const base::Result<render::ImageFormat> format = render::ImageFormatFromPath(pattern);
     settings.write_depth = format.ok() && *format == render::ImageFormat::kExr;
   }
   render::Renderer renderer;
@@ -515,7 +519,7 @@ int RunRender(const RenderOptions& options) {
     if (v.ok()) {
       video = std::move(*v);
     } else {
-      const mocap::Warning w{v.error().loc, v.error().message + "; no preview video"};
+      const base::Warning w{v.error().loc, v.error().message + "; no preview video"};
       std::fprintf(stderr, "%s\n", w.ToString().c_str());
     }
   }
@@ -527,23 +531,23 @@ int RunRender(const RenderOptions& options) {
   // The sheet gets every frame as its file will read back (render/output/stored_image.h),
   // so a --resume that rebuilds it from finished frames on disk gives the same
   // bytes; formats whose round trip is not modelled (JPEG) use the frame as is.
-  const mocap::Result<render::ImageFormat> frame_format = render::ImageFormatFromPath(pattern);
+  const base::Result<render::ImageFormat> frame_format = render::ImageFormatFromPath(pattern);
   auto feed_sheet_and_video = [&](std::size_t i, int number, const render::Image& img,
                                   bool read_back) {
     if (sheet && next_sheet < sheet_count &&
         static_cast<std::int64_t>(i) ==
             render::ContactSheetPick(next_sheet, sheet_count, static_cast<std::int64_t>(num_frames))) {
       const render::Image* thumb_source = &img;
-      mocap::Result<render::Image> stored = render::Image();
+      base::Result<render::Image> stored = render::Image();
       if (!read_back && frame_format.ok()) {
         stored = render::AsStored(img, *frame_format, write_options);
         if (stored.ok()) thumb_source = &*stored;
       }
-      if (mocap::Status st = sheet->Add(*thumb_source, number); !st.ok()) return st;
+      if (base::Status st = sheet->Add(*thumb_source, number); !st.ok()) return st;
       ++next_sheet;
     }
     if (video) return video->AddFrame(img);
-    return mocap::Status::Ok();
+    return base::Status::Ok();
   };
   // The sheet and the H.264 preview take frames in order on their own thread,
   // so encoding the video overlaps rendering the next frame (each task holds
@@ -551,7 +555,7 @@ int RunRender(const RenderOptions& options) {
   render::SerialTaskQueue side({.max_queued = 2});
   auto feed_async = [&](std::size_t i, int number, std::shared_ptr<const render::Image> img,
                         bool read_back) {
-    if (!sheet && !video) return mocap::Status::Ok();
+    if (!sheet && !video) return base::Status::Ok();
     return side.Submit([&feed_sheet_and_video, i, number, img = std::move(img), read_back] {
       return feed_sheet_and_video(i, number, *img, read_back);
     });
@@ -564,7 +568,7 @@ int RunRender(const RenderOptions& options) {
     // Skipped frames are still evaluated: a pipeline that carries state from
     // frame to frame (the elastic layer) must see every frame to give a
     // resumed range the same result.
-    mocap::Status s = pipeline->Evaluate(of.time_s, frame);
+    base::Status s = pipeline->Evaluate(of.time_s, frame);
     if (!s.ok()) return ReportError(s.error());
     if (right_pipeline) {
       s = right_pipeline->Evaluate(of.time_s, right_frame);
@@ -573,9 +577,9 @@ int RunRender(const RenderOptions& options) {
     if (guard.skip(i)) {
       // Resumed: the finished frame on disk feeds the sheet and the video.
       if (!sheet && !video) continue;
-      const mocap::Result<std::string> done_path = render::ExpandFramePattern(pattern, of.number);
+      const base::Result<std::string> done_path = render::ExpandFramePattern(pattern, of.number);
       if (!done_path.ok()) return ReportError(done_path.error());
-      mocap::Result<render::Image> done = render::ReadImage(*done_path);
+      base::Result<render::Image> done = render::ReadImage(*done_path);
       if (!done.ok()) return ReportError(done.error());
       s = feed_async(i, of.number, std::make_shared<const render::Image>(std::move(*done)),
                      /*read_back=*/true);
@@ -626,7 +630,7 @@ int RunRender(const RenderOptions& options) {
     if (!s.ok()) return ReportError(s.error());
     s = feed_async(i, of.number, std::make_shared<const render::Image>(image), /*read_back=*/false);
     if (!s.ok()) return ReportError(s.error());
-    const mocap::Result<std::string> path = render::ExpandFramePattern(pattern, of.number);
+    const base::Result<std::string> path = render::ExpandFramePattern(pattern, of.number);
     if (!path.ok()) return ReportError(path.error());
     write_options.frame = of.number;
     // The frame moves to the writer; the next one renders into the buffers
@@ -643,7 +647,7 @@ int RunRender(const RenderOptions& options) {
     progress.Step(of.number);
   }
   // Every frame handed to the writer is finished (so none is left half-written).
-  mocap::Status s = writer.Finish();
+  base::Status s = writer.Finish();
   if (!s.ok()) return ReportError(s.error());
   s = side.Finish();
   if (!s.ok()) return ReportError(s.error());

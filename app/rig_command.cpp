@@ -11,11 +11,11 @@
 namespace app {
 
 int RunRigAuto(const RigCommandOptions& o) {
-  mocap::Result<AutoRig> made = MakeAutoRig(o.capture, o.body, o.up, o.quiet);
+  base::Result<AutoRig> made = MakeAutoRig(o.capture, o.body, o.up, o.quiet);
   if (!made.ok()) return ReportError(made.error());
   const std::string folder =
       o.out.empty() ? std::string(".") : std::filesystem::path(o.out).parent_path().string();
-  mocap::Result<std::string> text = WriteRigJson(made->rig, folder);
+  base::Result<std::string> text = WriteRigJson(made->rig, folder);
   if (!text.ok()) {
     std::fprintf(stderr, "%s\n", text.error().ToString().c_str());
     return 3;

@@ -17,10 +17,10 @@ struct ElasticCtx {
   const std::string& path;
 
   std::string Field(const std::string& key) const { return path + "." + key; }
-  mocap::Error Fail(const std::string& field, const std::string& message) const {
-    return mocap::MakeError(mocap::ErrorCode::kInvalidArgument, {file, 0, 0, field}, message);
+  base::Error Fail(const std::string& field, const std::string& message) const {
+    return base::MakeError(base::ErrorCode::kInvalidArgument, {file, 0, 0, field}, message);
   }
-  mocap::Error Expected(const std::string& field, const std::string& what, const json& found) const {
+  base::Error Expected(const std::string& field, const std::string& what, const json& found) const {
     std::string s = found.dump();
     if (s.size() > 40) s = s.substr(0, 37) + "...";
     if (found.is_object()) s = "an object";
@@ -29,8 +29,8 @@ struct ElasticCtx {
   }
 
   // `key` (when present) as a number in [lo, hi].
-  std::optional<mocap::Error> Number(const json& obj, const char* key, double lo, double hi,
-                                     double& out) const {
+  std::optional<base::Error> Number(const json& obj, const char* key, double lo, double hi,
+                                    double& out) const {
     if (!obj.contains(key)) return std::nullopt;
     const json& v = obj[key];
     std::ostringstream range;
@@ -42,8 +42,8 @@ struct ElasticCtx {
     out = v.get<double>();
     return std::nullopt;
   }
-  std::optional<mocap::Error> Number(const json& obj, const char* key, double lo, double hi,
-                                     float& out) const {
+  std::optional<base::Error> Number(const json& obj, const char* key, double lo, double hi,
+                                    float& out) const {
     double d = out;
     if (auto e = Number(obj, key, lo, hi, d)) return e;
     out = static_cast<float>(d);
@@ -61,9 +61,9 @@ float UnitsPerMetre(const std::string& detected_units, float rest_height) {
   return rest_height > 0.0f ? rest_height / kHumanHeightM : 100.0f;
 }
 
-std::optional<mocap::Error> ParseRigElastic(const json& v, const std::string& file,
-                                            const std::string& path, int grid_u, int grid_v,
-                                            RigElastic& out) {
+std::optional<base::Error> ParseRigElastic(const json& v, const std::string& file,
+                                           const std::string& path, int grid_u, int grid_v,
+                                           RigElastic& out) {
   const ElasticCtx c{file, path};
   static constexpr const char* kFields[] = {
       "joint",          "mass",          "frequency_hz",     "damping_ratio",

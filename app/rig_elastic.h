@@ -15,7 +15,7 @@
 #include <string>
 
 #include "deform/elastic/mass_spring.h"
-#include "mocap/error.h"
+#include "base/error.h"
 
 namespace app {
 

@@ -15,7 +15,7 @@ namespace app {
 
 namespace {
 
-mocap::Error At(const std::string& file, const std::string& path, mocap::Error e) {
+base::Error At(const std::string& file, const std::string& path, base::Error e) {
   if (e.loc.file.empty()) e.loc = {file, 0, 0, path};
   return e;
 }
@@ -32,28 +32,28 @@ glm::vec3 ChildBoneAxis(const mocap::Skeleton& s, int j) {
 }
 
 // The local transforms of an example pose.
-mocap::Status ExampleLocals(const Rig& rig, const Character& ch, const RigExample& ex,
-                            std::vector<mocap::JointTransform>& locals) {
+base::Status ExampleLocals(const Rig& rig, const Character& ch, const RigExample& ex,
+                           std::vector<mocap::JointTransform>& locals) {
   const mocap::Skeleton& s = ch.skeleton;
   if (ex.pose.frame >= 0) {
     if (ex.pose.frame >= ch.motion.num_frames) {
-      return mocap::MakeError(mocap::ErrorCode::kInvalidArgument,
-                              {rig.file, 0, 0, ex.path + ".pose.frame"},
-                              "expected a frame in 0.." + std::to_string(ch.motion.num_frames - 1) +
-                                  " of the motion, found " + std::to_string(ex.pose.frame));
+      return base::MakeError(base::ErrorCode::kInvalidArgument,
+                             {rig.file, 0, 0, ex.path + ".pose.frame"},
+                             "expected a frame in 0.." + std::to_string(ch.motion.num_frames - 1) +
+                                 " of the motion, found " + std::to_string(ex.pose.frame));
     }
-    const mocap::JobStatus st =
+    const base::JobStatus st =
         mocap::LocalPoseJob{&s, ch.motion.frame(ex.pose.frame), locals}.Run();
-    if (!st) return mocap::MakeError(mocap::ErrorCode::kInternal, {rig.file, 0, 0, ex.path}, st.what);
-    return mocap::Status::Ok();
+    if (!st) return base::MakeError(base::ErrorCode::kInternal, {rig.file, 0, 0, ex.path}, st.what);
+    return base::Status::Ok();
   }
   mocap::RestPose(s, locals);
   for (const auto& [name, xyz] : ex.pose.joints) {
     const int j = s.FindJoint(name);
     if (j < 0) {
-      return mocap::MakeError(mocap::ErrorCode::kNotFound,
-                              {rig.file, 0, 0, ex.path + ".pose.joints." + name},
-                              "expected a joint of " + ch.source + ", found \"" + name + "\"");
+      return base::MakeError(base::ErrorCode::kNotFound,
+                             {rig.file, 0, 0, ex.path + ".pose.joints." + name},
+                             "expected a joint of " + ch.source + ", found \"" + name + "\"");
     }
     // The joint's Euler channel order, then any axis it lacks (ZXY order for none).
     mocap::ChannelType axes[3];
@@ -81,12 +81,12 @@ mocap::Status ExampleLocals(const Rig& rig, const Character& ch, const RigExampl
     locals[static_cast<std::size_t>(j)].rotation =
         s.rest_rotations[static_cast<std::size_t>(j)] * mocap::EulerToQuat(axes, angles, 3);
   }
-  return mocap::Status::Ok();
+  return base::Status::Ok();
 }
 
-mocap::Result<deform::PoseFeatureSpec> FeatureSpec(const Rig& rig, const Character& ch,
-                                                   const RigPatch& rp, const std::string& path,
-                                                   const deform::PatchSetup& patch) {
+base::Result<deform::PoseFeatureSpec> FeatureSpec(const Rig& rig, const Character& ch,
+                                                  const RigPatch& rp, const std::string& path,
+                                                  const deform::PatchSetup& patch) {
   const mocap::Skeleton& s = ch.skeleton;
   deform::PoseFeatureSpec spec;
   spec.kind = rp.pose_space.features == "euler"        ? deform::PoseFeatureKind::kEuler
@@ -100,21 +100,22 @@ mocap::Result<deform::PoseFeatureSpec> FeatureSpec(const Rig& rig, const Charact
     for (std::size_t k = 0; k < rp.pose_space.joints.size(); ++k) {
       const int j = s.FindJoint(rp.pose_space.joints[k]);
       if (j < 0) {
-        return mocap::MakeError(mocap::ErrorCode::kNotFound,
-                                {rig.file, 0, 0, path + ".pose_space.joints[" + std::to_string(k) + "]"},
-                                "expected a joint of " + ch.source + ", found \"" +
-                                    rp.pose_space.joints[k] + "\"");
+        return base::MakeError(
+            base::ErrorCode::kNotFound,
+            {rig.file, 0, 0, path + ".pose_space.joints[" + std::to_string(k) + "]"},
+            "expected a joint of " + ch.source + ", found \"" + rp.pose_space.joints[k] + "\"");
       }
       spec.joints.push_back({.joint = j});
     }
   }
   if (spec.joints.empty()) {
-    return mocap::MakeError(mocap::ErrorCode::kInvalidArgument, {rig.file, 0, 0, path + ".pose_space"},
-                            "no joint other than the root weights this patch: name the joints "
-                            "of theta in \"joints\"");
+    return base::MakeError(base::ErrorCode::kInvalidArgument,
+                           {rig.file, 0, 0, path + ".pose_space"},
+                           "no joint other than the root weights this patch: name the joints "
+                           "of theta in \"joints\"");
   }
   for (deform::PoseFeatureJoint& fj : spec.joints) fj.twist_axis = ChildBoneAxis(s, fj.joint);
-  const mocap::Status checked = deform::CheckPoseFeatureSpec(s, spec);
+  const base::Status checked = deform::CheckPoseFeatureSpec(s, spec);
   if (!checked.ok()) return At(rig.file, path + ".pose_space", checked.error());
   return spec;
 }
@@ -128,14 +129,14 @@ deform::RbfKernel Kernel(const std::string& name) {
 
 }  // namespace
 
-mocap::Result<RigPoseSpaces> BuildRigPoseSpaces(const Rig& rig, const Character& ch,
-                                                const std::vector<deform::PatchSetup>& patches,
-                                                GlobalMethod method) {
+base::Result<RigPoseSpaces> BuildRigPoseSpaces(const Rig& rig, const Character& ch,
+                                               const std::vector<deform::PatchSetup>& patches,
+                                               GlobalMethod method) {
   RigPoseSpaces out;
   out.patches.resize(rig.patches.size());
   if (patches.size() != rig.patches.size()) {
-    return mocap::MakeError(mocap::ErrorCode::kInternal, {rig.file, 0, 0, "patches"},
-                            "patch count differs from the rig's");
+    return base::MakeError(base::ErrorCode::kInternal, {rig.file, 0, 0, "patches"},
+                           "patch count differs from the rig's");
   }
   const mocap::Skeleton& s = ch.skeleton;
   const auto nj = static_cast<std::size_t>(s.num_joints());
@@ -150,34 +151,37 @@ mocap::Result<RigPoseSpaces> BuildRigPoseSpaces(const Rig& rig, const Character&
     if (method == GlobalMethod::kSwd) {
       // dS lives in control-point frames A (ALGORITHMS.md 4.3), defined here
       // for SSD and DQS only: say so instead of dropping the examples.
-      return mocap::MakeError(mocap::ErrorCode::kUnsupported, {rig.file, 0, 0, path + ".examples"},
-                              "example shapes need \"global\": \"ssd\" or \"dqs\" (not available "
-                              "with swd yet)");
+      return base::MakeError(base::ErrorCode::kUnsupported, {rig.file, 0, 0, path + ".examples"},
+                             "example shapes need \"global\": \"ssd\" or \"dqs\" (not available "
+                             "with swd yet)");
     }
     const deform::PatchSetup& patch = patches[i];
-    mocap::Result<deform::PoseFeatureSpec> spec = FeatureSpec(rig, ch, rp, path, patch);
+    base::Result<deform::PoseFeatureSpec> spec = FeatureSpec(rig, ch, rp, path, patch);
     if (!spec.ok()) return std::move(spec).error();
     const int dim = deform::PoseFeatureDimension(s, *spec);
     std::vector<deform::PoseExample> examples;
     for (const RigExample& ex : rp.examples) {
-      if (mocap::Status st = ExampleLocals(rig, ch, ex, locals); !st.ok()) return st.error();
-      mocap::JobStatus js = mocap::LocalToModelJob{.parents = s.parents, .locals = locals,
-                                                   .model_from_root = ch.world_from_model,
-                                                   .model_from_joint = model}
-                                .Run();
+      if (base::Status st = ExampleLocals(rig, ch, ex, locals); !st.ok()) return st.error();
+      base::JobStatus js = mocap::LocalToModelJob{.parents = s.parents,
+                                                  .locals = locals,
+                                                  .model_from_root = ch.world_from_model,
+                                                  .model_from_joint = model}
+                               .Run();
       if (js) js = deform::BuildSkinningPalette(model, ch.mesh, palette);
       if (js && method == GlobalMethod::kDqs) js = deform::BuildDualQuatPalette(palette, dq);
-      if (!js) return mocap::MakeError(mocap::ErrorCode::kInternal, {rig.file, 0, 0, ex.path}, js.what);
+      if (!js)
+        return base::MakeError(base::ErrorCode::kInternal, {rig.file, 0, 0, ex.path}, js.what);
       const deform::ExamplePose pose{
           .model_from_bind = palette,
           .dq_palette = method == GlobalMethod::kDqs ? std::span<const deform::DualQuat>(dq)
                                                      : std::span<const deform::DualQuat>()};
-      mocap::Result<deform::SculptedExample> sculpted = deform::SculptedExample{};
+      base::Result<deform::SculptedExample> sculpted = deform::SculptedExample{};
       if (!ex.auto_kind.empty()) {
         // Computed at load, once (deform/shapes/corrective_example.h).
         const bool volume = ex.auto_kind == "volume";
-        mocap::Result<deform::CorrectedExample> corrected = deform::CorrectExample(
-            patch, ch.mesh, pose, volume ? deform::CorrectiveKind::kVolume : deform::CorrectiveKind::kRest);
+        base::Result<deform::CorrectedExample> corrected = deform::CorrectExample(
+            patch, ch.mesh, pose,
+            volume ? deform::CorrectiveKind::kVolume : deform::CorrectiveKind::kRest);
         if (!corrected.ok()) return At(rig.file, ex.path + ".auto", std::move(corrected).error());
         std::ostringstream note;
         note << ex.path << " auto " << ex.auto_kind << ": "
@@ -193,7 +197,8 @@ mocap::Result<RigPoseSpaces> BuildRigPoseSpaces(const Rig& rig, const Character&
           edits.push_back({.vertex = e.vertex, .uv = e.point, .move = e.move, .world_frame = e.world,
                            .radius = e.radius, .loc = {rig.file, 0, 0, e.path}});
         }
-        mocap::Result<deform::SculptedExample> edited = deform::SculptExample(patch, ch.mesh, pose, edits);
+        base::Result<deform::SculptedExample> edited =
+            deform::SculptExample(patch, ch.mesh, pose, edits);
         if (!edited.ok()) return At(rig.file, ex.path + ".edits", std::move(edited).error());
         if (!ex.auto_kind.empty()) {
           // Edits move the corrected shape further: the changes add (s is linear in Q).
@@ -207,17 +212,19 @@ mocap::Result<RigPoseSpaces> BuildRigPoseSpaces(const Rig& rig, const Character&
       deform::PoseExample pe{.name = ex.path, .loc = {rig.file, 0, 0, ex.path + ".pose"},
                              .features = std::vector<float>(static_cast<std::size_t>(dim)),
                              .displacement = std::move(sculpted->displacement)};
-      const mocap::Status f = deform::ComputePoseFeatures(s, *spec, locals, pe.features);
+      const base::Status f = deform::ComputePoseFeatures(s, *spec, locals, pe.features);
       if (!f.ok()) return At(rig.file, ex.path + ".pose", f.error());
       examples.push_back(std::move(pe));
     }
     const bool euler = spec->kind == deform::PoseFeatureKind::kEuler;
-    mocap::Result<deform::RbfModel> model_fit = deform::RbfPoseSpace::Fit(
-        examples, dim, patch.num_control(),
-        {.kernel = Kernel(rp.pose_space.kernel), .kappa = rp.pose_space.kappa,
-         .width = rp.pose_space.width, .wrap_angles = euler});
+    base::Result<deform::RbfModel> model_fit =
+        deform::RbfPoseSpace::Fit(examples, dim, patch.num_control(),
+                                  {.kernel = Kernel(rp.pose_space.kernel),
+                                   .kappa = rp.pose_space.kappa,
+                                   .width = rp.pose_space.width,
+                                   .wrap_angles = euler});
     if (!model_fit.ok()) return At(rig.file, path + ".examples", std::move(model_fit).error());
-    for (mocap::Warning w : model_fit->warnings) {
+    for (base::Warning w : model_fit->warnings) {
       if (w.loc.file.empty()) w.loc = {rig.file, 0, 0, path + ".pose_space"};
       out.warnings.push_back(std::move(w));
     }

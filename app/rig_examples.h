@@ -20,7 +20,7 @@
 
 #include <glm/glm.hpp>
 
-#include "mocap/error.h"
+#include "base/error.h"
 
 namespace deform {
 struct PatchSetup;
@@ -78,7 +78,7 @@ struct RigPoseSpace {
 struct RigPoseSpaces {
   std::vector<deform::PatchPoseSpace> patches;  // one per rig patch; inactive without examples
   std::vector<std::string> notes;               // per patch with examples: count, condition
-  std::vector<mocap::Warning> warnings;         // ill-conditioning, unsatisfied edits
+  std::vector<base::Warning> warnings;          // ill-conditioning, unsatisfied edits
 };
 
 // Sculpts every example of every patch at its pose with `method`'s global
@@ -88,8 +88,8 @@ struct RigPoseSpaces {
 // (kNotFound), a frame out of range, edits the patch cannot take (a vertex
 // not bound to it, on its faded border), duplicate poses (naming both
 // examples), a feature spec over kMaxPoseFeatures.
-mocap::Result<RigPoseSpaces> BuildRigPoseSpaces(const Rig& rig, const Character& character,
-                                                const std::vector<deform::PatchSetup>& patches,
-                                                GlobalMethod method);
+base::Result<RigPoseSpaces> BuildRigPoseSpaces(const Rig& rig, const Character& character,
+                                               const std::vector<deform::PatchSetup>& patches,
+                                               GlobalMethod method);
 
 }  // namespace app

@@ -33,8 +33,8 @@ bool NumberIn(const json& v, double lo, double hi) {
          v.get<double>() <= hi;
 }
 
-std::optional<mocap::Error> GetVec(const JsonFile& c, const json& v, const std::string& path,
-                                   std::size_t n, double lo, double hi, double* out) {
+std::optional<base::Error> GetVec(const JsonFile& c, const json& v, const std::string& path,
+                                  std::size_t n, double lo, double hi, double* out) {
   std::ostringstream what;
   what << "an array of " << n << " numbers in " << lo << ".." << hi;
   if (!v.is_array() || v.size() != n) return c.Expected(path, what.str(), v);
@@ -45,8 +45,8 @@ std::optional<mocap::Error> GetVec(const JsonFile& c, const json& v, const std::
   return std::nullopt;
 }
 
-std::optional<mocap::Error> ParsePose(const JsonFile& c, const json& v, const std::string& path,
-                                      RigExamplePose& pose) {
+std::optional<base::Error> ParsePose(const JsonFile& c, const json& v, const std::string& path,
+                                     RigExamplePose& pose) {
   if (auto e = c.Keys(v, path, {"frame", "joints"})) return e;
   if (v.contains("frame") == v.contains("joints")) {
     return c.Fail(path, "expected exactly one of \"frame\" (a frame of the motion) or \"joints\" "
@@ -74,8 +74,8 @@ std::optional<mocap::Error> ParsePose(const JsonFile& c, const json& v, const st
   return std::nullopt;
 }
 
-std::optional<mocap::Error> ParseEdit(const JsonFile& c, const json& v, const std::string& path,
-                                      RigEdit& edit) {
+std::optional<base::Error> ParseEdit(const JsonFile& c, const json& v, const std::string& path,
+                                     RigEdit& edit) {
   if (auto e = c.Keys(v, path, {"vertex", "point", "move", "frame", "radius"})) return e;
   edit.path = path;
   if (v.contains("vertex") == v.contains("point")) {
@@ -114,11 +114,11 @@ std::optional<mocap::Error> ParseEdit(const JsonFile& c, const json& v, const st
   return std::nullopt;
 }
 
-std::optional<mocap::Error> ParsePoseSpace(const JsonFile& c, const json& v,
-                                           const std::string& path, RigPoseSpace& ps) {
+std::optional<base::Error> ParsePoseSpace(const JsonFile& c, const json& v, const std::string& path,
+                                          RigPoseSpace& ps) {
   if (auto e = c.Keys(v, path, {"features", "kernel", "kappa", "width", "joints"})) return e;
   auto choice = [&](const char* key, std::initializer_list<const char*> options,
-                    std::string& out) -> std::optional<mocap::Error> {
+                    std::string& out) -> std::optional<base::Error> {
     if (!v.contains(key)) return std::nullopt;
     std::string list;
     bool found = false;
@@ -172,8 +172,8 @@ bool SamePose(const RigExamplePose& a, const RigExamplePose& b) {
 
 namespace internal {
 
-std::optional<mocap::Error> ParsePatchExamples(const std::string& file, const json& patch,
-                                               const std::string& path, RigPatch& out) {
+std::optional<base::Error> ParsePatchExamples(const std::string& file, const json& patch,
+                                              const std::string& path, RigPatch& out) {
   const JsonFile c{file};
   if (patch.contains("pose_space")) {
     if (auto e = ParsePoseSpace(c, patch["pose_space"], path + ".pose_space", out.pose_space)) {

@@ -25,13 +25,13 @@ std::string Join(const std::string& path, const std::string& key) {
 }
 
 // Checks `obj` is an object with only `allowed` keys.
-std::optional<mocap::Error> CheckObject(const JsonFile& c, const json& obj, const std::string& path,
-                                        std::initializer_list<const char*> allowed) {
+std::optional<base::Error> CheckObject(const JsonFile& c, const json& obj, const std::string& path,
+                                       std::initializer_list<const char*> allowed) {
   return c.Keys(obj, path, allowed, "rig");
 }
 
-std::optional<mocap::Error> GetNumber(const JsonFile& c, const json& v, const std::string& path,
-                                      double lo, double hi, double& out) {
+std::optional<base::Error> GetNumber(const JsonFile& c, const json& v, const std::string& path,
+                                     double lo, double hi, double& out) {
   std::ostringstream range;
   range << "a number in " << lo << ".." << hi;
   if (!v.is_number() || !std::isfinite(v.get<double>()) || v.get<double>() < lo ||
@@ -42,24 +42,23 @@ std::optional<mocap::Error> GetNumber(const JsonFile& c, const json& v, const st
   return std::nullopt;
 }
 
-std::optional<mocap::Error> GetFloat(const JsonFile& c, const json& v, const std::string& path,
-                                     double lo, double hi, float& out) {
+std::optional<base::Error> GetFloat(const JsonFile& c, const json& v, const std::string& path,
+                                    double lo, double hi, float& out) {
   double d = 0.0;
   if (auto e = GetNumber(c, v, path, lo, hi, d)) return e;
   out = static_cast<float>(d);
   return std::nullopt;
 }
 
-std::optional<mocap::Error> GetString(const JsonFile& c, const json& v, const std::string& path,
-                                      std::string& out) {
+std::optional<base::Error> GetString(const JsonFile& c, const json& v, const std::string& path,
+                                     std::string& out) {
   if (!v.is_string() || v.get<std::string>().empty()) return c.Expected(path, "a non-empty string", v);
   out = v.get<std::string>();
   return std::nullopt;
 }
 
-std::optional<mocap::Error> GetChoice(const JsonFile& c, const json& v, const std::string& path,
-                                      std::initializer_list<const char*> choices,
-                                      std::string& out) {
+std::optional<base::Error> GetChoice(const JsonFile& c, const json& v, const std::string& path,
+                                     std::initializer_list<const char*> choices, std::string& out) {
   std::string list;
   bool ok = false;
   for (const char* ch : choices) {
@@ -71,8 +70,8 @@ std::optional<mocap::Error> GetChoice(const JsonFile& c, const json& v, const st
   return std::nullopt;
 }
 
-std::optional<mocap::Error> GetIntPair(const JsonFile& c, const json& v, const std::string& path,
-                                       int lo, int hi, glm::ivec2& out) {
+std::optional<base::Error> GetIntPair(const JsonFile& c, const json& v, const std::string& path,
+                                      int lo, int hi, glm::ivec2& out) {
   const std::string what =
       "an array of two integers in " + std::to_string(lo) + ".." + std::to_string(hi);
   if (!v.is_array() || v.size() != 2 || !v[0].is_number_integer() || !v[1].is_number_integer()) {
@@ -85,8 +84,8 @@ std::optional<mocap::Error> GetIntPair(const JsonFile& c, const json& v, const s
 }
 
 template <int N>
-std::optional<mocap::Error> GetFloats(const JsonFile& c, const json& v, const std::string& path,
-                                      double lo, double hi, glm::vec<N, float>& out) {
+std::optional<base::Error> GetFloats(const JsonFile& c, const json& v, const std::string& path,
+                                     double lo, double hi, glm::vec<N, float>& out) {
   std::ostringstream what;
   what << "an array of " << N << " numbers in " << lo << ".." << hi;
   if (!v.is_array() || v.size() != N) return c.Expected(path, what.str(), v);
@@ -107,8 +106,8 @@ std::string Resolve(const std::string& rig_file, const std::string& path) {
   return (std::filesystem::path(rig_file).parent_path() / p).lexically_normal().string();
 }
 
-std::optional<mocap::Error> ParseRegion(const JsonFile& c, const json& v, const std::string& path,
-                                        RigRegion& r) {
+std::optional<base::Error> ParseRegion(const JsonFile& c, const json& v, const std::string& path,
+                                       RigRegion& r) {
   if (auto e = CheckObject(c, v, path, {"joint", "radius", "side", "half_angle_deg",
                                         "min_bone_weight", "vertices", "view", "rect"})) {
     return e;
@@ -174,8 +173,8 @@ std::optional<mocap::Error> ParseRegion(const JsonFile& c, const json& v, const 
   return std::nullopt;
 }
 
-std::optional<mocap::Error> ParsePatch(const JsonFile& c, const json& v, const std::string& path,
-                                       RigPatch& p) {
+std::optional<base::Error> ParsePatch(const JsonFile& c, const json& v, const std::string& path,
+                                      RigPatch& p) {
   if (auto e = CheckObject(c, v, path, {"name", "region", "parametrization", "sampling", "grid",
                                         "border_width", "examples", "pose_space", "elastic"})) {
     return e;
@@ -220,7 +219,7 @@ std::optional<mocap::Error> ParsePatch(const JsonFile& c, const json& v, const s
 }
 
 // render.camera: a mode string, or an object of the mode and the view.
-std::optional<mocap::Error> ParseCamera(const JsonFile& c, const json& v, RigRender& r) {
+std::optional<base::Error> ParseCamera(const JsonFile& c, const json& v, RigRender& r) {
   const std::initializer_list<const char*> modes = {"follow", "fixed", "turntable"};
   if (v.is_string()) return GetChoice(c, v, "render.camera", modes, r.camera);
   if (auto e = CheckObject(c, v, "render.camera",
@@ -251,7 +250,7 @@ std::optional<mocap::Error> ParseCamera(const JsonFile& c, const json& v, RigRen
   return std::nullopt;
 }
 
-std::optional<mocap::Error> ParseRender(const JsonFile& c, const json& v, RigRender& r) {
+std::optional<base::Error> ParseRender(const JsonFile& c, const json& v, RigRender& r) {
   if (auto e = CheckObject(c, v, "render",
                            {"size", "camera", "overlays", "split", "compare", "wipe", "output",
                             "frames"})) {
@@ -289,8 +288,7 @@ std::optional<mocap::Error> ParseRender(const JsonFile& c, const json& v, RigRen
   if (v.contains("output")) {
     if (auto e = GetString(c, v["output"], "render.output", r.output)) return e;
     // A pattern from a file may not leave the rig's folder (no "..", not absolute).
-    const mocap::Status confined =
-        CheckRigOutputPattern(r.output, {c.file, 0, 0, "render.output"});
+    const base::Status confined = CheckRigOutputPattern(r.output, {c.file, 0, 0, "render.output"});
     if (!confined.ok()) return confined.error();
     r.output = Resolve(c.file, r.output);
   }
@@ -306,7 +304,7 @@ bool IsBuiltInBody(const std::string& character) {
   return character == "generated" || character == "tubes" || character == "mannequin";
 }
 
-mocap::Result<Rig> ParseRig(const std::string& text, const std::string& file) {
+base::Result<Rig> ParseRig(const std::string& text, const std::string& file) {
   const JsonFile c{file};
   json doc;
   try {
@@ -324,8 +322,8 @@ mocap::Result<Rig> ParseRig(const std::string& text, const std::string& file) {
     const auto at = what.find("column ");
     const auto colon = what.find(": ", at == std::string::npos ? 0 : at);
     if (colon != std::string::npos) what = what.substr(colon + 2);
-    return mocap::MakeError(mocap::ErrorCode::kSyntax, {file, line, column, {}},
-                            "invalid JSON: " + what);
+    return base::MakeError(base::ErrorCode::kSyntax, {file, line, column, {}},
+                           "invalid JSON: " + what);
   } catch (const json::exception& e) {
     // A number too large for a double (out_of_range 406, "number overflow
     // parsing '1e999'") carries no position: point at the first occurrence of
@@ -346,8 +344,8 @@ mocap::Result<Rig> ParseRig(const std::string& text, const std::string& file) {
         }
       }
     }
-    return mocap::MakeError(mocap::ErrorCode::kSyntax, {file, line, column, {}},
-                            "invalid JSON: " + what);
+    return base::MakeError(base::ErrorCode::kSyntax, {file, line, column, {}},
+                           "invalid JSON: " + what);
   }
   if (auto e = CheckObject(c, doc, "", {"character", "motion", "global", "patches", "render"})) {
     return *e;
@@ -402,33 +400,34 @@ mocap::Result<Rig> ParseRig(const std::string& text, const std::string& file) {
   return rig;
 }
 
-mocap::Result<Rig> LoadRig(const std::string& path) {
-  const mocap::FileLoc loc{path, 0, 0, {}};
+base::Result<Rig> LoadRig(const std::string& path) {
+  const base::FileLoc loc{path, 0, 0, {}};
   std::error_code ec;
   const auto status = std::filesystem::status(path, ec);
   if (ec || !std::filesystem::exists(status)) {
-    return mocap::MakeError(mocap::ErrorCode::kIo, loc, "no such file");
+    return base::MakeError(base::ErrorCode::kIo, loc, "no such file");
   }
   if (std::filesystem::is_directory(status)) {
-    return mocap::MakeError(mocap::ErrorCode::kIo, loc, "expected a rig file, found a directory");
+    return base::MakeError(base::ErrorCode::kIo, loc, "expected a rig file, found a directory");
   }
   if (!std::filesystem::is_regular_file(status)) {
-    return mocap::MakeError(mocap::ErrorCode::kIo, loc, "expected a rig file, found a special file");
+    return base::MakeError(base::ErrorCode::kIo, loc, "expected a rig file, found a special file");
   }
   // Checked before reading, so a huge file is never loaded into memory.
   const std::uintmax_t bytes = std::filesystem::file_size(path, ec);
-  if (ec) return mocap::MakeError(mocap::ErrorCode::kIo, loc, "cannot read the rig file: " + ec.message());
+  if (ec)
+    return base::MakeError(base::ErrorCode::kIo, loc, "cannot read the rig file: " + ec.message());
   if (bytes > kMaxRigFileBytes) {
-    return mocap::MakeError(mocap::ErrorCode::kLimitExceeded, loc,
-                            "expected a rig file of at most 16 MiB, found " +
-                                std::to_string(bytes) + " bytes");
+    return base::MakeError(
+        base::ErrorCode::kLimitExceeded, loc,
+        "expected a rig file of at most 16 MiB, found " + std::to_string(bytes) + " bytes");
   }
   std::ifstream in(path, std::ios::binary);
-  if (!in) return mocap::MakeError(mocap::ErrorCode::kIo, loc, "cannot open the rig file");
+  if (!in) return base::MakeError(base::ErrorCode::kIo, loc, "cannot open the rig file");
   std::string text(static_cast<std::size_t>(bytes), '\0');
   in.read(text.data(), static_cast<std::streamsize>(text.size()));
   if (!in || in.gcount() != static_cast<std::streamsize>(text.size())) {
-    return mocap::MakeError(mocap::ErrorCode::kIo, loc, "cannot read the rig file");
+    return base::MakeError(base::ErrorCode::kIo, loc, "cannot read the rig file");
   }
   return ParseRig(text, path);
 }

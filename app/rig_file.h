@@ -30,7 +30,7 @@
 
 #include "app/rig_elastic.h"
 #include "app/rig_examples.h"
-#include "mocap/error.h"
+#include "base/error.h"
 
 namespace app {
 
@@ -105,9 +105,9 @@ inline constexpr std::uintmax_t kMaxRigFileBytes = std::uintmax_t{1} << 24;
 
 // Parses rig JSON text; `file` names it in messages and its folder resolves
 // relative paths.
-mocap::Result<Rig> ParseRig(const std::string& text, const std::string& file);
+base::Result<Rig> ParseRig(const std::string& text, const std::string& file);
 // Reads and parses a rig file: kIo when it is missing, a directory or cannot
 // be read, kLimitExceeded above kMaxRigFileBytes (checked before reading).
-mocap::Result<Rig> LoadRig(const std::string& path);
+base::Result<Rig> LoadRig(const std::string& path);
 
 }  // namespace app

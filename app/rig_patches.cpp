@@ -10,7 +10,7 @@
 namespace app {
 namespace {
 
-mocap::Error At(const Rig& rig, const std::string& path, mocap::Error e) {
+base::Error At(const Rig& rig, const std::string& path, base::Error e) {
   e.loc = {rig.file, 0, 0, path};
   return e;
 }
@@ -32,8 +32,8 @@ std::optional<glm::vec3> BindPosition(const Character& c, int j) {
 
 }  // namespace
 
-mocap::Result<std::vector<deform::PatchSetup>> BuildRigPatches(const Rig& rig,
-                                                               const Character& character) {
+base::Result<std::vector<deform::PatchSetup>> BuildRigPatches(const Rig& rig,
+                                                              const Character& character) {
   std::vector<deform::PatchSetup> out;
   const deform::SkinnedMesh& mesh = character.mesh;
   for (std::size_t i = 0; i < rig.patches.size(); ++i) {
@@ -49,10 +49,10 @@ mocap::Result<std::vector<deform::PatchSetup>> BuildRigPatches(const Rig& rig,
         .border_width = p.border_width};
     std::vector<int> region;
     if (p.region.kind != RigRegion::Kind::kJoint && p.cylinder) {
-      return mocap::MakeError(mocap::ErrorCode::kInvalidArgument,
-                              {rig.file, 0, 0, path + ".parametrization"},
-                              "expected \"plane\" for a vertex-list or screen region (a cylinder "
-                              "needs a joint for its axis), found \"cylinder\"");
+      return base::MakeError(base::ErrorCode::kInvalidArgument,
+                             {rig.file, 0, 0, path + ".parametrization"},
+                             "expected \"plane\" for a vertex-list or screen region (a cylinder "
+                             "needs a joint for its axis), found \"cylinder\"");
     }
     if (p.region.kind == RigRegion::Kind::kScreen) {
       // The named view frames the bind mesh; the character faces +Z, its left is +X.
@@ -73,17 +73,17 @@ mocap::Result<std::vector<deform::PatchSetup>> BuildRigPatches(const Rig& rig,
     } else {
       const int j = character.skeleton.FindJoint(p.region.joint);
       if (j < 0) {
-        return mocap::MakeError(mocap::ErrorCode::kNotFound, {rig.file, 0, 0, path + ".region.joint"},
-                                "expected a joint of " + character.source + ", found \"" +
-                                    p.region.joint + "\"");
+        return base::MakeError(
+            base::ErrorCode::kNotFound, {rig.file, 0, 0, path + ".region.joint"},
+            "expected a joint of " + character.source + ", found \"" + p.region.joint + "\"");
       }
       const int parent = character.skeleton.parents[static_cast<std::size_t>(j)];
       const std::optional<glm::vec3> centre = BindPosition(character, j);
       const std::optional<glm::vec3> base = BindPosition(character, parent);
       if (!centre || !base || glm::length(*centre - *base) <= 0.0f) {
-        return mocap::MakeError(mocap::ErrorCode::kNotFound, {rig.file, 0, 0, path + ".region.joint"},
-                                "joint \"" + p.region.joint +
-                                    "\" has no skinned bone from its parent");
+        return base::MakeError(
+            base::ErrorCode::kNotFound, {rig.file, 0, 0, path + ".region.joint"},
+            "joint \"" + p.region.joint + "\" has no skinned bone from its parent");
       }
       auto selected = deform::SelectJointRegion(
           mesh, {.bone_joints = {parent, j}, .centre = *centre, .radius = p.region.radius,

@@ -9,7 +9,7 @@
 #include "app/pipeline.h"
 #include "app/rig_file.h"
 #include "deform/patch/patch_layer.h"
-#include "mocap/error.h"
+#include "base/error.h"
 
 namespace app {
 
@@ -22,7 +22,7 @@ namespace app {
 // Errors: an unknown or unskinned joint (kNotFound, "patches[i].region.joint"),
 // a cylinder on a vertex-list or screen region (kInvalidArgument), and anything the region
 // selection or the patch build reports (with "patches[i]" as the field path).
-mocap::Result<std::vector<deform::PatchSetup>> BuildRigPatches(const Rig& rig,
-                                                               const Character& character);
+base::Result<std::vector<deform::PatchSetup>> BuildRigPatches(const Rig& rig,
+                                                              const Character& character);
 
 }  // namespace app

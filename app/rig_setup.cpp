@@ -14,24 +14,24 @@ BodyKind RigBodyKind(const Rig& rig) {
   return rig.character == "generated" ? BodyKind::kGenerated : BodyKind::kTubes;
 }
 
-mocap::Status ApplyRigLayers(const Rig& rig, const Character& character, FramePipeline& pipeline,
-                             std::vector<std::string>* notes) {
-  mocap::Result<std::vector<deform::PatchSetup>> patches = BuildRigPatches(rig, character);
+base::Status ApplyRigLayers(const Rig& rig, const Character& character, FramePipeline& pipeline,
+                            std::vector<std::string>* notes) {
+  base::Result<std::vector<deform::PatchSetup>> patches = BuildRigPatches(rig, character);
   if (!patches.ok()) return std::move(patches).error();
-  if (patches->empty()) return mocap::Status::Ok();
+  if (patches->empty()) return base::Status::Ok();
   // Example shapes are sculpted in the frames of the method this pipeline
   // carries the control points with; the elastic specs need the patches too.
-  mocap::Result<RigPoseSpaces> spaces =
+  base::Result<RigPoseSpaces> spaces =
       BuildRigPoseSpaces(rig, character, *patches, pipeline.method());
   if (!spaces.ok()) return std::move(spaces).error();
-  mocap::Result<std::vector<ElasticPatchSpec>> elastic = ResolveRigElastic(rig, character, *patches);
+  base::Result<std::vector<ElasticPatchSpec>> elastic = ResolveRigElastic(rig, character, *patches);
   if (!elastic.ok()) return std::move(elastic).error();
-  if (mocap::Status s = pipeline.SetPatches(std::move(*patches)); !s.ok()) return s;
-  if (mocap::Status s = pipeline.SetPoseSpaces(std::move(spaces->patches)); !s.ok()) return s;
-  if (mocap::Status s = pipeline.SetElastic(std::move(*elastic)); !s.ok()) return s;
+  if (base::Status s = pipeline.SetPatches(std::move(*patches)); !s.ok()) return s;
+  if (base::Status s = pipeline.SetPoseSpaces(std::move(spaces->patches)); !s.ok()) return s;
+  if (base::Status s = pipeline.SetElastic(std::move(*elastic)); !s.ok()) return s;
   if (notes != nullptr) {
     for (const std::string& note : spaces->notes) notes->push_back("examples: " + note);
-    for (const mocap::Warning& w : spaces->warnings) notes->push_back(w.ToString());
+    for (const base::Warning& w : spaces->warnings) notes->push_back(w.ToString());
     for (const ElasticPatchReport& r : pipeline.elastic_report()) {
       for (const std::string& note : r.messages) {
         notes->push_back(rig.file + ": patches[" + std::to_string(r.patch) +
@@ -39,16 +39,16 @@ mocap::Status ApplyRigLayers(const Rig& rig, const Character& character, FramePi
       }
     }
   }
-  return mocap::Status::Ok();
+  return base::Status::Ok();
 }
 
-mocap::Status ResolveLookAt(const std::string& text, const Rig* rig, const Character& ch,
-                            CameraSpec& spec) {
-  if (text.empty()) return mocap::Status::Ok();
+base::Status ResolveLookAt(const std::string& text, const Rig* rig, const Character& ch,
+                           CameraSpec& spec) {
+  if (text.empty()) return base::Status::Ok();
   const std::string prefix = "patch:";
   if (!text.starts_with(prefix)) {
     spec.look_joint = ch.skeleton.FindJoint(text);
-    if (spec.look_joint >= 0) return mocap::Status::Ok();
+    if (spec.look_joint >= 0) return base::Status::Ok();
     return ArgError("--look-at",
                     "expected a joint of " + ch.source + " or patch:NAME, found '" + text + "'");
   }
@@ -59,10 +59,10 @@ mocap::Status ResolveLookAt(const std::string& text, const Rig* rig, const Chara
       names += (names.empty() ? "" : ", ") + rig->patches[i].name;
       continue;
     }
-    mocap::Result<std::vector<deform::PatchSetup>> patches = BuildRigPatches(*rig, ch);
+    base::Result<std::vector<deform::PatchSetup>> patches = BuildRigPatches(*rig, ch);
     if (!patches.ok()) return std::move(patches).error();
     spec.look_region = (*patches)[i].region;
-    return mocap::Status::Ok();
+    return base::Status::Ok();
   }
   return ArgError("--look-at", "expected the name of one of the rig's patches (" +
                                    (names.empty() ? std::string("it has none") : names) +

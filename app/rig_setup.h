@@ -12,7 +12,7 @@
 #include "app/frame_plan.h"
 #include "app/pipeline.h"
 #include "app/rig_file.h"
-#include "mocap/error.h"
+#include "base/error.h"
 
 namespace app {
 
@@ -29,14 +29,14 @@ BodyKind RigBodyKind(const Rig& rig);
 // which must evaluate that character. Errors name the rig file and the field
 // path. `notes` (optional) receives the lines worth printing: condition
 // numbers of the example fits, their warnings, elastic step notes.
-mocap::Status ApplyRigLayers(const Rig& rig, const Character& character, FramePipeline& pipeline,
-                             std::vector<std::string>* notes = nullptr);
+base::Status ApplyRigLayers(const Rig& rig, const Character& character, FramePipeline& pipeline,
+                            std::vector<std::string>* notes = nullptr);
 
 // Resolves a camera's look-at text into `spec`: a joint of the character
 // (look_joint) or "patch:NAME", one of the rig's patches (look_region: the
 // vertices of its region, built as BuildRigPatches builds them). Empty text
 // leaves `spec` as it is. kInvalidArgument naming --look-at and what exists.
-mocap::Status ResolveLookAt(const std::string& text, const Rig* rig, const Character& character,
-                            CameraSpec& spec);
+base::Status ResolveLookAt(const std::string& text, const Rig* rig, const Character& character,
+                           CameraSpec& spec);
 
 }  // namespace app

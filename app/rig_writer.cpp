@@ -117,7 +117,7 @@ std::string Render(const RigRender& r, const std::string& folder) {
 
 }  // namespace
 
-mocap::Result<std::string> WriteRigJson(const Rig& rig, const std::string& folder) {
+base::Result<std::string> WriteRigJson(const Rig& rig, const std::string& folder) {
   std::string s = "{\n";
   s += "  \"character\": " +
        Str(IsBuiltInBody(rig.character) ? rig.character : RelativePath(rig.character, folder)) + ",\n";
@@ -134,9 +134,10 @@ mocap::Result<std::string> WriteRigJson(const Rig& rig, const std::string& folde
     const RigPatch& p = rig.patches[i];
     for (const RigExample& e : p.examples) {
       if (!e.edits.empty() || e.pose.frame < 0 || e.auto_kind.empty()) {
-        return mocap::MakeError(mocap::ErrorCode::kUnsupported,
-                                {rig.file, 0, 0, "patches[" + std::to_string(i) + "].examples"},
-                                "only computed examples at a frame are written (no edits, no joint angles)");
+        return base::MakeError(
+            base::ErrorCode::kUnsupported,
+            {rig.file, 0, 0, "patches[" + std::to_string(i) + "].examples"},
+            "only computed examples at a frame are written (no edits, no joint angles)");
       }
     }
     s += std::string(i ? "," : "") + "\n    {\"name\": " + Str(p.name) + ",\n";

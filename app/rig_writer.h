@@ -15,10 +15,10 @@
 #include <string>
 
 #include "app/rig_file.h"
-#include "mocap/error.h"
+#include "base/error.h"
 
 namespace app {
 
-mocap::Result<std::string> WriteRigJson(const Rig& rig, const std::string& folder);
+base::Result<std::string> WriteRigJson(const Rig& rig, const std::string& folder);
 
 }  // namespace app

@@ -46,7 +46,7 @@ int RunSheet(const SheetOptions& o) {
     return ReportError(
         ArgError("--frames", "expected A:B[:STEP] with both ends, found '" + o.frames + "'"));
   }
-  mocap::Result<FrameRange> range = ParseFrames(o.frames, kMaxFrameNumber);
+  base::Result<FrameRange> range = ParseFrames(o.frames, kMaxFrameNumber);
   if (!range.ok()) return ReportError(range.error());
   if (!(o.fps > 0.0) || o.fps > 10000.0)
     return ReportError(ArgError("--fps", "expected 0 < fps <= 10000"));
@@ -61,7 +61,7 @@ int RunSheet(const SheetOptions& o) {
   std::string first_missing;
   int missing = 0;
   for (int f = range->first; f <= range->last; f += range->step) {
-    mocap::Result<std::string> path = render::ExpandFramePattern(o.pattern, f);
+    base::Result<std::string> path = render::ExpandFramePattern(o.pattern, f);
     if (!path.ok()) return ReportError(path.error());
     std::error_code ec;
     if (!std::filesystem::is_regular_file(*path, ec)) {
@@ -70,10 +70,10 @@ int RunSheet(const SheetOptions& o) {
     frames.emplace_back(f, std::move(*path));
   }
   if (missing > 0) {
-    return ReportError(mocap::MakeError(mocap::ErrorCode::kIo, {first_missing, 0, 0, {}},
-                                        "frame missing (" + std::to_string(missing) + " of " +
-                                            std::to_string(frames.size()) +
-                                            " frames are missing; render them first)"));
+    return ReportError(base::MakeError(base::ErrorCode::kIo, {first_missing, 0, 0, {}},
+                                       "frame missing (" + std::to_string(missing) + " of " +
+                                           std::to_string(frames.size()) +
+                                           " frames are missing; render them first)"));
   }
   const std::filesystem::path dir = std::filesystem::path(frames.front().second).parent_path();
   const std::string sheet_path = (dir / "contact_sheet.png").string();
@@ -81,13 +81,13 @@ int RunSheet(const SheetOptions& o) {
   if (!o.overwrite) {
     for (const auto& [skip, path] : {std::pair{o.no_sheet, sheet_path}, std::pair{o.no_video, video_path}}) {
       if (!skip && std::filesystem::exists(path)) {
-        return ReportError(mocap::MakeError(mocap::ErrorCode::kInvalidArgument, {path, 0, 0, {}},
-                                            "exists; pass --overwrite to replace it"));
+        return ReportError(base::MakeError(base::ErrorCode::kInvalidArgument, {path, 0, 0, {}},
+                                           "exists; pass --overwrite to replace it"));
       }
     }
   }
 
-  mocap::Result<render::Image> first = render::ReadImage(frames.front().second);
+  base::Result<render::Image> first = render::ReadImage(frames.front().second);
   if (!first.ok()) return ReportError(first.error());
   const int width = first->width, height = first->height;
   const int n = static_cast<int>(frames.size());
@@ -112,34 +112,33 @@ int RunSheet(const SheetOptions& o) {
     const bool on_sheet = sheet && next_sheet < sheet_count &&
                           i == render::ContactSheetPick(next_sheet, sheet_count, n);
     if (!on_sheet && !video) continue;
-    mocap::Result<render::Image> image =
+    base::Result<render::Image> image =
         i == 0 ? std::move(first) : render::ReadImage(frames[static_cast<std::size_t>(i)].second);
     if (!image.ok()) return ReportError(image.error());
     if (image->width != width || image->height != height) {
-      return ReportError(
-          mocap::MakeError(mocap::ErrorCode::kInvalidArgument,
-                           {frames[static_cast<std::size_t>(i)].second, 0, 0, {}},
-                           "expected " + std::to_string(width) + "x" + std::to_string(height) +
-                               " like the first frame, found " + std::to_string(image->width) +
-                               "x" + std::to_string(image->height)));
+      return ReportError(base::MakeError(
+          base::ErrorCode::kInvalidArgument, {frames[static_cast<std::size_t>(i)].second, 0, 0, {}},
+          "expected " + std::to_string(width) + "x" + std::to_string(height) +
+              " like the first frame, found " + std::to_string(image->width) + "x" +
+              std::to_string(image->height)));
     }
     if (on_sheet) {
-      const mocap::Status s = sheet->Add(*image, frames[static_cast<std::size_t>(i)].first);
+      const base::Status s = sheet->Add(*image, frames[static_cast<std::size_t>(i)].first);
       if (!s.ok()) return ReportError(s.error());
       ++next_sheet;
     }
     if (video) {
-      const mocap::Status s = video->AddFrame(*image);
+      const base::Status s = video->AddFrame(*image);
       if (!s.ok()) return ReportError(s.error());
     }
   }
   if (sheet) {
-    const mocap::Status s = render::WriteImage(sheet->sheet(), sheet_path, {});
+    const base::Status s = render::WriteImage(sheet->sheet(), sheet_path, {});
     if (!s.ok()) return ReportError(s.error());
     if (!o.quiet) std::printf("contact sheet: %s\n", sheet_path.c_str());
   }
   if (video) {
-    const mocap::Status s = video->Close();
+    const base::Status s = video->Close();
     if (!s.ok()) return ReportError(s.error());
     if (!o.quiet) {
       std::printf("video:         %s (%s)\n", video->path().c_str(),

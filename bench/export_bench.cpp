@@ -40,7 +40,7 @@ void BM_ObjFormat(benchmark::State& state) {
   std::string text;
   for (auto _ : state) {
     text.clear();
-    const mocap::Status s = deform::AppendObj(
+    const base::Status s = deform::AppendObj(
         {.positions = g.positions, .normals = g.normals, .triangles = g.triangles}, text);
     if (!s) state.SkipWithError("AppendObj failed");
     benchmark::DoNotOptimize(text.data());

@@ -59,11 +59,11 @@ void BM_ModelMatricesJob(benchmark::State& state) {
   std::vector<mocap::JointTransform> locals(nj);
   std::vector<glm::mat4> model(static_cast<std::size_t>(c.motion.num_frames) * nj);
   for (auto _ : state) {
-    const mocap::JobStatus s = mocap::ModelMatricesJob{.skeleton = &c.skeleton,
-                                                       .motion = &c.motion,
-                                                       .locals = locals,
-                                                       .model_from_joint = model}
-                                   .Run();
+    const base::JobStatus s = mocap::ModelMatricesJob{.skeleton = &c.skeleton,
+                                                      .motion = &c.motion,
+                                                      .locals = locals,
+                                                      .model_from_joint = model}
+                                  .Run();
     benchmark::DoNotOptimize(s);
     benchmark::DoNotOptimize(model.data());
   }
@@ -82,11 +82,11 @@ void BM_KinematicsJob(benchmark::State& state) {
       .Run();
   std::vector<mocap::JointKinematics> out(model.size());
   for (auto _ : state) {
-    const mocap::JobStatus s = mocap::KinematicsJob{.model_from_joint = model,
-                                                    .num_joints = static_cast<int>(nj),
-                                                    .frame_time_s = c.motion.frame_time_s,
-                                                    .output = out}
-                                   .Run();
+    const base::JobStatus s = mocap::KinematicsJob{.model_from_joint = model,
+                                                   .num_joints = static_cast<int>(nj),
+                                                   .frame_time_s = c.motion.frame_time_s,
+                                                   .output = out}
+                                  .Run();
     benchmark::DoNotOptimize(s);
     benchmark::DoNotOptimize(out.data());
   }
@@ -106,12 +106,12 @@ void BM_SmoothTrajectoriesJob(benchmark::State& state) {
   std::vector<glm::mat4> out(model.size());
   for (auto _ : state) {
     // 10 Hz at 30 fps is a 1-tap kernel; use 4 Hz so the window has 3 taps.
-    const mocap::JobStatus s = mocap::SmoothTrajectoriesJob{.model_from_joint = model,
-                                                            .num_joints = static_cast<int>(nj),
-                                                            .frame_time_s = c.motion.frame_time_s,
-                                                            .cutoff_hz = 4.0,
-                                                            .output = out}
-                                   .Run();
+    const base::JobStatus s = mocap::SmoothTrajectoriesJob{.model_from_joint = model,
+                                                           .num_joints = static_cast<int>(nj),
+                                                           .frame_time_s = c.motion.frame_time_s,
+                                                           .cutoff_hz = 4.0,
+                                                           .output = out}
+                                  .Run();
     benchmark::DoNotOptimize(s);
     benchmark::DoNotOptimize(out.data());
   }
@@ -141,12 +141,12 @@ void BM_SampleLocalsJob(benchmark::State& state) {
   for (auto _ : state) {
     t += 0.0123;
     if (t > kClipSeconds) t = 0.0;
-    const mocap::JobStatus s = mocap::SampleLocalsJob{.skeleton = &c.skeleton,
-                                                      .motion = &c.motion,
-                                                      .time_s = t,
-                                                      .scratch = scratch,
-                                                      .locals = locals}
-                                   .Run();
+    const base::JobStatus s = mocap::SampleLocalsJob{.skeleton = &c.skeleton,
+                                                     .motion = &c.motion,
+                                                     .time_s = t,
+                                                     .scratch = scratch,
+                                                     .locals = locals}
+                                  .Run();
     benchmark::DoNotOptimize(s);
     benchmark::DoNotOptimize(locals.data());
   }
@@ -162,8 +162,8 @@ void BM_SampleJointKinematics(benchmark::State& state) {
   for (auto _ : state) {
     t += 1.0 / 240.0;  // RK4 at the default 1/240 s step
     if (t > kClipSeconds) t = 0.0;
-    const mocap::JobStatus s = mocap::SampleJointKinematics(*k, c.skeleton.num_joints(), 1,
-                                                            c.motion.frame_time_s, t, &out);
+    const base::JobStatus s = mocap::SampleJointKinematics(*k, c.skeleton.num_joints(), 1,
+                                                           c.motion.frame_time_s, t, &out);
     benchmark::DoNotOptimize(s);
     benchmark::DoNotOptimize(out);
   }

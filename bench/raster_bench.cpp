@@ -29,7 +29,7 @@ void RenderEachIteration(benchmark::State& state, render::Renderer& renderer, co
                          const render::SceneMesh& mesh, const render::RenderSettings& settings,
                          render::Image& image) {
   for (auto _ : state) {
-    const mocap::JobStatus status = renderer.Render(camera, {&mesh, 1}, {}, settings, image);
+    const base::JobStatus status = renderer.Render(camera, {&mesh, 1}, {}, settings, image);
     if (!status.ok()) state.SkipWithError(status.what);
     benchmark::DoNotOptimize(image.rgba.data());
     benchmark::ClobberMemory();

@@ -8,43 +8,43 @@
 
 namespace deform {
 
-mocap::Status Mesh::Check() const {
-  using mocap::ErrorCode;
+base::Status Mesh::Check() const {
+  using base::ErrorCode;
   const std::size_t n = positions.size();
   if (!normals.empty() && normals.size() != n) {
-    return mocap::MakeError(ErrorCode::kCountMismatch, {},
-                            "mesh has " + std::to_string(n) + " positions but " +
-                                std::to_string(normals.size()) + " normals");
+    return base::MakeError(ErrorCode::kCountMismatch, {},
+                           "mesh has " + std::to_string(n) + " positions but " +
+                               std::to_string(normals.size()) + " normals");
   }
   if (!colors.empty() && colors.size() != n) {
-    return mocap::MakeError(ErrorCode::kCountMismatch, {},
-                            "mesh has " + std::to_string(n) + " positions but " +
-                                std::to_string(colors.size()) + " colors");
+    return base::MakeError(ErrorCode::kCountMismatch, {},
+                           "mesh has " + std::to_string(n) + " positions but " +
+                               std::to_string(colors.size()) + " colors");
   }
   if (!uvs.empty() && uvs.size() != n) {
-    return mocap::MakeError(ErrorCode::kCountMismatch, {},
-                            "mesh has " + std::to_string(n) + " positions but " +
-                                std::to_string(uvs.size()) + " texture coordinates");
+    return base::MakeError(ErrorCode::kCountMismatch, {},
+                           "mesh has " + std::to_string(n) + " positions but " +
+                               std::to_string(uvs.size()) + " texture coordinates");
   }
   for (const glm::vec2& uv : uvs) {
     if (!std::isfinite(uv.x) || !std::isfinite(uv.y)) {
-      return mocap::MakeError(ErrorCode::kNonFinite, {}, "mesh has a non-finite texture coordinate");
+      return base::MakeError(ErrorCode::kNonFinite, {}, "mesh has a non-finite texture coordinate");
     }
   }
   for (std::size_t t = 0; t < triangles.size(); ++t) {
     const glm::uvec3& tri = triangles[t];
     if (tri.x >= n || tri.y >= n || tri.z >= n) {
-      return mocap::MakeError(ErrorCode::kCountMismatch, {},
-                              "triangle " + std::to_string(t) + " indexes past the " +
-                                  std::to_string(n) + " vertices");
+      return base::MakeError(
+          ErrorCode::kCountMismatch, {},
+          "triangle " + std::to_string(t) + " indexes past the " + std::to_string(n) + " vertices");
     }
   }
   for (const glm::vec3& p : positions) {
     if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
-      return mocap::MakeError(ErrorCode::kNonFinite, {}, "mesh has a non-finite position");
+      return base::MakeError(ErrorCode::kNonFinite, {}, "mesh has a non-finite position");
     }
   }
-  return mocap::Status::Ok();
+  return base::Status::Ok();
 }
 
 void ComputeVertexNormals(std::span<const glm::vec3> positions,

@@ -14,7 +14,7 @@
 
 #include <glm/glm.hpp>
 
-#include "mocap/error.h"
+#include "base/error.h"
 
 namespace deform {
 
@@ -34,7 +34,7 @@ struct Mesh {
   int num_vertices() const { return static_cast<int>(positions.size()); }
   int num_triangles() const { return static_cast<int>(triangles.size()); }
   // Sizes agree, indices in range, values finite.
-  mocap::Status Check() const;
+  base::Status Check() const;
 };
 
 // How a texture coordinate outside [0, 1] is mapped back (glTF 2.0 sampler wrap modes).

@@ -33,7 +33,7 @@ void PoseFrame(const mocap::BvhFile& file, int frame) {
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string_view text(reinterpret_cast<const char*>(data), size);
-  mocap::Result<mocap::BvhFile> file = mocap::ParseBvh(text, "fuzz.bvh");
+  base::Result<mocap::BvhFile> file = mocap::ParseBvh(text, "fuzz.bvh");
   if (!file.ok()) {
     (void)file.error().ToString();
     return 0;
@@ -44,7 +44,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   options.scale = 0.0f;
   options.convert_to_y_up = true;
   options.position_mode = mocap::PositionChannelMode::kAddToOffset;
-  mocap::Result<mocap::BvhFile> converted = mocap::ParseBvh(text, "fuzz.bvh", options);
+  base::Result<mocap::BvhFile> converted = mocap::ParseBvh(text, "fuzz.bvh", options);
   if (converted.ok()) PoseFrame(*converted, 0);
   return 0;
 }

@@ -14,8 +14,9 @@
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   deform::GltfReadOptions options;
   options.max_file_bytes = std::size_t{1} << 24;  // keep each run small and fast
-  mocap::Result<deform::GltfModel> model = deform::ReadGltfFromMemory(
-      std::span<const unsigned char>(data, size), "/nonexistent-patchskin-fuzz/model.gltf", options);
+  base::Result<deform::GltfModel> model =
+      deform::ReadGltfFromMemory(std::span<const unsigned char>(data, size),
+                                 "/nonexistent-patchskin-fuzz/model.gltf", options);
   if (!model.ok()) {
     (void)model.error().ToString();
     return 0;
@@ -24,7 +25,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     // A fixed 1/30 s step bounds the frames by the animation's duration, which
     // AnimationToMotion itself bounds (10^7 frames); keep runs short instead.
     if (model->animations[static_cast<std::size_t>(a)].duration_s > 60.0) continue;
-    mocap::Result<mocap::Motion> motion = deform::AnimationToMotion(*model, a, 1.0 / 30.0);
+    base::Result<mocap::Motion> motion = deform::AnimationToMotion(*model, a, 1.0 / 30.0);
     (void)motion.ok();
   }
   return 0;

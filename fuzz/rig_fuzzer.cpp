@@ -13,7 +13,7 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);
-  mocap::Result<app::Rig> rig = app::ParseRig(text, "/nonexistent-patchskin-fuzz/rig.json");
+  base::Result<app::Rig> rig = app::ParseRig(text, "/nonexistent-patchskin-fuzz/rig.json");
   if (!rig.ok()) {
     (void)rig.error().ToString();
     return 0;

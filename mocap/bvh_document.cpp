@@ -99,68 +99,69 @@ class HierarchyParser {
     doc_.file_name = file_name;
   }
 
-  Result<BvhDocument> Run() {
+  base::Result<BvhDocument> Run() {
     BvhToken t = tok_.Next();
     if (!BvhKeywordEquals(t.text, "HIERARCHY")) {
-      return Fail(ErrorCode::kSyntax, t,
+      return Fail(base::ErrorCode::kSyntax, t,
                   "expected 'HIERARCHY' at the start of the file, found " + Found(t));
     }
     for (;;) {
       t = tok_.Next();
       if (BvhKeywordEquals(t.text, "ROOT")) {
-        if (Status s = ParseTree(t); !s) return s.error();
+        if (base::Status s = ParseTree(t); !s) return s.error();
       } else if (BvhKeywordEquals(t.text, "MOTION") && !doc_.joints.empty()) {
         break;
       } else {
         return Fail(
-            ErrorCode::kSyntax, t,
+            base::ErrorCode::kSyntax, t,
             std::string(doc_.joints.empty() ? "expected 'ROOT'" : "expected 'ROOT' or 'MOTION'") +
                 ", found " + Found(t));
       }
     }
-    if (Status s = ParseMotionHeader(); !s) return s.error();
+    if (base::Status s = ParseMotionHeader(); !s) return s.error();
     return std::move(doc_);
   }
 
  private:
-  Error Fail(ErrorCode code, const BvhToken& where, std::string message) const {
-    return MakeError(code, FileLoc{doc_.file_name, where.line, where.column, {}},
-                     std::move(message));
+  base::Error Fail(base::ErrorCode code, const BvhToken& where, std::string message) const {
+    return base::MakeError(code, base::FileLoc{doc_.file_name, where.line, where.column, {}},
+                           std::move(message));
   }
 
-  Status ParseFloat(const BvhToken& t, const char* what, float* value) {
+  base::Status ParseFloat(const BvhToken& t, const char* what, float* value) {
     if (t.empty() || t.text == "{" || t.text == "}") {
-      return Fail(ErrorCode::kSyntax, t, std::string("expected ") + what + ", found " + Found(t));
+      return Fail(base::ErrorCode::kSyntax, t,
+                  std::string("expected ") + what + ", found " + Found(t));
     }
     const char* next = nullptr;
     const char* end = t.text.data() + t.text.size();
     const internal::NumberStatus s = internal::ParseBvhNumber(t.text.data(), end, *value, &next);
     if (s == internal::NumberStatus::kNonFinite) {
-      return Fail(ErrorCode::kNonFinite, t,
+      return Fail(base::ErrorCode::kNonFinite, t,
                   std::string("expected a finite ") + what + ", found " + Found(t));
     }
     if (s != internal::NumberStatus::kOk || next != end) {
-      return Fail(ErrorCode::kBadNumber, t,
+      return Fail(base::ErrorCode::kBadNumber, t,
                   std::string("expected ") + what + ", found " + Found(t));
     }
-    return Status::Ok();
+    return base::Status::Ok();
   }
 
-  Status ParseOffset(glm::vec3* offset) {
+  base::Status ParseOffset(glm::vec3* offset) {
     static const char* const kWhat[3] = {"OFFSET x", "OFFSET y", "OFFSET z"};
     for (int i = 0; i < 3; ++i) {
-      if (Status s = ParseFloat(tok_.Next(), kWhat[i], &(*offset)[i]); !s) return s;
+      if (base::Status s = ParseFloat(tok_.Next(), kWhat[i], &(*offset)[i]); !s) return s;
     }
-    return Status::Ok();
+    return base::Status::Ok();
   }
 
   // Reads the name after ROOT/JOINT/End Site and the '{' that follows.
-  Status ParseNameAndBrace(const BvhToken& keyword, bool name_required, std::string* name,
-                           BvhToken* name_loc) {
+  base::Status ParseNameAndBrace(const BvhToken& keyword, bool name_required, std::string* name,
+                                 BvhToken* name_loc) {
     tok_.RestOfLineName(name_loc);
     if (name_loc->text.empty()) {
       if (name_required) {
-        return Fail(ErrorCode::kSyntax, *name_loc,
+        return Fail(base::ErrorCode::kSyntax, *name_loc,
                     "expected a joint name after " + Found(keyword) + ", found end of line");
       }
     } else {
@@ -168,108 +169,110 @@ class HierarchyParser {
       // Names are UTF-8 everywhere they go (JSON, glTF); older tools wrote Latin-1.
       if (!IsUtf8(*name)) {
         *name = Latin1ToUtf8(name_loc->text);
-        doc_.warnings.push_back(Warning{FileLoc{doc_.file_name, name_loc->line, name_loc->column, {}},
-                                        "name '" + *name + "' is not UTF-8; read as Latin-1"});
+        doc_.warnings.push_back(
+            base::Warning{base::FileLoc{doc_.file_name, name_loc->line, name_loc->column, {}},
+                          "name '" + *name + "' is not UTF-8; read as Latin-1"});
       }
     }
     const BvhToken brace = tok_.Next();
     if (brace.text != "{") {
-      return Fail(ErrorCode::kSyntax, brace,
+      return Fail(base::ErrorCode::kSyntax, brace,
                   "expected '{' after " + (name->empty() ? Found(keyword) : "'" + *name + "'") +
                       ", found " + Found(brace));
     }
-    return Status::Ok();
+    return base::Status::Ok();
   }
 
-  Status AddJoint(const BvhToken& keyword, int parent, int depth) {
+  base::Status AddJoint(const BvhToken& keyword, int parent, int depth) {
     if (depth > limits_.max_depth) {
-      return Fail(ErrorCode::kLimitExceeded, keyword,
+      return Fail(base::ErrorCode::kLimitExceeded, keyword,
                   "joint nesting deeper than the limit of " + std::to_string(limits_.max_depth));
     }
     if (static_cast<int>(doc_.joints.size()) >= limits_.max_joints) {
-      return Fail(ErrorCode::kLimitExceeded, keyword,
+      return Fail(base::ErrorCode::kLimitExceeded, keyword,
                   "more joints than the limit of " + std::to_string(limits_.max_joints));
     }
     BvhJoint joint;
     joint.parent = parent;
     BvhToken name_loc;
-    if (Status s = ParseNameAndBrace(keyword, true, &joint.name, &name_loc); !s) return s;
+    if (base::Status s = ParseNameAndBrace(keyword, true, &joint.name, &name_loc); !s) return s;
     joint.line = name_loc.line;
     joint.column = name_loc.column;
     doc_.joints.push_back(std::move(joint));
-    return Status::Ok();
+    return base::Status::Ok();
   }
 
-  Status ParseChannels(const BvhToken& keyword, BvhJoint* joint) {
+  base::Status ParseChannels(const BvhToken& keyword, BvhJoint* joint) {
     const BvhToken count_tok = tok_.Next();
     int count = -1;
     const char* end = count_tok.text.data() + count_tok.text.size();
     const auto r = std::from_chars(count_tok.text.data(), end, count);
     if (count_tok.empty() || r.ec != std::errc() || r.ptr != end) {
-      return Fail(ErrorCode::kBadNumber, count_tok,
+      return Fail(base::ErrorCode::kBadNumber, count_tok,
                   "expected a channel count after CHANNELS, found " + Found(count_tok));
     }
     if (count < 0 || count > 6) {
-      return Fail(ErrorCode::kBadChannel, count_tok,
+      return Fail(base::ErrorCode::kBadChannel, count_tok,
                   "expected a channel count from 0 to 6, found " + Found(count_tok));
     }
     if (joint->num_channels > 0) {
-      return Fail(ErrorCode::kBadChannel, keyword,
+      return Fail(base::ErrorCode::kBadChannel, keyword,
                   "second CHANNELS line for joint '" + joint->name + "'");
     }
     for (int i = 0; i < count; ++i) {
       const BvhToken t = tok_.Next();
       ChannelType type{};
       if (!ParseChannelName(t.text, &type)) {
-        return Fail(ErrorCode::kBadChannel, t,
+        return Fail(base::ErrorCode::kBadChannel, t,
                     "expected a channel name (Xposition ... Zrotation), channel " +
                         std::to_string(i + 1) + " of " + std::to_string(count) + ", found " +
                         Found(t));
       }
       for (int k = 0; k < i; ++k) {
         if (joint->channels[k] == type) {
-          return Fail(ErrorCode::kBadChannel, t, "duplicate channel " + Found(t));
+          return Fail(base::ErrorCode::kBadChannel, t, "duplicate channel " + Found(t));
         }
       }
       joint->channels[i] = type;
     }
     joint->num_channels = count;
     doc_.num_channels += count;
-    return Status::Ok();
+    return base::Status::Ok();
   }
 
-  Status ParseEndSite(const BvhToken& end_kw, int parent) {
+  base::Status ParseEndSite(const BvhToken& end_kw, int parent) {
     const BvhToken site = tok_.Next();
     if (!BvhKeywordEquals(site.text, "Site")) {
-      return Fail(ErrorCode::kSyntax, site, "expected 'Site' after 'End', found " + Found(site));
+      return Fail(base::ErrorCode::kSyntax, site,
+                  "expected 'Site' after 'End', found " + Found(site));
     }
     BvhEndSite end_site;
     end_site.parent = parent;
     end_site.line = end_kw.line;
     end_site.column = end_kw.column;
     BvhToken name_loc;
-    if (Status s = ParseNameAndBrace(end_kw, false, &end_site.name, &name_loc); !s) return s;
+    if (base::Status s = ParseNameAndBrace(end_kw, false, &end_site.name, &name_loc); !s) return s;
     if (end_site.name.empty()) end_site.name = "End Site";
     bool has_offset = false;
     for (;;) {
       const BvhToken t = tok_.Next();
       if (t.text == "}") break;
       if (BvhKeywordEquals(t.text, "OFFSET") && !has_offset) {
-        if (Status s = ParseOffset(&end_site.offset); !s) return s;
+        if (base::Status s = ParseOffset(&end_site.offset); !s) return s;
         has_offset = true;
       } else {
-        return Fail(ErrorCode::kSyntax, t,
+        return Fail(base::ErrorCode::kSyntax, t,
                     std::string(has_offset ? "expected '}'" : "expected 'OFFSET'") +
                         " in End Site, found " + Found(t));
       }
     }
     doc_.end_sites.push_back(std::move(end_site));
-    return Status::Ok();
+    return base::Status::Ok();
   }
 
   // One ROOT and everything below it, with an explicit stack of open joints.
-  Status ParseTree(const BvhToken& root_kw) {
-    if (Status s = AddJoint(root_kw, kNoParent, 1); !s) return s;
+  base::Status ParseTree(const BvhToken& root_kw) {
+    if (base::Status s = AddJoint(root_kw, kNoParent, 1); !s) return s;
     struct Open {
       int joint;
       bool has_offset;
@@ -282,40 +285,40 @@ class HierarchyParser {
       const BvhToken t = tok_.Next();
       if (t.text == "}") {
         if (!top.has_offset) {
-          return Fail(ErrorCode::kSyntax, t,
+          return Fail(base::ErrorCode::kSyntax, t,
                       "expected 'OFFSET' in joint '" + joint.name + "', found '}'");
         }
         stack.pop_back();
       } else if (BvhKeywordEquals(t.text, "OFFSET")) {
         if (top.has_offset)
-          return Fail(ErrorCode::kSyntax, t, "second OFFSET in joint '" + joint.name + "'");
-        if (Status s = ParseOffset(&joint.offset); !s) return s;
+          return Fail(base::ErrorCode::kSyntax, t, "second OFFSET in joint '" + joint.name + "'");
+        if (base::Status s = ParseOffset(&joint.offset); !s) return s;
         top.has_offset = true;
       } else if (BvhKeywordEquals(t.text, "CHANNELS")) {
         if (top.has_children) {
-          return Fail(ErrorCode::kSyntax, t,
+          return Fail(base::ErrorCode::kSyntax, t,
                       "CHANNELS of joint '" + joint.name + "' must come before its children");
         }
-        if (Status s = ParseChannels(t, &joint); !s) return s;
+        if (base::Status s = ParseChannels(t, &joint); !s) return s;
       } else if (BvhKeywordEquals(t.text, "JOINT")) {
         top.has_children = true;
         const int parent = top.joint;
-        if (Status s = AddJoint(t, parent, static_cast<int>(stack.size()) + 1); !s) return s;
+        if (base::Status s = AddJoint(t, parent, static_cast<int>(stack.size()) + 1); !s) return s;
         stack.push_back({static_cast<int>(doc_.joints.size()) - 1, false, false});
       } else if (BvhKeywordEquals(t.text, "End")) {
         top.has_children = true;
-        if (Status s = ParseEndSite(t, top.joint); !s) return s;
+        if (base::Status s = ParseEndSite(t, top.joint); !s) return s;
       } else {
-        return Fail(ErrorCode::kSyntax, t,
+        return Fail(base::ErrorCode::kSyntax, t,
                     "expected 'OFFSET', 'CHANNELS', 'JOINT', 'End Site' or '}' in joint '" +
                         joint.name + "', found " + Found(t));
       }
     }
-    return Status::Ok();
+    return base::Status::Ok();
   }
 
   // "Frames: N" and "Frame Time: T"; the value may be glued after the colon.
-  Status ParseMotionHeader() {
+  base::Status ParseMotionHeader() {
     BvhToken t = tok_.Next();
     std::string_view value_text;
     BvhToken value_tok;
@@ -329,7 +332,8 @@ class HierarchyParser {
       value_tok = colon;
       value_tok.column += 1;
     } else {
-      return Fail(ErrorCode::kSyntax, t, "expected 'Frames:' after MOTION, found " + Found(t));
+      return Fail(base::ErrorCode::kSyntax, t,
+                  "expected 'Frames:' after MOTION, found " + Found(t));
     }
     if (value_text.empty()) {
       value_tok = tok_.Next();
@@ -342,18 +346,18 @@ class HierarchyParser {
     const auto r = std::from_chars(value_text.data(), end, frames);
     if (value_text.empty() || r.ptr != end ||
         (r.ec != std::errc() && r.ec != std::errc::result_out_of_range)) {
-      return Fail(ErrorCode::kBadNumber, value_tok,
+      return Fail(base::ErrorCode::kBadNumber, value_tok,
                   "expected a frame count after 'Frames:', found " +
                       (value_text.empty() ? std::string("end of file")
                                           : "'" + std::string(value_text) + "'"));
     }
     if (r.ec == std::errc::result_out_of_range || frames > INT_MAX) {
-      return Fail(ErrorCode::kLimitExceeded, value_tok,
+      return Fail(base::ErrorCode::kLimitExceeded, value_tok,
                   "declared frame count " + std::string(value_text) +
                       " is larger than the limit of " + std::to_string(INT_MAX));
     }
     if (frames < 0) {
-      return Fail(ErrorCode::kBadNumber, value_tok,
+      return Fail(base::ErrorCode::kBadNumber, value_tok,
                   "expected a frame count of 0 or more, found " + std::to_string(frames));
     }
     doc_.declared_frames = frames;
@@ -364,7 +368,7 @@ class HierarchyParser {
       const BvhToken time_kw = tok_.Next();
       if (!BvhKeywordEquals(time_kw.text.substr(0, 5), "Time:") &&
           !(BvhKeywordEquals(time_kw.text, "Time") && tok_.Peek().text.substr(0, 1) == ":")) {
-        return Fail(ErrorCode::kSyntax, time_kw,
+        return Fail(base::ErrorCode::kSyntax, time_kw,
                     "expected 'Time:' after 'Frame', found " + Found(time_kw));
       }
       BvhToken time_value = time_kw;
@@ -387,26 +391,27 @@ class HierarchyParser {
           internal::ParseBvhNumber(text.data(), text_end, seconds, &next);
       if (text.empty() || s == internal::NumberStatus::kBadNumber || next != text_end) {
         return Fail(
-            ErrorCode::kBadNumber, time_value,
+            base::ErrorCode::kBadNumber, time_value,
             "expected a frame time in seconds, found " +
                 (text.empty() ? std::string("end of file") : "'" + std::string(text) + "'"));
       }
       if (s == internal::NumberStatus::kNonFinite || !(seconds > 0.0)) {
-        return Fail(
-            s == internal::NumberStatus::kNonFinite ? ErrorCode::kNonFinite : ErrorCode::kBadNumber,
-            time_value,
-            "expected a positive, finite frame time, found '" + std::string(text) + "'");
+        return Fail(s == internal::NumberStatus::kNonFinite ? base::ErrorCode::kNonFinite
+                                                            : base::ErrorCode::kBadNumber,
+                    time_value,
+                    "expected a positive, finite frame time, found '" + std::string(text) + "'");
       }
       doc_.frame_time_s = seconds;
       doc_.has_frame_time = true;
     } else {
-      doc_.warnings.push_back(Warning{FileLoc{doc_.file_name, frame_kw.line, frame_kw.column, {}},
-                                      "no 'Frame Time:' line; using the default of 1/30 s"});
+      doc_.warnings.push_back(
+          base::Warning{base::FileLoc{doc_.file_name, frame_kw.line, frame_kw.column, {}},
+                        "no 'Frame Time:' line; using the default of 1/30 s"});
     }
     doc_.motion_offset = tok_.offset();
     doc_.motion_line = tok_.line();
     doc_.motion_line_start = tok_.offset() - static_cast<std::size_t>(tok_.column() - 1);
-    return Status::Ok();
+    return base::Status::Ok();
   }
 
   BvhTokenizer tok_;
@@ -416,16 +421,17 @@ class HierarchyParser {
 
 }  // namespace
 
-Result<BvhDocument> ParseBvhHierarchy(std::string_view text, const std::string& file_name,
-                                      const BvhParseLimits& limits) {
+base::Result<BvhDocument> ParseBvhHierarchy(std::string_view text, const std::string& file_name,
+                                            const BvhParseLimits& limits) {
   BvhParseLimits checked = limits;
   if (checked.max_joints > kMaxJoints || checked.max_joints < 1) checked.max_joints = kMaxJoints;
   if (checked.max_depth < 1) checked.max_depth = 1;
   return HierarchyParser(text, file_name, checked).Run();
 }
 
-Result<Skeleton> BuildBvhSkeleton(const BvhDocument& document, PositionChannelMode position_mode,
-                                  std::vector<Warning>* warnings) {
+base::Result<Skeleton> BuildBvhSkeleton(const BvhDocument& document,
+                                        PositionChannelMode position_mode,
+                                        std::vector<base::Warning>* warnings) {
   Skeleton skeleton;
   const std::size_t n = document.joints.size();
   skeleton.names.reserve(n);
@@ -452,8 +458,8 @@ Result<Skeleton> BuildBvhSkeleton(const BvhDocument& document, PositionChannelMo
       }
       if (warnings != nullptr) {
         warnings->push_back(
-            Warning{FileLoc{document.file_name, j.line, j.column, {}},
-                    "duplicate joint name '" + j.name + "' renamed to '" + name + "'"});
+            base::Warning{base::FileLoc{document.file_name, j.line, j.column, {}},
+                          "duplicate joint name '" + j.name + "' renamed to '" + name + "'"});
       }
     }
     skeleton.names.push_back(std::move(name));
@@ -473,7 +479,7 @@ Result<Skeleton> BuildBvhSkeleton(const BvhDocument& document, PositionChannelMo
   skeleton.num_channels = static_cast<int>(first);
   skeleton.position_mode = position_mode;
   skeleton.info.source_file = document.file_name;
-  if (Status s = skeleton.Check(); !s) return s.error();
+  if (base::Status s = skeleton.Check(); !s) return s.error();
   return skeleton;
 }
 

@@ -34,7 +34,7 @@
 
 #include <glm/glm.hpp>
 
-#include "mocap/error.h"
+#include "base/error.h"
 #include "mocap/skeleton.h"
 
 namespace mocap {
@@ -76,7 +76,7 @@ struct BvhDocument {
   std::size_t motion_offset = 0;                // byte offset just after the MOTION header
   int motion_line = 1;                          // line number at motion_offset
   std::size_t motion_line_start = 0;            // byte offset of the start of that line
-  std::vector<Warning> warnings;
+  std::vector<base::Warning> warnings;
 };
 
 struct BvhParseLimits {
@@ -86,17 +86,17 @@ struct BvhParseLimits {
 
 // Parses HIERARCHY and the MOTION header of `text`. Does not read frame data.
 // `file_name` is used only in messages.
-[[nodiscard]] Result<BvhDocument> ParseBvhHierarchy(std::string_view text,
-                                                    const std::string& file_name,
-                                                    const BvhParseLimits& limits = {});
+[[nodiscard]] base::Result<BvhDocument> ParseBvhHierarchy(std::string_view text,
+                                                          const std::string& file_name,
+                                                          const BvhParseLimits& limits = {});
 
 // Builds the runtime skeleton: joints in file order (parent before child),
 // unique names (duplicates renamed, with a warning appended to `warnings`),
 // rest translations = OFFSET, rest rotations identity, rest scales one,
 // contiguous channel ranges in file order, end sites, position_mode as given,
 // info.source_file set. Units, scale and up axis are left for the reader.
-[[nodiscard]] Result<Skeleton> BuildBvhSkeleton(const BvhDocument& document,
-                                                PositionChannelMode position_mode,
-                                                std::vector<Warning>* warnings);
+[[nodiscard]] base::Result<Skeleton> BuildBvhSkeleton(const BvhDocument& document,
+                                                      PositionChannelMode position_mode,
+                                                      std::vector<base::Warning>* warnings);
 
 }  // namespace mocap

@@ -9,7 +9,6 @@
 #include <cstring>
 #include <limits>
 #include <mutex>
-#include <thread>
 #include <utility>
 
 #include <fcntl.h>
@@ -17,6 +16,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "base/parallel.h"
 #include "mocap/channel_use.h"
 #include "mocap/internal/bvh_number.h"
 #include "mocap/pose.h"
@@ -73,7 +73,8 @@ class MotionParser {
         doc_(doc),
         release_(release) {}
 
-  Status Run(const BvhReadOptions& options, Motion* motion, std::vector<Warning>* warnings) {
+  base::Status Run(const BvhReadOptions& options, Motion* motion,
+                   std::vector<base::Warning>* warnings) {
     const int num_channels = doc_.num_channels;
     motion->num_channels = num_channels;
     motion->frame_time_s = doc_.frame_time_s;
@@ -84,7 +85,7 @@ class MotionParser {
       motion->values.clear();
       SkipSpace();
       if (p_ != end_) WarnExtraLines(warnings, 0);
-      return Status::Ok();
+      return base::Status::Ok();
     }
     // A frame needs at least one digit and one separator per value.
     const std::size_t remaining = static_cast<std::size_t>(end_ - p_);
@@ -98,7 +99,7 @@ class MotionParser {
     motion->values.clear();
     if (remaining >= options.parallel_min_bytes && static_cast<std::size_t>(declared) == capacity &&
         TryParseBlocks(num_channels, capacity, block_bytes, motion)) {
-      return Status::Ok();
+      return base::Status::Ok();
     }
     motion->values.clear();
     motion->values.reserve(capacity * static_cast<std::size_t>(num_channels));
@@ -109,7 +110,8 @@ class MotionParser {
     for (; frames < capacity; ++frames) {
       SkipSpace();
       if (p_ == end_) break;
-      if (Status s = ParseLine(static_cast<long long>(frames) + 1, num_channels, out); !s) return s;
+      if (base::Status s = ParseLine(static_cast<long long>(frames) + 1, num_channels, out); !s)
+        return s;
       motion->values.insert(motion->values.end(), out, out + num_channels);
       if (static_cast<std::size_t>(p_ - released) >= block_bytes) {
         release_.Release(released, p_);
@@ -122,22 +124,23 @@ class MotionParser {
       SkipSpace();
       if (p_ != end_) {
         std::vector<float> scratch(static_cast<std::size_t>(num_channels));
-        if (Status s = ParseLine(static_cast<long long>(frames) + 1, num_channels, scratch.data());
+        if (base::Status s =
+                ParseLine(static_cast<long long>(frames) + 1, num_channels, scratch.data());
             !s)
           return s;
       }
       const std::string counts = "'Frames:' declares " + std::to_string(declared) +
                                  " frames but the file holds " + std::to_string(frames);
       if (!options.allow_short_motion) {
-        return MakeError(ErrorCode::kCountMismatch, Loc(p_), counts);
+        return base::MakeError(base::ErrorCode::kCountMismatch, Loc(p_), counts);
       }
-      warnings->push_back(Warning{Loc(p_), counts + "; loading " + std::to_string(frames)});
+      warnings->push_back(base::Warning{Loc(p_), counts + "; loading " + std::to_string(frames)});
     } else {
       SkipSpace();
       if (p_ != end_) WarnExtraLines(warnings, declared);
     }
     motion->num_frames = static_cast<int>(frames);
-    return Status::Ok();
+    return base::Status::Ok();
   }
 
  private:
@@ -222,17 +225,15 @@ class MotionParser {
         turn.notify_all();
       }
     };
-    std::thread worker(work);
-    work();
-    worker.join();
+    base::RunOnThreads(2, [&](int) { work(); });
     if (failed || total != frames) return false;
     motion->num_frames = static_cast<int>(frames);
     p_ = end_;
     return true;
   }
 
-  FileLoc Loc(const char* where) const {
-    return FileLoc{doc_.file_name, line_, static_cast<int>(where - line_start_) + 1, {}};
+  base::FileLoc Loc(const char* where) const {
+    return base::FileLoc{doc_.file_name, line_, static_cast<int>(where - line_start_) + 1, {}};
   }
 
   // Skips blanks and line ends, counting lines (LF, CRLF and CR each end one).
@@ -259,7 +260,7 @@ class MotionParser {
   // Parses one data line starting at a non-blank byte; leaves p_ at its line end.
   // The hot loop of the reader: works on local pointers (so they stay in
   // registers) and classifies bytes with one table lookup.
-  Status ParseLine(long long frame, int num_channels, float* out) {
+  base::Status ParseLine(long long frame, int num_channels, float* out) {
     const char* p = p_;
     const char* const end = end_;
     int count = 0;
@@ -282,14 +283,14 @@ class MotionParser {
     }
     p_ = p;
     if (count != num_channels) [[unlikely]] {
-      return MakeError(ErrorCode::kCountMismatch, Loc(p_),
-                       "expected " + std::to_string(num_channels) + " values in frame " +
-                           std::to_string(frame) + ", found " + std::to_string(count));
+      return base::MakeError(base::ErrorCode::kCountMismatch, Loc(p_),
+                             "expected " + std::to_string(num_channels) + " values in frame " +
+                                 std::to_string(frame) + ", found " + std::to_string(count));
     }
-    return Status::Ok();
+    return base::Status::Ok();
   }
 
-  Error TooMany(long long frame, int num_channels, const char* extra) {
+  base::Error TooMany(long long frame, int num_channels, const char* extra) {
     int count = num_channels;
     const char* q = extra;
     while (q != end_ && !IsLineEnd(*q)) {
@@ -298,33 +299,34 @@ class MotionParser {
       ++count;
       while (q != end_ && !IsBlank(*q) && !IsLineEnd(*q)) ++q;
     }
-    return MakeError(ErrorCode::kCountMismatch, Loc(extra),
-                     "expected " + std::to_string(num_channels) + " values in frame " +
-                         std::to_string(frame) + ", found " + std::to_string(count));
+    return base::MakeError(base::ErrorCode::kCountMismatch, Loc(extra),
+                           "expected " + std::to_string(num_channels) + " values in frame " +
+                               std::to_string(frame) + ", found " + std::to_string(count));
   }
 
-  Error BadNumber(long long frame, int index, internal::NumberStatus s, const char* token) {
+  base::Error BadNumber(long long frame, int index, internal::NumberStatus s, const char* token) {
     const char* q = token;
     while (q != end_ && !IsBlank(*q) && !IsLineEnd(*q) && q - token < 40) ++q;
     const std::string found(token, static_cast<std::size_t>(q - token));
     const bool non_finite = s == internal::NumberStatus::kNonFinite;
-    return MakeError(non_finite ? ErrorCode::kNonFinite : ErrorCode::kBadNumber, Loc(token),
-                     std::string(non_finite ? "expected a finite number" : "expected a number") +
-                         " for value " + std::to_string(index + 1) + " of frame " +
-                         std::to_string(frame) + ", found '" + found + "'");
+    return base::MakeError(
+        non_finite ? base::ErrorCode::kNonFinite : base::ErrorCode::kBadNumber, Loc(token),
+        std::string(non_finite ? "expected a finite number" : "expected a number") + " for value " +
+            std::to_string(index + 1) + " of frame " + std::to_string(frame) + ", found '" + found +
+            "'");
   }
 
-  void WarnExtraLines(std::vector<Warning>* warnings, long long declared) {
-    const FileLoc first = Loc(p_);
+  void WarnExtraLines(std::vector<base::Warning>* warnings, long long declared) {
+    const base::FileLoc first = Loc(p_);
     long long extra = 0;
     while (p_ != end_) {
       ++extra;
       while (p_ != end_ && !IsLineEnd(*p_)) ++p_;
       SkipSpace();
     }
-    warnings->push_back(Warning{first, std::to_string(extra) + " data line(s) after the " +
-                                           std::to_string(declared) +
-                                           " frames 'Frames:' declares; ignored"});
+    warnings->push_back(base::Warning{first, std::to_string(extra) + " data line(s) after the " +
+                                                 std::to_string(declared) +
+                                                 " frames 'Frames:' declares; ignored"});
   }
 
   const char* p_;
@@ -592,24 +594,26 @@ namespace {
 
 // ParseBvh, with the pages of `text` given back as they are parsed when it is
 // a file mapping (`release`).
-Result<BvhFile> ParseBvhText(std::string_view text, const std::string& file_name,
-                             const BvhReadOptions& options, PageReleaser release) {
+base::Result<BvhFile> ParseBvhText(std::string_view text, const std::string& file_name,
+                                   const BvhReadOptions& options, PageReleaser release) {
   if (!(options.scale >= 0.0f) || !std::isfinite(options.scale)) {
-    return MakeError(
-        ErrorCode::kInvalidArgument, FileLoc{file_name, 0, 0, {}},
+    return base::MakeError(
+        base::ErrorCode::kInvalidArgument, base::FileLoc{file_name, 0, 0, {}},
         "scale must be finite and >= 0 (0 = automatic), got " + std::to_string(options.scale));
   }
   // Windows tools sometimes write a UTF-8 byte order mark; it is not part of the grammar.
   if (text.size() >= 3 && text.compare(0, 3, "\xEF\xBB\xBF") == 0) text.remove_prefix(3);
-  Result<BvhDocument> document =
+  base::Result<BvhDocument> document =
       ParseBvhHierarchy(text, file_name, {options.max_depth, options.max_joints});
   if (!document) return std::move(document).error();
   BvhFile file;
   file.warnings = std::move(document->warnings);
-  Result<Skeleton> skeleton = BuildBvhSkeleton(*document, options.position_mode, &file.warnings);
+  base::Result<Skeleton> skeleton =
+      BuildBvhSkeleton(*document, options.position_mode, &file.warnings);
   if (!skeleton) return std::move(skeleton).error();
   file.skeleton = std::move(skeleton).value();
-  if (Status s = MotionParser(text, *document, release).Run(options, &file.motion, &file.warnings);
+  if (base::Status s =
+          MotionParser(text, *document, release).Run(options, &file.motion, &file.warnings);
       !s)
     return s.error();
 
@@ -630,10 +634,10 @@ Result<BvhFile> ParseBvhText(std::string_view text, const std::string& file_name
   if (scale == 0.0f) {
     scale = MetresPerUnit(info.detected_units) > 0.0f ? MetresPerUnit(info.detected_units) : 1.0f;
     if (info.detected_units == std::string("unknown")) {
-      file.warnings.push_back(
-          Warning{FileLoc{file_name, 0, 0, {}}, "units not recognised from a rest height of " +
-                                                    std::to_string(raw_height) +
-                                                    "; automatic scale left at 1"});
+      file.warnings.push_back(base::Warning{base::FileLoc{file_name, 0, 0, {}},
+                                            "units not recognised from a rest height of " +
+                                                std::to_string(raw_height) +
+                                                "; automatic scale left at 1"});
     }
   }
   if (scale != 1.0f) ScaleSkeletonAndMotion(scale, &file.skeleton, &file.motion);
@@ -646,8 +650,8 @@ Result<BvhFile> ParseBvhText(std::string_view text, const std::string& file_name
 
 }  // namespace
 
-Result<BvhFile> ParseBvh(std::string_view text, const std::string& file_name,
-                         const BvhReadOptions& options) {
+base::Result<BvhFile> ParseBvh(std::string_view text, const std::string& file_name,
+                               const BvhReadOptions& options) {
   return ParseBvhText(text, file_name, options, PageReleaser{});
 }
 
@@ -666,25 +670,25 @@ class MappedFile {
     if (fd_ >= 0) close(fd_);
   }
 
-  Status Open(const std::string& path) {
-    const FileLoc loc{path, 0, 0, {}};
+  base::Status Open(const std::string& path) {
+    const base::FileLoc loc{path, 0, 0, {}};
     fd_ = open(path.c_str(), O_RDONLY | O_CLOEXEC);
     if (fd_ < 0)
-      return MakeError(ErrorCode::kIo, loc,
-                       std::string("cannot open the file: ") + std::strerror(errno));
+      return base::MakeError(base::ErrorCode::kIo, loc,
+                             std::string("cannot open the file: ") + std::strerror(errno));
     struct stat info {};
     if (fstat(fd_, &info) != 0 || !S_ISREG(info.st_mode)) {
-      return MakeError(ErrorCode::kIo, loc, "not a regular file");
+      return base::MakeError(base::ErrorCode::kIo, loc, "not a regular file");
     }
     size_ = static_cast<std::size_t>(info.st_size);
-    if (size_ == 0) return Status::Ok();
+    if (size_ == 0) return base::Status::Ok();
     void* data = mmap(nullptr, size_, PROT_READ, MAP_PRIVATE, fd_, 0);
     if (data == MAP_FAILED)
-      return MakeError(ErrorCode::kIo, loc,
-                       std::string("cannot map the file: ") + std::strerror(errno));
+      return base::MakeError(base::ErrorCode::kIo, loc,
+                             std::string("cannot map the file: ") + std::strerror(errno));
     data_ = data;
     madvise(data_, size_, MADV_SEQUENTIAL);
-    return Status::Ok();
+    return base::Status::Ok();
   }
 
   // Gives parsed pages back (see PageReleaser); none for an empty file.
@@ -703,9 +707,9 @@ class MappedFile {
 
 }  // namespace
 
-Result<BvhFile> ReadBvhFile(const std::string& path, const BvhReadOptions& options) {
+base::Result<BvhFile> ReadBvhFile(const std::string& path, const BvhReadOptions& options) {
   MappedFile file;
-  if (Status s = file.Open(path); !s) return s.error();
+  if (base::Status s = file.Open(path); !s) return s.error();
   return ParseBvhText(file.text(), path, options, file.releaser());
 }
 

@@ -46,7 +46,7 @@
 //   0.5 <= h <= 3 -> "m"; 40 <= h < 100 -> "inch"; 100 <= h <= 300 -> "cm";
 //   otherwise "unknown" (e.g. CMU cgspeed files, ~26 units tall).
 //
-// Errors (codes from mocap::ErrorCode, messages "file:line:col: error: ...")
+// Errors (codes from base::ErrorCode, messages "file:line:col: error: ...")
 // - Every frame is one non-blank line holding exactly #C numbers; a short or long
 //   line is kCountMismatch "expected 96 values in frame 118, found 95".
 // - A number must fill its whole token; NaN, infinity and overflow are kNonFinite.
@@ -64,7 +64,7 @@
 #include <vector>
 
 #include "mocap/bvh_document.h"
-#include "mocap/error.h"
+#include "base/error.h"
 #include "mocap/motion.h"
 #include "mocap/skeleton.h"
 
@@ -104,20 +104,20 @@ struct BvhReadOptions {
 struct BvhFile {
   Skeleton skeleton;
   Motion motion;
-  std::vector<Warning> warnings;  // non-fatal findings, in file order where possible
+  std::vector<base::Warning> warnings;  // non-fatal findings, in file order where possible
 };
 
 // Parses a whole BVH text. `file_name_for_messages` only labels errors and warnings.
-[[nodiscard]] Result<BvhFile> ParseBvh(std::string_view text,
-                                       const std::string& file_name_for_messages,
-                                       const BvhReadOptions& options = {});
+[[nodiscard]] base::Result<BvhFile> ParseBvh(std::string_view text,
+                                             const std::string& file_name_for_messages,
+                                             const BvhReadOptions& options = {});
 
 // Maps `path` into memory (mmap, read-only) and parses it, giving the frame
 // data's pages back as they are parsed (BvhReadOptions::block_bytes): peak
 // memory is the motion's floats plus a few blocks. kIo when it cannot be
 // opened, is not a regular file or cannot be mapped.
-[[nodiscard]] Result<BvhFile> ReadBvhFile(const std::string& path,
-                                          const BvhReadOptions& options = {});
+[[nodiscard]] base::Result<BvhFile> ReadBvhFile(const std::string& path,
+                                                const BvhReadOptions& options = {});
 
 // Detection helpers (rules above), exposed for tests and `inspect`.
 UpAxis DetectBvhUpAxis(const Skeleton& skeleton);

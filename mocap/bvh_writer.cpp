@@ -29,51 +29,52 @@ bool IsBvhChannel(ChannelType t) {
   return static_cast<int>(t) <= static_cast<int>(ChannelType::kZRotation);
 }
 
-Status CheckName(const std::string& name, const char* what) {
+base::Status CheckName(const std::string& name, const char* what) {
   const bool bad = name.empty() || name.find_first_of("{}\r\n") != std::string::npos ||
                    name.front() == ' ' || name.front() == '\t' || name.back() == ' ' ||
                    name.back() == '\t';
   if (bad) {
-    return MakeError(ErrorCode::kUnsupported, {},
-                     std::string(what) + " name '" + name + "' cannot be written to BVH");
+    return base::MakeError(base::ErrorCode::kUnsupported, {},
+                           std::string(what) + " name '" + name + "' cannot be written to BVH");
   }
-  return Status::Ok();
+  return base::Status::Ok();
 }
 
 }  // namespace
 
-Result<std::string> FormatBvh(const Skeleton& skeleton, const Motion& motion) {
-  if (Status s = skeleton.Check(); !s) return s.error();
+base::Result<std::string> FormatBvh(const Skeleton& skeleton, const Motion& motion) {
+  if (base::Status s = skeleton.Check(); !s) return s.error();
   const int n = skeleton.num_joints();
   if (motion.num_channels != skeleton.num_channels || motion.num_frames < 0 ||
       motion.values.size() != static_cast<std::size_t>(motion.num_frames) *
                                   static_cast<std::size_t>(motion.num_channels)) {
-    return MakeError(ErrorCode::kInvalidArgument, {},
-                     "motion size does not match the skeleton's channels");
+    return base::MakeError(base::ErrorCode::kInvalidArgument, {},
+                           "motion size does not match the skeleton's channels");
   }
-  if (n == 0) return MakeError(ErrorCode::kInvalidArgument, {}, "skeleton has no joints");
+  if (n == 0)
+    return base::MakeError(base::ErrorCode::kInvalidArgument, {}, "skeleton has no joints");
   std::vector<std::vector<int>> children(static_cast<std::size_t>(n));
   std::vector<std::vector<int>> end_sites(static_cast<std::size_t>(n));
   for (int j = 0; j < n; ++j) {
     const std::size_t js = static_cast<std::size_t>(j);
-    if (Status s = CheckName(skeleton.names[js], "joint"); !s) return s.error();
+    if (base::Status s = CheckName(skeleton.names[js], "joint"); !s) return s.error();
     const JointChannels& c = skeleton.channels[js];
     if (c.count > 6)
-      return MakeError(ErrorCode::kUnsupported, {},
-                       "joint '" + skeleton.names[js] + "' has more than 6 channels");
+      return base::MakeError(base::ErrorCode::kUnsupported, {},
+                             "joint '" + skeleton.names[js] + "' has more than 6 channels");
     for (int k = 0; k < c.count; ++k) {
       if (!IsBvhChannel(c.types[static_cast<std::size_t>(k)])) {
-        return MakeError(ErrorCode::kUnsupported, {},
-                         "joint '" + skeleton.names[js] + "' has a " +
-                             ChannelTypeName(c.types[static_cast<std::size_t>(k)]) +
-                             " channel, which BVH cannot hold");
+        return base::MakeError(base::ErrorCode::kUnsupported, {},
+                               "joint '" + skeleton.names[js] + "' has a " +
+                                   ChannelTypeName(c.types[static_cast<std::size_t>(k)]) +
+                                   " channel, which BVH cannot hold");
       }
     }
     const int p = skeleton.parents[js];
     if (p != kNoParent) children[static_cast<std::size_t>(p)].push_back(j);
   }
   for (std::size_t e = 0; e < skeleton.end_sites.size(); ++e) {
-    if (Status s = CheckName(skeleton.end_sites[e].name, "end site"); !s) return s.error();
+    if (base::Status s = CheckName(skeleton.end_sites[e].name, "end site"); !s) return s.error();
     end_sites[static_cast<std::size_t>(skeleton.end_sites[e].parent)].push_back(
         static_cast<int>(e));
   }
@@ -138,8 +139,8 @@ Result<std::string> FormatBvh(const Skeleton& skeleton, const Motion& motion) {
   return out;
 }
 
-Status WriteBvhFile(const std::string& path, const Skeleton& skeleton, const Motion& motion) {
-  Result<std::string> text = FormatBvh(skeleton, motion);
+base::Status WriteBvhFile(const std::string& path, const Skeleton& skeleton, const Motion& motion) {
+  base::Result<std::string> text = FormatBvh(skeleton, motion);
   if (!text) return std::move(text).error();
   const std::string temp = path + ".tmp";
   {
@@ -148,17 +149,18 @@ Status WriteBvhFile(const std::string& path, const Skeleton& skeleton, const Mot
         !out.flush()) {
       std::error_code ignored;
       std::filesystem::remove(temp, ignored);
-      return MakeError(ErrorCode::kIo, FileLoc{temp, 0, 0, {}}, "cannot write the file");
+      return base::MakeError(base::ErrorCode::kIo, base::FileLoc{temp, 0, 0, {}},
+                             "cannot write the file");
     }
   }
   std::error_code ec;
   std::filesystem::rename(temp, path, ec);
   if (ec) {
     std::filesystem::remove(temp, ec);
-    return MakeError(ErrorCode::kIo, FileLoc{path, 0, 0, {}},
-                     "cannot rename the temporary file into place");
+    return base::MakeError(base::ErrorCode::kIo, base::FileLoc{path, 0, 0, {}},
+                           "cannot rename the temporary file into place");
   }
-  return Status::Ok();
+  return base::Status::Ok();
 }
 
 }  // namespace mocap

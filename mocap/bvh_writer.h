@@ -17,7 +17,7 @@
 
 #include <string>
 
-#include "mocap/error.h"
+#include "base/error.h"
 #include "mocap/motion.h"
 #include "mocap/skeleton.h"
 
@@ -25,11 +25,11 @@ namespace mocap {
 
 // The BVH text of `skeleton` and `motion` (motion.num_channels must equal
 // skeleton.num_channels and values hold #F x #C floats; kInvalidArgument if not).
-[[nodiscard]] Result<std::string> FormatBvh(const Skeleton& skeleton, const Motion& motion);
+[[nodiscard]] base::Result<std::string> FormatBvh(const Skeleton& skeleton, const Motion& motion);
 
 // Writes FormatBvh's text to `path`: first to "<path>.tmp", then renamed over
 // `path`, so a reader never sees a half-written file. kIo on failure.
-[[nodiscard]] Status WriteBvhFile(const std::string& path, const Skeleton& skeleton,
-                                  const Motion& motion);
+[[nodiscard]] base::Status WriteBvhFile(const std::string& path, const Skeleton& skeleton,
+                                        const Motion& motion);
 
 }  // namespace mocap

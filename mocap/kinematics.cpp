@@ -43,43 +43,44 @@ void FillLocal(JointKinematics* k) {
 
 }  // namespace
 
-JobStatus ModelMatricesJob::Validate() const {
+base::JobStatus ModelMatricesJob::Validate() const {
   if (skeleton == nullptr || motion == nullptr) {
-    return {JobStatus::kMissingInput, "skeleton and motion are required"};
+    return {base::JobStatus::kMissingInput, "skeleton and motion are required"};
   }
   const std::size_t num_joints = static_cast<std::size_t>(skeleton->num_joints());
-  if (num_joints == 0) return {JobStatus::kMissingInput, "skeleton has no joints"};
+  if (num_joints == 0) return {base::JobStatus::kMissingInput, "skeleton has no joints"};
   if (motion->num_channels != skeleton->num_channels) {
-    return {JobStatus::kSizeMismatch, "motion and skeleton have different channel counts"};
+    return {base::JobStatus::kSizeMismatch, "motion and skeleton have different channel counts"};
   }
   if (locals.size() != num_joints) {
-    return {JobStatus::kSizeMismatch, "locals must hold one transform per joint"};
+    return {base::JobStatus::kSizeMismatch, "locals must hold one transform per joint"};
   }
   if (model_from_joint.size() % num_joints != 0) {
-    return {JobStatus::kSizeMismatch, "model_from_joint must hold whole frames of #J matrices"};
+    return {base::JobStatus::kSizeMismatch,
+            "model_from_joint must hold whole frames of #J matrices"};
   }
   const std::size_t frames = model_from_joint.size() / num_joints;
   if (first_frame < 0 || static_cast<std::size_t>(first_frame) + frames >
                              static_cast<std::size_t>(std::max(motion->num_frames, 0))) {
-    return {JobStatus::kOutOfRange, "frames outside the motion"};
+    return {base::JobStatus::kOutOfRange, "frames outside the motion"};
   }
   if (motion->values.size() < static_cast<std::size_t>(motion->num_frames) *
                                   static_cast<std::size_t>(motion->num_channels)) {
-    return {JobStatus::kOutOfRange, "motion values hold fewer than num_frames rows"};
+    return {base::JobStatus::kOutOfRange, "motion values hold fewer than num_frames rows"};
   }
-  return kJobOk;
+  return base::kJobOk;
 }
 
-JobStatus ModelMatricesJob::Run() const {
-  const JobStatus status = Validate();
+base::JobStatus ModelMatricesJob::Run() const {
+  const base::JobStatus status = Validate();
   if (!status) return status;
   const std::size_t num_joints = locals.size();
   const std::size_t frames = model_from_joint.size() / num_joints;
   for (std::size_t k = 0; k < frames; ++k) {
     const int f = first_frame + static_cast<int>(k);
-    const JobStatus pose = LocalPoseJob{skeleton, motion->frame(f), locals}.Run();
+    const base::JobStatus pose = LocalPoseJob{skeleton, motion->frame(f), locals}.Run();
     if (!pose) return pose;
-    const JobStatus model =
+    const base::JobStatus model =
         LocalToModelJob{.parents = skeleton->parents,
                         .locals = locals,
                         .model_from_root = model_from_root,
@@ -87,26 +88,27 @@ JobStatus ModelMatricesJob::Run() const {
             .Run();
     if (!model) return model;
   }
-  return kJobOk;
+  return base::kJobOk;
 }
 
-JobStatus KinematicsJob::Validate() const {
-  if (num_joints <= 0) return {JobStatus::kMissingInput, "num_joints must be positive"};
+base::JobStatus KinematicsJob::Validate() const {
+  if (num_joints <= 0) return {base::JobStatus::kMissingInput, "num_joints must be positive"};
   const std::size_t nj = static_cast<std::size_t>(num_joints);
-  if (model_from_joint.empty()) return {JobStatus::kMissingInput, "model_from_joint is empty"};
+  if (model_from_joint.empty())
+    return {base::JobStatus::kMissingInput, "model_from_joint is empty"};
   if (model_from_joint.size() % nj != 0 || output.size() % nj != 0) {
-    return {JobStatus::kSizeMismatch, "model_from_joint and output must hold whole frames"};
+    return {base::JobStatus::kSizeMismatch, "model_from_joint and output must hold whole frames"};
   }
-  if (!(frame_time_s > 0.0)) return {JobStatus::kOutOfRange, "frame_time_s must be positive"};
+  if (!(frame_time_s > 0.0)) return {base::JobStatus::kOutOfRange, "frame_time_s must be positive"};
   const std::size_t total = model_from_joint.size() / nj;
   if (first_frame < 0 || static_cast<std::size_t>(first_frame) + output.size() / nj > total) {
-    return {JobStatus::kOutOfRange, "output frames outside the motion"};
+    return {base::JobStatus::kOutOfRange, "output frames outside the motion"};
   }
-  return kJobOk;
+  return base::kJobOk;
 }
 
-JobStatus KinematicsJob::Run() const {
-  const JobStatus status = Validate();
+base::JobStatus KinematicsJob::Run() const {
+  const base::JobStatus status = Validate();
   if (!status) return status;
   const std::size_t nj = static_cast<std::size_t>(num_joints);
   const int num_frames = static_cast<int>(model_from_joint.size() / nj);
@@ -157,11 +159,11 @@ JobStatus KinematicsJob::Run() const {
       FillLocal(&out);
     }
   }
-  return kJobOk;
+  return base::kJobOk;
 }
 
-JobStatus SmoothTrajectoriesJob::Validate() const {
-  const JobStatus base = KinematicsJob{
+base::JobStatus SmoothTrajectoriesJob::Validate() const {
+  const base::JobStatus base = KinematicsJob{
       .model_from_joint = model_from_joint,
       .num_joints = num_joints,
       .frame_time_s = frame_time_s,
@@ -169,20 +171,20 @@ JobStatus SmoothTrajectoriesJob::Validate() const {
       .output = {}}.Validate();
   if (!base) return base;
   if (output.size() % static_cast<std::size_t>(num_joints) != 0) {
-    return {JobStatus::kSizeMismatch, "output must hold whole frames"};
+    return {base::JobStatus::kSizeMismatch, "output must hold whole frames"};
   }
   if (static_cast<std::size_t>(first_frame) * static_cast<std::size_t>(num_joints) + output.size() >
       model_from_joint.size()) {
-    return {JobStatus::kOutOfRange, "output frames outside the motion"};
+    return {base::JobStatus::kOutOfRange, "output frames outside the motion"};
   }
   if (!(cutoff_hz > 0.0) || !std::isfinite(cutoff_hz)) {
-    return {JobStatus::kOutOfRange, "cutoff_hz must be positive and finite"};
+    return {base::JobStatus::kOutOfRange, "cutoff_hz must be positive and finite"};
   }
-  return kJobOk;
+  return base::kJobOk;
 }
 
-JobStatus SmoothTrajectoriesJob::Run() const {
-  const JobStatus status = Validate();
+base::JobStatus SmoothTrajectoriesJob::Run() const {
+  const base::JobStatus status = Validate();
   if (!status) return status;
   const std::size_t nj = static_cast<std::size_t>(num_joints);
   const int num_frames = static_cast<int>(model_from_joint.size() / nj);
@@ -222,58 +224,59 @@ JobStatus SmoothTrajectoriesJob::Run() const {
       out[3] = glm::vec4(glm::vec3(p), 1.0f);
     }
   }
-  return kJobOk;
+  return base::kJobOk;
 }
 
-Result<std::vector<JointKinematics>> ComputeKinematics(const Skeleton& skeleton,
-                                                       const Motion& motion) {
-  const FileLoc loc{skeleton.info.source_file, 0, 0, {}};
+base::Result<std::vector<JointKinematics>> ComputeKinematics(const Skeleton& skeleton,
+                                                             const Motion& motion) {
+  const base::FileLoc loc{skeleton.info.source_file, 0, 0, {}};
   const std::size_t nj = static_cast<std::size_t>(skeleton.num_joints());
   if (nj == 0 || motion.num_frames < 1 || motion.num_channels != skeleton.num_channels ||
       !(motion.frame_time_s > 0.0) ||
       motion.values.size() != static_cast<std::size_t>(motion.num_frames) *
                                   static_cast<std::size_t>(motion.num_channels)) {
-    return MakeError(ErrorCode::kInvalidArgument, loc,
-                     "expected a motion with frames, a positive frame time and " +
-                         std::to_string(skeleton.num_channels) + " channels per frame for " +
-                         std::to_string(nj) + " joints");
+    return base::MakeError(base::ErrorCode::kInvalidArgument, loc,
+                           "expected a motion with frames, a positive frame time and " +
+                               std::to_string(skeleton.num_channels) + " channels per frame for " +
+                               std::to_string(nj) + " joints");
   }
   const std::size_t frames = static_cast<std::size_t>(motion.num_frames);
   std::vector<JointTransform> locals(nj);
   std::vector<glm::mat4> model(frames * nj);
-  const JobStatus m =
+  const base::JobStatus m =
       ModelMatricesJob{
           .skeleton = &skeleton, .motion = &motion, .locals = locals, .model_from_joint = model}
           .Run();
-  if (!m) return MakeError(ErrorCode::kInternal, loc, m.what);
+  if (!m) return base::MakeError(base::ErrorCode::kInternal, loc, m.what);
   std::vector<JointKinematics> out(frames * nj);
-  const JobStatus k = KinematicsJob{.model_from_joint = model,
-                                    .num_joints = static_cast<int>(nj),
-                                    .frame_time_s = motion.frame_time_s,
-                                    .output = out}
-                          .Run();
-  if (!k) return MakeError(ErrorCode::kInternal, loc, k.what);
+  const base::JobStatus k = KinematicsJob{.model_from_joint = model,
+                                          .num_joints = static_cast<int>(nj),
+                                          .frame_time_s = motion.frame_time_s,
+                                          .output = out}
+                                .Run();
+  if (!k) return base::MakeError(base::ErrorCode::kInternal, loc, k.what);
   return out;
 }
 
-JobStatus SampleJointKinematics(std::span<const JointKinematics> kinematics, int num_joints,
-                                int joint, double frame_time_s, double time_s,
-                                JointKinematics* out) {
+base::JobStatus SampleJointKinematics(std::span<const JointKinematics> kinematics, int num_joints,
+                                      int joint, double frame_time_s, double time_s,
+                                      JointKinematics* out) {
   if (out == nullptr || kinematics.empty())
-    return {JobStatus::kMissingInput, "no buffer or no output"};
+    return {base::JobStatus::kMissingInput, "no buffer or no output"};
   if (num_joints <= 0 || joint < 0 || joint >= num_joints) {
-    return {JobStatus::kOutOfRange, "joint outside [0, num_joints)"};
+    return {base::JobStatus::kOutOfRange, "joint outside [0, num_joints)"};
   }
   const std::size_t nj = static_cast<std::size_t>(num_joints);
-  if (kinematics.size() % nj != 0) return {JobStatus::kSizeMismatch, "buffer is not whole frames"};
-  if (!(frame_time_s > 0.0)) return {JobStatus::kOutOfRange, "frame_time_s must be positive"};
+  if (kinematics.size() % nj != 0)
+    return {base::JobStatus::kSizeMismatch, "buffer is not whole frames"};
+  if (!(frame_time_s > 0.0)) return {base::JobStatus::kOutOfRange, "frame_time_s must be positive"};
   const int num_frames = static_cast<int>(kinematics.size() / nj);
   const FrameBlend b = FindFrameBlend(num_frames, frame_time_s, time_s);
   const std::size_t js = static_cast<std::size_t>(joint);
   const JointKinematics& k0 = kinematics[static_cast<std::size_t>(b.frame0) * nj + js];
   if (b.frame1 == b.frame0) {
     *out = k0;
-    return kJobOk;
+    return base::kJobOk;
   }
   const JointKinematics& k1 = kinematics[static_cast<std::size_t>(b.frame1) * nj + js];
   const double s = b.weight;
@@ -295,7 +298,7 @@ JobStatus SampleJointKinematics(std::span<const JointKinematics> kinematics, int
   out->angular_velocity = lerp(k0.angular_velocity, k1.angular_velocity);
   out->angular_acceleration = lerp(k0.angular_acceleration, k1.angular_acceleration);
   FillLocal(out);
-  return kJobOk;
+  return base::kJobOk;
 }
 
 }  // namespace mocap

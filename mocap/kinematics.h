@@ -35,7 +35,7 @@
 #include <glm/glm.hpp>
 #include <glm/gtc/quaternion.hpp>
 
-#include "mocap/error.h"
+#include "base/error.h"
 #include "mocap/motion.h"
 #include "mocap/pose.h"
 #include "mocap/skeleton.h"
@@ -70,8 +70,8 @@ struct ModelMatricesJob {
   // kSizeMismatch: locals, channel counts, or an output that is not a whole
   // number of frames; kOutOfRange: frames past the motion's end or
   // motion->values too short.
-  [[nodiscard]] JobStatus Validate() const;
-  [[nodiscard]] JobStatus Run() const;  // no allocation
+  [[nodiscard]] base::JobStatus Validate() const;
+  [[nodiscard]] base::JobStatus Run() const;  // no allocation
 };
 
 // Finite-difference kinematics of every joint over a range of frames.
@@ -85,11 +85,11 @@ struct KinematicsJob {
 
   // kMissingInput: no joints or no frames; kSizeMismatch: spans that are not
   // whole frames; kOutOfRange: frame_time_s <= 0 or frames outside [0, #F).
-  [[nodiscard]] JobStatus Validate() const;
+  [[nodiscard]] base::JobStatus Validate() const;
   // Validate(), then the formulas above. No allocation. Each output depends only
   // on model_from_joint, so splitting the frame range over threads gives the
   // same bits.
-  [[nodiscard]] JobStatus Run() const;
+  [[nodiscard]] base::JobStatus Run() const;
 };
 
 // Optional zero-phase low-pass of the joint trajectories before KinematicsJob
@@ -113,15 +113,15 @@ struct SmoothTrajectoriesJob {
   std::span<glm::mat4> output;                  // #F' x #J smoothed matrices; must not alias input
 
   // Same checks as KinematicsJob, plus kOutOfRange for cutoff_hz <= 0.
-  [[nodiscard]] JobStatus Validate() const;
-  [[nodiscard]] JobStatus Run() const;  // no allocation; splitting ranges gives the same bits
+  [[nodiscard]] base::JobStatus Validate() const;
+  [[nodiscard]] base::JobStatus Run() const;  // no allocation; splitting ranges gives the same bits
 };
 
 // Convenience: model matrices and kinematics of all frames (#F x #J, frame-major),
 // allocated once. Errors (kInvalidArgument) for a motion that does not match the
 // skeleton or has no frames or a non-positive frame time.
-Result<std::vector<JointKinematics>> ComputeKinematics(const Skeleton& skeleton,
-                                                       const Motion& motion);
+base::Result<std::vector<JointKinematics>> ComputeKinematics(const Skeleton& skeleton,
+                                                             const Motion& motion);
 
 // Kinematics of ONE joint at any time t (seconds), e.g. an RK4 stage time, from
 // the two frames around t in a per-frame buffer (as KinematicsJob fills it, for
@@ -132,8 +132,8 @@ Result<std::vector<JointKinematics>> ComputeKinematics(const Skeleton& skeleton,
 // Exact at frame times; t is clamped to [0, (#F-1) h]. kSizeMismatch: buffer not
 // a whole number of frames; kOutOfRange: joint outside [0, #J), h <= 0;
 // kMissingInput: empty buffer or out == nullptr.
-[[nodiscard]] JobStatus SampleJointKinematics(std::span<const JointKinematics> kinematics,
-                                              int num_joints, int joint, double frame_time_s,
-                                              double time_s, JointKinematics* out);
+[[nodiscard]] base::JobStatus SampleJointKinematics(std::span<const JointKinematics> kinematics,
+                                                    int num_joints, int joint, double frame_time_s,
+                                                    double time_s, JointKinematics* out);
 
 }  // namespace mocap

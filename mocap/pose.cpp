@@ -36,19 +36,19 @@ void RestPose(const Skeleton& skeleton, std::span<JointTransform> locals) {
   }
 }
 
-JobStatus LocalPoseJob::Validate() const {
-  if (skeleton == nullptr) return {JobStatus::kMissingInput, "skeleton is null"};
+base::JobStatus LocalPoseJob::Validate() const {
+  if (skeleton == nullptr) return {base::JobStatus::kMissingInput, "skeleton is null"};
   if (frame_values.size() != static_cast<std::size_t>(skeleton->num_channels)) {
-    return {JobStatus::kSizeMismatch, "frame_values must hold num_channels values"};
+    return {base::JobStatus::kSizeMismatch, "frame_values must hold num_channels values"};
   }
   if (locals.size() != static_cast<std::size_t>(skeleton->num_joints())) {
-    return {JobStatus::kSizeMismatch, "locals must hold one transform per joint"};
+    return {base::JobStatus::kSizeMismatch, "locals must hold one transform per joint"};
   }
-  return kJobOk;
+  return base::kJobOk;
 }
 
-JobStatus LocalPoseJob::Run() const {
-  const JobStatus status = Validate();
+base::JobStatus LocalPoseJob::Run() const {
+  const base::JobStatus status = Validate();
   if (!status) return status;
   const Skeleton& s = *skeleton;
   for (std::size_t j = 0; j < static_cast<std::size_t>(s.num_joints()); ++j) {
@@ -118,28 +118,28 @@ JobStatus LocalPoseJob::Run() const {
     if (num_euler > 0) out.rotation = s.rest_rotations[j] * EulerToQuat(euler_axes, euler_deg, num_euler);
     if (has_quat) out.rotation = glm::normalize(quat);
   }
-  return kJobOk;
+  return base::kJobOk;
 }
 
-JobStatus LocalToModelJob::Validate() const {
+base::JobStatus LocalToModelJob::Validate() const {
   if (locals.size() != parents.size()) {
-    return {JobStatus::kSizeMismatch, "locals must hold one transform per joint"};
+    return {base::JobStatus::kSizeMismatch, "locals must hold one transform per joint"};
   }
   if (model_from_joint.size() != parents.size()) {
-    return {JobStatus::kSizeMismatch, "model_from_joint must hold one matrix per joint"};
+    return {base::JobStatus::kSizeMismatch, "model_from_joint must hold one matrix per joint"};
   }
-  return kJobOk;
+  return base::kJobOk;
 }
 
-JobStatus LocalToModelJob::Run() const {
-  const JobStatus status = Validate();
+base::JobStatus LocalToModelJob::Run() const {
+  const base::JobStatus status = Validate();
   if (!status) return status;
   for (std::size_t j = 0; j < parents.size(); ++j) {
     const int p = parents[j];
     const glm::mat4& parent = p == kNoParent ? model_from_root : model_from_joint[static_cast<std::size_t>(p)];
     model_from_joint[j] = parent * locals[j].ToMatrix();
   }
-  return kJobOk;
+  return base::kJobOk;
 }
 
 }  // namespace mocap

@@ -16,7 +16,7 @@
 #include <glm/glm.hpp>
 #include <glm/gtc/quaternion.hpp>
 
-#include "mocap/error.h"
+#include "base/error.h"
 #include "mocap/skeleton.h"
 
 namespace mocap {
@@ -44,8 +44,8 @@ struct LocalPoseJob {
   std::span<const float> frame_values;        // #C values of one frame (Motion::frame)
   std::span<JointTransform> locals;           // #J output
 
-  [[nodiscard]] JobStatus Validate() const;
-  [[nodiscard]] JobStatus Run() const;
+  [[nodiscard]] base::JobStatus Validate() const;
+  [[nodiscard]] base::JobStatus Run() const;
 };
 
 // Model-space matrices from local transforms, one forward pass over the
@@ -56,8 +56,8 @@ struct LocalToModelJob {
   glm::mat4 model_from_root{1.0f};            // applied above every root joint
   std::span<glm::mat4> model_from_joint;      // #J output
 
-  [[nodiscard]] JobStatus Validate() const;
-  [[nodiscard]] JobStatus Run() const;
+  [[nodiscard]] base::JobStatus Validate() const;
+  [[nodiscard]] base::JobStatus Run() const;
 };
 
 }  // namespace mocap

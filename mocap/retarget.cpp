@@ -88,9 +88,10 @@ float HipHeight(const Skeleton& skeleton, int joint) {
   return model[static_cast<std::size_t>(joint)][3].y - lowest;
 }
 
-Result<RetargetPlan> PlanByName(const Skeleton& target, const Skeleton& source,
-                                const std::string& target_file, const std::string& source_file,
-                                std::vector<Warning>* warnings) {
+base::Result<RetargetPlan> PlanByName(const Skeleton& target, const Skeleton& source,
+                                      const std::string& target_file,
+                                      const std::string& source_file,
+                                      std::vector<base::Warning>* warnings) {
   RetargetPlan plan;
   plan.source_of_target = MapJointsByName(target, source);
   const int nt = target.num_joints();
@@ -119,10 +120,12 @@ Result<RetargetPlan> PlanByName(const Skeleton& target, const Skeleton& source,
       list += (i ? ", " : "") + missing[i];
     }
     if (missing.size() > 12) list += ", ... (" + std::to_string(missing.size()) + " in all)";
-    return MakeError(ErrorCode::kInvalidArgument, {source_file, 0, 0, {}},
-                     "expected the joints of " + target_file +
-                         " that the motion must drive (matched by name, then case-insensitively "
-                         "without prefixes such as \"mixamorig:\"), found none for: " + list);
+    return base::MakeError(
+        base::ErrorCode::kInvalidArgument, {source_file, 0, 0, {}},
+        "expected the joints of " + target_file +
+            " that the motion must drive (matched by name, then case-insensitively "
+            "without prefixes such as \"mixamorig:\"), found none for: " +
+            list);
   }
   std::string unmapped;
   int num_unmapped = 0;
@@ -140,17 +143,19 @@ Result<RetargetPlan> PlanByName(const Skeleton& target, const Skeleton& source,
   const float source_hips = HipHeight(source, 0);
   const float target_hips = HipHeight(target, plan.target_root);
   if (!(source_hips > 0.0f) || !(target_hips > 0.0f)) {
-    return MakeError(ErrorCode::kInvalidArgument, {source_hips > 0.0f ? target_file : source_file, 0, 0, {}},
-                     "expected the root joint above the lowest joint in the rest pose (a hip "
-                     "height > 0) to scale the root translation");
+    return base::MakeError(base::ErrorCode::kInvalidArgument,
+                           {source_hips > 0.0f ? target_file : source_file, 0, 0, {}},
+                           "expected the root joint above the lowest joint in the rest pose (a hip "
+                           "height > 0) to scale the root translation");
   }
   plan.translation_scale = target_hips / source_hips;
   return plan;
 }
 
-Result<RetargetedMotion> ApplyRetargetPlan(const Skeleton& target, const Skeleton& source,
-                                           const Motion& source_motion, const RetargetPlan& plan,
-                                           const std::string& source_file) {
+base::Result<RetargetedMotion> ApplyRetargetPlan(const Skeleton& target, const Skeleton& source,
+                                                 const Motion& source_motion,
+                                                 const RetargetPlan& plan,
+                                                 const std::string& source_file) {
   const int nt = target.num_joints();
   const auto ns = static_cast<std::size_t>(source.num_joints());
   const auto& map = plan.source_of_target;
@@ -159,15 +164,16 @@ Result<RetargetedMotion> ApplyRetargetPlan(const Skeleton& target, const Skeleto
       (aligned && plan.align.size() != static_cast<std::size_t>(nt)) || plan.target_root < 0 ||
       plan.target_root >= nt || map[static_cast<std::size_t>(plan.target_root)] < 0 ||
       plan.source_root < 0 || static_cast<std::size_t>(plan.source_root) >= ns) {
-    return MakeError(ErrorCode::kInvalidArgument, {source_file, 0, 0, {}},
-                     "expected a retargeting plan with one entry per target joint and a mapped "
-                     "root joint");
+    return base::MakeError(
+        base::ErrorCode::kInvalidArgument, {source_file, 0, 0, {}},
+        "expected a retargeting plan with one entry per target joint and a mapped "
+        "root joint");
   }
   for (const int b : map) {
     if (b >= static_cast<int>(ns)) {
-      return MakeError(ErrorCode::kInvalidArgument, {source_file, 0, 0, {}},
-                       "retargeting plan names source joint " + std::to_string(b) +
-                           ", expected one of the motion's " + std::to_string(ns));
+      return base::MakeError(base::ErrorCode::kInvalidArgument, {source_file, 0, 0, {}},
+                             "retargeting plan names source joint " + std::to_string(b) +
+                                 ", expected one of the motion's " + std::to_string(ns));
     }
   }
   auto mapped = [&map](int j) { return map[static_cast<std::size_t>(j)] >= 0; };
@@ -231,12 +237,12 @@ Result<RetargetedMotion> ApplyRetargetPlan(const Skeleton& target, const Skeleto
   std::vector<glm::quat> previous(static_cast<std::size_t>(nt), glm::quat(1, 0, 0, 0));
   const auto source_root = static_cast<std::size_t>(plan.source_root);
   for (int f = 0; f < source_motion.num_frames; ++f) {
-    JobStatus s = LocalPoseJob{&source, source_motion.frame(f), source_locals}.Run();
+    base::JobStatus s = LocalPoseJob{&source, source_motion.frame(f), source_locals}.Run();
     if (s) s = LocalToModelJob{.parents = source.parents, .locals = source_locals,
                                .model_from_joint = source_model}.Run();
     if (!s) {
-      return MakeError(ErrorCode::kInternal, {source_file, 0, 0, {}},
-                       std::string("retargeting: pose evaluation refused to run: ") + s.what);
+      return base::MakeError(base::ErrorCode::kInternal, {source_file, 0, 0, {}},
+                             std::string("retargeting: pose evaluation refused to run: ") + s.what);
     }
     WorldRotations(source, source_locals, source_world);
     std::span<float> row = out.motion.frame(f);
@@ -268,19 +274,20 @@ Result<RetargetedMotion> ApplyRetargetPlan(const Skeleton& target, const Skeleto
       *v++ = local.w;
     }
   }
-  const Status checked = out.skeleton.Check();
+  const base::Status checked = out.skeleton.Check();
   if (!checked.ok()) return checked.error();
   return out;
 }
 
-Result<RetargetedMotion> RetargetMotion(const Skeleton& target, const Skeleton& source,
-                                        const Motion& source_motion,
-                                        const std::string& target_file,
-                                        const std::string& source_file) {
-  std::vector<Warning> warnings;
-  Result<RetargetPlan> plan = PlanByName(target, source, target_file, source_file, &warnings);
+base::Result<RetargetedMotion> RetargetMotion(const Skeleton& target, const Skeleton& source,
+                                              const Motion& source_motion,
+                                              const std::string& target_file,
+                                              const std::string& source_file) {
+  std::vector<base::Warning> warnings;
+  base::Result<RetargetPlan> plan = PlanByName(target, source, target_file, source_file, &warnings);
   if (!plan.ok()) return std::move(plan).error();
-  Result<RetargetedMotion> out = ApplyRetargetPlan(target, source, source_motion, *plan, source_file);
+  base::Result<RetargetedMotion> out =
+      ApplyRetargetPlan(target, source, source_motion, *plan, source_file);
   if (out.ok()) out->warnings = std::move(warnings);
   return out;
 }

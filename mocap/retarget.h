@@ -41,7 +41,7 @@
 #include <string>
 #include <vector>
 
-#include "mocap/error.h"
+#include "base/error.h"
 #include "mocap/motion.h"
 #include "mocap/skeleton.h"
 
@@ -67,7 +67,7 @@ struct RetargetedMotion {
   std::vector<int> source_of_target;  // #J of target, see MapJointsByName
   int root = -1;                   // target joint driven by the source root
   float translation_scale = 1.0f;  // hip_height(target) / hip_height(source)
-  std::vector<Warning> warnings;   // e.g. skin joints left unmapped
+  std::vector<base::Warning> warnings;  // e.g. skin joints left unmapped
 };
 
 // How one skeleton drives another, however it was found (by name here, by body
@@ -87,24 +87,26 @@ struct RetargetPlan {
 
 // The plan of the convention above: MapJointsByName, hip heights, identity
 // alignment. Errors as RetargetMotion's (required joints, zero hip height).
-Result<RetargetPlan> PlanByName(const Skeleton& target, const Skeleton& source,
-                                const std::string& target_file, const std::string& source_file,
-                                std::vector<Warning>* warnings);
+base::Result<RetargetPlan> PlanByName(const Skeleton& target, const Skeleton& source,
+                                      const std::string& target_file,
+                                      const std::string& source_file,
+                                      std::vector<base::Warning>* warnings);
 
 // Runs `plan`: kQuatX..W channels on every mapped joint, kX/Y/ZPosition on
 // plan.target_root, which must be mapped (kInvalidArgument otherwise, naming
 // `source_file`). Cost: one pose evaluation of the source per frame.
-Result<RetargetedMotion> ApplyRetargetPlan(const Skeleton& target, const Skeleton& source,
-                                           const Motion& source_motion, const RetargetPlan& plan,
-                                           const std::string& source_file);
+base::Result<RetargetedMotion> ApplyRetargetPlan(const Skeleton& target, const Skeleton& source,
+                                                 const Motion& source_motion,
+                                                 const RetargetPlan& plan,
+                                                 const std::string& source_file);
 
 // Retargets `source_motion` (on `source`) onto `target` (conventions above).
 // `target_file` and `source_file` name the files in errors:
 // kInvalidArgument "expected joints ... in the motion (matched by name), found
 // none for: Spine1, Neck", or a zero source hip height.
-Result<RetargetedMotion> RetargetMotion(const Skeleton& target, const Skeleton& source,
-                                        const Motion& source_motion,
-                                        const std::string& target_file,
-                                        const std::string& source_file);
+base::Result<RetargetedMotion> RetargetMotion(const Skeleton& target, const Skeleton& source,
+                                              const Motion& source_motion,
+                                              const std::string& target_file,
+                                              const std::string& source_file);
 
 }  // namespace mocap

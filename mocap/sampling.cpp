@@ -52,38 +52,38 @@ FrameBlend FindFrameBlend(int num_frames, double frame_time_s, double time_s) {
   return {k, k + 1, static_cast<float>(fraction)};
 }
 
-JobStatus SampleLocalsJob::Validate() const {
+base::JobStatus SampleLocalsJob::Validate() const {
   if (skeleton == nullptr || motion == nullptr) {
-    return {JobStatus::kMissingInput, "skeleton and motion are required"};
+    return {base::JobStatus::kMissingInput, "skeleton and motion are required"};
   }
-  if (motion->num_frames < 1) return {JobStatus::kMissingInput, "motion has no frames"};
+  if (motion->num_frames < 1) return {base::JobStatus::kMissingInput, "motion has no frames"};
   if (motion->num_channels != skeleton->num_channels) {
-    return {JobStatus::kSizeMismatch, "motion and skeleton have different channel counts"};
+    return {base::JobStatus::kSizeMismatch, "motion and skeleton have different channel counts"};
   }
   const std::size_t num_joints = static_cast<std::size_t>(skeleton->num_joints());
   if (locals.size() != num_joints || scratch.size() != num_joints) {
-    return {JobStatus::kSizeMismatch, "locals and scratch must hold one transform per joint"};
+    return {base::JobStatus::kSizeMismatch, "locals and scratch must hold one transform per joint"};
   }
   if (!(motion->frame_time_s > 0.0)) {
-    return {JobStatus::kOutOfRange, "motion frame_time_s must be positive"};
+    return {base::JobStatus::kOutOfRange, "motion frame_time_s must be positive"};
   }
   if (motion->values.size() < static_cast<std::size_t>(motion->num_frames) *
                                   static_cast<std::size_t>(motion->num_channels)) {
-    return {JobStatus::kOutOfRange, "motion values hold fewer than num_frames rows"};
+    return {base::JobStatus::kOutOfRange, "motion values hold fewer than num_frames rows"};
   }
-  return kJobOk;
+  return base::kJobOk;
 }
 
-JobStatus SampleLocalsJob::Run() const {
-  const JobStatus status = Validate();
+base::JobStatus SampleLocalsJob::Run() const {
+  const base::JobStatus status = Validate();
   if (!status) return status;
   const FrameBlend blend = FindFrameBlend(motion->num_frames, motion->frame_time_s, time_s);
-  const JobStatus first =
+  const base::JobStatus first =
       LocalPoseJob{
           .skeleton = skeleton, .frame_values = motion->frame(blend.frame0), .locals = locals}
           .Run();
   if (!first || blend.frame1 == blend.frame0) return first;
-  const JobStatus second =
+  const base::JobStatus second =
       LocalPoseJob{
           .skeleton = skeleton, .frame_values = motion->frame(blend.frame1), .locals = scratch}
           .Run();
@@ -96,7 +96,7 @@ JobStatus SampleLocalsJob::Run() const {
     a.rotation = SlerpShortest(a.rotation, b.rotation, w);
     a.scale = a.scale + w * (b.scale - a.scale);
   }
-  return kJobOk;
+  return base::kJobOk;
 }
 
 namespace {
@@ -180,29 +180,30 @@ void WriteJointChannels(const Skeleton& s, std::size_t j, const JointTransform& 
 
 }  // namespace
 
-Result<Motion> Resample(const Skeleton& skeleton, const Motion& motion, double new_frame_time_s) {
-  const FileLoc loc{skeleton.info.source_file, 0, 0, {}};
+base::Result<Motion> Resample(const Skeleton& skeleton, const Motion& motion,
+                              double new_frame_time_s) {
+  const base::FileLoc loc{skeleton.info.source_file, 0, 0, {}};
   if (!std::isfinite(new_frame_time_s) || new_frame_time_s <= 0.0) {
-    return MakeError(
-        ErrorCode::kInvalidArgument, loc,
+    return base::MakeError(
+        base::ErrorCode::kInvalidArgument, loc,
         "expected a positive finite frame time, found " + std::to_string(new_frame_time_s));
   }
   if (motion.num_channels != skeleton.num_channels || motion.num_frames < 1 ||
       motion.values.size() != static_cast<std::size_t>(motion.num_frames) *
                                   static_cast<std::size_t>(motion.num_channels) ||
       !(motion.frame_time_s > 0.0)) {
-    return MakeError(ErrorCode::kInvalidArgument, loc,
-                     "expected a motion with frames, a positive frame time and " +
-                         std::to_string(skeleton.num_channels) + " channels per frame, found " +
-                         std::to_string(motion.num_frames) + " frames of " +
-                         std::to_string(motion.num_channels) + " channels");
+    return base::MakeError(base::ErrorCode::kInvalidArgument, loc,
+                           "expected a motion with frames, a positive frame time and " +
+                               std::to_string(skeleton.num_channels) +
+                               " channels per frame, found " + std::to_string(motion.num_frames) +
+                               " frames of " + std::to_string(motion.num_channels) + " channels");
   }
-  const Status check = skeleton.Check();
+  const base::Status check = skeleton.Check();
   if (!check) return check.error();
   const double steps = std::floor(motion.duration_s() / new_frame_time_s + 1e-9);
   if (!(steps + 1.0 <= static_cast<double>(kMaxResampledFrames))) {
-    return MakeError(
-        ErrorCode::kLimitExceeded, loc,
+    return base::MakeError(
+        base::ErrorCode::kLimitExceeded, loc,
         "resampling would produce more than " + std::to_string(kMaxResampledFrames) + " frames");
   }
   Motion out;
@@ -215,13 +216,13 @@ Result<Motion> Resample(const Skeleton& skeleton, const Motion& motion, double n
   std::vector<JointTransform> locals(num_joints);
   std::vector<JointTransform> scratch(num_joints);
   for (int f = 0; f < out.num_frames; ++f) {
-    const JobStatus status = SampleLocalsJob{.skeleton = &skeleton,
-                                             .motion = &motion,
-                                             .time_s = f * new_frame_time_s,
-                                             .scratch = scratch,
-                                             .locals = locals}
-                                 .Run();
-    if (!status) return MakeError(ErrorCode::kInternal, loc, status.what);
+    const base::JobStatus status = SampleLocalsJob{.skeleton = &skeleton,
+                                                   .motion = &motion,
+                                                   .time_s = f * new_frame_time_s,
+                                                   .scratch = scratch,
+                                                   .locals = locals}
+                                       .Run();
+    if (!status) return base::MakeError(base::ErrorCode::kInternal, loc, status.what);
     const std::span<const float> reference =
         f == 0 ? motion.frame(0) : std::span<const float>(out.frame(f - 1));
     for (std::size_t j = 0; j < num_joints; ++j) {

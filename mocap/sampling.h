@@ -12,7 +12,7 @@
 
 #include <span>
 
-#include "mocap/error.h"
+#include "base/error.h"
 #include "mocap/motion.h"
 #include "mocap/pose.h"
 #include "mocap/skeleton.h"
@@ -48,9 +48,9 @@ struct SampleLocalsJob {
   // kMissingInput: skeleton or motion null, or motion without frames;
   // kSizeMismatch: channel counts or span sizes; kOutOfRange: frame_time_s <= 0
   // or motion->values too short. Reads no channel values.
-  [[nodiscard]] JobStatus Validate() const;
+  [[nodiscard]] base::JobStatus Validate() const;
   // Validate(), then two LocalPoseJob evaluations and the blend. No allocation.
-  [[nodiscard]] JobStatus Run() const;
+  [[nodiscard]] base::JobStatus Run() const;
 };
 
 // Largest number of frames Resample produces (about 2.3 hours at 120 fps).
@@ -70,6 +70,7 @@ inline constexpr int kMaxResampledFrames = 1 << 20;
 // Errors (kInvalidArgument): new_frame_time_s not finite or <= 0, a motion that
 // does not match the skeleton or has no frames; kLimitExceeded: more than
 // kMaxResampledFrames frames.
-Result<Motion> Resample(const Skeleton& skeleton, const Motion& motion, double new_frame_time_s);
+base::Result<Motion> Resample(const Skeleton& skeleton, const Motion& motion,
+                              double new_frame_time_s);
 
 }  // namespace mocap

@@ -32,47 +32,49 @@ int Skeleton::FindJoint(std::string_view name) const {
   return -1;
 }
 
-Status Skeleton::Check() const {
+base::Status Skeleton::Check() const {
   const std::size_t n = parents.size();
-  FileLoc loc{info.source_file, 0, 0, {}};
+  base::FileLoc loc{info.source_file, 0, 0, {}};
   if (n > static_cast<std::size_t>(kMaxJoints)) {
-    return MakeError(ErrorCode::kLimitExceeded, loc,
-                     "skeleton has " + std::to_string(n) + " joints, more than the limit of " +
-                         std::to_string(kMaxJoints));
+    return base::MakeError(base::ErrorCode::kLimitExceeded, loc,
+                           "skeleton has " + std::to_string(n) +
+                               " joints, more than the limit of " + std::to_string(kMaxJoints));
   }
   if (names.size() != n || rest_translations.size() != n || rest_rotations.size() != n ||
       rest_scales.size() != n || channels.size() != n ||
       (!channel_use.empty() && channel_use.size() != n)) {
-    return MakeError(ErrorCode::kInternal, loc, "skeleton arrays have different sizes");
+    return base::MakeError(base::ErrorCode::kInternal, loc, "skeleton arrays have different sizes");
   }
   int expected_first = 0;
   for (std::size_t j = 0; j < n; ++j) {
     const int p = parents[j];
     if (p != kNoParent && (p < 0 || p >= static_cast<int>(j))) {
-      return MakeError(ErrorCode::kInternal, loc,
-                       "joint '" + names[j] + "' does not come after its parent");
+      return base::MakeError(base::ErrorCode::kInternal, loc,
+                             "joint '" + names[j] + "' does not come after its parent");
     }
     const JointChannels& c = channels[j];
     if (c.count > kMaxChannelsPerJoint) {
-      return MakeError(ErrorCode::kInternal, loc, "joint '" + names[j] + "' has too many channels");
+      return base::MakeError(base::ErrorCode::kInternal, loc,
+                             "joint '" + names[j] + "' has too many channels");
     }
     if (c.count > 0) {
       if (static_cast<int>(c.first) != expected_first) {
-        return MakeError(ErrorCode::kInternal, loc,
-                         "channels of joint '" + names[j] + "' are not contiguous");
+        return base::MakeError(base::ErrorCode::kInternal, loc,
+                               "channels of joint '" + names[j] + "' are not contiguous");
       }
       expected_first += c.count;
     }
   }
   if (expected_first != num_channels) {
-    return MakeError(ErrorCode::kInternal, loc, "channel count does not match the joints'");
+    return base::MakeError(base::ErrorCode::kInternal, loc,
+                           "channel count does not match the joints'");
   }
   for (const EndSite& e : end_sites) {
     if (e.parent < 0 || e.parent >= static_cast<int>(n)) {
-      return MakeError(ErrorCode::kInternal, loc, "end site with an invalid parent");
+      return base::MakeError(base::ErrorCode::kInternal, loc, "end site with an invalid parent");
     }
   }
-  return Status::Ok();
+  return base::Status::Ok();
 }
 
 double NominalFps(double frame_time_s) {

@@ -15,7 +15,7 @@
 #include <glm/glm.hpp>
 #include <glm/gtc/quaternion.hpp>
 
-#include "mocap/error.h"
+#include "base/error.h"
 
 namespace mocap {
 
@@ -109,7 +109,7 @@ struct Skeleton {
   // Index of the joint with exactly this name, or -1.
   int FindJoint(std::string_view name) const;
   // Verifies sizes, parent order, channel ranges (contiguous, within num_channels).
-  Status Check() const;
+  base::Status Check() const;
 };
 
 }  // namespace mocap

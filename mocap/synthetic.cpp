@@ -91,25 +91,25 @@ struct HumanoidPose {
 // Writes motions of a humanoid skeleton frame by frame, whatever its channel order.
 class MotionWriter {
  public:
-  static Result<MotionWriter> Create(const Skeleton& s, double frame_time_s, int num_frames) {
-    const FileLoc loc{s.info.source_file, 0, 0, {}};
+  static base::Result<MotionWriter> Create(const Skeleton& s, double frame_time_s, int num_frames) {
+    const base::FileLoc loc{s.info.source_file, 0, 0, {}};
     if (!(frame_time_s > 0.0) || !std::isfinite(frame_time_s) || num_frames < 1 ||
         num_frames > (1 << 20)) {
-      return MakeError(ErrorCode::kInvalidArgument, loc,
-                       "expected a positive frame time and duration, found frame time " +
-                           std::to_string(frame_time_s) + " s for " + std::to_string(num_frames) +
-                           " frames");
+      return base::MakeError(base::ErrorCode::kInvalidArgument, loc,
+                             "expected a positive frame time and duration, found frame time " +
+                                 std::to_string(frame_time_s) + " s for " +
+                                 std::to_string(num_frames) + " frames");
     }
-    const Status check = s.Check();
+    const base::Status check = s.Check();
     if (!check) return check.error();
     MotionWriter w(s);
     for (int i = 0; i < kNumH; ++i) {
       w.index_[static_cast<std::size_t>(i)] =
           s.FindJoint(kHumanoidNames[static_cast<std::size_t>(i)]);
       if (w.index_[static_cast<std::size_t>(i)] < 0) {
-        return MakeError(ErrorCode::kNotFound, loc,
-                         std::string("expected a humanoid joint named '") +
-                             kHumanoidNames[static_cast<std::size_t>(i)] + "'");
+        return base::MakeError(base::ErrorCode::kNotFound, loc,
+                               std::string("expected a humanoid joint named '") +
+                                   kHumanoidNames[static_cast<std::size_t>(i)] + "'");
       }
     }
     w.motion_.frame_time_s = frame_time_s;
@@ -245,11 +245,11 @@ Skeleton MakeHumanoidSkeleton() {
   return s;
 }
 
-Result<Motion> MakeWalkMotion(const Skeleton& humanoid, const WalkOptions& o) {
+base::Result<Motion> MakeWalkMotion(const Skeleton& humanoid, const WalkOptions& o) {
   if (!(o.step_length_cm > 0.0 && o.step_length_cm <= 60.0) ||
       !(o.foot_lift_cm >= 0.0 && o.foot_lift_cm <= 30.0)) {
-    return MakeError(ErrorCode::kInvalidArgument, {humanoid.info.source_file, 0, 0, {}},
-                     "expected a step length in (0, 60] cm and a foot lift in [0, 30] cm");
+    return base::MakeError(base::ErrorCode::kInvalidArgument, {humanoid.info.source_file, 0, 0, {}},
+                           "expected a step length in (0, 60] cm and a foot lift in [0, 30] cm");
   }
   const int frames = o.num_cycles >= 1 && o.cycle_s > 0.0
                          ? FramesFor(o.num_cycles * o.cycle_s, o.frame_time_s) - 1
@@ -328,8 +328,8 @@ Result<Motion> MakeWalkMotion(const Skeleton& humanoid, const WalkOptions& o) {
   return writer->Take();
 }
 
-Result<Motion> MakeBendRamp(const Skeleton& humanoid, float end_deg, double duration_s,
-                            double frame_time_s) {
+base::Result<Motion> MakeBendRamp(const Skeleton& humanoid, float end_deg, double duration_s,
+                                  double frame_time_s) {
   auto writer = MotionWriter::Create(humanoid, frame_time_s, FramesFor(duration_s, frame_time_s));
   if (!writer.ok()) return std::move(writer).error();
   const int last = writer->num_frames() - 1;
@@ -357,9 +357,10 @@ std::pair<int, double> EasedSegment(double t, double segment_s, int num_keys) {
 
 }  // namespace
 
-Result<Motion> MakeShoulderSweep(const Skeleton& humanoid, double segment_s,
-                                 double frame_time_s) {
-  if (!(segment_s > 0.0)) return MakeError(ErrorCode::kInvalidArgument, {}, "expected segment_s > 0");
+base::Result<Motion> MakeShoulderSweep(const Skeleton& humanoid, double segment_s,
+                                       double frame_time_s) {
+  if (!(segment_s > 0.0))
+    return base::MakeError(base::ErrorCode::kInvalidArgument, {}, "expected segment_s > 0");
   const glm::quat t_pose(1.0f, 0.0f, 0.0f, 0.0f);
   const glm::quat poses[5] = {Zxy(-75, 0, 0), Zxy(60, 0, 0), Zxy(0, 0, -90), Zxy(0, 0, 40),
                               Zxy(-60, 0, -50)};
@@ -382,8 +383,9 @@ Result<Motion> MakeShoulderSweep(const Skeleton& humanoid, double segment_s,
   return writer->Take();
 }
 
-Result<Motion> MakeHipSwing(const Skeleton& humanoid, double segment_s, double frame_time_s) {
-  if (!(segment_s > 0.0)) return MakeError(ErrorCode::kInvalidArgument, {}, "expected segment_s > 0");
+base::Result<Motion> MakeHipSwing(const Skeleton& humanoid, double segment_s, double frame_time_s) {
+  if (!(segment_s > 0.0))
+    return base::MakeError(base::ErrorCode::kInvalidArgument, {}, "expected segment_s > 0");
   // (thigh X, knee X) in degrees: stand, stretched back, stand, lifted, stand.
   const double keys[5][2] = {{0, 0}, {40, 0}, {0, 0}, {-80, 90}, {0, 0}};
   auto writer = MotionWriter::Create(humanoid, frame_time_s, FramesFor(4 * segment_s, frame_time_s));
@@ -399,8 +401,8 @@ Result<Motion> MakeHipSwing(const Skeleton& humanoid, double segment_s, double f
   return writer->Take();
 }
 
-Result<Motion> MakeTwistRamp(const Skeleton& humanoid, float end_deg, double duration_s,
-                             double frame_time_s) {
+base::Result<Motion> MakeTwistRamp(const Skeleton& humanoid, float end_deg, double duration_s,
+                                   double frame_time_s) {
   auto writer = MotionWriter::Create(humanoid, frame_time_s, FramesFor(duration_s, frame_time_s));
   if (!writer.ok()) return std::move(writer).error();
   const int last = writer->num_frames() - 1;
@@ -431,12 +433,12 @@ JumpTimeline MakeJumpTimeline(const JumpOptions& o) {
   return t;
 }
 
-Result<Motion> MakeJumpMotion(const Skeleton& humanoid, const JumpOptions& o) {
+base::Result<Motion> MakeJumpMotion(const Skeleton& humanoid, const JumpOptions& o) {
   const double leg = kThighCm + kShinCm;
   if (!(o.height_cm > 0.0) || !(o.crouch_cm > 0.0 && o.crouch_cm < leg) ||
       !(o.landing_crouch_cm > 0.0 && o.landing_crouch_cm < leg)) {
-    return MakeError(
-        ErrorCode::kInvalidArgument, {humanoid.info.source_file, 0, 0, {}},
+    return base::MakeError(
+        base::ErrorCode::kInvalidArgument, {humanoid.info.source_file, 0, 0, {}},
         "expected a positive jump height and crouch depths below the leg length (84 cm)");
   }
   const JumpTimeline tl = MakeJumpTimeline(o);
@@ -489,14 +491,14 @@ Result<Motion> MakeJumpMotion(const Skeleton& humanoid, const JumpOptions& o) {
   return writer->Take();
 }
 
-Result<Skeleton> MakeChainSkeleton(int num_joints, float segment_length_cm) {
+base::Result<Skeleton> MakeChainSkeleton(int num_joints, float segment_length_cm) {
   if (num_joints < 1 || num_joints > kMaxJoints || !(segment_length_cm > 0.0f) ||
       !std::isfinite(segment_length_cm)) {
-    return MakeError(ErrorCode::kInvalidArgument, {"synthetic:chain", 0, 0, {}},
-                     "expected 1.." + std::to_string(kMaxJoints) +
-                         " joints and a positive segment length, found " +
-                         std::to_string(num_joints) + " joints of " +
-                         std::to_string(segment_length_cm) + " cm");
+    return base::MakeError(base::ErrorCode::kInvalidArgument, {"synthetic:chain", 0, 0, {}},
+                           "expected 1.." + std::to_string(kMaxJoints) +
+                               " joints and a positive segment length, found " +
+                               std::to_string(num_joints) + " joints of " +
+                               std::to_string(segment_length_cm) + " cm");
   }
   Builder b;
   int parent = b.Add("Chain0", kNoParent, {0, 50, 0}, true);

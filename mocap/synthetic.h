@@ -19,7 +19,7 @@
 // relative to its rest rotation). They return kNotFound naming the first missing
 // joint, and kInvalidArgument for a non-positive frame time or duration.
 
-#include "mocap/error.h"
+#include "base/error.h"
 #include "mocap/motion.h"
 #include "mocap/skeleton.h"
 
@@ -54,14 +54,14 @@ struct WalkOptions {
   float arm_swing_deg = 15.0f;   // upper-arm swing amplitude
   float elbow_peak_deg = 45.0f;  // elbow flexion with the arm fully forward (<= 120)
 };
-Result<Motion> MakeWalkMotion(const Skeleton& humanoid, const WalkOptions& options = {});
+base::Result<Motion> MakeWalkMotion(const Skeleton& humanoid, const WalkOptions& options = {});
 
 // Elbows (both, arms in T-pose, forearms bending forward) and the left knee
 // (the thigh flexing forward to 0.4x the knee angle, so the shin stays clear of
 // the body) bend linearly from 0 to end_deg over duration_s; the right leg
 // stands still. num_frames = round(duration_s / frame_time_s) + 1.
-Result<Motion> MakeBendRamp(const Skeleton& humanoid, float end_deg = 150.0f,
-                            double duration_s = 2.0, double frame_time_s = 1.0 / 30.0);
+base::Result<Motion> MakeBendRamp(const Skeleton& humanoid, float end_deg = 150.0f,
+                                  double duration_s = 2.0, double frame_time_s = 1.0 / 30.0);
 
 // The left upper arm (joint LeftArm) visits five poses, returning to the
 // T-pose between them: down at the side (Z -75), raised (Z +60), forward
@@ -70,21 +70,21 @@ Result<Motion> MakeBendRamp(const Skeleton& humanoid, float end_deg = 150.0f,
 // (zero speed at both ends), so pose k (0..4) is reached exactly at
 // (2k + 1) * segment_s and the motion lasts 10 * segment_s. Angles in degrees
 // about the joint's own axes, composed in its ZXY order (pose.h).
-Result<Motion> MakeShoulderSweep(const Skeleton& humanoid, double segment_s = 0.5,
-                                 double frame_time_s = 1.0 / 30.0);
+base::Result<Motion> MakeShoulderSweep(const Skeleton& humanoid, double segment_s = 0.5,
+                                       double frame_time_s = 1.0 / 30.0);
 
 // The left leg stretches back (thigh 40 degrees behind, knee straight), returns
 // to standing, lifts forward (thigh 80 degrees forward, knee 90 degrees bent)
 // and returns; the foot follows the shin (ankle and right leg still). Each move takes
 // segment_s with a cosine ease; the stretched-back pose is reached exactly at
 // segment_s and the lifted pose at 3 * segment_s; 4 * segment_s in all.
-Result<Motion> MakeHipSwing(const Skeleton& humanoid, double segment_s = 0.5,
-                            double frame_time_s = 1.0 / 30.0);
+base::Result<Motion> MakeHipSwing(const Skeleton& humanoid, double segment_s = 0.5,
+                                  double frame_time_s = 1.0 / 30.0);
 
 // Both forearms twist about their bone axis (X) linearly from 0 to end_deg
 // (mirrored: the right forearm by -end_deg about +X), arms in T-pose.
-Result<Motion> MakeTwistRamp(const Skeleton& humanoid, float end_deg = 180.0f,
-                             double duration_s = 2.0, double frame_time_s = 1.0 / 30.0);
+base::Result<Motion> MakeTwistRamp(const Skeleton& humanoid, float end_deg = 180.0f,
+                                   double duration_s = 2.0, double frame_time_s = 1.0 / 30.0);
 
 // A standing vertical jump: stand, crouch (cosine ease), push with constant
 // upward hip acceleration v0^2 / (2 crouch) until the legs are straight at
@@ -99,7 +99,7 @@ struct JumpOptions {
   double crouch_cm = 25.0;          // hip drop before take-off (< 84, the leg length)
   double landing_crouch_cm = 20.0;  // hip drop while landing
 };
-Result<Motion> MakeJumpMotion(const Skeleton& humanoid, const JumpOptions& options = {});
+base::Result<Motion> MakeJumpMotion(const Skeleton& humanoid, const JumpOptions& options = {});
 
 // Times (seconds from the first frame) of the jump's phases, for tests.
 struct JumpTimeline {
@@ -114,7 +114,7 @@ JumpTimeline MakeJumpTimeline(const JumpOptions& options);
 // is the root at (0, 50, 0) with position channels, every next joint is
 // segment_length_cm further along -Z; all ZXY rotation channels; an end site.
 // kInvalidArgument unless 1 <= num_joints <= kMaxJoints and the length is > 0.
-Result<Skeleton> MakeChainSkeleton(int num_joints, float segment_length_cm = 10.0f);
+base::Result<Skeleton> MakeChainSkeleton(int num_joints, float segment_length_cm = 10.0f);
 
 // A simple quadruped standing on y = 0, facing +Z, in cm: Hips (root), Spine,
 // Chest, Neck, Head, four legs {Left,Right}{Front,Hind}{UpLeg,Leg,Foot,ToeBase}

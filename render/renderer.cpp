@@ -12,7 +12,7 @@
 #include <xmmintrin.h>
 #endif
 
-#include "render/internal/parallel.h"
+#include "base/parallel.h"
 #include "render/raster/shading4.h"
 
 namespace render {
@@ -83,10 +83,10 @@ bool PixelAllOf(const std::uint32_t* ids, int c0, int ss, std::uint32_t id) {
   return true;
 }
 
-mocap::JobStatus Fail(mocap::JobStatus::Code code, const char* what) { return {code, what}; }
+base::JobStatus Fail(base::JobStatus::Code code, const char* what) { return {code, what}; }
 
-mocap::JobStatus ValidateInputs(std::span<const SceneMesh> meshes, const RenderSettings& s) {
-  using Code = mocap::JobStatus::Code;
+base::JobStatus ValidateInputs(std::span<const SceneMesh> meshes, const RenderSettings& s) {
+  using Code = base::JobStatus::Code;
   if (s.supersample != 1 && s.supersample != 2 && s.supersample != 4)
     return Fail(Code::kOutOfRange, "supersample must be 1, 2 or 4");
   if (s.width < 1 || s.height < 1 || s.width * s.supersample > kMaxSamplesPerAxis ||
@@ -106,17 +106,17 @@ mocap::JobStatus ValidateInputs(std::span<const SceneMesh> meshes, const RenderS
     if (!mesh.triangle_textures.empty() && mesh.triangle_textures.size() != mesh.triangles.size())
       return Fail(Code::kSizeMismatch, "triangle_textures must be empty or #T");
   }
-  return mocap::kJobOk;
+  return base::kJobOk;
 }
 
 }  // namespace
 
-mocap::JobStatus Renderer::Render(const Camera& camera, std::span<const SceneMesh> meshes,
-                                  const Overlays& overlays, const RenderSettings& settings,
-                                  Image& image) {
-  const mocap::JobStatus status = ValidateInputs(meshes, settings);
+base::JobStatus Renderer::Render(const Camera& camera, std::span<const SceneMesh> meshes,
+                                 const Overlays& overlays, const RenderSettings& settings,
+                                 Image& image) {
+  const base::JobStatus status = ValidateInputs(meshes, settings);
   if (!status.ok()) return status;
-  const int threads = internal::ResolveThreads(settings.threads);
+  const int threads = base::ResolveThreads(settings.threads);
   const int ss = settings.supersample;
   const glm::mat4 view_from_world = camera.ViewFromWorld();
   const glm::mat4 clip_from_world = camera.ClipFromView() * view_from_world;
@@ -160,7 +160,7 @@ mocap::JobStatus Renderer::Render(const Camera& camera, std::span<const SceneMes
     const std::span<const glm::vec3> p =
         m < meshes.size() ? meshes[m].positions : std::span<const glm::vec3>(ground_positions_);
     clip_positions_[m].resize(p.size());
-    internal::RunOnThreads(p.size() > 8192 ? threads : 1, [&](int t) {
+    base::RunOnThreads(p.size() > 8192 ? threads : 1, [&](int t) {
       const int n = p.size() > 8192 ? threads : 1;
       const std::size_t begin = p.size() * static_cast<std::size_t>(t) / static_cast<std::size_t>(n);
       const std::size_t end = p.size() * static_cast<std::size_t>(t + 1) / static_cast<std::size_t>(n);
@@ -179,7 +179,7 @@ mocap::JobStatus Renderer::Render(const Camera& camera, std::span<const SceneMes
   raster.clip_far = settings.clip_far;
   raster.threads = threads;
   if (!rasterizer_.Setup(clip_meshes, raster))
-    return Fail(mocap::JobStatus::kOutOfRange, "raster size out of range");
+    return Fail(base::JobStatus::kOutOfRange, "raster size out of range");
 
   // The key light's shadow map, for the meshes and the ground.
   body_shadow_ = nullptr;
@@ -242,7 +242,7 @@ mocap::JobStatus Renderer::Render(const Camera& camera, std::span<const SceneMes
     s.nearest.resize(kTileSize * kTileSize);
   }
   if (tent) {
-    internal::ParallelForDynamic(rasterizer_.num_tiles(), threads, [&](int tile, int thread) {
+    base::ParallelForDynamic(rasterizer_.num_tiles(), threads, [&](int tile, int thread) {
       TileScratch& s = scratch_[static_cast<std::size_t>(thread)];
       if (rasterizer_.tile_triangle_count(tile) == 0) {
         FillBackgroundTile(tile, settings, image);
@@ -263,7 +263,7 @@ mocap::JobStatus Renderer::Render(const Camera& camera, std::span<const SceneMes
                settings.height, fill_cursor);
     const int count = static_cast<int>(shaded_tiles_.size());
     std::atomic<int> next{0};
-    internal::RunOnThreads(std::min(threads, std::max(count, 1)), [&](int thread) {
+    base::RunOnThreads(std::min(threads, std::max(count, 1)), [&](int thread) {
       TileScratch& s = scratch_[static_cast<std::size_t>(thread)];
       std::size_t credit = 0;  // background units owed, times count
       for (int i = next.fetch_add(1); i < count; i = next.fetch_add(1)) {
@@ -280,7 +280,7 @@ mocap::JobStatus Renderer::Render(const Camera& camera, std::span<const SceneMes
   }
   if (tent) {
     // Every sample is shaded before any pixel reads its neighbours' samples.
-    internal::RunOnThreads(threads, [&](int t) {
+    base::RunOnThreads(threads, [&](int t) {
       const int row0 = settings.height * t / threads, row1 = settings.height * (t + 1) / threads;
       TentResolveRows(row0, row1, settings, image);
     });
@@ -296,7 +296,7 @@ mocap::JobStatus Renderer::Render(const Camera& camera, std::span<const SceneMes
   for (const PointOverlay& points : overlays.points) DrawPoints(clip_from_world, points, image);
   for (const TextOverlay& text : overlays.text) DrawText(text, image);
   if (!settings.write_depth) image.depth.clear();
-  return mocap::kJobOk;
+  return base::kJobOk;
 }
 
 // Shades visible samples. Neighbouring samples usually hit the same few

@@ -4,7 +4,7 @@
 //   render::Renderer renderer;                 // keep one per output stream
 //   render::RenderSettings settings{.width = 1280, .height = 720, .supersample = 2};
 //   render::SceneMesh body{.positions = p, .normals = n, .triangles = t};
-//   mocap::JobStatus s = renderer.Render(camera, {&body, 1}, overlays, settings, image);
+//   base::JobStatus s = renderer.Render(camera, {&body, 1}, overlays, settings, image);
 //
 // Stages: world -> clip transform (threaded over vertices), rasterizer setup
 // and binning, then per 64x64-sample tile: visibility (z-buffer) pass,
@@ -20,7 +20,7 @@
 
 #include <glm/glm.hpp>
 
-#include "mocap/error.h"
+#include "base/error.h"
 #include "render/raster/background_fill.h"
 #include "render/camera.h"
 #include "render/raster/ground_shader.h"
@@ -121,8 +121,8 @@ class Renderer {
   // `image`, resizing it to width x height. Triangles with out-of-range
   // indices are skipped. On a bad argument returns the failed check and leaves
   // `image` untouched.
-  mocap::JobStatus Render(const Camera& camera, std::span<const SceneMesh> meshes,
-                          const Overlays& overlays, const RenderSettings& settings, Image& image);
+  base::JobStatus Render(const Camera& camera, std::span<const SceneMesh> meshes,
+                         const Overlays& overlays, const RenderSettings& settings, Image& image);
 
   // The rasterizer of the last frame (for tests and statistics).
   const Rasterizer& rasterizer() const { return rasterizer_; }

@@ -39,19 +39,19 @@ std::string DescribeJson(const json& v) {
   }
 }
 
-mocap::Error JsonFile::Fail(const std::string& path, const std::string& message,
-                            mocap::ErrorCode code) const {
-  return mocap::MakeError(code, {file, 0, 0, path}, message);
+base::Error JsonFile::Fail(const std::string& path, const std::string& message,
+                           base::ErrorCode code) const {
+  return base::MakeError(code, {file, 0, 0, path}, message);
 }
 
-mocap::Error JsonFile::Expected(const std::string& path, const std::string& what,
-                                const json& found) const {
+base::Error JsonFile::Expected(const std::string& path, const std::string& what,
+                               const json& found) const {
   return Fail(path, "expected " + what + ", found " + DescribeJson(found));
 }
 
-std::optional<mocap::Error> JsonFile::Keys(const json& obj, const std::string& path,
-                                           std::initializer_list<const char*> allowed,
-                                           const char* whole) const {
+std::optional<base::Error> JsonFile::Keys(const json& obj, const std::string& path,
+                                          std::initializer_list<const char*> allowed,
+                                          const char* whole) const {
   if (!obj.is_object()) return Expected(path.empty() ? whole : path, "an object", obj);
   for (const auto& [key, value] : obj.items()) {
     bool known = false;

@@ -12,7 +12,7 @@
 
 #include <nlohmann/json_fwd.hpp>
 
-#include "mocap/error.h"
+#include "base/error.h"
 
 namespace app {
 
@@ -25,16 +25,16 @@ std::string DescribeJson(const nlohmann::json& v);
 struct JsonFile {
   std::string file;
 
-  mocap::Error Fail(const std::string& path, const std::string& message,
-                    mocap::ErrorCode code = mocap::ErrorCode::kInvalidArgument) const;
+  base::Error Fail(const std::string& path, const std::string& message,
+                   base::ErrorCode code = base::ErrorCode::kInvalidArgument) const;
   // "expected <what>, found <DescribeJson(found)>".
-  mocap::Error Expected(const std::string& path, const std::string& what,
-                        const nlohmann::json& found) const;
+  base::Error Expected(const std::string& path, const std::string& what,
+                       const nlohmann::json& found) const;
   // `obj` must be an object whose keys are all in `allowed`. `whole` names the
   // object in the message when `path` is empty (the file's top level).
-  std::optional<mocap::Error> Keys(const nlohmann::json& obj, const std::string& path,
-                                   std::initializer_list<const char*> allowed,
-                                   const char* whole = "") const;
+  std::optional<base::Error> Keys(const nlohmann::json& obj, const std::string& path,
+                                  std::initializer_list<const char*> allowed,
+                                  const char* whole = "") const;
 };
 
 }  // namespace app

@@ -8,7 +8,7 @@
 #include <nlohmann/json_fwd.hpp>
 
 #include "app/rig_elastic.h"
-#include "mocap/error.h"
+#include "base/error.h"
 
 namespace app {
 
@@ -16,8 +16,8 @@ namespace app {
 // `grid_v`) into `out`. `path` is the field path ("patches[0].elastic"). Errors
 // (kInvalidArgument) name file, field path and what was expected; a grid larger
 // than 16 x 16 is refused at `path` (the network's limit).
-std::optional<mocap::Error> ParseRigElastic(const nlohmann::json& value, const std::string& file,
-                                            const std::string& path, int grid_u, int grid_v,
-                                            RigElastic& out);
+std::optional<base::Error> ParseRigElastic(const nlohmann::json& value, const std::string& file,
+                                           const std::string& path, int grid_u, int grid_v,
+                                           RigElastic& out);
 
 }  // namespace app

@@ -8,7 +8,7 @@
 #include <nlohmann/json_fwd.hpp>
 
 #include "app/rig_file.h"
-#include "mocap/error.h"
+#include "base/error.h"
 
 namespace app::internal {
 
@@ -17,7 +17,7 @@ namespace app::internal {
 // types, ranges and unknown fields. Duplicate poses that are the same frame or
 // the same joint angles are refused here, naming both examples; poses that are
 // different but too close are refused when the RBF is fitted.
-std::optional<mocap::Error> ParsePatchExamples(const std::string& file, const nlohmann::json& patch,
-                                               const std::string& path, RigPatch& out);
+std::optional<base::Error> ParsePatchExamples(const std::string& file, const nlohmann::json& patch,
+                                              const std::string& path, RigPatch& out);
 
 }  // namespace app::internal

@@ -43,20 +43,19 @@ float BodyHeight(const BodyChains& chains, const std::vector<glm::mat4>& model, 
 
 }  // namespace
 
-mocap::Result<BindPoseChoice> ChooseBindPose(const mocap::Skeleton& skeleton,
-                                             const mocap::Motion& motion,
-                                             float min_branch_extent) {
+base::Result<BindPoseChoice> ChooseBindPose(const mocap::Skeleton& skeleton,
+                                            const mocap::Motion& motion, float min_branch_extent) {
   const auto nj = static_cast<std::size_t>(skeleton.num_joints());
   std::vector<glm::mat4> rest(nj), first(nj);
   BindPoseChoice choice;
   const bool have_rest = PoseMatrices(skeleton, motion, -1, rest);
   const bool have_first = motion.num_frames > 0 && PoseMatrices(skeleton, motion, 0, first);
-  mocap::Result<BodyChains> chains =
+  base::Result<BodyChains> chains =
       have_rest ? BuildBodyChains(skeleton, rest, min_branch_extent)
-                : mocap::Result<BodyChains>(mocap::MakeError(mocap::ErrorCode::kInvalidArgument,
-                                                             {}, "rest pose not evaluated"));
+                : base::Result<BodyChains>(base::MakeError(base::ErrorCode::kInvalidArgument, {},
+                                                           "rest pose not evaluated"));
   if (!chains.ok() && have_first) {
-    mocap::Result<BodyChains> again = BuildBodyChains(skeleton, first, min_branch_extent);
+    base::Result<BodyChains> again = BuildBodyChains(skeleton, first, min_branch_extent);
     if (again.ok()) chains = std::move(again);
   }
   if (!chains.ok()) return std::move(chains).error();

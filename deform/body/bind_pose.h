@@ -13,7 +13,7 @@
 
 #include <span>
 
-#include "mocap/error.h"
+#include "base/error.h"
 #include "mocap/motion.h"
 #include "mocap/skeleton.h"
 
@@ -34,8 +34,8 @@ struct BindPoseChoice {
 // the rest pose, or from frame 0 when the rest pose has no body (all joints at one point).
 // Up is skeleton.info.up_axis. Errors: those of BuildBodyChains when neither pose gives a
 // body.
-[[nodiscard]] mocap::Result<BindPoseChoice> ChooseBindPose(const mocap::Skeleton& skeleton,
-                                                           const mocap::Motion& motion,
-                                                           float min_branch_extent = 0.15f);
+[[nodiscard]] base::Result<BindPoseChoice> ChooseBindPose(const mocap::Skeleton& skeleton,
+                                                          const mocap::Motion& motion,
+                                                          float min_branch_extent = 0.15f);
 
 }  // namespace deform

@@ -13,8 +13,8 @@
 
 namespace deform {
 
-using mocap::ErrorCode;
-using mocap::MakeError;
+using base::ErrorCode;
+using base::MakeError;
 
 namespace {
 constexpr float kMergeFraction = 1e-4f;
@@ -167,9 +167,9 @@ bool IsFloorAnchor(const std::vector<BodyPoint>& pts, int root, int heavy, const
 
 }  // namespace
 
-mocap::Result<BodyChains> BuildBodyChains(const mocap::Skeleton& skeleton,
-                                          std::span<const glm::mat4> rest_model_from_joint,
-                                          float min_branch_extent) {
+base::Result<BodyChains> BuildBodyChains(const mocap::Skeleton& skeleton,
+                                         std::span<const glm::mat4> rest_model_from_joint,
+                                         float min_branch_extent) {
   const int nj = skeleton.num_joints();
   if (rest_model_from_joint.size() != static_cast<std::size_t>(nj)) {
     return MakeError(ErrorCode::kCountMismatch, {},
@@ -411,10 +411,10 @@ mocap::Result<BodyChains> BuildBodyChains(const mocap::Skeleton& skeleton,
   return out;
 }
 
-mocap::Result<std::vector<std::uint8_t>> BodyPartJoints(
+base::Result<std::vector<std::uint8_t>> BodyPartJoints(
     const mocap::Skeleton& skeleton, std::span<const glm::mat4> rest_model_from_joint,
     float min_branch_extent) {
-  mocap::Result<BodyChains> chains =
+  base::Result<BodyChains> chains =
       BuildBodyChains(skeleton, rest_model_from_joint, min_branch_extent);
   if (!chains.ok()) return std::move(chains).error();
   return std::move(chains->body_part_joints);

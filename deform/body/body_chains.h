@@ -27,7 +27,7 @@
 
 #include <glm/glm.hpp>
 
-#include "mocap/error.h"
+#include "base/error.h"
 #include "mocap/skeleton.h"
 
 namespace deform {
@@ -70,14 +70,14 @@ struct BodyChains {
 // Errors: kCountMismatch when the matrix count is not #J, kInvalidArgument for
 // broken parent order or a skeleton without any bone of non-zero length, kNonFinite
 // for non-finite matrices.
-[[nodiscard]] mocap::Result<BodyChains> BuildBodyChains(
+[[nodiscard]] base::Result<BodyChains> BuildBodyChains(
     const mocap::Skeleton& skeleton, std::span<const glm::mat4> rest_model_from_joint,
     float min_branch_extent);
 
 // Which joints get a part of a generated body (BodyChains::body_part_joints),
 // for bodies built on these chains (the mannequin, others): one decision for
 // all of them. Errors: those of BuildBodyChains.
-[[nodiscard]] mocap::Result<std::vector<std::uint8_t>> BodyPartJoints(
+[[nodiscard]] base::Result<std::vector<std::uint8_t>> BodyPartJoints(
     const mocap::Skeleton& skeleton, std::span<const glm::mat4> rest_model_from_joint,
     float min_branch_extent);
 

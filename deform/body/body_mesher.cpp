@@ -18,8 +18,8 @@
 namespace deform {
 namespace {
 
-using mocap::ErrorCode;
-using mocap::MakeError;
+using base::ErrorCode;
+using base::MakeError;
 
 constexpr double kMaxVoxelTests = 40e6;
 
@@ -131,7 +131,8 @@ void KeepLargestPiece(Mesh& mesh) {
 
 // Meshes the body at voxel size h: level set, optional smoothing, volumeToMesh, quads
 // split along their shorter diagonal.
-mocap::Result<Mesh> MeshAtVoxelSize(const ImplicitBody& implicit, double h, const BodyMeshOptions& o) {
+base::Result<Mesh> MeshAtVoxelSize(const ImplicitBody& implicit, double h,
+                                   const BodyMeshOptions& o) {
   const auto band = static_cast<float>(o.band_voxels * h);
   openvdb::FloatGrid::Ptr grid = SampleLevelSet(implicit, h, band);
   if (o.smoothing_passes > 0) {
@@ -171,7 +172,7 @@ mocap::Result<Mesh> MeshAtVoxelSize(const ImplicitBody& implicit, double h, cons
 
 }  // namespace
 
-mocap::Result<Mesh> MeshImplicitBody(const ImplicitBody& body, const BodyMeshOptions& o) {
+base::Result<Mesh> MeshImplicitBody(const ImplicitBody& body, const BodyMeshOptions& o) {
   if (!(o.voxels_per_size >= 32.0f && o.voxels_per_size <= 512.0f) || !(o.band_voxels >= 2.0f && o.band_voxels <= 6.0f) ||
       !(o.adaptivity >= 0.0f && o.adaptivity <= 1.0f) || o.smoothing_passes < 0 || o.smoothing_passes > 8 ||
       o.max_triangles < 1000) {
@@ -194,7 +195,7 @@ mocap::Result<Mesh> MeshImplicitBody(const ImplicitBody& body, const BodyMeshOpt
     }
     h *= 1.25;
   }
-  mocap::Result<Mesh> meshed = MeshAtVoxelSize(body, h, o);
+  base::Result<Mesh> meshed = MeshAtVoxelSize(body, h, o);
   if (!meshed.ok()) return meshed;
   // Aim at the triangle budget: one more pass at the voxel size that scales the count
   // to the target (triangles go as 1 / h^2) when the first is more than 40 % off.

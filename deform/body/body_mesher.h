@@ -22,7 +22,7 @@
 
 #include "deform/body/implicit_body.h"
 #include "deform/mesh.h"
-#include "mocap/error.h"
+#include "base/error.h"
 
 namespace deform {
 
@@ -38,7 +38,7 @@ struct BodyMeshOptions {
 // Errors: kInvalidArgument for options out of range or an empty surface, kLimitExceeded
 // when the band would exceed 40 million voxel tests at any voxel size up to 4x the asked
 // one, or the mesh more than max_triangles.
-[[nodiscard]] mocap::Result<Mesh> MeshImplicitBody(const ImplicitBody& body,
-                                                   const BodyMeshOptions& options = {});
+[[nodiscard]] base::Result<Mesh> MeshImplicitBody(const ImplicitBody& body,
+                                                  const BodyMeshOptions& options = {});
 
 }  // namespace deform

@@ -11,8 +11,8 @@
 namespace deform {
 namespace {
 
-using mocap::ErrorCode;
-using mocap::MakeError;
+using base::ErrorCode;
+using base::MakeError;
 
 constexpr int kSolveBlock = 32;        // right-hand sides solved together
 constexpr int kVisibilitySamples = 12;  // tests along each vertex-to-bone segment
@@ -65,9 +65,9 @@ double Cot(const glm::dvec3& a, const glm::dvec3& b) {  // cotangent of the angl
 
 }  // namespace
 
-mocap::Result<BoneHeatWeights> ComputeBoneHeatWeights(const Mesh& mesh, std::span<const BodyBone> bones,
-                                                     const std::function<float(const glm::vec3&)>& distance,
-                                                     float size, const BoneHeatOptions& o) {
+base::Result<BoneHeatWeights> ComputeBoneHeatWeights(
+    const Mesh& mesh, std::span<const BodyBone> bones,
+    const std::function<float(const glm::vec3&)>& distance, float size, const BoneHeatOptions& o) {
   if (!(o.heat > 0.0f) || o.max_influences < 1 || o.max_influences > 4 || !(o.inside_tolerance >= 0.0f)) {
     return MakeError(ErrorCode::kInvalidArgument, {}, "bone heat options out of range (heat > 0, max_influences 1..4)");
   }

@@ -33,7 +33,7 @@
 
 #include "deform/body/implicit_body.h"
 #include "deform/mesh.h"
-#include "mocap/error.h"
+#include "base/error.h"
 
 namespace deform {
 
@@ -54,7 +54,7 @@ struct BoneHeatWeights {
 // `distance` is the body's signed distance (negative inside), `size` the body size S.
 // Errors: kInvalidArgument for options out of range, no bones, or a mesh the Cholesky
 // factorisation rejects (not one closed piece).
-[[nodiscard]] mocap::Result<BoneHeatWeights> ComputeBoneHeatWeights(
+[[nodiscard]] base::Result<BoneHeatWeights> ComputeBoneHeatWeights(
     const Mesh& mesh, std::span<const BodyBone> bones,
     const std::function<float(const glm::vec3&)>& distance, float size,
     const BoneHeatOptions& options = {});

@@ -18,8 +18,8 @@
 namespace deform {
 namespace {
 
-using mocap::ErrorCode;
-using mocap::MakeError;
+using base::ErrorCode;
+using base::MakeError;
 
 // Part of every cache key: bump it whenever the generated shape, mesh or
 // weights change, so that no cached body from an older build is read back.
@@ -130,16 +130,17 @@ void WriteCache(const std::filesystem::path& folder, const std::filesystem::path
 
 }  // namespace
 
-mocap::Result<SkinnedMesh> BuildGeneratedBody(const mocap::Skeleton& skeleton,
-                                              std::span<const glm::mat4> rest_model_from_joint,
-                                              const GeneratedBodyOptions& o) {
-  mocap::Result<ImplicitBody> shape = BuildImplicitBody(skeleton, rest_model_from_joint, o.shape);
+base::Result<SkinnedMesh> BuildGeneratedBody(const mocap::Skeleton& skeleton,
+                                             std::span<const glm::mat4> rest_model_from_joint,
+                                             const GeneratedBodyOptions& o) {
+  base::Result<ImplicitBody> shape = BuildImplicitBody(skeleton, rest_model_from_joint, o.shape);
   if (!shape.ok()) return std::move(shape).error();
-  mocap::Result<Mesh> mesh = MeshImplicitBody(*shape, o.mesh);
+  base::Result<Mesh> mesh = MeshImplicitBody(*shape, o.mesh);
   if (!mesh.ok()) return std::move(mesh).error();
   const ImplicitBody& body = *shape;
-  mocap::Result<BoneHeatWeights> heat = ComputeBoneHeatWeights(
-      *mesh, body.bones(), [&body](const glm::vec3& p) { return body.Distance(p); }, body.size(), o.weights);
+  base::Result<BoneHeatWeights> heat = ComputeBoneHeatWeights(
+      *mesh, body.bones(), [&body](const glm::vec3& p) { return body.Distance(p); }, body.size(),
+      o.weights);
   if (!heat.ok()) return std::move(heat).error();
 
   SkinnedMesh out;
@@ -184,7 +185,7 @@ std::uint64_t GeneratedBodyKey(const mocap::Skeleton& skeleton, std::span<const 
   for (const mocap::EndSite& e : skeleton.end_sites) h.Add(e.parent), h.Add(e.offset);
   // Which joints are body: the only thing the channels and the motion's use of
   // them change (so captures of one skeleton share a body whatever they do).
-  mocap::Result<std::vector<std::uint8_t>> body =
+  base::Result<std::vector<std::uint8_t>> body =
       BodyPartJoints(skeleton, rest_model_from_joint, o.shape.min_branch_extent);
   if (body.ok()) {
     for (const std::uint8_t b : *body) h.Add(b);
@@ -212,10 +213,11 @@ std::filesystem::path BodyCacheFolder() {
   return {};
 }
 
-mocap::Result<SkinnedMesh> BuildGeneratedBodyCached(const mocap::Skeleton& skeleton,
-                                                    std::span<const glm::mat4> rest_model_from_joint,
-                                                    const GeneratedBodyOptions& options,
-                                                    const std::filesystem::path& folder, bool* from_cache) {
+base::Result<SkinnedMesh> BuildGeneratedBodyCached(const mocap::Skeleton& skeleton,
+                                                   std::span<const glm::mat4> rest_model_from_joint,
+                                                   const GeneratedBodyOptions& options,
+                                                   const std::filesystem::path& folder,
+                                                   bool* from_cache) {
   if (from_cache != nullptr) *from_cache = false;
   if (folder.empty() || rest_model_from_joint.size() != static_cast<std::size_t>(skeleton.num_joints())) {
     return BuildGeneratedBody(skeleton, rest_model_from_joint, options);
@@ -229,7 +231,7 @@ mocap::Result<SkinnedMesh> BuildGeneratedBodyCached(const mocap::Skeleton& skele
     if (from_cache != nullptr) *from_cache = true;
     return cached;
   }
-  mocap::Result<SkinnedMesh> body = BuildGeneratedBody(skeleton, rest_model_from_joint, options);
+  base::Result<SkinnedMesh> body = BuildGeneratedBody(skeleton, rest_model_from_joint, options);
   if (body.ok()) WriteCache(folder, file, key, *body);
   return body;
 }

@@ -27,7 +27,7 @@
 #include "deform/body/bone_heat.h"
 #include "deform/body/implicit_body.h"
 #include "deform/mesh.h"
-#include "mocap/error.h"
+#include "base/error.h"
 #include "mocap/skeleton.h"
 
 namespace deform {
@@ -39,7 +39,7 @@ struct GeneratedBodyOptions {
 };
 
 // Errors: those of the three steps (each names the joint or option at fault).
-[[nodiscard]] mocap::Result<SkinnedMesh> BuildGeneratedBody(
+[[nodiscard]] base::Result<SkinnedMesh> BuildGeneratedBody(
     const mocap::Skeleton& skeleton, std::span<const glm::mat4> rest_model_from_joint,
     const GeneratedBodyOptions& options = {});
 
@@ -59,7 +59,7 @@ std::filesystem::path BodyCacheFolder();
 // again. A missing, unreadable or mismatched cache file means generate; the file is
 // written atomically (a temporary file renamed), and a failure to write is ignored.
 // `from_cache`, when given, says whether the body came from the cache.
-[[nodiscard]] mocap::Result<SkinnedMesh> BuildGeneratedBodyCached(
+[[nodiscard]] base::Result<SkinnedMesh> BuildGeneratedBodyCached(
     const mocap::Skeleton& skeleton, std::span<const glm::mat4> rest_model_from_joint,
     const GeneratedBodyOptions& options, const std::filesystem::path& folder,
     bool* from_cache = nullptr);

@@ -11,8 +11,8 @@
 
 namespace deform {
 
-using mocap::ErrorCode;
-using mocap::MakeError;
+using base::ErrorCode;
+using base::MakeError;
 
 namespace {
 
@@ -99,12 +99,13 @@ struct PoseState {
   std::vector<glm::mat4> model;
   std::vector<glm::quat> world;
 };
-mocap::Result<PoseState> EvaluatePose(const mocap::Skeleton& s, const mocap::Motion* motion, int frame) {
+base::Result<PoseState> EvaluatePose(const mocap::Skeleton& s, const mocap::Motion* motion,
+                                     int frame) {
   std::vector<mocap::JointTransform> locals(static_cast<std::size_t>(s.num_joints()));
   PoseState out;
   out.model.resize(locals.size());
   out.world.resize(locals.size());
-  mocap::JobStatus st;
+  base::JobStatus st;
   if (motion == nullptr) {
     mocap::RestPose(s, locals);
   } else {
@@ -277,9 +278,9 @@ int NameSide(const std::string& name) {
   return 0;
 }
 
-mocap::Result<Humanoid> FindHumanoid(const mocap::Skeleton& skeleton,
-                                     std::span<const glm::mat4> model_from_joint) {
-  mocap::Result<BodyChains> built = BuildBodyChains(skeleton, model_from_joint, kMinBranchExtent);
+base::Result<Humanoid> FindHumanoid(const mocap::Skeleton& skeleton,
+                                    std::span<const glm::mat4> model_from_joint) {
+  base::Result<BodyChains> built = BuildBodyChains(skeleton, model_from_joint, kMinBranchExtent);
   if (!built.ok()) return std::move(built).error();
   Humanoid h;
   h.chains = std::move(*built);
@@ -374,31 +375,31 @@ mocap::Result<Humanoid> FindHumanoid(const mocap::Skeleton& skeleton,
   return h;
 }
 
-mocap::Result<HumanoidMatch> MatchHumanoids(const mocap::Skeleton& target,
-                                            const mocap::Skeleton& source,
-                                            const mocap::Motion& source_motion,
-                                            const JointMapEntries& joint_map,
-                                            const std::string& target_file,
-                                            const std::string& source_file,
-                                            const std::string& joint_map_file) {
+base::Result<HumanoidMatch> MatchHumanoids(const mocap::Skeleton& target,
+                                           const mocap::Skeleton& source,
+                                           const mocap::Motion& source_motion,
+                                           const JointMapEntries& joint_map,
+                                           const std::string& target_file,
+                                           const std::string& source_file,
+                                           const std::string& joint_map_file) {
   HumanoidMatch out;
   const int nt = target.num_joints();
-  mocap::Result<PoseState> target_rest = EvaluatePose(target, nullptr, 0);
+  base::Result<PoseState> target_rest = EvaluatePose(target, nullptr, 0);
   if (!target_rest.ok()) return std::move(target_rest).error();
-  mocap::Result<PoseState> source_rest = EvaluatePose(source, nullptr, 0);
+  base::Result<PoseState> source_rest = EvaluatePose(source, nullptr, 0);
   if (!source_rest.ok()) return std::move(source_rest).error();
-  mocap::Result<Humanoid> th = FindHumanoid(target, target_rest->model);
+  base::Result<Humanoid> th = FindHumanoid(target, target_rest->model);
 
   // The source's reference pose: its rest pose if it stands, else a sampled frame.
-  mocap::Result<Humanoid> sh = FindHumanoid(source, source_rest->model);
+  base::Result<Humanoid> sh = FindHumanoid(source, source_rest->model);
   PoseState source_ref = *source_rest;
   out.source_pose = "rest";
   if (th.ok() && sh.ok() && !sh->standing) {
     for (int i = 0; i < kCandidateFrames && source_motion.num_frames > 0; ++i) {
       const int f = static_cast<int>(static_cast<long long>(i) * source_motion.num_frames / kCandidateFrames);
-      mocap::Result<PoseState> pose = EvaluatePose(source, &source_motion, f);
+      base::Result<PoseState> pose = EvaluatePose(source, &source_motion, f);
       if (!pose.ok()) return std::move(pose).error();
-      mocap::Result<Humanoid> at = FindHumanoid(source, pose->model);
+      base::Result<Humanoid> at = FindHumanoid(source, pose->model);
       if (at.ok() && at->standing) {
         sh = std::move(at);
         source_ref = std::move(*pose);
@@ -453,10 +454,10 @@ mocap::Result<HumanoidMatch> MatchHumanoids(const mocap::Skeleton& target,
       }
     }
   } else {
-    mocap::Result<mocap::RetargetPlan> by_name =
+    base::Result<mocap::RetargetPlan> by_name =
         mocap::PlanByName(target, source, target_file, source_file, &out.warnings);
     if (!by_name.ok()) {
-      mocap::Error e = std::move(by_name).error();
+      base::Error e = std::move(by_name).error();
       e.message += "; nor could the skeletons be matched by body topology: " +
                    (th.ok() ? sh.error() : th.error()).message;
       return e;

@@ -38,7 +38,7 @@
 #include <glm/glm.hpp>
 
 #include "deform/body/body_chains.h"
-#include "mocap/error.h"
+#include "base/error.h"
 #include "mocap/motion.h"
 #include "mocap/retarget.h"
 #include "mocap/skeleton.h"
@@ -65,8 +65,8 @@ struct Humanoid {
 // `model_from_joint`: #J model matrices of the pose to read. Errors:
 // kInvalidArgument "expected a humanoid skeleton ..." naming what is missing, and
 // BuildBodyChains's.
-[[nodiscard]] mocap::Result<Humanoid> FindHumanoid(const mocap::Skeleton& skeleton,
-                                                   std::span<const glm::mat4> model_from_joint);
+[[nodiscard]] base::Result<Humanoid> FindHumanoid(const mocap::Skeleton& skeleton,
+                                                  std::span<const glm::mat4> model_from_joint);
 
 // +1 when a joint name reads as left ("LeftArm", "leg_joint_L_1", "LHipJoint"),
 // -1 as right, 0 otherwise.
@@ -80,7 +80,7 @@ struct HumanoidMatch {
   std::string method;        // "topology" or "names" (when either is no humanoid)
   std::string source_pose;   // "rest" or "frame N": the source pose aligned to the target's rest
   std::string target_sides, source_sides;  // Humanoid::sides of each
-  std::vector<mocap::Warning> warnings;
+  std::vector<base::Warning> warnings;
 };
 
 // The plan driving `target` (rest pose) with `source_motion` on `source`; entries
@@ -88,10 +88,12 @@ struct HumanoidMatch {
 // either skeleton is no humanoid, joints are matched by name (mocap::PlanByName)
 // before the overrides. Errors: kInvalidArgument for a joint map naming a joint
 // that does not exist (naming `joint_map_file`) and PlanByName's.
-[[nodiscard]] mocap::Result<HumanoidMatch> MatchHumanoids(
-    const mocap::Skeleton& target, const mocap::Skeleton& source,
-    const mocap::Motion& source_motion, const JointMapEntries& joint_map,
-    const std::string& target_file, const std::string& source_file,
-    const std::string& joint_map_file);
+[[nodiscard]] base::Result<HumanoidMatch> MatchHumanoids(const mocap::Skeleton& target,
+                                                         const mocap::Skeleton& source,
+                                                         const mocap::Motion& source_motion,
+                                                         const JointMapEntries& joint_map,
+                                                         const std::string& target_file,
+                                                         const std::string& source_file,
+                                                         const std::string& joint_map_file);
 
 }  // namespace deform

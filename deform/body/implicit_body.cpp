@@ -11,8 +11,8 @@
 namespace deform {
 namespace {
 
-using mocap::ErrorCode;
-using mocap::MakeError;
+using base::ErrorCode;
+using base::MakeError;
 
 constexpr int kMaxPrimitives = 4096;
 constexpr int kCellsPerAxis = 32;
@@ -255,18 +255,19 @@ void ImplicitBody::BuildCells() {
   }
 }
 
-mocap::Result<ImplicitBody> BuildImplicitBody(const mocap::Skeleton& skeleton,
-                                              std::span<const glm::mat4> rest_model_from_joint,
-                                              const ImplicitBodyOptions& o) {
+base::Result<ImplicitBody> BuildImplicitBody(const mocap::Skeleton& skeleton,
+                                             std::span<const glm::mat4> rest_model_from_joint,
+                                             const ImplicitBodyOptions& o) {
   if (!(o.min_branch_extent >= 0.0f && o.min_branch_extent <= 0.5f) || !(o.blend >= 0.0f && o.blend <= 2.0f) ||
       !(o.radius_scale >= 0.5f && o.radius_scale <= 2.0f)) {
     return MakeError(ErrorCode::kInvalidArgument, {},
                      "body options out of range (min_branch_extent 0..0.5, blend 0..2, "
                      "radius_scale 0.5..2)");
   }
-  mocap::Result<BodyChains> tree = BuildBodyChains(skeleton, rest_model_from_joint, o.min_branch_extent);
+  base::Result<BodyChains> tree =
+      BuildBodyChains(skeleton, rest_model_from_joint, o.min_branch_extent);
   if (!tree.ok()) {
-    mocap::Error e = std::move(tree).error();
+    base::Error e = std::move(tree).error();
     if (skeleton.num_joints() == 1) {
       e.message += " (the skeleton's only joint is '" + skeleton.names[0] + "')";
     } else if (e.code == ErrorCode::kInvalidArgument && skeleton.num_joints() > 1 &&

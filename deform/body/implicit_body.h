@@ -31,7 +31,7 @@
 
 #include <glm/glm.hpp>
 
-#include "mocap/error.h"
+#include "base/error.h"
 #include "mocap/skeleton.h"
 
 namespace deform {
@@ -86,9 +86,9 @@ class ImplicitBody {
   float max_blend() const { return max_blend_; }    // largest smooth-union radius k
 
  private:
-  friend mocap::Result<ImplicitBody> BuildImplicitBody(const mocap::Skeleton&,
-                                                       std::span<const glm::mat4>,
-                                                       const ImplicitBodyOptions&);
+  friend base::Result<ImplicitBody> BuildImplicitBody(const mocap::Skeleton&,
+                                                      std::span<const glm::mat4>,
+                                                      const ImplicitBodyOptions&);
   void BuildCells();
 
   std::vector<BodyPrimitive> primitives_;
@@ -110,7 +110,7 @@ class ImplicitBody {
 // Builds the implicit body. Errors: those of BuildBodyChains (kCountMismatch, kNonFinite,
 // kInvalidArgument naming a joint where one is to blame), kInvalidArgument for options
 // out of range, kLimitExceeded for more than 4096 primitives.
-[[nodiscard]] mocap::Result<ImplicitBody> BuildImplicitBody(
+[[nodiscard]] base::Result<ImplicitBody> BuildImplicitBody(
     const mocap::Skeleton& skeleton, std::span<const glm::mat4> rest_model_from_joint,
     const ImplicitBodyOptions& options = {});
 

@@ -14,8 +14,8 @@
 namespace deform {
 namespace {
 
-using mocap::ErrorCode;
-using mocap::MakeError;
+using base::ErrorCode;
+using base::MakeError;
 using internal::AnyPerpendicular;
 using internal::CatmullRom;
 using internal::kCapRings;
@@ -42,9 +42,9 @@ struct ChainShape {
 
 }  // namespace
 
-mocap::Result<SkinnedMesh> BuildMannequin(const mocap::Skeleton& skeleton,
-                                          std::span<const glm::mat4> rest_model_from_joint,
-                                          const MannequinOptions& o) {
+base::Result<SkinnedMesh> BuildMannequin(const mocap::Skeleton& skeleton,
+                                         std::span<const glm::mat4> rest_model_from_joint,
+                                         const MannequinOptions& o) {
   const int nj = skeleton.num_joints();
   if (o.ring_vertices < 8 || o.ring_vertices > 64 || o.target_vertices < 10000 ||
       o.target_vertices > kMaxVertices || !(o.radius_scale >= 0.25f && o.radius_scale <= 4.0f) ||
@@ -55,7 +55,8 @@ mocap::Result<SkinnedMesh> BuildMannequin(const mocap::Skeleton& skeleton,
                      "10000..40000, radius_scale 0.25..4, min_branch_extent 0..0.5, "
                      "blend_width in (0, 4])");
   }
-  mocap::Result<BodyChains> tree = BuildBodyChains(skeleton, rest_model_from_joint, o.min_branch_extent);
+  base::Result<BodyChains> tree =
+      BuildBodyChains(skeleton, rest_model_from_joint, o.min_branch_extent);
   if (!tree.ok()) return std::move(tree).error();
   const std::vector<Point>& pts = tree->points;
   const std::vector<Chain>& chains = tree->chains;

@@ -43,7 +43,7 @@
 #include <glm/glm.hpp>
 
 #include "deform/mesh.h"
-#include "mocap/error.h"
+#include "base/error.h"
 #include "mocap/skeleton.h"
 
 namespace deform {
@@ -63,7 +63,7 @@ struct MannequinOptions {
 // out-of-range options, broken parent order, non-finite matrices or a skeleton
 // without any bone of non-zero length, kLimitExceeded when the skeleton has so
 // many chains that the mesh would exceed 40000 vertices.
-[[nodiscard]] mocap::Result<SkinnedMesh> BuildMannequin(
+[[nodiscard]] base::Result<SkinnedMesh> BuildMannequin(
     const mocap::Skeleton& skeleton, std::span<const glm::mat4> rest_model_from_joint,
     const MannequinOptions& options = {});
 

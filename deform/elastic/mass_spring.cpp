@@ -346,7 +346,7 @@ JobStatus MassSpringStepJob::Validate() const {
     }
   }
   if (!std::isfinite(time_s)) return {JobStatus::kOutOfRange, "time_s is not finite"};
-  return mocap::kJobOk;
+  return base::kJobOk;
 }
 
 JobStatus MassSpringStepJob::Run() const {
@@ -403,7 +403,7 @@ JobStatus MassSpringStepJob::Run() const {
     }
   }
   st.output_time_s_ = time_s;
-  if (displacements.empty()) return mocap::kJobOk;
+  if (displacements.empty()) return base::kJobOk;
 
   // Linear interpolation between the last two steps (exact when no step was taken
   // since a reset: both are the same zero state), then to point space.
@@ -416,7 +416,7 @@ JobStatus MassSpringStepJob::Run() const {
     displacements[static_cast<std::size_t>(net.point_of_free[a])] =
         st.modal_ ? PointOf(net, blend, a) : blend[a];
   }
-  return mocap::kJobOk;
+  return base::kJobOk;
 }
 
 void MassSpringPointDisplacements(const MassSpringNetwork& network, const MassSpringState& state,

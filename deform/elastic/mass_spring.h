@@ -51,13 +51,13 @@
 #include <glm/glm.hpp>
 #include <glm/gtc/quaternion.hpp>
 
-#include "mocap/error.h"
+#include "base/error.h"
 #include "mocap/kinematics.h"
 
 namespace deform {
 
-using mocap::JobStatus;
-using mocap::Result;
+using base::JobStatus;
+using base::Result;
 
 // Spring force law.
 enum class SpringForceModel {

@@ -15,9 +15,9 @@
 namespace deform {
 namespace {
 
-using mocap::ErrorCode;
-using mocap::FileLoc;
-using mocap::MakeError;
+using base::ErrorCode;
+using base::FileLoc;
+using base::MakeError;
 
 constexpr double kStepRuleAccurate = 0.5;  // h x rate for ~1e-4 amplitude error per step
 constexpr double kStepRuleHardLimit = 2.5; // RK4 reaches 2.78 (real) / 2.83 (imaginary)

@@ -9,8 +9,8 @@
 namespace deform {
 namespace {
 
-using mocap::ErrorCode;
-using mocap::MakeError;
+using base::ErrorCode;
+using base::MakeError;
 
 // Two unit vectors spanning the plane orthogonal to unit n.
 void PlaneBasis(const glm::dvec3& n, glm::dvec3* e1, glm::dvec3* e2) {
@@ -55,9 +55,8 @@ double ProjectedRingArea(std::span<const glm::vec3> positions,
   return 0.5 * std::abs(twice_area);
 }
 
-mocap::Result<double> RingAreaRatio(std::span<const glm::vec3> rest_positions,
-                                    std::span<const glm::vec3> positions,
-                                    const ArtifactRing& ring) {
+base::Result<double> RingAreaRatio(std::span<const glm::vec3> rest_positions,
+                                   std::span<const glm::vec3> positions, const ArtifactRing& ring) {
   if (rest_positions.size() != positions.size()) {
     return MakeError(ErrorCode::kInvalidArgument, {},
                      "expected as many deformed as rest positions (" +
@@ -84,23 +83,23 @@ mocap::Result<double> RingAreaRatio(std::span<const glm::vec3> rest_positions,
   return ProjectedRingArea(positions, ring.vertices, ring.plane) / rest_area;
 }
 
-mocap::Result<double> CollapseFigure(std::span<const glm::vec3> rest_positions,
-                                     std::span<const glm::vec3> positions,
-                                     const ArtifactRing& ring) {
+base::Result<double> CollapseFigure(std::span<const glm::vec3> rest_positions,
+                                    std::span<const glm::vec3> positions,
+                                    const ArtifactRing& ring) {
   return RingAreaRatio(rest_positions, positions, ring);
 }
 
-mocap::Result<double> CandyWrapperFigure(std::span<const glm::vec3> rest_positions,
-                                         std::span<const glm::vec3> positions,
-                                         std::span<const ArtifactRing> rings) {
+base::Result<double> CandyWrapperFigure(std::span<const glm::vec3> rest_positions,
+                                        std::span<const glm::vec3> positions,
+                                        std::span<const ArtifactRing> rings) {
   if (rings.empty()) {
     return MakeError(ErrorCode::kInvalidArgument, {}, "expected at least one ring, found none");
   }
   double minimum = 0.0;
   for (std::size_t r = 0; r < rings.size(); ++r) {
-    mocap::Result<double> ratio = RingAreaRatio(rest_positions, positions, rings[r]);
+    base::Result<double> ratio = RingAreaRatio(rest_positions, positions, rings[r]);
     if (!ratio) {
-      mocap::Error error = std::move(ratio).error();
+      base::Error error = std::move(ratio).error();
       error.message = "ring " + std::to_string(r) + ": " + error.message;
       return error;
     }
@@ -109,9 +108,9 @@ mocap::Result<double> CandyWrapperFigure(std::span<const glm::vec3> rest_positio
   return minimum;
 }
 
-mocap::Result<double> CappedVolume(std::span<const glm::vec3> positions,
-                                   std::span<const glm::uvec3> triangles,
-                                   std::span<const std::vector<std::uint32_t>> caps) {
+base::Result<double> CappedVolume(std::span<const glm::vec3> positions,
+                                  std::span<const glm::uvec3> triangles,
+                                  std::span<const std::vector<std::uint32_t>> caps) {
   if (triangles.empty()) {
     return MakeError(ErrorCode::kInvalidArgument, {}, "expected triangles, found none");
   }
@@ -164,22 +163,22 @@ mocap::Result<double> CappedVolume(std::span<const glm::vec3> positions,
   return std::abs(six_volume) / 6.0;
 }
 
-mocap::Result<double> VolumeFigure(std::span<const glm::vec3> rest_positions,
-                                   std::span<const glm::vec3> positions,
-                                   std::span<const glm::uvec3> triangles,
-                                   std::span<const std::vector<std::uint32_t>> caps) {
+base::Result<double> VolumeFigure(std::span<const glm::vec3> rest_positions,
+                                  std::span<const glm::vec3> positions,
+                                  std::span<const glm::uvec3> triangles,
+                                  std::span<const std::vector<std::uint32_t>> caps) {
   if (rest_positions.size() != positions.size()) {
     return MakeError(ErrorCode::kInvalidArgument, {},
                      "expected as many deformed as rest positions (" +
                          std::to_string(rest_positions.size()) + "), found " +
                          std::to_string(positions.size()));
   }
-  mocap::Result<double> rest = CappedVolume(rest_positions, triangles, caps);
+  base::Result<double> rest = CappedVolume(rest_positions, triangles, caps);
   if (!rest) return rest;
   if (!(*rest > 1e-12)) {
     return MakeError(ErrorCode::kInvalidArgument, {}, "the section encloses no volume at rest");
   }
-  mocap::Result<double> current = CappedVolume(positions, triangles, caps);
+  base::Result<double> current = CappedVolume(positions, triangles, caps);
   if (!current) return current;
   return *current / *rest;
 }

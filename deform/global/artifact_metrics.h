@@ -18,7 +18,7 @@
 #include <glm/glm.hpp>
 
 #include "deform/global/sweep.h"
-#include "mocap/error.h"
+#include "base/error.h"
 
 namespace deform {
 
@@ -47,19 +47,17 @@ struct ArtifactRing {
 
 // Deformed area / rest area of one ring. Errors (kInvalidArgument): sizes differ,
 // fewer than 3 vertices, an index past the arrays, or a rest area below 1e-12.
-mocap::Result<double> RingAreaRatio(std::span<const glm::vec3> rest_positions,
-                                    std::span<const glm::vec3> positions,
-                                    const ArtifactRing& ring);
+base::Result<double> RingAreaRatio(std::span<const glm::vec3> rest_positions,
+                                   std::span<const glm::vec3> positions, const ArtifactRing& ring);
 
 // Collapse figure of one joint ring (= RingAreaRatio).
-mocap::Result<double> CollapseFigure(std::span<const glm::vec3> rest_positions,
-                                     std::span<const glm::vec3> positions,
-                                     const ArtifactRing& ring);
+base::Result<double> CollapseFigure(std::span<const glm::vec3> rest_positions,
+                                    std::span<const glm::vec3> positions, const ArtifactRing& ring);
 
 // Candy-wrapper figure: the minimum RingAreaRatio over `rings` (at least one).
-mocap::Result<double> CandyWrapperFigure(std::span<const glm::vec3> rest_positions,
-                                         std::span<const glm::vec3> positions,
-                                         std::span<const ArtifactRing> rings);
+base::Result<double> CandyWrapperFigure(std::span<const glm::vec3> rest_positions,
+                                        std::span<const glm::vec3> positions,
+                                        std::span<const ArtifactRing> rings);
 
 // Volume enclosed by `triangles` (a section of a closed skin, e.g. a limb between two
 // rings, wound consistently) after closing every boundary loop with a fan from the
@@ -67,16 +65,16 @@ mocap::Result<double> CandyWrapperFigure(std::span<const glm::vec3> rest_positio
 // boundary edge (one used by a single triangle) must have both ends in one ring of
 // `caps`. Errors (kInvalidArgument): index past the positions, an open boundary edge
 // outside the caps, no triangles.
-mocap::Result<double> CappedVolume(std::span<const glm::vec3> positions,
-                                   std::span<const glm::uvec3> triangles,
-                                   std::span<const std::vector<std::uint32_t>> caps);
+base::Result<double> CappedVolume(std::span<const glm::vec3> positions,
+                                  std::span<const glm::uvec3> triangles,
+                                  std::span<const std::vector<std::uint32_t>> caps);
 
 // Volume figure: CappedVolume(positions) / CappedVolume(rest_positions) over the same
 // triangles and caps (e.g. the limb within a few units of a joint). 1 = volume kept.
-mocap::Result<double> VolumeFigure(std::span<const glm::vec3> rest_positions,
-                                   std::span<const glm::vec3> positions,
-                                   std::span<const glm::uvec3> triangles,
-                                   std::span<const std::vector<std::uint32_t>> caps);
+base::Result<double> VolumeFigure(std::span<const glm::vec3> rest_positions,
+                                  std::span<const glm::vec3> positions,
+                                  std::span<const glm::uvec3> triangles,
+                                  std::span<const std::vector<std::uint32_t>> caps);
 
 // Vertices within `half_thickness` of `plane` (rest positions, model units): the ring
 // "nearest the rest bisector plane" used for SSD and DQS.

@@ -7,7 +7,7 @@
 namespace deform {
 namespace {
 
-using mocap::JobStatus;
+using base::JobStatus;
 
 inline glm::vec3 Rotate(const glm::quat& q, const glm::vec3& v) {
   const glm::vec3 u(q.x, q.y, q.z);
@@ -37,7 +37,7 @@ JobStatus BuildDualQuatPalette(std::span<const glm::mat4> model_from_bind,
     palette[i].real = real;
     palette[i].dual = 0.5f * (glm::quat(0.0f, t.x, t.y, t.z) * real);
   }
-  return mocap::kJobOk;
+  return base::kJobOk;
 }
 
 JobStatus DqsJob::Validate() const {
@@ -60,7 +60,7 @@ JobStatus DqsJob::Validate() const {
       return {JobStatus::kSizeMismatch, "rest_normals and normals must have #V entries"};
     }
   }
-  return mocap::kJobOk;
+  return base::kJobOk;
 }
 
 JobStatus DqsJob::Run() const {
@@ -94,7 +94,7 @@ JobStatus DqsJob::Run() const {
     positions[v] = Rotate(real, rest_positions[v]) + t;
     if (!rest_normals.empty()) normals[v] = Rotate(real, rest_normals[v]);
   }
-  return mocap::kJobOk;
+  return base::kJobOk;
 }
 
 }  // namespace deform

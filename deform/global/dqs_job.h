@@ -19,7 +19,7 @@
 #include <glm/glm.hpp>
 #include <glm/gtc/quaternion.hpp>
 
-#include "mocap/error.h"
+#include "base/error.h"
 
 namespace deform {
 
@@ -33,8 +33,8 @@ struct DualQuat {
 // Converts #S rigid skin matrices (model_from_bind, see BuildSkinningPalette)
 // to dual quaternions. The rotation is taken from the matrix's 3x3 part with
 // its columns normalized (scale is discarded). Sizes must match.
-[[nodiscard]] mocap::JobStatus BuildDualQuatPalette(std::span<const glm::mat4> model_from_bind,
-                                                    std::span<DualQuat> palette);
+[[nodiscard]] base::JobStatus BuildDualQuatPalette(std::span<const glm::mat4> model_from_bind,
+                                                   std::span<DualQuat> palette);
 
 struct DqsJob {
   // Inputs.
@@ -49,8 +49,8 @@ struct DqsJob {
   std::span<glm::vec3> positions;  // #V, model space
   std::span<glm::vec3> normals;    // #V unit length; required iff rest_normals is set
 
-  [[nodiscard]] mocap::JobStatus Validate() const;  // sizes and ranges only
-  [[nodiscard]] mocap::JobStatus Run() const;       // Validate(), then skin; never allocates
+  [[nodiscard]] base::JobStatus Validate() const;  // sizes and ranges only
+  [[nodiscard]] base::JobStatus Run() const;       // Validate(), then skin; never allocates
 };
 
 }  // namespace deform

@@ -15,8 +15,8 @@
 namespace deform {
 namespace {
 
-using mocap::ErrorCode;
-using mocap::MakeError;
+using base::ErrorCode;
+using base::MakeError;
 
 constexpr double kRingReach = 0.6;       // ring vertices lie within this x Lmin of the joint
 constexpr double kRingThickness = 0.02;  // one mesh ring: within this x Lmin of the nearest
@@ -61,13 +61,13 @@ int TopJointAt(const mocap::Skeleton& skeleton, std::span<const glm::mat4> bind,
   }
 }
 
-mocap::Status DeformAll(const SkinnedMesh& mesh, const SwdRig& rig,
-                        std::span<const glm::mat4> model, std::vector<glm::vec3> out[3]) {
+base::Status DeformAll(const SkinnedMesh& mesh, const SwdRig& rig, std::span<const glm::mat4> model,
+                       std::vector<glm::vec3> out[3]) {
   const std::size_t nv = mesh.bind.positions.size();
   std::vector<glm::mat4> palette(mesh.skin_joints.size());
   std::vector<DualQuat> dq(mesh.skin_joints.size());
   for (int m = 0; m < 3; ++m) out[m].resize(nv);
-  mocap::JobStatus s = BuildSkinningPalette(model, mesh, palette);
+  base::JobStatus s = BuildSkinningPalette(model, mesh, palette);
   if (s) s = BuildDualQuatPalette(palette, dq);
   const int k = mesh.weights.influences;
   if (s) {
@@ -92,16 +92,16 @@ mocap::Status DeformAll(const SkinnedMesh& mesh, const SwdRig& rig,
             .Run();
   }
   if (!s) return MakeError(ErrorCode::kInternal, {}, std::string("artifact pose: ") + s.what);
-  return mocap::Status::Ok();
+  return base::Status::Ok();
 }
 
 // Ratios of one set of rings for the three methods (minimum over the rings).
-mocap::Result<MethodFigures> Figures(std::span<const glm::vec3> rest,
-                                     const std::vector<glm::vec3> deformed[3],
-                                     std::span<const ArtifactRing> rings) {
+base::Result<MethodFigures> Figures(std::span<const glm::vec3> rest,
+                                    const std::vector<glm::vec3> deformed[3],
+                                    std::span<const ArtifactRing> rings) {
   double f[3];
   for (int m = 0; m < 3; ++m) {
-    mocap::Result<double> r = CandyWrapperFigure(rest, deformed[m], rings);
+    base::Result<double> r = CandyWrapperFigure(rest, deformed[m], rings);
     if (!r.ok()) return std::move(r).error();
     f[m] = *r;
   }
@@ -122,7 +122,7 @@ void TurnSubtree(const mocap::Skeleton& skeleton, int joint, const glm::quat& ro
   }
 }
 
-mocap::Result<std::vector<LimbArtifacts>> MeasureLimbArtifacts(
+base::Result<std::vector<LimbArtifacts>> MeasureLimbArtifacts(
     const mocap::Skeleton& skeleton, std::span<const glm::mat4> bind, const SkinnedMesh& mesh,
     const SwdRig& rig, std::span<const double> bend_degrees,
     std::span<const double> twist_degrees) {
@@ -169,9 +169,9 @@ mocap::Result<std::vector<LimbArtifacts>> MeasureLimbArtifacts(
       const glm::quat q = glm::angleAxis(static_cast<float>(glm::radians(deg)), axis);
       std::copy(bind.begin(), bind.end(), model.begin());
       TurnSubtree(skeleton, bent, q, joint, model);
-      if (mocap::Status s = DeformAll(mesh, rig, model, deformed); !s.ok()) return s.error();
+      if (base::Status s = DeformAll(mesh, rig, model, deformed); !s.ok()) return s.error();
       ring.plane = BisectorPlane(joint, a_in, q * a_out);
-      mocap::Result<MethodFigures> f = Figures(rest, deformed, std::span(&ring, 1));
+      base::Result<MethodFigures> f = Figures(rest, deformed, std::span(&ring, 1));
       if (!f.ok()) return std::move(f).error();
       limb_out.collapse.push_back({deg, *f});
     }
@@ -199,8 +199,8 @@ mocap::Result<std::vector<LimbArtifacts>> MeasureLimbArtifacts(
         const glm::quat q = glm::angleAxis(static_cast<float>(glm::radians(deg)), a_out);
         std::copy(bind.begin(), bind.end(), model.begin());
         TurnSubtree(skeleton, twisted, q, wrist, model);
-        if (mocap::Status s = DeformAll(mesh, rig, model, deformed); !s.ok()) return s.error();
-        mocap::Result<MethodFigures> f = Figures(rest, deformed, rings);
+        if (base::Status s = DeformAll(mesh, rig, model, deformed); !s.ok()) return s.error();
+        base::Result<MethodFigures> f = Figures(rest, deformed, rings);
         if (!f.ok()) return std::move(f).error();
         limb_out.candy.push_back({deg, *f});
       }

@@ -19,7 +19,7 @@
 
 #include "deform/mesh.h"
 #include "deform/global/swd_rig.h"
-#include "mocap/error.h"
+#include "base/error.h"
 #include "mocap/skeleton.h"
 
 namespace deform {
@@ -53,7 +53,7 @@ void TurnSubtree(const mocap::Skeleton& skeleton, int joint, const glm::quat& ro
 // bind_model_from_joint the #J matrices of its bind pose. Errors: kCountMismatch for a
 // matrix count other than #J or a rig of another mesh, kInvalidArgument when the rig
 // has no limb or a ring cannot be found, and errors of the skinning jobs (kInternal).
-[[nodiscard]] mocap::Result<std::vector<LimbArtifacts>> MeasureLimbArtifacts(
+[[nodiscard]] base::Result<std::vector<LimbArtifacts>> MeasureLimbArtifacts(
     const mocap::Skeleton& skeleton, std::span<const glm::mat4> bind_model_from_joint,
     const SkinnedMesh& mesh, const SwdRig& rig, std::span<const double> bend_degrees,
     std::span<const double> twist_degrees);

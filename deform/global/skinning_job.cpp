@@ -21,7 +21,7 @@
 namespace deform {
 namespace {
 
-using mocap::JobStatus;
+using base::JobStatus;
 
 #if defined(PATCHSKIN_SKINNING_SSE2)
 
@@ -229,7 +229,7 @@ JobStatus SkinningJob::Validate() const {
       return {JobStatus::kSizeMismatch, "rest_normals and normals must have #V entries"};
     }
   }
-  return mocap::kJobOk;
+  return base::kJobOk;
 }
 
 JobStatus SkinningJob::Run() const { return RunImpl(true); }
@@ -249,7 +249,7 @@ JobStatus SkinningJob::RunImpl(bool allow_avx) const {
     case 7: SkinDispatchNormals<7>(*this, allow_avx); break;
     default: SkinDispatchNormals<8>(*this, allow_avx); break;
   }
-  return mocap::kJobOk;
+  return base::kJobOk;
 }
 
 JobStatus BuildSkinningPalette(std::span<const glm::mat4> model_from_joint,
@@ -265,12 +265,12 @@ JobStatus BuildSkinningPalette(std::span<const glm::mat4> model_from_joint,
     }
     model_from_bind[i] = model_from_joint[static_cast<std::size_t>(j)] * mesh.joint_from_bind[i];
   }
-  return mocap::kJobOk;
+  return base::kJobOk;
 }
 
-mocap::Status CheckSkinWeights(const SkinWeights& weights, int num_skin_joints, int num_vertices) {
-  using mocap::ErrorCode;
-  using mocap::MakeError;
+base::Status CheckSkinWeights(const SkinWeights& weights, int num_skin_joints, int num_vertices) {
+  using base::ErrorCode;
+  using base::MakeError;
   if (weights.influences < 1 || weights.influences > kMaxInfluences) {
     return MakeError(ErrorCode::kInvalidArgument, {},
                      "skin weights have " + std::to_string(weights.influences) +
@@ -311,7 +311,7 @@ mocap::Status CheckSkinWeights(const SkinWeights& weights, int num_skin_joints, 
                            ", expected 1");
     }
   }
-  return mocap::Status::Ok();
+  return base::Status::Ok();
 }
 
 void NormalizeSkinWeights(SkinWeights& weights) {

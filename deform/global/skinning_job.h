@@ -28,7 +28,7 @@
 #include <glm/glm.hpp>
 
 #include "deform/mesh.h"
-#include "mocap/error.h"
+#include "base/error.h"
 
 namespace deform {
 
@@ -56,16 +56,16 @@ struct SkinningJob {
   std::span<glm::vec3> normals;    // #V; required iff rest_normals is set, else ignored
 
   // Sizes and parameter ranges only; reads no array contents.
-  [[nodiscard]] mocap::JobStatus Validate() const;
+  [[nodiscard]] base::JobStatus Validate() const;
   // Validate(), then skin every vertex. Never allocates; thread-safe for
   // disjoint outputs.
-  [[nodiscard]] mocap::JobStatus Run() const;
+  [[nodiscard]] base::JobStatus Run() const;
   // Run() without the AVX path (SSE2 or scalar only), so tests and benchmarks
   // can compare the paths; the output bits are the same.
-  [[nodiscard]] mocap::JobStatus RunWithoutAvx() const;
+  [[nodiscard]] base::JobStatus RunWithoutAvx() const;
 
  private:
-  [[nodiscard]] mocap::JobStatus RunImpl(bool allow_avx) const;
+  [[nodiscard]] base::JobStatus RunImpl(bool allow_avx) const;
 };
 
 // The instruction set SkinningJob uses on this machine: "avx", "sse2" or "scalar".
@@ -76,16 +76,16 @@ const char* SkinningSimdPath();
 // model_from_joint has #J entries (LocalToModelJob output). Returns
 // kSizeMismatch if the output is not #S long or mesh arrays disagree, and
 // kOutOfRange if a skin joint is not a valid index into model_from_joint.
-[[nodiscard]] mocap::JobStatus BuildSkinningPalette(std::span<const glm::mat4> model_from_joint,
-                                                    const SkinnedMesh& mesh,
-                                                    std::span<glm::mat4> model_from_bind);
+[[nodiscard]] base::JobStatus BuildSkinningPalette(std::span<const glm::mat4> model_from_joint,
+                                                   const SkinnedMesh& mesh,
+                                                   std::span<glm::mat4> model_from_bind);
 
 // Checks skin weights once, before any job runs: influences in
 // 1..kMaxInfluences, array sizes #V x influences (num_vertices if >= 0),
 // indices < num_skin_joints, weights finite, >= 0 and summing to 1 within
 // 1e-4 per vertex.
-[[nodiscard]] mocap::Status CheckSkinWeights(const SkinWeights& weights, int num_skin_joints,
-                                             int num_vertices = -1);
+[[nodiscard]] base::Status CheckSkinWeights(const SkinWeights& weights, int num_skin_joints,
+                                            int num_vertices = -1);
 
 // Makes each vertex's weights sum to exactly 1.0f when added in slot order
 // (as the skinning jobs add them): sorts each vertex's slots by decreasing

@@ -6,7 +6,7 @@
 namespace deform {
 namespace {
 
-using mocap::JobStatus;
+using base::JobStatus;
 
 struct Deformed {
   glm::vec3 position;
@@ -86,7 +86,7 @@ JobStatus SwdJob::Validate() const {
       return {JobStatus::kSizeMismatch, "normals and bindings differ in size"};
     }
   }
-  return mocap::kJobOk;
+  return base::kJobOk;
 }
 
 JobStatus SwdJob::Run() const {
@@ -128,7 +128,7 @@ JobStatus SwdJob::Run() const {
     positions[v] = result.position;
     if (with_normals) normals[v] = result.normal;
   }
-  return mocap::kJobOk;
+  return base::kJobOk;
 }
 
 }  // namespace deform

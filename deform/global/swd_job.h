@@ -16,7 +16,7 @@
 #include <glm/gtc/quaternion.hpp>
 
 #include "deform/global/sweep.h"
-#include "mocap/error.h"
+#include "base/error.h"
 
 namespace deform {
 
@@ -54,10 +54,10 @@ struct SwdJob {
   // Sizes, chain joint indices and section scales (chain, interior joint, finite scales
   // > 0) only (kMissingInput, kOutOfRange, kSizeMismatch, kMissingOutput); reads no
   // per-vertex data.
-  [[nodiscard]] mocap::JobStatus Validate() const;
+  [[nodiscard]] base::JobStatus Validate() const;
   // Validate(), a pass checking every binding's chain index (kOutOfRange), then the
   // deformation. Never allocates; thread-safe over disjoint output ranges.
-  [[nodiscard]] mocap::JobStatus Run() const;
+  [[nodiscard]] base::JobStatus Run() const;
 };
 
 }  // namespace deform

@@ -12,9 +12,9 @@
 namespace deform {
 namespace {
 
-using mocap::ErrorCode;
-using mocap::JobStatus;
-using mocap::MakeError;
+using base::ErrorCode;
+using base::JobStatus;
+using base::MakeError;
 
 // One sweep cut from a body chain: body-chain points [first, last].
 struct Piece {
@@ -91,7 +91,7 @@ float SegmentDistance2(const glm::vec3& p, const glm::vec3& a, const glm::vec3& 
 // Other parts (a welded skin) are bound to all sweeps.
 // Vertices marked in `skip` (#V, or empty) are left unbound (default bindings) and do
 // not vote.
-mocap::Result<std::vector<SweepVertexBinding>> BindByComponent(
+base::Result<std::vector<SweepVertexBinding>> BindByComponent(
     std::span<const SweepChain> chains, std::span<const SweepJunction> junctions,
     std::span<const int> piece_chain, const Mesh& mesh, std::span<const std::uint8_t> skip) {
   constexpr float kFamilyShare = 0.75f;
@@ -181,7 +181,7 @@ mocap::Result<std::vector<SweepVertexBinding>> BindByComponent(
       members.push_back(static_cast<std::uint32_t>(v));
       positions.push_back(mesh.positions[v]);
     }
-    mocap::Result<std::vector<SweepVertexBinding>> b =
+    base::Result<std::vector<SweepVertexBinding>> b =
         BindToSweeps(sub, sub_junctions, positions, primary_ok);
     if (!b.ok()) return std::move(b).error();
     for (std::size_t i = 0; i < members.size(); ++i) {
@@ -196,9 +196,9 @@ mocap::Result<std::vector<SweepVertexBinding>> BindByComponent(
 
 }  // namespace
 
-mocap::Result<SwdRig> BuildSwdRig(const mocap::Skeleton& skeleton,
-                                  std::span<const glm::mat4> bind_model_from_joint,
-                                  const Mesh& bind_mesh, const SwdRigOptions& options) {
+base::Result<SwdRig> BuildSwdRig(const mocap::Skeleton& skeleton,
+                                 std::span<const glm::mat4> bind_model_from_joint,
+                                 const Mesh& bind_mesh, const SwdRigOptions& options) {
   if (bind_mesh.positions.empty()) {
     return MakeError(ErrorCode::kInvalidArgument, {}, "SWD rig: the mesh has no vertices");
   }
@@ -212,7 +212,7 @@ mocap::Result<SwdRig> BuildSwdRig(const mocap::Skeleton& skeleton,
     return MakeError(ErrorCode::kInvalidArgument, {},
                      "SWD rig: max_bend_rad must be in (0, 3.2]");
   }
-  mocap::Result<BodyChains> tree =
+  base::Result<BodyChains> tree =
       BuildBodyChains(skeleton, bind_model_from_joint, options.min_branch_extent);
   if (!tree.ok()) return std::move(tree).error();
   const std::vector<BodyPoint>& pts = tree->points;
@@ -283,9 +283,9 @@ mocap::Result<SwdRig> BuildSwdRig(const mocap::Skeleton& skeleton,
       spec.half_widths[static_cast<std::size_t>(k)] =
           static_cast<float>(DefaultHalfWidth(radius, options.max_bend_rad, lin, lout));
     }
-    mocap::Result<SweepChain> sweep = BuildSweepChain(spec);
+    base::Result<SweepChain> sweep = BuildSweepChain(spec);
     if (!sweep.ok()) {
-      mocap::Error e = std::move(sweep).error();
+      base::Error e = std::move(sweep).error();
       e.message = "SWD: body chain " + std::to_string(piece.body_chain) +
                   " cannot carry a sweep: " + e.message;
       return e;
@@ -371,7 +371,7 @@ mocap::Result<SwdRig> BuildSwdRig(const mocap::Skeleton& skeleton,
       !placed.empty() && std::find(placed.begin(), placed.end(), std::uint8_t{0}) == placed.end();
   std::vector<SweepVertexBinding> by_distance(nv);
   if (!all_placed) {
-    mocap::Result<std::vector<SweepVertexBinding>> bindings =
+    base::Result<std::vector<SweepVertexBinding>> bindings =
         BindByComponent(rig.chains_, rig.junctions_, piece_chain, bind_mesh, placed);
     if (!bindings.ok()) return std::move(bindings).error();
     by_distance = std::move(*bindings);
@@ -385,7 +385,7 @@ mocap::Result<SwdRig> BuildSwdRig(const mocap::Skeleton& skeleton,
       positions.push_back(bind_mesh.positions[v]);
       where.push_back(placements[v]);
     }
-    mocap::Result<std::vector<SweepVertexBinding>> bound =
+    base::Result<std::vector<SweepVertexBinding>> bound =
         BindToSweeps(rig.chains_, rig.junctions_, positions, {}, where);
     if (!bound.ok()) return std::move(bound).error();
     std::size_t i = 0;
@@ -397,7 +397,7 @@ mocap::Result<SwdRig> BuildSwdRig(const mocap::Skeleton& skeleton,
   return rig;
 }
 
-mocap::Result<std::vector<SweepVertexBinding>> BindPointsLikeVertices(
+base::Result<std::vector<SweepVertexBinding>> BindPointsLikeVertices(
     const SwdRig& rig, std::span<const glm::vec3> points, std::span<const int> guides) {
   if (points.size() != guides.size()) {
     return MakeError(ErrorCode::kInvalidArgument, {},
@@ -438,10 +438,10 @@ mocap::Result<std::vector<SweepVertexBinding>> BindPointsLikeVertices(
       j.trunk = static_cast<int>(t - set.begin());
       sub_junctions.push_back(j);
     }
-    mocap::Result<std::vector<SweepVertexBinding>> b =
+    base::Result<std::vector<SweepVertexBinding>> b =
         BindToSweeps(sub, sub_junctions, points.subspan(i, 1), primary_ok);
     if (!b.ok()) {
-      mocap::Error e = std::move(b).error();
+      base::Error e = std::move(b).error();
       e.message = "SWD: point " + std::to_string(i) + ": " + e.message;
       return e;
     }

@@ -36,7 +36,7 @@
 
 #include "deform/mesh.h"
 #include "deform/global/sweep.h"
-#include "mocap/error.h"
+#include "base/error.h"
 #include "mocap/skeleton.h"
 
 namespace deform {
@@ -76,8 +76,8 @@ class SwdRig {
   int num_vertices() const { return static_cast<int>(bindings_.size()); }
 
  private:
-  friend mocap::Result<SwdRig> BuildSwdRig(const mocap::Skeleton&, std::span<const glm::mat4>,
-                                           const Mesh&, const SwdRigOptions&);
+  friend base::Result<SwdRig> BuildSwdRig(const mocap::Skeleton&, std::span<const glm::mat4>,
+                                          const Mesh&, const SwdRigOptions&);
   std::vector<SweepChain> chains_;
   std::vector<SweepJunction> junctions_;
   std::vector<SweepVertexBinding> bindings_;
@@ -91,7 +91,7 @@ class SwdRig {
 // BuildBodyChains; kLimitExceeded when the body needs more than kMaxSwdChains sweeps;
 // kInvalidArgument when a chain cannot carry a sweep, the mesh is empty or the normals'
 // count is not #V.
-[[nodiscard]] mocap::Result<SwdRig> BuildSwdRig(const mocap::Skeleton& skeleton,
+[[nodiscard]] base::Result<SwdRig> BuildSwdRig(const mocap::Skeleton& skeleton,
                                                std::span<const glm::mat4> bind_model_from_joint,
                                                const Mesh& bind_mesh,
                                                const SwdRigOptions& options = {});
@@ -104,17 +104,17 @@ class SwdRig {
 // that set the nearest rest bone segment, the root of g(u) and the junction weight follow
 // BindToSweeps. At the bind pose SwdJob rebuilds each point exactly (up to float).
 // Errors (kInvalidArgument): sizes that differ, a guide outside 0..#V-1, non-finite points.
-[[nodiscard]] mocap::Result<std::vector<SweepVertexBinding>> BindPointsLikeVertices(
+[[nodiscard]] base::Result<std::vector<SweepVertexBinding>> BindPointsLikeVertices(
     const SwdRig& rig, std::span<const glm::vec3> points, std::span<const int> guides);
 
 // The per-frame joint state SwdJob reads, from #J rigid model-space joint matrices W_j:
 // rotations dQ_j = rotation of W_j B_j^-1 (scale dropped, unit) and positions (W_j's
 // translation). SwdRigJob does this first; call it to carry other bindings (patch control
 // points) with SwdJob in the same pose. kSizeMismatch when a span is not #J.
-[[nodiscard]] mocap::JobStatus ComputeSwdJointState(const SwdRig& rig,
-                                                    std::span<const glm::mat4> model_from_joint,
-                                                    std::span<glm::quat> joint_rotations,
-                                                    std::span<glm::vec3> joint_positions);
+[[nodiscard]] base::JobStatus ComputeSwdJointState(const SwdRig& rig,
+                                                   std::span<const glm::mat4> model_from_joint,
+                                                   std::span<glm::quat> joint_rotations,
+                                                   std::span<glm::vec3> joint_positions);
 
 // One frame of the rig over vertices [vertex_begin, vertex_begin + #n). Recomputes the
 // joint rotations dQ_j = rotation(W_j B_j^-1) and positions into the caller's scratch, so
@@ -129,7 +129,7 @@ struct SwdRigJob {
   std::span<glm::vec3> positions;               // #n outputs, model space
   std::span<glm::vec3> normals;                 // #n unit normals (empty: not computed)
 
-  [[nodiscard]] mocap::JobStatus Run() const;
+  [[nodiscard]] base::JobStatus Run() const;
 };
 
 }  // namespace deform

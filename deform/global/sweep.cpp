@@ -9,8 +9,8 @@
 namespace deform {
 namespace {
 
-using mocap::ErrorCode;
-using mocap::MakeError;
+using base::ErrorCode;
+using base::MakeError;
 
 template <typename T>
 using Vec3T = glm::vec<3, T, glm::defaultp>;
@@ -148,7 +148,7 @@ QuatT<T> SlerpShort(const QuatT<T>& q0, const QuatT<T>& q1_in, T w) {
                   c0 * q0.z + c1 * q1.z);
 }
 
-mocap::Result<SweepChain> BuildSweepChain(const SweepChainSpec& spec) {
+base::Result<SweepChain> BuildSweepChain(const SweepChainSpec& spec) {
   const int num_bones = static_cast<int>(spec.joints.size());
   if (num_bones < 1 || num_bones > kMaxSweepBones) {
     return MakeError(ErrorCode::kLimitExceeded, {},

@@ -26,7 +26,7 @@
 #include <glm/glm.hpp>
 #include <glm/gtc/quaternion.hpp>
 
-#include "mocap/error.h"
+#include "base/error.h"
 
 namespace deform {
 
@@ -113,7 +113,7 @@ class SweepChain {
   const BasicSweepPose<double>& rest_pose() const { return rest_pose_; }
 
  private:
-  friend mocap::Result<SweepChain> BuildSweepChain(const SweepChainSpec& spec);
+  friend base::Result<SweepChain> BuildSweepChain(const SweepChainSpec& spec);
   int num_bones_ = 0;
   std::array<int, kMaxSweepBones> joints_{};
   std::array<double, kMaxSweepBones> lengths_{};
@@ -131,7 +131,7 @@ class SweepChain {
 // finite values, bones longer than 1e-6, joint indices >= 0, regions of neighbouring
 // joints not overlapping (hp_k + hm_{k+1} < L_k). Errors are kInvalidArgument or
 // kLimitExceeded, naming the joint or bone.
-mocap::Result<SweepChain> BuildSweepChain(const SweepChainSpec& spec);
+base::Result<SweepChain> BuildSweepChain(const SweepChainSpec& spec);
 
 // Fills `pose` from the skeleton's current joint rotations dQ (#J, relative to bind,
 // unit) and positions (#J, model space). J_0 is the position of joints(0); the other
@@ -255,7 +255,7 @@ struct SweepPlacement {
 // (offset o = p0 - c0(u)); junction weight and trunk binding follow as above. Errors
 // also for a placement list of another size, a placement chain out of range or a
 // non-finite placement u.
-mocap::Result<std::vector<SweepVertexBinding>> BindToSweeps(
+base::Result<std::vector<SweepVertexBinding>> BindToSweeps(
     std::span<const SweepChain> chains, std::span<const SweepJunction> junctions,
     std::span<const glm::vec3> rest_positions, std::span<const std::uint8_t> primary_ok = {},
     std::span<const SweepPlacement> placements = {});

@@ -11,8 +11,8 @@
 namespace deform {
 namespace {
 
-using mocap::ErrorCode;
-using mocap::MakeError;
+using base::ErrorCode;
+using base::MakeError;
 
 float Smoothstep(float x) {
   const float y = std::clamp(x, 0.0f, 1.0f);
@@ -167,7 +167,7 @@ SweepBinding BindToSweep(const SweepChain& chain, int chain_index, const glm::dv
   return binding;
 }
 
-mocap::Result<std::vector<SweepVertexBinding>> BindToSweeps(
+base::Result<std::vector<SweepVertexBinding>> BindToSweeps(
     std::span<const SweepChain> chains, std::span<const SweepJunction> junctions,
     std::span<const glm::vec3> rest_positions, std::span<const std::uint8_t> primary_ok,
     std::span<const SweepPlacement> placements) {

@@ -10,7 +10,7 @@
 
 #include <glm/glm.hpp>
 
-#include "mocap/error.h"
+#include "base/error.h"
 
 namespace deform::internal {
 
@@ -29,12 +29,12 @@ inline bool AllFinite(std::span<const glm::vec3> points) {
   return true;
 }
 
-inline mocap::Error InvalidArgument(mocap::FileLoc loc, std::string message) {
-  return mocap::MakeError(mocap::ErrorCode::kInvalidArgument, std::move(loc), std::move(message));
+inline base::Error InvalidArgument(base::FileLoc loc, std::string message) {
+  return base::MakeError(base::ErrorCode::kInvalidArgument, std::move(loc), std::move(message));
 }
 
-inline mocap::Error InvalidArgument(std::string message) {
-  return InvalidArgument(mocap::FileLoc{}, std::move(message));
+inline base::Error InvalidArgument(std::string message) {
+  return InvalidArgument(base::FileLoc{}, std::move(message));
 }
 
 }  // namespace deform::internal

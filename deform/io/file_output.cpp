@@ -9,8 +9,8 @@
 namespace deform {
 namespace {
 
-mocap::Error IoError(const std::string& path, const std::string& why) {
-  return mocap::MakeError(mocap::ErrorCode::kIo, {path, 0, 0, {}}, why);
+base::Error IoError(const std::string& path, const std::string& why) {
+  return base::MakeError(base::ErrorCode::kIo, {path, 0, 0, {}}, why);
 }
 
 }  // namespace
@@ -26,7 +26,7 @@ std::string TemporaryOutputPath(const std::string& final_path) {
   return (dir / name).string();
 }
 
-mocap::Status WriteFileAtomic(const std::string& path, std::string_view bytes) {
+base::Status WriteFileAtomic(const std::string& path, std::string_view bytes) {
   const std::string temp = TemporaryOutputPath(path);
   std::FILE* f = std::fopen(temp.c_str(), "wb");
   if (f == nullptr) {
@@ -48,7 +48,7 @@ mocap::Status WriteFileAtomic(const std::string& path, std::string_view bytes) {
     std::filesystem::remove(temp, ignored);
     return IoError(path, "cannot rename the finished temporary file into place: " + ec.message());
   }
-  return mocap::Status::Ok();
+  return base::Status::Ok();
 }
 
 }  // namespace deform

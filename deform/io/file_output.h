@@ -7,7 +7,7 @@
 #include <string>
 #include <string_view>
 
-#include "mocap/error.h"
+#include "base/error.h"
 
 namespace deform {
 
@@ -17,6 +17,6 @@ std::string TemporaryOutputPath(const std::string& final_path);
 // Writes `bytes` to `path` atomically (temporary file, then rename). Creates
 // no folders. Errors: kIo naming `path` and the OS's reason; the temporary
 // file is removed on failure.
-mocap::Status WriteFileAtomic(const std::string& path, std::string_view bytes);
+base::Status WriteFileAtomic(const std::string& path, std::string_view bytes);
 
 }  // namespace deform

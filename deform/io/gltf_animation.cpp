@@ -7,7 +7,7 @@
 #include <limits>
 
 #include "deform/io/gltf_import.h"
-#include "mocap/check.h"
+#include "base/check.h"
 
 namespace deform {
 namespace {
@@ -128,25 +128,26 @@ double DetectFrameTime(const GltfAnimation& animation) {
   return 1.0 / 30.0;
 }
 
-mocap::Result<mocap::Motion> AnimationToMotion(const GltfModel& model, int animation, double frame_time_s) {
-  using mocap::ErrorCode;
-  const mocap::FileLoc loc{model.skeleton.info.source_file, 0, 0, {}};
+base::Result<mocap::Motion> AnimationToMotion(const GltfModel& model, int animation,
+                                              double frame_time_s) {
+  using base::ErrorCode;
+  const base::FileLoc loc{model.skeleton.info.source_file, 0, 0, {}};
   if (animation < 0 || animation >= static_cast<int>(model.animations.size())) {
-    return mocap::MakeError(ErrorCode::kInvalidArgument, loc,
-                            "animation " + std::to_string(animation) + " requested, the model has " +
-                                std::to_string(model.animations.size()));
+    return base::MakeError(ErrorCode::kInvalidArgument, loc,
+                           "animation " + std::to_string(animation) + " requested, the model has " +
+                               std::to_string(model.animations.size()));
   }
   const GltfAnimation& anim = model.animations[static_cast<std::size_t>(animation)];
   if (!std::isfinite(frame_time_s)) {
-    return mocap::MakeError(ErrorCode::kInvalidArgument, loc, "frame time must be finite");
+    return base::MakeError(ErrorCode::kInvalidArgument, loc, "frame time must be finite");
   }
   if (frame_time_s <= 0.0) frame_time_s = DetectFrameTime(anim);
   const double intervals = anim.duration_s / frame_time_s;
   constexpr double kMaxFrames = 1e7;
   if (intervals > kMaxFrames) {
-    return mocap::MakeError(ErrorCode::kLimitExceeded, loc,
-                            "sampling " + std::to_string(anim.duration_s) + " s every " +
-                                std::to_string(frame_time_s) + " s needs more than 10^7 frames");
+    return base::MakeError(ErrorCode::kLimitExceeded, loc,
+                           "sampling " + std::to_string(anim.duration_s) + " s every " +
+                               std::to_string(frame_time_s) + " s needs more than 10^7 frames");
   }
   const int num_frames = static_cast<int>(std::ceil(intervals * (1.0 - 1e-6))) + 1;
 

@@ -46,8 +46,8 @@ constexpr std::size_t kCopyBlock = std::size_t{1} << 20;
 // A GLB's lengths are 32-bit.
 constexpr std::uint64_t kMaxGlbBytes = 0xFFFFFFFFu;
 
-mocap::Error GlbError(const std::string& what) {
-  return mocap::MakeError(mocap::ErrorCode::kInvalidArgument, {"glb", 0, 0, {}}, what);
+base::Error GlbError(const std::string& what) {
+  return base::MakeError(base::ErrorCode::kInvalidArgument, {"glb", 0, 0, {}}, what);
 }
 
 using internal::AllFinite;
@@ -158,7 +158,7 @@ struct GltfSequenceWriter::Impl {
     return static_cast<int>(model.bufferViews.size()) - 1;
   }
 
-  mocap::Status WriteGlb(const std::string& path);
+  base::Status WriteGlb(const std::string& path);
 
   int AddAccessor(int view, int component, int type, std::size_t count,
                   std::vector<double> min = {}, std::vector<double> max = {}) {
@@ -449,11 +449,11 @@ GltfSequenceWriter::~GltfSequenceWriter() = default;
 GltfExportLayout GltfSequenceWriter::layout() const { return impl_->layout; }
 int GltfSequenceWriter::frames_added() const { return impl_->added; }
 
-mocap::Result<GltfSequenceWriter> GltfSequenceWriter::Create(std::span<const glm::uvec3> triangles,
-                                                             std::span<const glm::vec3> colors,
-                                                             int num_vertices, int num_frames,
-                                                             const GltfExportOptions& options,
-                                                             const GltfExportSurface& surface) {
+base::Result<GltfSequenceWriter> GltfSequenceWriter::Create(std::span<const glm::uvec3> triangles,
+                                                            std::span<const glm::vec3> colors,
+                                                            int num_vertices, int num_frames,
+                                                            const GltfExportOptions& options,
+                                                            const GltfExportSurface& surface) {
   if (num_vertices < 1) return GlbError("the mesh has no vertices");
   if (num_frames < 1 || num_frames > kMaxFrames) {
     return GlbError("expected 1.." + std::to_string(kMaxFrames) + " frames, found " +
@@ -512,7 +512,7 @@ mocap::Result<GltfSequenceWriter> GltfSequenceWriter::Create(std::span<const glm
   std::string scratch_error;
   impl->scratch = OpenScratch(options.scratch_dir, scratch_error);
   if (impl->scratch == nullptr) {
-    return mocap::MakeError(mocap::ErrorCode::kIo, {options.scratch_dir, 0, 0, {}}, scratch_error);
+    return base::MakeError(base::ErrorCode::kIo, {options.scratch_dir, 0, 0, {}}, scratch_error);
   }
   impl->options = options;
   impl->num_vertices = num_vertices;
@@ -560,8 +560,8 @@ mocap::Result<GltfSequenceWriter> GltfSequenceWriter::Create(std::span<const glm
   return GltfSequenceWriter(std::move(impl));
 }
 
-mocap::Status GltfSequenceWriter::AddFrame(std::span<const glm::vec3> positions,
-                                           std::span<const glm::vec3> normals) {
+base::Status GltfSequenceWriter::AddFrame(std::span<const glm::vec3> positions,
+                                          std::span<const glm::vec3> normals) {
   Impl& m = *impl_;
   const auto nv = static_cast<std::size_t>(m.num_vertices);
   if (m.finished) return GlbError("the file was already written");
@@ -577,7 +577,7 @@ mocap::Status GltfSequenceWriter::AddFrame(std::span<const glm::vec3> positions,
     return GlbError("frame " + std::to_string(m.added) + ": positions and normals must be finite");
   }
   if (!m.write_error.empty()) {
-    return mocap::MakeError(mocap::ErrorCode::kIo, {m.options.scratch_dir, 0, 0, {}}, m.write_error);
+    return base::MakeError(base::ErrorCode::kIo, {m.options.scratch_dir, 0, 0, {}}, m.write_error);
   }
   std::map<std::string, int> attributes;
   if (m.layout == GltfExportLayout::kBakedMeshes) {
@@ -600,7 +600,7 @@ mocap::Status GltfSequenceWriter::AddFrame(std::span<const glm::vec3> positions,
           m.AddAccessor(-1, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, nv);
       m.frame_attributes.push_back(std::move(attributes));
       ++m.added;
-      return mocap::Status::Ok();
+      return base::Status::Ok();
     }
     m.delta.resize(nv);
     for (std::size_t i = 0; i < nv; ++i) m.delta[i] = positions[i] - m.base_positions[i];
@@ -610,10 +610,11 @@ mocap::Status GltfSequenceWriter::AddFrame(std::span<const glm::vec3> positions,
     m.frame_attributes.push_back(std::move(attributes));
   }
   ++m.added;
-  return mocap::Status::Ok();
+  return base::Status::Ok();
 }
 
-mocap::Status GltfSequenceWriter::AddCameraFrame(const glm::vec3& eye, const glm::quat& world_from_camera) {
+base::Status GltfSequenceWriter::AddCameraFrame(const glm::vec3& eye,
+                                                const glm::quat& world_from_camera) {
   Impl& m = *impl_;
   if (m.finished) return GlbError("the file was already written");
   if (!m.options.camera) return GlbError("a camera pose without a camera lens in the options");
@@ -630,21 +631,21 @@ mocap::Status GltfSequenceWriter::AddCameraFrame(const glm::vec3& eye, const glm
                     ": expected finite values and a non-zero rotation");
   m.camera_translations.insert(m.camera_translations.end(), {eye.x, eye.y, eye.z});
   m.camera_rotations.insert(m.camera_rotations.end(), {q.x, q.y, q.z, q.w});
-  return mocap::Status::Ok();
+  return base::Status::Ok();
 }
 
-mocap::Status GltfSequenceWriter::Finish(const std::string& path) {
+base::Status GltfSequenceWriter::Finish(const std::string& path) {
   Impl& m = *impl_;
   if (m.finished) return GlbError("the file was already written");
   if (m.added != m.num_frames) {
-    return mocap::MakeError(mocap::ErrorCode::kInvalidArgument, {path, 0, 0, {}},
-                            "expected " + std::to_string(m.num_frames) + " frames, " +
-                                std::to_string(m.added) + " were added");
+    return base::MakeError(base::ErrorCode::kInvalidArgument, {path, 0, 0, {}},
+                           "expected " + std::to_string(m.num_frames) + " frames, " +
+                               std::to_string(m.added) + " were added");
   }
   if (m.options.camera && m.camera_translations.size() / 3 != static_cast<std::size_t>(m.num_frames)) {
-    return mocap::MakeError(mocap::ErrorCode::kInvalidArgument, {path, 0, 0, {}},
-                            "expected " + std::to_string(m.num_frames) + " camera poses, " +
-                                std::to_string(m.camera_translations.size() / 3) + " were added");
+    return base::MakeError(base::ErrorCode::kInvalidArgument, {path, 0, 0, {}},
+                           "expected " + std::to_string(m.num_frames) + " camera poses, " +
+                               std::to_string(m.camera_translations.size() / 3) + " were added");
   }
   m.finished = true;  // the model is consumed below, whatever the outcome
   if (m.layout == GltfExportLayout::kBakedMeshes) {
@@ -653,15 +654,15 @@ mocap::Status GltfSequenceWriter::Finish(const std::string& path) {
     m.FinishMorph();
   }
   m.model.buffers[0].name = "geometry";
-  mocap::Status s = m.WriteGlb(path);
+  base::Status s = m.WriteGlb(path);
   std::fclose(m.scratch);  // the scratch file disappears with it
   m.scratch = nullptr;
   return s;
 }
 
-mocap::Status GltfSequenceWriter::Impl::WriteGlb(const std::string& path) {
+base::Status GltfSequenceWriter::Impl::WriteGlb(const std::string& path) {
   auto io_error = [&](const std::string& why) {
-    return mocap::MakeError(mocap::ErrorCode::kIo, {path, 0, 0, {}}, why);
+    return base::MakeError(base::ErrorCode::kIo, {path, 0, 0, {}}, why);
   };
   if (!write_error.empty()) return io_error(write_error);
   if (std::fflush(scratch) != 0) return io_error("writing the scratch file failed: " + ErrnoText(errno));
@@ -701,9 +702,9 @@ mocap::Status GltfSequenceWriter::Impl::WriteGlb(const std::string& path) {
   const std::uint64_t bin_padded = bin_bytes + (4 - bin_bytes % 4) % 4;
   const std::uint64_t total = 12 + 8 + json.size() + (bin_bytes > 0 ? 8 + bin_padded : 0);
   if (total > kMaxGlbBytes) {
-    return mocap::MakeError(mocap::ErrorCode::kLimitExceeded, {path, 0, 0, {}},
-                            "the .glb would have " + std::to_string(total) +
-                                " bytes; the format holds at most 4 GiB (export fewer frames)");
+    return base::MakeError(base::ErrorCode::kLimitExceeded, {path, 0, 0, {}},
+                           "the .glb would have " + std::to_string(total) +
+                               " bytes; the format holds at most 4 GiB (export fewer frames)");
   }
   std::string head = "glTF";
   PutU32(head, 2);
@@ -743,7 +744,7 @@ mocap::Status GltfSequenceWriter::Impl::WriteGlb(const std::string& path) {
     std::filesystem::remove(temp, ignored);
     return io_error("cannot rename the finished temporary file into place: " + ec.message());
   }
-  return mocap::Status::Ok();
+  return base::Status::Ok();
 }
 
 }  // namespace deform

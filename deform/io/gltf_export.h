@@ -56,7 +56,7 @@
 #include <glm/gtc/quaternion.hpp>
 
 #include "deform/mesh.h"
-#include "mocap/error.h"
+#include "base/error.h"
 
 namespace deform {
 
@@ -123,29 +123,29 @@ class GltfSequenceWriter {
   // layout when options.layout is kAuto; surface: uvs and materials (above).
   // Errors: kInvalidArgument (also: a texture whose image has no encoded bytes),
   // kIo (the scratch file cannot be created).
-  static mocap::Result<GltfSequenceWriter> Create(std::span<const glm::uvec3> triangles,
-                                                  std::span<const glm::vec3> colors,
-                                                  int num_vertices, int num_frames,
-                                                  const GltfExportOptions& options,
-                                                  const GltfExportSurface& surface = {});
+  static base::Result<GltfSequenceWriter> Create(std::span<const glm::uvec3> triangles,
+                                                 std::span<const glm::vec3> colors,
+                                                 int num_vertices, int num_frames,
+                                                 const GltfExportOptions& options,
+                                                 const GltfExportSurface& surface = {});
 
   // Adds the next frame: positions and normals are #V, finite. Errors:
   // kInvalidArgument (sizes, non-finite values, more frames than announced),
   // kIo (writing the scratch file failed, e.g. disk full).
-  mocap::Status AddFrame(std::span<const glm::vec3> positions, std::span<const glm::vec3> normals);
+  base::Status AddFrame(std::span<const glm::vec3> positions, std::span<const glm::vec3> normals);
 
   // With options.camera: the camera of the next frame, as its world position and
   // its world-from-camera rotation (the camera looks down its -Z with +Y up, as
   // an OpenGL view). Call once per frame. Errors: kInvalidArgument (no lens in
   // the options, non-finite values, more poses than frames announced).
-  mocap::Status AddCameraFrame(const glm::vec3& eye, const glm::quat& world_from_camera);
+  base::Status AddCameraFrame(const glm::vec3& eye, const glm::quat& world_from_camera);
 
   // Writes the .glb to `path` (folder must exist) after exactly num_frames
   // AddFrame calls (and as many AddCameraFrame calls with a lens). Call once:
   // after it, AddFrame and Finish are errors.
   // Errors: kInvalidArgument (frame or camera count, second call), kIo, kLimitExceeded
   // (more than 4 GiB).
-  mocap::Status Finish(const std::string& path);
+  base::Status Finish(const std::string& path);
 
   GltfExportLayout layout() const;  // kMorphTargets or kBakedMeshes, never kAuto
   int frames_added() const;

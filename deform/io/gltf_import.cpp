@@ -29,12 +29,12 @@ namespace deform {
 namespace {
 
 namespace fs = std::filesystem;
+using base::ErrorCode;
+using base::Result;
 using internal::AccessorView;
 using internal::ComponentBytes;
 using internal::InsideFolder;
 using internal::ReadFileBounded;
-using mocap::ErrorCode;
-using mocap::Result;
 
 // ---------------------------------------------------------------------------
 // Files and URIs.
@@ -90,11 +90,11 @@ bool CaptureImage(tinygltf::Image* image, const int, std::string*, std::string*,
   return true;
 }
 
-void AddLines(const std::string& path, const std::string& text, std::vector<mocap::Warning>& out) {
+void AddLines(const std::string& path, const std::string& text, std::vector<base::Warning>& out) {
   std::istringstream lines(text);
   std::string line;
   while (std::getline(lines, line)) {
-    if (!line.empty()) out.push_back({mocap::FileLoc{path, 0, 0, {}}, "tinygltf: " + line});
+    if (!line.empty()) out.push_back({base::FileLoc{path, 0, 0, {}}, "tinygltf: " + line});
   }
 }
 
@@ -115,8 +115,8 @@ class Converter {
   Converter(const tinygltf::Model& model, const std::string& path)
       : m_(model), path_(path), materials_(model, path) {}
 
-  mocap::Error Fail(ErrorCode code, std::string field, std::string message) const {
-    return mocap::MakeError(code, {path_, 0, 0, std::move(field)}, std::move(message));
+  base::Error Fail(ErrorCode code, std::string field, std::string message) const {
+    return base::MakeError(code, {path_, 0, 0, std::move(field)}, std::move(message));
   }
 
   // `user` names the field holding the index, e.g. "skins[0].inverseBindMatrices".
@@ -133,16 +133,16 @@ class Converter {
     return internal::ReadUints(v, limit, what, path_);
   }
 
-  Result<GltfModel> Run(const GltfReadOptions& options, std::vector<mocap::Warning> warnings);
+  Result<GltfModel> Run(const GltfReadOptions& options, std::vector<base::Warning> warnings);
 
  private:
-  mocap::Status BuildSkeleton(int skin);
-  mocap::Status ReadSkin(int skin);
-  mocap::Status ReadMeshes(int skin);
+  base::Status BuildSkeleton(int skin);
+  base::Status ReadSkin(int skin);
+  base::Status ReadMeshes(int skin);
   Result<glm::mat4> RestWorld(int node) const;
-  mocap::Status ReadPrimitive(int mesh, int prim, int skin, int rigid_slot, bool& computed_normals);
-  mocap::Status MergeMorphTargets(std::size_t num_vertices);
-  mocap::Status ReadAnimations();
+  base::Status ReadPrimitive(int mesh, int prim, int skin, int rigid_slot, bool& computed_normals);
+  base::Status MergeMorphTargets(std::size_t num_vertices);
+  base::Status ReadAnimations();
   void Warn(std::string field, std::string message) {
     out_.warnings.push_back({{path_, 0, 0, std::move(field)}, std::move(message)});
   }
@@ -179,13 +179,14 @@ class Converter {
   bool SharesVertices(const Part& into, const Part& from) const;
   static void MergeSharedPrimitive(Part& into, Part& from);
   static void AppendVertexCopies(Part& part, std::span<const std::uint32_t> sources);
-  mocap::Status ReadMaterial(const tinygltf::Primitive& p, const std::string& at, bool has_uvs, int& material_out);
+  base::Status ReadMaterial(const tinygltf::Primitive& p, const std::string& at, bool has_uvs,
+                            int& material_out);
   internal::GltfMaterialReader materials_;
   std::vector<int> material_slot_;  // 2 x file material + has TEXCOORD_0 -> out index, -1 not yet
   std::vector<Part> parts_;
   template <typename VertexView>
-  mocap::Status ReadColors(const tinygltf::Primitive& p, int color_index, const VertexView& vertex_view,
-                           Part& part);
+  base::Status ReadColors(const tinygltf::Primitive& p, int color_index,
+                          const VertexView& vertex_view, Part& part);
   std::vector<int> mesh_first_target_;  // glTF mesh -> its first row in out_.morph, or -1
   std::vector<int> mesh_num_targets_;   // glTF mesh -> its target count, -1 when not imported
 };
@@ -222,7 +223,7 @@ Result<mocap::JointTransform> NodeTransform(const tinygltf::Node& n, const std::
   return t;
 }
 
-mocap::Status Converter::BuildSkeleton(int skin) {
+base::Status Converter::BuildSkeleton(int skin) {
   const auto num_nodes = static_cast<int>(m_.nodes.size());
   std::vector<int> parent(static_cast<std::size_t>(num_nodes), -1);
   for (int n = 0; n < num_nodes; ++n) {
@@ -299,18 +300,18 @@ mocap::Status Converter::BuildSkeleton(int skin) {
   sk.info.source_file = path_;
   sk.info.detected_units = "m";
   for (int j : leaves) out_.mesh.skin_joints.push_back(node_joint_[static_cast<std::size_t>(j)]);
-  return mocap::Status::Ok();
+  return base::Status::Ok();
 }
 
-mocap::Status Converter::ReadSkin(int skin) {
+base::Status Converter::ReadSkin(int skin) {
   if (skin < 0) {  // rigid attachment: bind space is each mesh's own space
     out_.mesh.joint_from_bind.assign(rigid_nodes_.size(), glm::mat4(1.0f));
-    return mocap::Status::Ok();
+    return base::Status::Ok();
   }
   const tinygltf::Skin& s = m_.skins[static_cast<std::size_t>(skin)];
   const std::size_t n = s.joints.size();
   out_.mesh.joint_from_bind.assign(n, glm::mat4(1.0f));
-  if (s.inverseBindMatrices < 0) return mocap::Status::Ok();
+  if (s.inverseBindMatrices < 0) return base::Status::Ok();
   const std::string at = Indexed("skins", skin) + ".inverseBindMatrices";
   auto view = View(s.inverseBindMatrices, at, TINYGLTF_TYPE_MAT4, {TINYGLTF_COMPONENT_TYPE_FLOAT});
   if (!view.ok()) return std::move(view).error();
@@ -325,17 +326,17 @@ mocap::Status Converter::ReadSkin(int skin) {
     for (int c = 0; c < 4; ++c)
       for (int r = 0; r < 4; ++r)
         out_.mesh.joint_from_bind[k][c][r] = (*values)[k * 16 + static_cast<std::size_t>(c * 4 + r)];
-  return mocap::Status::Ok();
+  return base::Status::Ok();
 }
 
-mocap::Status Converter::ReadPrimitive(int mesh, int prim, int skin, int rigid_slot,
-                                       bool& computed_normals) {
+base::Status Converter::ReadPrimitive(int mesh, int prim, int skin, int rigid_slot,
+                                      bool& computed_normals) {
   const tinygltf::Primitive& p =
       m_.meshes[static_cast<std::size_t>(mesh)].primitives[static_cast<std::size_t>(prim)];
   const std::string at = Indexed("meshes", mesh) + ".primitives[" + std::to_string(prim) + "]";
   if (p.mode != TINYGLTF_MODE_TRIANGLES) {
     Warn(at + ".mode", "only triangle lists are imported; primitive skipped");
-    return mocap::Status::Ok();
+    return base::Status::Ok();
   }
   auto attribute = [&](const char* name) {
     const auto it = p.attributes.find(name);
@@ -492,11 +493,11 @@ mocap::Status Converter::ReadPrimitive(int mesh, int prim, int skin, int rigid_s
   for (Part& earlier : parts_) {
     if (SharesVertices(earlier, part)) {
       MergeSharedPrimitive(earlier, part);
-      return mocap::Status::Ok();
+      return base::Status::Ok();
     }
   }
   parts_.push_back(std::move(part));
-  return mocap::Status::Ok();
+  return base::Status::Ok();
 }
 
 bool Converter::SharesVertices(const Part& into, const Part& from) const {
@@ -581,8 +582,8 @@ void Converter::AppendVertexCopies(Part& part, std::span<const std::uint32_t> so
 // colours, so the renderer's grey stands in (tinygltf cannot tell an omitted factor
 // from an explicit white one).
 template <typename VertexView>
-mocap::Status Converter::ReadColors(const tinygltf::Primitive& p, int color_index,
-                                    const VertexView& vertex_view, Part& part) {
+base::Status Converter::ReadColors(const tinygltf::Primitive& p, int color_index,
+                                   const VertexView& vertex_view, Part& part) {
   glm::vec3 factor(1.0f);
   if (p.material >= 0 && p.material < static_cast<int>(m_.materials.size())) {
     const std::vector<double>& f =
@@ -597,7 +598,7 @@ mocap::Status Converter::ReadColors(const tinygltf::Primitive& p, int color_inde
   const std::size_t n = part.positions.size();
   if (color_index < 0) {
     if (factor != glm::vec3(1.0f)) part.colors.assign(n, factor);
-    return mocap::Status::Ok();
+    return base::Status::Ok();
   }
   auto view = vertex_view(color_index, "COLOR_0", TINYGLTF_TYPE_VEC3,
                           {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE,
@@ -616,20 +617,20 @@ mocap::Status Converter::ReadColors(const tinygltf::Primitive& p, int color_inde
     const glm::vec3 c((*values)[v * stride], (*values)[v * stride + 1], (*values)[v * stride + 2]);
     part.colors[v] = glm::clamp(c, 0.0f, 1.0f) * factor;
   }
-  return mocap::Status::Ok();
+  return base::Status::Ok();
 }
 
 // The primitive's material, imported once per file material (and per
 // with/without TEXCOORD_0: a texture needs them).
-mocap::Status Converter::ReadMaterial(const tinygltf::Primitive& p, const std::string& at, bool has_uvs,
-                                      int& material_out) {
-  if (p.material < 0) return mocap::Status::Ok();
+base::Status Converter::ReadMaterial(const tinygltf::Primitive& p, const std::string& at,
+                                     bool has_uvs, int& material_out) {
+  if (p.material < 0) return base::Status::Ok();
   if (p.material < static_cast<int>(m_.materials.size())) {
     material_slot_.resize(2 * m_.materials.size(), -1);
     const int cached = material_slot_[static_cast<std::size_t>(2 * p.material + (has_uvs ? 1 : 0))];
     if (cached >= 0) {
       material_out = cached;
-      return mocap::Status::Ok();
+      return base::Status::Ok();
     }
   }
   auto material = materials_.Read(p.material, has_uvs, at, out_.warnings);
@@ -638,7 +639,7 @@ mocap::Status Converter::ReadMaterial(const tinygltf::Primitive& p, const std::s
   material_out = static_cast<int>(out.materials.size());
   out.materials.push_back(std::move(material).value());
   material_slot_[static_cast<std::size_t>(2 * p.material + (has_uvs ? 1 : 0))] = material_out;
-  return mocap::Status::Ok();
+  return base::Status::Ok();
 }
 
 // Rest-pose model_from_node through the node's whole ancestor chain.
@@ -657,7 +658,7 @@ Result<glm::mat4> Converter::RestWorld(int node) const {
   return world;
 }
 
-mocap::Status Converter::ReadMeshes(int skin) {
+base::Status Converter::ReadMeshes(int skin) {
   std::vector<char> used(m_.meshes.size(), 0);
   bool computed_normals = false;
   for (std::size_t n = 0; n < m_.nodes.size(); ++n) {
@@ -757,12 +758,12 @@ mocap::Status Converter::ReadMeshes(int skin) {
     }
   }
   parts_.clear();
-  return mocap::Status::Ok();
+  return base::Status::Ok();
 }
 
 // Concatenates the targets of every morphed glTF mesh into out_.morph (each
 // mesh's targets once, zero on other meshes' vertices).
-mocap::Status Converter::MergeMorphTargets(std::size_t num_vertices) {
+base::Status Converter::MergeMorphTargets(std::size_t num_vertices) {
   GltfMorphTargets& morph = out_.morph;
   mesh_first_target_.assign(m_.meshes.size(), -1);
   mesh_num_targets_.assign(m_.meshes.size(), -1);
@@ -791,7 +792,7 @@ mocap::Status Converter::MergeMorphTargets(std::size_t num_vertices) {
     }
     any_normals = any_normals || !part.targets.normals.empty();
   }
-  if (morph.num_targets == 0) return mocap::Status::Ok();
+  if (morph.num_targets == 0) return base::Status::Ok();
   const auto k_total = static_cast<std::size_t>(morph.num_targets);
   if (num_vertices != 0 && k_total > options_.max_morph_values / num_vertices) {
     return Fail(ErrorCode::kLimitExceeded, "meshes",
@@ -817,10 +818,10 @@ mocap::Status Converter::MergeMorphTargets(std::size_t num_vertices) {
     }
     part.targets = {};  // free as we go
   }
-  return mocap::Status::Ok();
+  return base::Status::Ok();
 }
 
-mocap::Status Converter::ReadAnimations() {
+base::Status Converter::ReadAnimations() {
   mocap::Skeleton& sk = out_.skeleton;
   std::vector<std::array<bool, 3>> driven(static_cast<std::size_t>(sk.num_joints()), {false, false, false});
   for (std::size_t a = 0; a < m_.animations.size(); ++a) {
@@ -932,10 +933,11 @@ mocap::Status Converter::ReadAnimations() {
     out_.animations.push_back(std::move(anim));
   }
   internal::AssignChannelLayout(driven, sk);
-  return mocap::Status::Ok();
+  return base::Status::Ok();
 }
 
-Result<GltfModel> Converter::Run(const GltfReadOptions& options, std::vector<mocap::Warning> warnings) {
+Result<GltfModel> Converter::Run(const GltfReadOptions& options,
+                                 std::vector<base::Warning> warnings) {
   out_.warnings = std::move(warnings);
   options_ = options;
   for (const std::string& ext : m_.extensionsRequired) {
@@ -959,7 +961,7 @@ Result<GltfModel> Converter::Run(const GltfReadOptions& options, std::vector<moc
   if (auto st = ReadAnimations(); !st) return st.error();
   if (auto st = out_.skeleton.Check(); !st) return st.error();
   if (auto st = out_.mesh.bind.Check(); !st) {
-    mocap::Error e = st.error();
+    base::Error e = st.error();
     e.loc.file = path_;
     return e;
   }
@@ -968,12 +970,12 @@ Result<GltfModel> Converter::Run(const GltfReadOptions& options, std::vector<moc
 }
 
 Result<GltfModel> ConvertGltf(const tinygltf::Model& model, const std::string& path,
-                              const GltfReadOptions& options, std::vector<mocap::Warning> warnings) {
+                              const GltfReadOptions& options, std::vector<base::Warning> warnings) {
   try {
     return Converter(model, path).Run(options, std::move(warnings));
   } catch (const std::exception& e) {
-    return mocap::MakeError(ErrorCode::kInternal, mocap::FileLoc{path, 0, 0, {}},
-                            std::string("unexpected exception: ") + e.what());
+    return base::MakeError(ErrorCode::kInternal, base::FileLoc{path, 0, 0, {}},
+                           std::string("unexpected exception: ") + e.what());
   }
 }
 }  // namespace
@@ -987,9 +989,10 @@ Result<GltfModel> ReadGltf(const std::string& path, const GltfReadOptions& optio
 Result<GltfModel> ReadGltfFromMemory(std::span<const unsigned char> bytes, const std::string& path,
                                      const GltfReadOptions& options) {
   if (bytes.size() > options.max_file_bytes) {
-    return mocap::MakeError(ErrorCode::kLimitExceeded, mocap::FileLoc{path, 0, 0, {}},
-                            "file has " + std::to_string(bytes.size()) +
-                                " bytes, more than the limit of " + std::to_string(options.max_file_bytes));
+    return base::MakeError(ErrorCode::kLimitExceeded, base::FileLoc{path, 0, 0, {}},
+                           "file has " + std::to_string(bytes.size()) +
+                               " bytes, more than the limit of " +
+                               std::to_string(options.max_file_bytes));
   }
   const std::vector<unsigned char> data(bytes.begin(), bytes.end());
   const bool is_glb = data.size() >= 4 && std::memcmp(data.data(), "glTF", 4) == 0;
@@ -1001,10 +1004,10 @@ Result<GltfModel> ReadGltfFromMemory(std::span<const unsigned char> bytes, const
   } else {
     json_text.assign(reinterpret_cast<const char*>(data.data()), data.size());
   }
-  if (mocap::Status uris = internal::CheckUris(path, json_text); !uris) return uris.error();
+  if (base::Status uris = internal::CheckUris(path, json_text); !uris) return uris.error();
   if (data.size() > std::numeric_limits<unsigned int>::max()) {
-    return mocap::MakeError(ErrorCode::kLimitExceeded, mocap::FileLoc{path, 0, 0, {}},
-                            "file larger than 4 GiB");
+    return base::MakeError(ErrorCode::kLimitExceeded, base::FileLoc{path, 0, 0, {}},
+                           "file larger than 4 GiB");
   }
 
   FsContext fs_context;
@@ -1030,19 +1033,20 @@ Result<GltfModel> ReadGltfFromMemory(std::span<const unsigned char> bytes, const
                                           static_cast<unsigned int>(json_text.size()), base_dir);
     }
   } catch (const std::exception& e) {
-    return mocap::MakeError(ErrorCode::kSyntax, mocap::FileLoc{path, 0, 0, {}},
-                            std::string("tinygltf: ") + e.what());
+    return base::MakeError(ErrorCode::kSyntax, base::FileLoc{path, 0, 0, {}},
+                           std::string("tinygltf: ") + e.what());
   }
-  std::vector<mocap::Warning> warnings;
+  std::vector<base::Warning> warnings;
   AddLines(path, warn, warnings);
   if (!fs_context.rejected.empty()) {
-    return mocap::MakeError(
-        ErrorCode::kUnsupported, mocap::FileLoc{path, 0, 0, {}},
+    return base::MakeError(
+        ErrorCode::kUnsupported, base::FileLoc{path, 0, 0, {}},
         "refused to read '" + fs_context.rejected + "': it resolves outside the model's folder");
   }
   if (!loaded) {
-    return mocap::MakeError(ErrorCode::kSyntax, mocap::FileLoc{path, 0, 0, {}},
-                            "tinygltf: " + (err.empty() ? std::string("load failed") : FirstLines(err)));
+    return base::MakeError(
+        ErrorCode::kSyntax, base::FileLoc{path, 0, 0, {}},
+        "tinygltf: " + (err.empty() ? std::string("load failed") : FirstLines(err)));
   }
   if (!err.empty()) AddLines(path, err, warnings);
   return ConvertGltf(model, path, options, std::move(warnings));

@@ -39,7 +39,7 @@
 #include <vector>
 
 #include "deform/mesh.h"
-#include "mocap/error.h"
+#include "base/error.h"
 #include "mocap/motion.h"
 #include "mocap/pose.h"
 #include "mocap/skeleton.h"
@@ -140,7 +140,7 @@ struct GltfModel {
   // Morph targets of `mesh` (num_targets 0 when the file has none).
   GltfMorphTargets morph;
   std::vector<GltfAnimation> animations;  // in file order
-  std::vector<mocap::Warning> warnings;   // tinygltf's warnings and ours
+  std::vector<base::Warning> warnings;    // tinygltf's warnings and ours
 };
 
 struct GltfReadOptions {
@@ -168,16 +168,16 @@ struct GltfReadOptions {
 // Every accessor is checked (bounds, component type, count, index ranges,
 // finite values) before use; errors name the file and the glTF field, e.g.
 // "walk.gltf: accessors[3].count: error: ...". Never throws.
-mocap::Result<GltfModel> ReadGltf(const std::string& path, const GltfReadOptions& options = {});
+base::Result<GltfModel> ReadGltf(const std::string& path, const GltfReadOptions& options = {});
 
 // ReadGltf on the bytes of a .gltf or .glb already in memory (the fuzz target,
 // embedders). `path` labels messages and decides the folder that external
 // buffers are read from (its parent; "." when it has none), under the same
 // confinement rules; a path whose folder does not exist makes every external
 // URI a read error, so only data: URIs and the GLB chunk load. Never throws.
-mocap::Result<GltfModel> ReadGltfFromMemory(std::span<const unsigned char> bytes,
-                                            const std::string& path,
-                                            const GltfReadOptions& options = {});
+base::Result<GltfModel> ReadGltfFromMemory(std::span<const unsigned char> bytes,
+                                           const std::string& path,
+                                           const GltfReadOptions& options = {});
 
 // Exact evaluation of animation `animation` at time t_s into local transforms:
 // rest TRS for joints and properties the animation does not drive; before the
@@ -202,7 +202,7 @@ double DetectFrameTime(const GltfAnimation& animation);
 // The values follow model.skeleton's channel layout; un-driven channels hold
 // rest values. Errors: bad animation index, non-finite frame time, more than
 // 10^7 frames.
-mocap::Result<mocap::Motion> AnimationToMotion(const GltfModel& model, int animation,
-                                               double frame_time_s = 0.0);
+base::Result<mocap::Motion> AnimationToMotion(const GltfModel& model, int animation,
+                                              double frame_time_s = 0.0);
 
 }  // namespace deform

@@ -4,7 +4,7 @@
 #include <cmath>
 
 #include "deform/global/skinning_job.h"
-#include "mocap/check.h"
+#include "base/check.h"
 
 namespace deform {
 namespace {
@@ -47,9 +47,9 @@ void EvaluateWeights(const GltfWeightsChannel& channel, float t, std::span<float
   }
 }
 
-mocap::Error ModelError(const GltfModel& model, const std::string& what) {
-  return mocap::MakeError(mocap::ErrorCode::kInvalidArgument,
-                          {model.skeleton.info.source_file, 0, 0, {}}, what);
+base::Error ModelError(const GltfModel& model, const std::string& what) {
+  return base::MakeError(base::ErrorCode::kInvalidArgument,
+                         {model.skeleton.info.source_file, 0, 0, {}}, what);
 }
 
 }  // namespace
@@ -77,12 +77,12 @@ GltfMeshSampler::GltfMeshSampler(const GltfModel& model) : model_(&model) {
   palette_.resize(model.mesh.skin_joints.size());
 }
 
-mocap::Result<GltfMeshSampler> GltfMeshSampler::Create(const GltfModel& model) {
-  const mocap::Status weights = CheckSkinWeights(model.mesh.weights,
-                                                 static_cast<int>(model.mesh.skin_joints.size()),
-                                                 model.mesh.bind.num_vertices());
+base::Result<GltfMeshSampler> GltfMeshSampler::Create(const GltfModel& model) {
+  const base::Status weights =
+      CheckSkinWeights(model.mesh.weights, static_cast<int>(model.mesh.skin_joints.size()),
+                       model.mesh.bind.num_vertices());
   if (!weights.ok()) {
-    mocap::Error e = weights.error();
+    base::Error e = weights.error();
     if (e.loc.file.empty()) e.loc.file = model.skeleton.info.source_file;
     return e;
   }
@@ -96,8 +96,8 @@ mocap::Result<GltfMeshSampler> GltfMeshSampler::Create(const GltfModel& model) {
   return GltfMeshSampler(model);
 }
 
-mocap::Status GltfMeshSampler::Sample(int animation, double t_s, std::span<glm::vec3> positions,
-                                      std::span<glm::vec3> normals) {
+base::Status GltfMeshSampler::Sample(int animation, double t_s, std::span<glm::vec3> positions,
+                                     std::span<glm::vec3> normals) {
   const GltfModel& m = *model_;
   const std::size_t nv = morphed_positions_.size();
   if (animation < -1 || animation >= static_cast<int>(m.animations.size())) {
@@ -128,9 +128,10 @@ mocap::Status GltfMeshSampler::Sample(int animation, double t_s, std::span<glm::
   } else {
     mocap::RestPose(m.skeleton, locals_);
   }
-  mocap::JobStatus s = mocap::LocalToModelJob{
-      .parents = m.skeleton.parents, .locals = locals_, .model_from_joint = model_from_joint_}
-                           .Run();
+  base::JobStatus s =
+      mocap::LocalToModelJob{
+          .parents = m.skeleton.parents, .locals = locals_, .model_from_joint = model_from_joint_}
+          .Run();
   if (s) s = BuildSkinningPalette(model_from_joint_, m.mesh, palette_);
   // 4. Skinning.
   if (s) {
@@ -146,8 +147,8 @@ mocap::Status GltfMeshSampler::Sample(int animation, double t_s, std::span<glm::
             .Run();
   }
   if (!s) {
-    return mocap::MakeError(mocap::ErrorCode::kInternal, {m.skeleton.info.source_file, 0, 0, {}},
-                            std::string("glTF sampling refused to run: ") + s.what);
+    return base::MakeError(base::ErrorCode::kInternal, {m.skeleton.info.source_file, 0, 0, {}},
+                           std::string("glTF sampling refused to run: ") + s.what);
   }
   // 5. Unit normals (computed from the skinned mesh when the file has none).
   if (!has_normals) {
@@ -158,7 +159,7 @@ mocap::Status GltfMeshSampler::Sample(int animation, double t_s, std::span<glm::
       if (len > 0.0f) n /= len;
     }
   }
-  return mocap::Status::Ok();
+  return base::Status::Ok();
 }
 
 }  // namespace deform

@@ -23,7 +23,7 @@
 #include <glm/glm.hpp>
 
 #include "deform/io/gltf_import.h"
-#include "mocap/error.h"
+#include "base/error.h"
 #include "mocap/pose.h"
 
 namespace deform {
@@ -44,13 +44,13 @@ class GltfMeshSampler {
  public:
   // Checks the skin weights once (CheckSkinWeights). Errors: kCountMismatch /
   // kBadNumber from that check, naming the model's file.
-  static mocap::Result<GltfMeshSampler> Create(const GltfModel& model);
+  static base::Result<GltfMeshSampler> Create(const GltfModel& model);
 
   // Positions and normals (#V each, model space, file units) at t_s seconds
   // of `animation` (-1: rest pose with the default weights). Errors:
   // kInvalidArgument for an animation index out of range or wrong output sizes.
-  mocap::Status Sample(int animation, double t_s, std::span<glm::vec3> positions,
-                       std::span<glm::vec3> normals);
+  base::Status Sample(int animation, double t_s, std::span<glm::vec3> positions,
+                      std::span<glm::vec3> normals);
 
   // The morph weights (#K) and joint matrices (#J) of the last Sample call.
   std::span<const float> weights() const { return weights_; }

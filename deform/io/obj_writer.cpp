@@ -9,8 +9,8 @@
 namespace deform {
 namespace {
 
-mocap::Error ObjError(const std::string& what) {
-  return mocap::MakeError(mocap::ErrorCode::kInvalidArgument, {"obj", 0, 0, {}}, what);
+base::Error ObjError(const std::string& what) {
+  return base::MakeError(base::ErrorCode::kInvalidArgument, {"obj", 0, 0, {}}, what);
 }
 
 using internal::AllFinite;
@@ -44,7 +44,7 @@ bool HasSpace(const std::string& s) {
 
 }  // namespace
 
-mocap::Status AppendObj(const ObjFrame& frame, std::string& out) {
+base::Status AppendObj(const ObjFrame& frame, std::string& out) {
   const std::size_t nv = frame.positions.size();
   if (!frame.normals.empty() && frame.normals.size() != nv) {
     return ObjError("normals must be empty or one per vertex: " + std::to_string(nv) +
@@ -138,31 +138,32 @@ mocap::Status AppendObj(const ObjFrame& frame, std::string& out) {
     }
     out += '\n';
   }
-  return mocap::Status::Ok();
+  return base::Status::Ok();
 }
 
-mocap::Status ObjSequenceWriter::Write(const ObjFrame& frame, const std::string& path) {
+base::Status ObjSequenceWriter::Write(const ObjFrame& frame, const std::string& path) {
   buffer_.clear();  // keeps the capacity: one frame's text is reused for the next
-  if (mocap::Status s = AppendObj(frame, buffer_); !s) {
-    mocap::Error e = s.error();
+  if (base::Status s = AppendObj(frame, buffer_); !s) {
+    base::Error e = s.error();
     e.loc.file = path;
     return e;
   }
   return WriteFileAtomic(path, buffer_);
 }
 
-mocap::Status WriteObjMaterials(const std::string& path, std::span<const std::string> names,
-                                std::span<const glm::vec3> diffuse,
-                                std::span<const std::string> texture_files) {
+base::Status WriteObjMaterials(const std::string& path, std::span<const std::string> names,
+                               std::span<const glm::vec3> diffuse,
+                               std::span<const std::string> texture_files) {
   if (diffuse.size() != names.size() || texture_files.size() != names.size()) {
-    return mocap::MakeError(mocap::ErrorCode::kInvalidArgument, {path, 0, 0, {}},
-                            "expected a colour and a texture file (or none) per material name");
+    return base::MakeError(base::ErrorCode::kInvalidArgument, {path, 0, 0, {}},
+                           "expected a colour and a texture file (or none) per material name");
   }
   std::string out = "# patchskin materials: Kd is the linear base colour factor\n";
   for (std::size_t k = 0; k < names.size(); ++k) {
     if (names[k].empty() || HasSpace(names[k]) || HasSpace(texture_files[k])) {
-      return mocap::MakeError(mocap::ErrorCode::kInvalidArgument, {path, 0, 0, {}},
-                              "material '" + names[k] + "': names and files must be non-empty words");
+      return base::MakeError(
+          base::ErrorCode::kInvalidArgument, {path, 0, 0, {}},
+          "material '" + names[k] + "': names and files must be non-empty words");
     }
     out += "newmtl " + names[k] + "\nKd";
     for (int c = 0; c < 3; ++c) {

@@ -19,7 +19,7 @@
 
 #include <glm/glm.hpp>
 
-#include "mocap/error.h"
+#include "base/error.h"
 
 namespace deform {
 
@@ -42,21 +42,21 @@ struct ObjFrame {
 // material "newmtl NAME", "Kd r g b" (the base colour factor, linear) and, for
 // a textured one, "map_Kd FILE". `texture_files[k]` is material k's texture
 // file name relative to the .mtl (empty: none). Writes atomically.
-mocap::Status WriteObjMaterials(const std::string& path, std::span<const std::string> names,
-                                std::span<const glm::vec3> diffuse,
-                                std::span<const std::string> texture_files);
+base::Status WriteObjMaterials(const std::string& path, std::span<const std::string> names,
+                               std::span<const glm::vec3> diffuse,
+                               std::span<const std::string> texture_files);
 
 // Appends the OBJ text of `frame` to `out` (out is not cleared). Errors:
 // kInvalidArgument when sizes disagree, an index is out of range or a value
 // is not finite (nothing is appended then).
-mocap::Status AppendObj(const ObjFrame& frame, std::string& out);
+base::Status AppendObj(const ObjFrame& frame, std::string& out);
 
 // Writes frames to files one at a time, reusing one text buffer: memory held
 // is one frame's text, whatever the number of frames.
 class ObjSequenceWriter {
  public:
   // Formats `frame` and writes it atomically to `path` (the folder must exist).
-  mocap::Status Write(const ObjFrame& frame, const std::string& path);
+  base::Status Write(const ObjFrame& frame, const std::string& path);
   // Bytes of the reused text buffer (its capacity): one frame's worth.
   std::size_t buffer_bytes() const { return buffer_.capacity(); }
 

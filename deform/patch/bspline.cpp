@@ -8,8 +8,8 @@
 namespace deform {
 namespace {
 
-using mocap::ErrorCode;
-using mocap::MakeError;
+using base::ErrorCode;
+using base::MakeError;
 
 using internal::InvalidArgument;
 
@@ -33,8 +33,8 @@ std::vector<double> MakeClampedUniformKnots(int num_control, int degree) {
   return knots;
 }
 
-mocap::Status CheckKnots(std::span<const double> knots, int num_control, int degree,
-                         const char* what) {
+base::Status CheckKnots(std::span<const double> knots, int num_control, int degree,
+                        const char* what) {
   if (degree < 1 || degree > kMaxSplineDegree) {
     return InvalidArgument(std::string(what) + ": expected degree in 1.." +
                            std::to_string(kMaxSplineDegree) + ", found " + std::to_string(degree));
@@ -69,7 +69,7 @@ mocap::Status CheckKnots(std::span<const double> knots, int num_control, int deg
       return InvalidArgument(std::string(what) + ": interior knot multiplicity exceeds the degree");
     }
   }
-  return mocap::Status::Ok();
+  return base::Status::Ok();
 }
 
 int FindSpan(std::span<const double> knots, int num_control, int degree, double u) {
@@ -198,8 +198,8 @@ KnotInsertionMap KnotInsertionMap::After(const KnotInsertionMap& first) const {
   return out;
 }
 
-mocap::Result<KnotInsertionMap> InsertKnot(std::vector<double>& knots, int num_control,
-                                           int degree, double ub) {
+base::Result<KnotInsertionMap> InsertKnot(std::vector<double>& knots, int num_control, int degree,
+                                          double ub) {
   if (!(ub > 0.0 && ub < 1.0)) {
     return InvalidArgument("knot insertion: expected a knot in (0,1), found " + std::to_string(ub));
   }
@@ -233,13 +233,13 @@ mocap::Result<KnotInsertionMap> InsertKnot(std::vector<double>& knots, int num_c
   return map;
 }
 
-mocap::Result<BSplineSurface> BSplineSurface::Create(int degree_u, int degree_v,
-                                                     std::vector<double> knots_u,
-                                                     std::vector<double> knots_v, int num_u,
-                                                     int num_v, std::vector<glm::dvec3> control,
-                                                     int sigma) {
-  if (mocap::Status st = CheckKnots(knots_u, num_u, degree_u, "u knots"); !st) return st.error();
-  if (mocap::Status st = CheckKnots(knots_v, num_v, degree_v, "v knots"); !st) return st.error();
+base::Result<BSplineSurface> BSplineSurface::Create(int degree_u, int degree_v,
+                                                    std::vector<double> knots_u,
+                                                    std::vector<double> knots_v, int num_u,
+                                                    int num_v, std::vector<glm::dvec3> control,
+                                                    int sigma) {
+  if (base::Status st = CheckKnots(knots_u, num_u, degree_u, "u knots"); !st) return st.error();
+  if (base::Status st = CheckKnots(knots_v, num_v, degree_v, "v knots"); !st) return st.error();
   if (control.size() != static_cast<size_t>(num_u) * static_cast<size_t>(num_v)) {
     return InvalidArgument("expected " + std::to_string(num_u * num_v) + " control points, found " +
                            std::to_string(control.size()));
@@ -261,9 +261,9 @@ mocap::Result<BSplineSurface> BSplineSurface::Create(int degree_u, int degree_v,
   return s;
 }
 
-mocap::Result<BSplineSurface> BSplineSurface::CreateUniform(int num_u, int num_v,
-                                                            std::vector<glm::dvec3> control,
-                                                            int degree) {
+base::Result<BSplineSurface> BSplineSurface::CreateUniform(int num_u, int num_v,
+                                                           std::vector<glm::dvec3> control,
+                                                           int degree) {
   return Create(degree, degree, MakeClampedUniformKnots(num_u, degree),
                 MakeClampedUniformKnots(num_v, degree), num_u, num_v, std::move(control));
 }
@@ -332,9 +332,9 @@ double BSplineSurface::ControlDiagonal() const {
   return glm::length(hi - lo);
 }
 
-mocap::Result<KnotInsertionMap> BSplineSurface::InsertKnotU(double ub) {
+base::Result<KnotInsertionMap> BSplineSurface::InsertKnotU(double ub) {
   std::vector<double> knots = knots_u_;
-  mocap::Result<KnotInsertionMap> map = InsertKnot(knots, num_u_, degree_u_, ub);
+  base::Result<KnotInsertionMap> map = InsertKnot(knots, num_u_, degree_u_, ub);
   if (!map) return map;
   std::vector<glm::dvec3> next(static_cast<size_t>(num_u_ + 1) * num_v_, glm::dvec3(0.0));
   for (int r = 0; r <= num_u_; ++r) {
@@ -350,9 +350,9 @@ mocap::Result<KnotInsertionMap> BSplineSurface::InsertKnotU(double ub) {
   return map;
 }
 
-mocap::Result<KnotInsertionMap> BSplineSurface::InsertKnotV(double vb) {
+base::Result<KnotInsertionMap> BSplineSurface::InsertKnotV(double vb) {
   std::vector<double> knots = knots_v_;
-  mocap::Result<KnotInsertionMap> map = InsertKnot(knots, num_v_, degree_v_, vb);
+  base::Result<KnotInsertionMap> map = InsertKnot(knots, num_v_, degree_v_, vb);
   if (!map) return map;
   const int nn = num_v_ + 1;
   std::vector<glm::dvec3> next(static_cast<size_t>(num_u_) * nn, glm::dvec3(0.0));
@@ -372,13 +372,13 @@ mocap::Result<KnotInsertionMap> BSplineSurface::InsertKnotV(double vb) {
 
 namespace {
 template <typename InsertFn>
-mocap::Result<KnotInsertionMap> RefineWith(std::span<const double> knots, int num, InsertFn insert) {
+base::Result<KnotInsertionMap> RefineWith(std::span<const double> knots, int num, InsertFn insert) {
   KnotInsertionMap total;
   total.num_old = total.num_new = num;
   total.matrix.assign(static_cast<size_t>(num) * num, 0.0);
   for (int i = 0; i < num; ++i) total.matrix[static_cast<size_t>(i) * num + i] = 1.0;
   for (double ub : knots) {
-    mocap::Result<KnotInsertionMap> step = insert(ub);
+    base::Result<KnotInsertionMap> step = insert(ub);
     if (!step) return step;
     total = step->After(total);
   }
@@ -394,11 +394,11 @@ std::vector<double> Midpoints(const std::vector<double>& knots) {
 }
 }  // namespace
 
-mocap::Result<KnotInsertionMap> BSplineSurface::RefineU(std::span<const double> knots) {
+base::Result<KnotInsertionMap> BSplineSurface::RefineU(std::span<const double> knots) {
   return RefineWith(knots, num_u_, [this](double ub) { return InsertKnotU(ub); });
 }
 
-mocap::Result<KnotInsertionMap> BSplineSurface::RefineV(std::span<const double> knots) {
+base::Result<KnotInsertionMap> BSplineSurface::RefineV(std::span<const double> knots) {
   return RefineWith(knots, num_v_, [this](double vb) { return InsertKnotV(vb); });
 }
 

@@ -14,7 +14,7 @@
 
 #include <glm/glm.hpp>
 
-#include "mocap/error.h"
+#include "base/error.h"
 
 namespace deform {
 
@@ -34,8 +34,8 @@ std::vector<double> MakeClampedUniformKnots(int num_control, int degree);
 // Checks that `knots` is a clamped knot vector on [0,1] for `num_control`
 // points of degree `degree`: size M+p+1, non-decreasing, finite, end
 // multiplicity p+1, interior multiplicity <= p. `what` names it in messages.
-mocap::Status CheckKnots(std::span<const double> knots, int num_control, int degree,
-                         const char* what);
+base::Status CheckKnots(std::span<const double> knots, int num_control, int degree,
+                        const char* what);
 
 // The span k in [p, M-1] with u_k <= u < u_{k+1}; u >= 1 gives M-1 and u <= 0
 // gives p (values outside [0,1] are clamped). Binary search, O(log M).
@@ -86,14 +86,14 @@ class BSplineSurface {
 
   // Builds and checks a surface: knots per CheckKnots, #M*#N control points
   // (row-major: index i*N + j, i along u), finite; sigma = +1 or -1.
-  static mocap::Result<BSplineSurface> Create(int degree_u, int degree_v,
-                                              std::vector<double> knots_u,
-                                              std::vector<double> knots_v, int num_u, int num_v,
-                                              std::vector<glm::dvec3> control, int sigma = 1);
+  static base::Result<BSplineSurface> Create(int degree_u, int degree_v,
+                                             std::vector<double> knots_u,
+                                             std::vector<double> knots_v, int num_u, int num_v,
+                                             std::vector<glm::dvec3> control, int sigma = 1);
   // Bicubic surface on uniform clamped knots with the given control grid.
-  static mocap::Result<BSplineSurface> CreateUniform(int num_u, int num_v,
-                                                     std::vector<glm::dvec3> control,
-                                                     int degree = 3);
+  static base::Result<BSplineSurface> CreateUniform(int num_u, int num_v,
+                                                    std::vector<glm::dvec3> control,
+                                                    int degree = 3);
 
   int degree_u() const { return degree_u_; }
   int degree_v() const { return degree_v_; }
@@ -122,13 +122,13 @@ class BSplineSurface {
   // Boehm insertion of knot ub in (0,1) once along u (resp. v); fails when its
   // multiplicity would exceed the degree. Returns the map of the direction's
   // control indices (#M+1 x #M along u); the surface is unchanged.
-  mocap::Result<KnotInsertionMap> InsertKnotU(double ub);
-  mocap::Result<KnotInsertionMap> InsertKnotV(double vb);
+  base::Result<KnotInsertionMap> InsertKnotU(double ub);
+  base::Result<KnotInsertionMap> InsertKnotV(double vb);
   // Inserts every knot of `knots` (each in (0,1), any order) one at a time;
   // returns the composed map. On failure the knots inserted before the bad
   // one stay inserted (the surface is still unchanged).
-  mocap::Result<KnotInsertionMap> RefineU(std::span<const double> knots);
-  mocap::Result<KnotInsertionMap> RefineV(std::span<const double> knots);
+  base::Result<KnotInsertionMap> RefineU(std::span<const double> knots);
+  base::Result<KnotInsertionMap> RefineV(std::span<const double> knots);
   // Midpoints of every non-empty knot span along u (resp. v), for refinement.
   std::vector<double> SpanMidpointsU() const;
   std::vector<double> SpanMidpointsV() const;
@@ -147,7 +147,7 @@ class BSplineSurface {
 // Insertion of ub once into `knots` for `num_control` points of `degree`:
 // the new knot vector and the (#M+1 x #M) map. Fails on ub outside (0,1) or a
 // multiplicity that would exceed the degree.
-mocap::Result<KnotInsertionMap> InsertKnot(std::vector<double>& knots, int num_control,
-                                           int degree, double ub);
+base::Result<KnotInsertionMap> InsertKnot(std::vector<double>& knots, int num_control, int degree,
+                                          double ub);
 
 }  // namespace deform

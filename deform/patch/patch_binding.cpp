@@ -8,8 +8,8 @@
 namespace deform {
 namespace {
 
-using mocap::ErrorCode;
-using mocap::MakeError;
+using base::ErrorCode;
+using base::MakeError;
 
 // Knot constants of every span of one direction, kSpanTableStride floats per
 // span k (row k-3): u_{k-1}, u_k, u_{k+1}, u_{k+2}, then with
@@ -225,8 +225,8 @@ PatchBindingView PatchBinding::view() const {
                           .nv0 = nv0, .nv1 = nv1, .nv2 = nv2, .first = first};
 }
 
-mocap::Result<PatchBinding> RefreshBinding(const PatchBinding& binding,
-                                           const BSplineSurface& refined) {
+base::Result<PatchBinding> RefreshBinding(const PatchBinding& binding,
+                                          const BSplineSurface& refined) {
   if (refined.degree_u() != 3 || refined.degree_v() != 3 || refined.num_u() > 256 ||
       refined.num_v() > 256) {
     return MakeError(ErrorCode::kUnsupported, {}, "refresh binding: expected a bicubic patch of at most 256 x 256");
@@ -246,11 +246,11 @@ std::vector<glm::vec3> ControlPointsAsFloat(const BSplineSurface& surface) {
   return out;
 }
 
-mocap::Result<BindResult> BindPatch(const BSplineSurface& surface,
-                                    std::span<const glm::vec3> positions,
-                                    std::span<const int> region,
-                                    std::span<const glm::dvec2> region_uv,
-                                    const ProjectionOptions& options) {
+base::Result<BindResult> BindPatch(const BSplineSurface& surface,
+                                   std::span<const glm::vec3> positions,
+                                   std::span<const int> region,
+                                   std::span<const glm::dvec2> region_uv,
+                                   const ProjectionOptions& options) {
   if (surface.degree_u() != 3 || surface.degree_v() != 3) {
     return MakeError(ErrorCode::kUnsupported, {}, "binding: expected a bicubic patch");
   }
@@ -304,7 +304,7 @@ mocap::Result<BindResult> BindPatch(const BSplineSurface& surface,
   const std::vector<glm::vec3> control = ControlPointsAsFloat(surface);
   std::vector<glm::vec3> rebuilt(b.size());
   const PatchRebuildJob job{.control = control, .bindings = b.view(), .positions = rebuilt};
-  if (const mocap::JobStatus st = job.Run(); !st) {
+  if (const base::JobStatus st = job.Run(); !st) {
     return MakeError(ErrorCode::kInternal, {}, std::string("binding: rest rebuild failed: ") + st.what);
   }
   for (size_t i = 0; i < b.size(); ++i) {

@@ -28,7 +28,7 @@
 #include <glm/glm.hpp>
 
 #include "deform/patch/bspline.h"
-#include "mocap/error.h"
+#include "base/error.h"
 
 namespace deform {
 
@@ -130,19 +130,19 @@ struct BindResult {
 // far vertices are reported and left unbound (the caller keeps their global
 // result). Fails on a non-bicubic surface, indices out of range or sizes
 // that disagree. The rest rebuild error is measured with PatchRebuildJob.
-mocap::Result<BindResult> BindPatch(const BSplineSurface& surface,
-                                    std::span<const glm::vec3> positions,
-                                    std::span<const int> region,
-                                    std::span<const glm::dvec2> region_uv,
-                                    const ProjectionOptions& options = {});
+base::Result<BindResult> BindPatch(const BSplineSurface& surface,
+                                   std::span<const glm::vec3> positions,
+                                   std::span<const int> region,
+                                   std::span<const glm::dvec2> region_uv,
+                                   const ProjectionOptions& options = {});
 
 // After knot insertion or refinement (ALGORITHMS.md 7) the surface is the
 // same, so every record's (u, v, d) stays valid: this recomputes only the
 // spans, basis values and span tables for `refined` and re-sorts the records
 // by span (vertex order may change; read PatchBinding::vertex). Fails on a
 // non-bicubic surface.
-mocap::Result<PatchBinding> RefreshBinding(const PatchBinding& binding,
-                                           const BSplineSurface& refined);
+base::Result<PatchBinding> RefreshBinding(const PatchBinding& binding,
+                                          const BSplineSurface& refined);
 
 // Float copy of a surface's control points (#M x #N row-major) for the rebuild.
 std::vector<glm::vec3> ControlPointsAsFloat(const BSplineSurface& surface);
@@ -162,8 +162,8 @@ struct PatchRebuildJob {
   std::span<glm::vec3> positions{};    // #B rebuilt positions (model space)
   std::span<glm::vec3> normals{};      // #B patch normals, or empty
 
-  [[nodiscard]] mocap::JobStatus Validate() const;
-  [[nodiscard]] mocap::JobStatus Run() const;
+  [[nodiscard]] base::JobStatus Validate() const;
+  [[nodiscard]] base::JobStatus Run() const;
 };
 
 }  // namespace deform

@@ -52,18 +52,18 @@ constexpr glm::quat kIdentity(1.0f, 0.0f, 0.0f, 0.0f);
 
 }  // namespace
 
-mocap::JobStatus PatchControlRotations(const PatchSetup& patch, const ExamplePose& pose,
-                                       std::span<glm::quat> rotations,
-                                       std::span<const glm::vec3> displacement) {
+base::JobStatus PatchControlRotations(const PatchSetup& patch, const ExamplePose& pose,
+                                      std::span<glm::quat> rotations,
+                                      std::span<const glm::vec3> displacement) {
   if (!displacement.empty() && displacement.size() != rotations.size()) {
-    return {mocap::JobStatus::kSizeMismatch, "displacement must be empty or #C"};
+    return {base::JobStatus::kSizeMismatch, "displacement must be empty or #C"};
   }
   // Q = G + A dS is G whatever A is where dS is exactly zero (A 0 = 0): the
   // identity stands in for A there.
   const auto skip = [&](std::size_t c) {
     return !displacement.empty() && displacement[c] == glm::vec3(0.0f);
   };
-  const auto identity_where_skipped = [&](mocap::JobStatus st) {
+  const auto identity_where_skipped = [&](base::JobStatus st) {
     if (!st) return st;
     for (std::size_t c = 0; c < rotations.size(); ++c) {
       if (skip(c)) rotations[c] = kIdentity;
@@ -198,7 +198,7 @@ mocap::JobStatus PatchControlRotations(const PatchSetup& patch, const ExamplePos
       num_two += n == 2 ? 1 : 0;  // rejects it): no turn
       num_many += n >= 3 ? 1 : 0;
     }
-    if (beyond) return {mocap::JobStatus::kOutOfRange, "joint index beyond the palette"};
+    if (beyond) return {base::JobStatus::kOutOfRange, "joint index beyond the palette"};
     for (std::size_t i = 0; i < num_one; ++i) {
       const std::size_t j = one[i];
       const std::size_t b = joint[moving[j] * kk + static_cast<std::size_t>(__builtin_ctz(mask[j]))];
@@ -258,7 +258,7 @@ mocap::JobStatus PatchControlRotations(const PatchSetup& patch, const ExamplePos
       rotations[moving[j]] = glm::normalize(glm::quat(glm::quat_cast(r)));
     }
   }
-  return mocap::kJobOk;
+  return base::kJobOk;
 }
 
 }  // namespace deform

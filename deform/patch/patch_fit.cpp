@@ -12,8 +12,8 @@
 namespace deform {
 namespace {
 
-using mocap::ErrorCode;
-using mocap::MakeError;
+using base::ErrorCode;
+using base::MakeError;
 
 using internal::InvalidArgument;
 
@@ -34,7 +34,7 @@ std::vector<glm::ivec3> RegionTriangles(std::span<const glm::uvec3> triangles,
   return out;
 }
 
-mocap::Status CheckRegion(std::span<const glm::vec3> positions, std::span<const int> region) {
+base::Status CheckRegion(std::span<const glm::vec3> positions, std::span<const int> region) {
   if (region.size() < 3) {
     return InvalidArgument("patch region: expected at least 3 vertices, found " +
                            std::to_string(region.size()));
@@ -45,7 +45,7 @@ mocap::Status CheckRegion(std::span<const glm::vec3> positions, std::span<const 
                              " out of range 0.." + std::to_string(positions.size()));
     }
   }
-  return mocap::Status::Ok();
+  return base::Status::Ok();
 }
 
 // Symmetric 3x3 eigen decomposition by cyclic Jacobi rotations; columns of
@@ -90,7 +90,7 @@ int CountFolded(const std::vector<glm::ivec3>& tris, const std::vector<glm::dvec
 }
 
 // Normalizes raw (a,b) coordinates by their bounding box into [0,1]^2.
-mocap::Status NormalizeUv(std::vector<glm::dvec2>& uv) {
+base::Status NormalizeUv(std::vector<glm::dvec2>& uv) {
   glm::dvec2 lo(1e300), hi(-1e300);
   for (const glm::dvec2& p : uv) {
     lo = glm::min(lo, p);
@@ -101,11 +101,11 @@ mocap::Status NormalizeUv(std::vector<glm::dvec2>& uv) {
     return MakeError(ErrorCode::kUnsupported, {}, "patch region: parameter domain is degenerate");
   }
   for (glm::dvec2& p : uv) p = (p - lo) / ext;
-  return mocap::Status::Ok();
+  return base::Status::Ok();
 }
 
-mocap::Status CheckOneToOne(const RegionParametrization& param, const std::vector<glm::ivec3>& tris,
-                            const char* hint) {
+base::Status CheckOneToOne(const RegionParametrization& param, const std::vector<glm::ivec3>& tris,
+                           const char* hint) {
   const int folded = CountFolded(tris, param.uv);
   if (folded > 0) {
     return MakeError(ErrorCode::kUnsupported, {},
@@ -113,7 +113,7 @@ mocap::Status CheckOneToOne(const RegionParametrization& param, const std::vecto
                          std::to_string(tris.size()) +
                          " triangles fold over in the parameter domain; " + hint);
   }
-  return mocap::Status::Ok();
+  return base::Status::Ok();
 }
 
 // Area-weighted moments of the region: the normal sum, the centroid and the
@@ -189,7 +189,7 @@ struct DirectionFit {
   bool interpolating = false;
   int s = 0, m = 0;
 
-  mocap::Status Setup(const std::vector<double>& params, int num_control, double smoothing) {
+  base::Status Setup(const std::vector<double>& params, int num_control, double smoothing) {
     const int p = 3;
     s = static_cast<int>(params.size());
     m = num_control;
@@ -230,7 +230,7 @@ struct DirectionFit {
     if (!lu.Factor(std::move(sys), m)) {
       return MakeError(ErrorCode::kInternal, {}, "patch fit: singular system (too few distinct samples?)");
     }
-    return mocap::Status::Ok();
+    return base::Status::Ok();
   }
 
   // Fits S data values (stride-accessed) to M control values.
@@ -309,7 +309,7 @@ double ClosestInTriangle(const glm::dvec2& x, const glm::dvec2& a, const glm::dv
   return best;
 }
 
-mocap::Status CheckParameterList(std::span<const double> xs, const char* what) {
+base::Status CheckParameterList(std::span<const double> xs, const char* what) {
   if (xs.size() < 2)
     return InvalidArgument(std::string(what) + ": expected at least 2 sample parameters");
   for (size_t i = 0; i < xs.size(); ++i) {
@@ -317,7 +317,7 @@ mocap::Status CheckParameterList(std::span<const double> xs, const char* what) {
       return InvalidArgument(std::string(what) + ": sample parameters must increase within [0,1]");
     }
   }
-  return mocap::Status::Ok();
+  return base::Status::Ok();
 }
 
 }  // namespace
@@ -328,11 +328,11 @@ std::vector<double> UniformParameters(int count) {
   return out;
 }
 
-mocap::Result<RegionParametrization> ParametrizePlane(std::span<const glm::vec3> positions,
-                                                      std::span<const int> region,
-                                                      std::span<const glm::uvec3> triangles,
-                                                      glm::dvec3 axis_hint) {
-  if (mocap::Status st = CheckRegion(positions, region); !st) return st.error();
+base::Result<RegionParametrization> ParametrizePlane(std::span<const glm::vec3> positions,
+                                                     std::span<const int> region,
+                                                     std::span<const glm::uvec3> triangles,
+                                                     glm::dvec3 axis_hint) {
+  if (base::Status st = CheckRegion(positions, region); !st) return st.error();
   const std::vector<glm::ivec3> tris = RegionTriangles(triangles, region, positions.size());
   RegionParametrization param;
   param.kind = RegionParametrization::Kind::kPlane;
@@ -362,18 +362,21 @@ mocap::Result<RegionParametrization> ParametrizePlane(std::span<const glm::vec3>
     const glm::dvec3 d = D(positions[static_cast<size_t>(v)]) - c;
     param.uv.emplace_back(glm::dot(d, e1), glm::dot(d, e2));
   }
-  if (mocap::Status st = NormalizeUv(param.uv); !st) return st.error();
-  if (mocap::Status st = CheckOneToOne(param, tris, "try the cylinder map or a smaller region"); !st) {
+  if (base::Status st = NormalizeUv(param.uv); !st) return st.error();
+  if (base::Status st = CheckOneToOne(param, tris, "try the cylinder map or a smaller region");
+      !st) {
     return st.error();
   }
   return param;
 }
 
-mocap::Result<RegionParametrization> ParametrizeCylinder(
-    std::span<const glm::vec3> positions, std::span<const int> region,
-    std::span<const glm::uvec3> triangles, glm::dvec3 axis_origin, glm::dvec3 axis_direction,
-    double max_span_deg) {
-  if (mocap::Status st = CheckRegion(positions, region); !st) return st.error();
+base::Result<RegionParametrization> ParametrizeCylinder(std::span<const glm::vec3> positions,
+                                                        std::span<const int> region,
+                                                        std::span<const glm::uvec3> triangles,
+                                                        glm::dvec3 axis_origin,
+                                                        glm::dvec3 axis_direction,
+                                                        double max_span_deg) {
+  if (base::Status st = CheckRegion(positions, region); !st) return st.error();
   if (!(glm::length(axis_direction) > 0.0))
     return InvalidArgument("cylinder map: zero axis direction");
   const std::vector<glm::ivec3> tris = RegionTriangles(triangles, region, positions.size());
@@ -411,23 +414,23 @@ mocap::Result<RegionParametrization> ParametrizeCylinder(
                          " deg around the axis, expected at most " + std::to_string(max_span_deg) +
                          " (closed tubes need periodic splines)");
   }
-  if (mocap::Status st = NormalizeUv(param.uv); !st) return st.error();
-  if (mocap::Status st = CheckOneToOne(param, tris, "check the axis or use a smaller region"); !st) {
+  if (base::Status st = NormalizeUv(param.uv); !st) return st.error();
+  if (base::Status st = CheckOneToOne(param, tris, "check the axis or use a smaller region"); !st) {
     return st.error();
   }
   return param;
 }
 
-mocap::Result<PatchSamples> SampleRegion(std::span<const glm::vec3> positions,
-                                         std::span<const glm::uvec3> triangles,
-                                         const RegionParametrization& param,
-                                         std::span<const double> us, std::span<const double> vs,
-                                         SampleMode mode) {
-  if (mocap::Status st = CheckParameterList(us, "sampling u"); !st) return st.error();
-  if (mocap::Status st = CheckParameterList(vs, "sampling v"); !st) return st.error();
+base::Result<PatchSamples> SampleRegion(std::span<const glm::vec3> positions,
+                                        std::span<const glm::uvec3> triangles,
+                                        const RegionParametrization& param,
+                                        std::span<const double> us, std::span<const double> vs,
+                                        SampleMode mode) {
+  if (base::Status st = CheckParameterList(us, "sampling u"); !st) return st.error();
+  if (base::Status st = CheckParameterList(vs, "sampling v"); !st) return st.error();
   if (param.uv.size() != param.region.size())
     return InvalidArgument("sampling: parametrization has mismatched sizes");
-  if (mocap::Status st = CheckRegion(positions, param.region); !st) return st.error();
+  if (base::Status st = CheckRegion(positions, param.region); !st) return st.error();
   const std::vector<glm::ivec3> tris = RegionTriangles(triangles, param.region, positions.size());
   PatchSamples out;
   out.num_s = static_cast<int>(us.size());
@@ -487,13 +490,13 @@ mocap::Result<PatchSamples> SampleRegion(std::span<const glm::vec3> positions,
   return out;
 }
 
-mocap::Result<PatchSamples> SampleHandPicked(std::span<const glm::vec3> positions,
-                                             std::span<const int> vertices, int num_s, int num_t) {
+base::Result<PatchSamples> SampleHandPicked(std::span<const glm::vec3> positions,
+                                            std::span<const int> vertices, int num_s, int num_t) {
   if (num_s < 2 || num_t < 2 || vertices.size() != static_cast<size_t>(num_s) * static_cast<size_t>(num_t)) {
     return InvalidArgument("hand-picked samples: expected S x T >= 2 x 2 vertices, found " +
                            std::to_string(vertices.size()));
   }
-  if (mocap::Status st = CheckRegion(positions, vertices); !st) return st.error();
+  if (base::Status st = CheckRegion(positions, vertices); !st) return st.error();
   PatchSamples out;
   out.num_s = num_s;
   out.num_t = num_t;
@@ -506,7 +509,7 @@ mocap::Result<PatchSamples> SampleHandPicked(std::span<const glm::vec3> position
   return out;
 }
 
-mocap::Result<PatchFit> FitSurface(const PatchSamples& samples, const FitOptions& options) {
+base::Result<PatchFit> FitSurface(const PatchSamples& samples, const FitOptions& options) {
   const int s = samples.num_s, t = samples.num_t, m = options.num_u, n = options.num_v;
   if (samples.points.size() != static_cast<size_t>(s) * static_cast<size_t>(t) ||
       samples.us.size() != static_cast<size_t>(s) || samples.vs.size() != static_cast<size_t>(t)) {
@@ -534,8 +537,8 @@ mocap::Result<PatchFit> FitSurface(const PatchSamples& samples, const FitOptions
     }
   }
   DirectionFit fu, fv;
-  if (mocap::Status st = fu.Setup(fit.ub, m, options.smoothing); !st) return st.error();
-  if (mocap::Status st = fv.Setup(fit.vb, n, options.smoothing); !st) return st.error();
+  if (base::Status st = fu.Setup(fit.ub, m, options.smoothing); !st) return st.error();
+  if (base::Status st = fv.Setup(fit.vb, n, options.smoothing); !st) return st.error();
   // Rows in u: every data column l (fixed v) gives M intermediate points R_il.
   std::vector<glm::dvec3> r(static_cast<size_t>(m) * t);
   std::vector<glm::dvec3> line;
@@ -551,7 +554,8 @@ mocap::Result<PatchFit> FitSurface(const PatchSamples& samples, const FitOptions
     fv.Fit(line);
     for (int j = 0; j < n; ++j) control[static_cast<size_t>(i) * n + j] = line[static_cast<size_t>(j)];
   }
-  mocap::Result<BSplineSurface> surface = BSplineSurface::Create(3, 3, fu.knots, fv.knots, m, n, std::move(control));
+  base::Result<BSplineSurface> surface =
+      BSplineSurface::Create(3, 3, fu.knots, fv.knots, m, n, std::move(control));
   if (!surface) return std::move(surface).error();
   fit.surface = std::move(*surface);
   fit.interpolating = fu.interpolating && fv.interpolating;

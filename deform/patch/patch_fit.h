@@ -20,7 +20,7 @@
 #include <glm/glm.hpp>
 
 #include "deform/patch/bspline.h"
-#include "mocap/error.h"
+#include "base/error.h"
 
 namespace deform {
 
@@ -46,20 +46,22 @@ struct RegionParametrization {
 // align the grid with a limb). Fails (kInvalidArgument) on fewer than 3
 // vertices or out-of-range indices, and (kUnsupported) when a region triangle
 // folds over in (u,v), naming how many: the map must be one-to-one.
-mocap::Result<RegionParametrization> ParametrizePlane(std::span<const glm::vec3> positions,
-                                                      std::span<const int> region,
-                                                      std::span<const glm::uvec3> triangles,
-                                                      glm::dvec3 axis_hint = glm::dvec3(0.0));
+base::Result<RegionParametrization> ParametrizePlane(std::span<const glm::vec3> positions,
+                                                     std::span<const int> region,
+                                                     std::span<const glm::uvec3> triangles,
+                                                     glm::dvec3 axis_hint = glm::dvec3(0.0));
 
 // Cylinder map (3.2) around the axis through `axis_origin` along
 // `axis_direction` (need not be unit): u = normalized angle (seam opposite the
 // region), v = normalized height. Fails when the angular span exceeds
 // `max_span_deg` (closed tubes need periodic splines), on a degenerate axis,
 // or when a triangle folds over.
-mocap::Result<RegionParametrization> ParametrizeCylinder(
-    std::span<const glm::vec3> positions, std::span<const int> region,
-    std::span<const glm::uvec3> triangles, glm::dvec3 axis_origin, glm::dvec3 axis_direction,
-    double max_span_deg = 300.0);
+base::Result<RegionParametrization> ParametrizeCylinder(std::span<const glm::vec3> positions,
+                                                        std::span<const int> region,
+                                                        std::span<const glm::uvec3> triangles,
+                                                        glm::dvec3 axis_origin,
+                                                        glm::dvec3 axis_direction,
+                                                        double max_span_deg = 300.0);
 
 // k/(S-1), k = 0..S-1 (S >= 2).
 std::vector<double> UniformParameters(int count);
@@ -79,22 +81,22 @@ struct PatchSamples {
   std::vector<double> vs;           // #T increasing sample parameters in [0,1]
   std::vector<glm::dvec3> points;   // #S x #T row-major (k*T + l), model space
   std::vector<int> vertex;          // #S x #T mesh vertex used, or -1 for a barycentric point
-  std::vector<mocap::Warning> warnings;  // e.g. two samples on the same vertex
+  std::vector<base::Warning> warnings;  // e.g. two samples on the same vertex
 };
 
 // Samples the region at every (us[k], vs[l]) (uniform or any non-uniform
 // increasing lists). Fails on lists that are not increasing in [0,1] or shorter
 // than 2, or on a parametrization that does not match `region`.
-mocap::Result<PatchSamples> SampleRegion(std::span<const glm::vec3> positions,
-                                         std::span<const glm::uvec3> triangles,
-                                         const RegionParametrization& param,
-                                         std::span<const double> us, std::span<const double> vs,
-                                         SampleMode mode = SampleMode::kBarycentric);
+base::Result<PatchSamples> SampleRegion(std::span<const glm::vec3> positions,
+                                        std::span<const glm::uvec3> triangles,
+                                        const RegionParametrization& param,
+                                        std::span<const double> us, std::span<const double> vs,
+                                        SampleMode mode = SampleMode::kBarycentric);
 
 // Hand-picked samples: an S x T grid of mesh vertex indices (row-major). Their
 // parameters come from the points themselves (chord length, 3.4).
-mocap::Result<PatchSamples> SampleHandPicked(std::span<const glm::vec3> positions,
-                                             std::span<const int> vertices, int num_s, int num_t);
+base::Result<PatchSamples> SampleHandPicked(std::span<const glm::vec3> positions,
+                                            std::span<const int> vertices, int num_s, int num_t);
 
 // How the fit assigns a parameter to each sample row and column (3.4).
 enum class FitParameterization {
@@ -126,7 +128,7 @@ struct PatchFit {
 // v, each a small dense solve (interpolation or normal equations). Fails
 // (kInvalidArgument) when M > S, N > T or M, N < 4, and (kInternal) on a
 // singular system.
-mocap::Result<PatchFit> FitSurface(const PatchSamples& samples, const FitOptions& options);
+base::Result<PatchFit> FitSurface(const PatchSamples& samples, const FitOptions& options);
 
 // Sets the surface's sigma so its normal agrees, on average over the region's
 // parameters, with the region's mean normal (3.2).

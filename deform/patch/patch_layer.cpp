@@ -136,8 +136,8 @@ std::vector<float> BorderWeights(const PatchBinding& binding,
   return out;
 }
 
-mocap::Result<PatchSetup> BuildPatchSetup(const SkinnedMesh& mesh, std::span<const int> region,
-                                          const PatchOptions& options) {
+base::Result<PatchSetup> BuildPatchSetup(const SkinnedMesh& mesh, std::span<const int> region,
+                                         const PatchOptions& options) {
   if (options.grid_u < 4 || options.grid_v < 4 || options.grid_u > 64 || options.grid_v > 64) {
     return InvalidArgument("patch grid must be 4..64 control points each way, found " +
                            std::to_string(options.grid_u) + "x" + std::to_string(options.grid_v));
@@ -154,7 +154,7 @@ mocap::Result<PatchSetup> BuildPatchSetup(const SkinnedMesh& mesh, std::span<con
   PatchSetup out;
   out.region.assign(region.begin(), region.end());
   const Mesh& bind = mesh.bind;
-  mocap::Result<RegionParametrization> param =
+  base::Result<RegionParametrization> param =
       options.parametrization == RegionParametrization::Kind::kCylinder
           ? ParametrizeCylinder(bind.positions, region, bind.triangles, options.axis_origin,
                                 options.axis_direction)
@@ -163,17 +163,16 @@ mocap::Result<PatchSetup> BuildPatchSetup(const SkinnedMesh& mesh, std::span<con
   out.param = std::move(*param);
   const std::vector<double> us = UniformParameters(options.samples_u);
   const std::vector<double> vs = UniformParameters(options.samples_v);
-  mocap::Result<PatchSamples> samples =
+  base::Result<PatchSamples> samples =
       SampleRegion(bind.positions, bind.triangles, out.param, us, vs);
   if (!samples.ok()) return std::move(samples).error();
-  mocap::Result<PatchFit> fit = FitSurface(
+  base::Result<PatchFit> fit = FitSurface(
       *samples, {.num_u = options.grid_u, .num_v = options.grid_v, .smoothing = options.smoothing});
   if (!fit.ok()) return std::move(fit).error();
   out.fit = std::move(*fit);
   OrientNormal(out.fit.surface, out.param);
   const std::vector<glm::dvec2> region_uv = RegionUv(out.param);
-  mocap::Result<BindResult> bound =
-      BindPatch(out.fit.surface, bind.positions, region, region_uv);
+  base::Result<BindResult> bound = BindPatch(out.fit.surface, bind.positions, region, region_uv);
   if (!bound.ok()) return std::move(bound).error();
   out.bound = std::move(*bound);
   out.rest_control = ControlPointsAsFloat(out.fit.surface);
@@ -184,8 +183,8 @@ mocap::Result<PatchSetup> BuildPatchSetup(const SkinnedMesh& mesh, std::span<con
   return out;
 }
 
-mocap::JobStatus CarryControlPointsJob::Validate() const {
-  using S = mocap::JobStatus;
+base::JobStatus CarryControlPointsJob::Validate() const {
+  using S = base::JobStatus;
   if (patch == nullptr) return {S::kMissingInput, "no patch"};
   if (model_from_bind.empty() == dq_palette.empty()) {
     return {S::kMissingInput, "exactly one of the SSD and DQS palettes is required"};
@@ -196,8 +195,8 @@ mocap::JobStatus CarryControlPointsJob::Validate() const {
   return {};
 }
 
-mocap::JobStatus CarryControlPointsJob::Run() const {
-  const mocap::JobStatus s = Validate();
+base::JobStatus CarryControlPointsJob::Run() const {
+  const base::JobStatus s = Validate();
   if (!s) return s;
   const SkinWeights& w = patch->control_weights;
   if (!dq_palette.empty()) {
@@ -226,11 +225,11 @@ void PatchLayerScratch::Prepare(std::span<const PatchSetup> patches, int num_ver
   beta_sum.assign(static_cast<std::size_t>(std::max(0, num_vertices)), 0.0f);
 }
 
-mocap::Status ApplyPatchLayer(std::span<const PatchSetup> patches,
-                              std::span<const std::span<const glm::vec3>> carried,
-                              std::span<const std::span<const glm::vec3>> displacements,
-                              PatchLayerScratch& scratch, std::span<glm::vec3> positions,
-                              std::span<const std::span<const glm::vec3>> reference) {
+base::Status ApplyPatchLayer(std::span<const PatchSetup> patches,
+                             std::span<const std::span<const glm::vec3>> carried,
+                             std::span<const std::span<const glm::vec3>> displacements,
+                             PatchLayerScratch& scratch, std::span<glm::vec3> positions,
+                             std::span<const std::span<const glm::vec3>> reference) {
   if (carried.size() != patches.size()) {
     return InvalidArgument("patch layer: one carried control grid per patch is required");
   }
@@ -275,7 +274,7 @@ mocap::Status ApplyPatchLayer(std::span<const PatchSetup> patches,
         displacements.empty() ? std::span<const glm::vec3>() : displacements[k];
     for (std::size_t c = 0; c < nc; ++c) q[c] = dq.empty() ? carried[k][c] : carried[k][c] + dq[c];
     const std::span<glm::vec3> rebuilt(scratch.rebuilt.data(), nb);
-    const mocap::JobStatus s =
+    const base::JobStatus s =
         PatchRebuildJob{.control = q, .bindings = p.bound.binding.view(), .positions = rebuilt}
             .Run();
     if (!s) return InvalidArgument(std::string("patch layer: rebuild refused: ") + s.what);
@@ -283,9 +282,10 @@ mocap::Status ApplyPatchLayer(std::span<const PatchSetup> patches,
     // the displacements change reaches the mesh (the same grid gives exactly 0).
     const std::span<glm::vec3> base(scratch.reference_rebuilt.data(), reference.empty() ? 0 : nb);
     if (!reference.empty()) {
-      const mocap::JobStatus r = PatchRebuildJob{
-          .control = reference[k], .bindings = p.bound.binding.view(), .positions = base}
-                                     .Run();
+      const base::JobStatus r =
+          PatchRebuildJob{
+              .control = reference[k], .bindings = p.bound.binding.view(), .positions = base}
+              .Run();
       if (!r) return InvalidArgument(std::string("patch layer: rebuild refused: ") + r.what);
     }
     for (std::size_t r = 0; r < nb; ++r) {
@@ -309,7 +309,7 @@ mocap::Status ApplyPatchLayer(std::span<const PatchSetup> patches,
   for (const PatchSetup& p : patches) {
     for (const int vi : p.bound.binding.vertex) scratch.beta_sum[static_cast<std::size_t>(vi)] = 0.0f;
   }
-  return mocap::Status::Ok();
+  return base::Status::Ok();
 }
 
 }  // namespace deform

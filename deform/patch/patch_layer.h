@@ -29,7 +29,7 @@
 #include "deform/mesh.h"
 #include "deform/patch/patch_binding.h"
 #include "deform/patch/patch_fit.h"
-#include "mocap/error.h"
+#include "base/error.h"
 
 namespace deform {
 
@@ -66,8 +66,8 @@ struct PatchSetup {
 // Builds a patch over `region` of `mesh` (bind pose). Errors come from the
 // parametrization (fold-overs, angular span), sampling, fitting and binding,
 // plus kInvalidArgument for options out of range.
-mocap::Result<PatchSetup> BuildPatchSetup(const SkinnedMesh& mesh, std::span<const int> region,
-                                          const PatchOptions& options);
+base::Result<PatchSetup> BuildPatchSetup(const SkinnedMesh& mesh, std::span<const int> region,
+                                         const PatchOptions& options);
 
 // Control-point skin weights (3.7): W_ij,b = sum_v B_ij(u_v, v_v) w_v,b /
 // sum_v B_ij(u_v, v_v) over the bound vertices v (B_ij = N_i(u) N_j(v)); a
@@ -102,8 +102,8 @@ struct CarryControlPointsJob {
   // Outputs.
   std::span<glm::vec3> control{};                // #M x #N carried control points G
 
-  [[nodiscard]] mocap::JobStatus Validate() const;
-  [[nodiscard]] mocap::JobStatus Run() const;
+  [[nodiscard]] base::JobStatus Validate() const;
+  [[nodiscard]] base::JobStatus Run() const;
 };
 
 // Per-frame scratch of ApplyPatchLayer, sized once by Prepare (the frame loop
@@ -130,10 +130,10 @@ struct PatchLayerScratch {
 // add (carried == reference, no displacement) p is G bit for bit, and the
 // fit's and the carried weights' own error never reaches the mesh.
 // Errors: sizes that disagree (kInvalidArgument).
-mocap::Status ApplyPatchLayer(std::span<const PatchSetup> patches,
-                              std::span<const std::span<const glm::vec3>> carried,
-                              std::span<const std::span<const glm::vec3>> displacements,
-                              PatchLayerScratch& scratch, std::span<glm::vec3> positions,
-                              std::span<const std::span<const glm::vec3>> reference = {});
+base::Status ApplyPatchLayer(std::span<const PatchSetup> patches,
+                             std::span<const std::span<const glm::vec3>> carried,
+                             std::span<const std::span<const glm::vec3>> displacements,
+                             PatchLayerScratch& scratch, std::span<glm::vec3> positions,
+                             std::span<const std::span<const glm::vec3>> reference = {});
 
 }  // namespace deform

@@ -195,8 +195,8 @@ constexpr size_t kMinBatch = 3;
 
 }  // namespace
 
-mocap::JobStatus PatchRebuildJob::Validate() const {
-  using mocap::JobStatus;
+base::JobStatus PatchRebuildJob::Validate() const {
+  using base::JobStatus;
   const PatchBindingView& b = bindings;
   if (b.num_u < 4 || b.num_v < 4 || b.num_u > 256 || b.num_v > 256) {
     return {JobStatus::kOutOfRange, "control grid must be 4..256 points each way"};
@@ -219,11 +219,11 @@ mocap::JobStatus PatchRebuildJob::Validate() const {
     return {JobStatus::kSizeMismatch, "normals must be empty or hold #B normals"};
   }
   if (b.sigma != 1.0f && b.sigma != -1.0f) return {JobStatus::kOutOfRange, "sigma must be +1 or -1"};
-  return mocap::kJobOk;
+  return base::kJobOk;
 }
 
-mocap::JobStatus PatchRebuildJob::Run() const {
-  if (const mocap::JobStatus st = Validate(); !st) return st;
+base::JobStatus PatchRebuildJob::Run() const {
+  if (const base::JobStatus st = Validate(); !st) return st;
   const size_t n = bindings.size();
   const bool simd = allow_simd && internal::CpuHasAvx();
   const std::uint16_t* first = bindings.first.data();
@@ -243,7 +243,7 @@ mocap::JobStatus PatchRebuildJob::Run() const {
     }
     i = end;
   }
-  return mocap::kJobOk;
+  return base::kJobOk;
 }
 
 }  // namespace deform

@@ -12,8 +12,8 @@ using internal::InvalidArgument;
 
 }  // namespace
 
-mocap::Result<std::vector<int>> SelectJointRegion(const SkinnedMesh& mesh,
-                                                  const JointRegionQuery& query) {
+base::Result<std::vector<int>> SelectJointRegion(const SkinnedMesh& mesh,
+                                                 const JointRegionQuery& query) {
   if (query.bone_joints.empty()) return InvalidArgument("joint region: no bone joints given");
   if (!(query.radius > 0.0f) || !std::isfinite(query.radius)) {
     return InvalidArgument("joint region: radius must be positive and finite, found " +
@@ -64,15 +64,14 @@ mocap::Result<std::vector<int>> SelectJointRegion(const SkinnedMesh& mesh,
     region.push_back(v);
   }
   if (region.empty()) {
-    return mocap::MakeError(mocap::ErrorCode::kNotFound, {},
-                            "joint region: no vertex within radius " +
-                                std::to_string(query.radius) + " is weighted to the joint's bones");
+    return base::MakeError(base::ErrorCode::kNotFound, {},
+                           "joint region: no vertex within radius " + std::to_string(query.radius) +
+                               " is weighted to the joint's bones");
   }
   return region;
 }
 
-mocap::Result<std::vector<int>> CheckVertexRegion(std::span<const int> vertices,
-                                                  int num_vertices) {
+base::Result<std::vector<int>> CheckVertexRegion(std::span<const int> vertices, int num_vertices) {
   if (vertices.empty()) return InvalidArgument("vertex region: the list is empty");
   std::vector<char> seen(static_cast<std::size_t>(std::max(0, num_vertices)), 0);
   for (std::size_t i = 0; i < vertices.size(); ++i) {

@@ -15,7 +15,7 @@
 #include <glm/glm.hpp>
 
 #include "deform/mesh.h"
-#include "mocap/error.h"
+#include "base/error.h"
 
 namespace deform {
 
@@ -37,12 +37,12 @@ struct JointRegionQuery {
 
 // Errors (kInvalidArgument): radius or weight out of range, no bone joints, a
 // mesh whose arrays disagree; (kNotFound): no vertex qualifies.
-mocap::Result<std::vector<int>> SelectJointRegion(const SkinnedMesh& mesh,
-                                                  const JointRegionQuery& query);
+base::Result<std::vector<int>> SelectJointRegion(const SkinnedMesh& mesh,
+                                                 const JointRegionQuery& query);
 
 // Explicit list: checks every index is in [0, num_vertices) and appears once,
 // returns the list sorted. Errors (kInvalidArgument) name the first bad entry
 // by position ("vertex 3 (index 912) is past the 800 vertices").
-mocap::Result<std::vector<int>> CheckVertexRegion(std::span<const int> vertices, int num_vertices);
+base::Result<std::vector<int>> CheckVertexRegion(std::span<const int> vertices, int num_vertices);
 
 }  // namespace deform

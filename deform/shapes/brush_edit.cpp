@@ -81,9 +81,9 @@ double BrushFalloff(double x) {
   return t * t * t * t * (4.0 * std::max(x, 0.0) + 1.0);
 }
 
-mocap::Result<ManipulationResult> SolveBrushStrokes(const BSplineSurface& surface,
-                                                    std::span<const BrushStroke> strokes,
-                                                    const BrushOptions& options) {
+base::Result<ManipulationResult> SolveBrushStrokes(const BSplineSurface& surface,
+                                                   std::span<const BrushStroke> strokes,
+                                                   const BrushOptions& options) {
   const int nu = surface.num_u(), nv = surface.num_v();
   const auto num_c = static_cast<std::size_t>(nu) * static_cast<std::size_t>(nv);
   if (strokes.empty()) return InvalidArgument("expected at least one brush stroke, found none");
@@ -148,7 +148,8 @@ mocap::Result<ManipulationResult> SolveBrushStrokes(const BSplineSurface& surfac
 
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(normal);
   if (ldlt.info() != Eigen::Success) {
-    return mocap::MakeError(mocap::ErrorCode::kInternal, {}, "brush: the normal matrix is not definite");
+    return base::MakeError(base::ErrorCode::kInternal, {},
+                           "brush: the normal matrix is not definite");
   }
   const Eigen::MatrixXd x = ldlt.solve(rhs);
 

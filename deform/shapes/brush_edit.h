@@ -33,7 +33,7 @@
 
 #include "deform/patch/bspline.h"
 #include "deform/shapes/direct_manipulation.h"
-#include "mocap/error.h"
+#include "base/error.h"
 
 namespace deform {
 
@@ -64,9 +64,9 @@ struct BrushOptions {
 // unsatisfied stroke indices. Fails (kInvalidArgument) on no strokes, a
 // centre outside [0,1]^2, a negative or non-finite radius, a non-finite
 // delta, a mask of the wrong size or with no free point, mu < 0.
-mocap::Result<ManipulationResult> SolveBrushStrokes(const BSplineSurface& surface,
-                                                    std::span<const BrushStroke> strokes,
-                                                    const BrushOptions& options = {});
+base::Result<ManipulationResult> SolveBrushStrokes(const BSplineSurface& surface,
+                                                   std::span<const BrushStroke> strokes,
+                                                   const BrushOptions& options = {});
 
 // The largest |second difference| of a control-grid change along u or v
 // (model units): how rough a change is; used by tests to compare a brush with

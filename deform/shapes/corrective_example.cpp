@@ -17,7 +17,7 @@
 namespace deform {
 namespace {
 
-using mocap::ErrorCode;
+using base::ErrorCode;
 using Triplet = Eigen::Triplet<double>;
 using SparseMatrix = Eigen::SparseMatrix<double>;
 
@@ -114,9 +114,9 @@ void RegionVolumeGradient(std::span<const glm::dvec3> positions,
   }
 }
 
-mocap::Result<CorrectedExample> CorrectExample(const PatchSetup& patch, const SkinnedMesh& mesh,
-                                               const ExamplePose& pose, CorrectiveKind kind,
-                                               const CorrectiveOptions& options) {
+base::Result<CorrectedExample> CorrectExample(const PatchSetup& patch, const SkinnedMesh& mesh,
+                                              const ExamplePose& pose, CorrectiveKind kind,
+                                              const CorrectiveOptions& options) {
   const std::size_t num_skin = mesh.skin_joints.size();
   if (pose.model_from_bind.size() != num_skin ||
       (!pose.dq_palette.empty() && pose.dq_palette.size() != num_skin)) {
@@ -140,18 +140,24 @@ mocap::Result<CorrectedExample> CorrectExample(const PatchSetup& patch, const Sk
   const auto num_v = static_cast<std::size_t>(mesh.bind.num_vertices());
   std::vector<glm::vec3> skinned(num_v);
   const SkinWeights& sw = mesh.weights;
-  mocap::JobStatus s =
-      pose.dq_palette.empty()
-          ? SkinningJob{.model_from_bind = pose.model_from_bind, .influences = sw.influences,
-                        .joint_indices = sw.joints, .joint_weights = sw.weights,
-                        .rest_positions = mesh.bind.positions, .rest_normals = {},
-                        .positions = skinned, .normals = {}}
-                .Run()
-          : DqsJob{.palette = pose.dq_palette, .influences = sw.influences,
-                   .joint_indices = sw.joints, .joint_weights = sw.weights,
-                   .rest_positions = mesh.bind.positions, .rest_normals = {},
-                   .positions = skinned, .normals = {}}
-                .Run();
+  base::JobStatus s = pose.dq_palette.empty() ? SkinningJob{.model_from_bind = pose.model_from_bind,
+                                                            .influences = sw.influences,
+                                                            .joint_indices = sw.joints,
+                                                            .joint_weights = sw.weights,
+                                                            .rest_positions = mesh.bind.positions,
+                                                            .rest_normals = {},
+                                                            .positions = skinned,
+                                                            .normals = {}}
+                                                    .Run()
+                                              : DqsJob{.palette = pose.dq_palette,
+                                                       .influences = sw.influences,
+                                                       .joint_indices = sw.joints,
+                                                       .joint_weights = sw.weights,
+                                                       .rest_positions = mesh.bind.positions,
+                                                       .rest_normals = {},
+                                                       .positions = skinned,
+                                                       .normals = {}}
+                                                    .Run();
   if (!s) return InvalidArgument(s.what);
   std::vector<glm::vec3> carried(static_cast<std::size_t>(nc));
   s = CarryControlPointsJob{.patch = &patch,
@@ -228,7 +234,7 @@ mocap::Result<CorrectedExample> CorrectExample(const PatchSetup& patch, const Sk
     }
     internal::AddSecondDifferences(nu, nv, free_index, options.smoothness / nf, entries);
     for (int f = 0; f < nf; ++f) entries.emplace_back(f, f, 1e-9 * w);  // untouched points stay
-    if (!factor(nf)) return mocap::MakeError(ErrorCode::kInternal, {}, "rest fit: not definite");
+    if (!factor(nf)) return base::MakeError(ErrorCode::kInternal, {}, "rest fit: not definite");
     out.report.before = RmsToTargets(rows, x, target);
     for (int it = 0; it < options.iterations; ++it) {
       Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(nf, 3);
@@ -248,7 +254,7 @@ mocap::Result<CorrectedExample> CorrectExample(const PatchSetup& patch, const Sk
     out.report.before = RegionVolume(x, mesh.bind.triangles, tris, centre);
     for (int f = 0; f < nf; ++f) entries.emplace_back(f, f, 1.0);
     internal::AddSecondDifferences(nu, nv, free_index, options.volume_smoothness, entries);
-    if (!factor(nf)) return mocap::MakeError(ErrorCode::kInternal, {}, "volume fit: not definite");
+    if (!factor(nf)) return base::MakeError(ErrorCode::kInternal, {}, "volume fit: not definite");
     std::vector<glm::dvec3> grad(num_v);
     for (int it = 0; it < options.iterations; ++it) {
       const double miss = out.report.bind_value - RegionVolume(x, mesh.bind.triangles, tris, centre);
@@ -276,7 +282,7 @@ mocap::Result<CorrectedExample> CorrectExample(const PatchSetup& patch, const Sk
   out.shape.displacement.resize(static_cast<std::size_t>(nc));
   const std::vector<glm::vec3> zero(static_cast<std::size_t>(nc), glm::vec3(0.0f));
   s = StoreExampleDisplacement(rotations, zero, out.shape.world_delta, out.shape.displacement);
-  if (!s) return mocap::MakeError(ErrorCode::kInternal, {}, s.what);
+  if (!s) return base::MakeError(ErrorCode::kInternal, {}, s.what);
   return out;
 }
 

@@ -47,7 +47,7 @@
 #include "deform/mesh.h"
 #include "deform/patch/patch_layer.h"
 #include "deform/shapes/example_shapes.h"
-#include "mocap/error.h"
+#include "base/error.h"
 
 namespace deform {
 
@@ -98,8 +98,8 @@ void RegionVolumeGradient(std::span<const glm::dvec3> positions,
 // SculptExample). Errors: palette sizes, an empty region, no free point,
 // iterations out of range (kInvalidArgument); a volume with no sensitivity
 // (kInvalidArgument: the region's triangles are all fixed or degenerate).
-mocap::Result<CorrectedExample> CorrectExample(const PatchSetup& patch, const SkinnedMesh& mesh,
-                                               const ExamplePose& pose, CorrectiveKind kind,
-                                               const CorrectiveOptions& options = {});
+base::Result<CorrectedExample> CorrectExample(const PatchSetup& patch, const SkinnedMesh& mesh,
+                                              const ExamplePose& pose, CorrectiveKind kind,
+                                              const CorrectiveOptions& options = {});
 
 }  // namespace deform

@@ -11,8 +11,8 @@
 namespace deform {
 namespace {
 
-using mocap::ErrorCode;
-using mocap::JobStatus;
+using base::ErrorCode;
+using base::JobStatus;
 
 size_t NumControl(const BSplineSurface& s) {
   return static_cast<size_t>(s.num_u()) * static_cast<size_t>(s.num_v());
@@ -126,9 +126,9 @@ PointConstraint KeepHere(const BSplineSurface& surface, double u, double v) {
   return {.u = u, .v = v, .target = surface.Evaluate(u, v)};
 }
 
-mocap::Result<ManipulationResult> SolvePointConstraints(
-    const BSplineSurface& surface, std::span<const PointConstraint> constraints,
-    const ManipulationOptions& options) {
+base::Result<ManipulationResult> SolvePointConstraints(const BSplineSurface& surface,
+                                                       std::span<const PointConstraint> constraints,
+                                                       const ManipulationOptions& options) {
   const size_t num_c = NumControl(surface);
   if (constraints.empty()) return InvalidArgument("expected at least one constraint, found none");
   for (size_t r = 0; r < constraints.size(); ++r) {
@@ -210,8 +210,8 @@ mocap::Result<ManipulationResult> SolvePointConstraints(
           glm::dvec3(dq.at<double>(f, 0), dq.at<double>(f, 1), dq.at<double>(f, 2));
     }
   } catch (const cv::Exception& e) {
-    return mocap::MakeError(ErrorCode::kInternal, {},
-                            std::string("constraint solve failed: ") + e.what());
+    return base::MakeError(ErrorCode::kInternal, {},
+                           std::string("constraint solve failed: ") + e.what());
   }
 
   const double tol = options.satisfied_tol_rel * PatchScale(surface);
@@ -226,22 +226,22 @@ mocap::Result<ManipulationResult> SolvePointConstraints(
   return out;
 }
 
-mocap::Result<VertexEdit> MakeVertexEdit(const PatchBinding& binding, int mesh_vertex,
-                                         const glm::dvec3& delta) {
+base::Result<VertexEdit> MakeVertexEdit(const PatchBinding& binding, int mesh_vertex,
+                                        const glm::dvec3& delta) {
   for (size_t b = 0; b < binding.size(); ++b) {
     if (binding.vertex[b] == mesh_vertex) {
       return VertexEdit{.u = binding.u[b], .v = binding.v[b], .d = binding.d[b], .delta = delta};
     }
   }
-  return mocap::MakeError(ErrorCode::kNotFound, {},
-                          "vertex " + std::to_string(mesh_vertex) + " is not bound to this patch");
+  return base::MakeError(ErrorCode::kNotFound, {},
+                         "vertex " + std::to_string(mesh_vertex) + " is not bound to this patch");
 }
 
-mocap::Result<ManipulationResult> MoveBoundVertices(const BSplineSurface& surface,
-                                                    std::span<const VertexEdit> edits,
-                                                    const ManipulationOptions& options,
-                                                    int iterations,
-                                                    std::span<const PointConstraint> keep) {
+base::Result<ManipulationResult> MoveBoundVertices(const BSplineSurface& surface,
+                                                   std::span<const VertexEdit> edits,
+                                                   const ManipulationOptions& options,
+                                                   int iterations,
+                                                   std::span<const PointConstraint> keep) {
   if (edits.empty()) return InvalidArgument("expected at least one vertex edit, found none");
   if (iterations < 0 || iterations > 100) return InvalidArgument("expected 0..100 iterations");
   BSplineSurface moved = surface;
@@ -325,7 +325,7 @@ JobStatus SsdControlRotations(std::span<const glm::mat4> model_from_bind, int in
     }
     rotations[c] = glm::normalize(glm::quat(glm::quat_cast(PolarRotation(blend))));
   }
-  return mocap::kJobOk;
+  return base::kJobOk;
 }
 
 JobStatus DqsControlRotations(std::span<const DualQuat> palette, int influences,
@@ -356,7 +356,7 @@ JobStatus DqsControlRotations(std::span<const DualQuat> palette, int influences,
     const double len = glm::length(sum);
     rotations[c] = len > 1e-12 ? glm::quat(sum / len) : glm::quat(1.0f, 0.0f, 0.0f, 0.0f);
   }
-  return mocap::kJobOk;
+  return base::kJobOk;
 }
 
 JobStatus StoreExampleDisplacement(std::span<const glm::quat> rotations,
@@ -371,7 +371,7 @@ JobStatus StoreExampleDisplacement(std::span<const glm::quat> rotations,
     const glm::dquat a(rotations[c]);
     example[c] = glm::vec3(glm::dvec3(current_ds[c]) + glm::inverse(a) * world_delta[c]);
   }
-  return mocap::kJobOk;
+  return base::kJobOk;
 }
 
 JobStatus PoseSpaceApplyJob::Validate() const {
@@ -379,7 +379,7 @@ JobStatus PoseSpaceApplyJob::Validate() const {
       control.size() != global.size()) {
     return {JobStatus::kSizeMismatch, "global, rotations, displacement and control must be #C"};
   }
-  return mocap::kJobOk;
+  return base::kJobOk;
 }
 
 JobStatus PoseSpaceApplyJob::Run() const {
@@ -391,7 +391,7 @@ JobStatus PoseSpaceApplyJob::Run() const {
     control[c] = displacement[c] == glm::vec3(0.0f) ? global[c]
                                                      : global[c] + rotations[c] * displacement[c];
   }
-  return mocap::kJobOk;
+  return base::kJobOk;
 }
 
 }  // namespace deform

@@ -25,7 +25,7 @@
 #include "deform/patch/bspline.h"
 #include "deform/global/dqs_job.h"
 #include "deform/patch/patch_binding.h"
-#include "mocap/error.h"
+#include "base/error.h"
 
 namespace deform {
 
@@ -99,9 +99,9 @@ struct ManipulationResult {
 // outside [0,1] or non-finite targets, a mask of the wrong size or with no
 // free point, or a negative mu. Coincident or too many constraints do not
 // fail: they are regularised (or pseudo-inverted) and listed in `unsatisfied`.
-mocap::Result<ManipulationResult> SolvePointConstraints(
-    const BSplineSurface& surface, std::span<const PointConstraint> constraints,
-    const ManipulationOptions& options = {});
+base::Result<ManipulationResult> SolvePointConstraints(const BSplineSurface& surface,
+                                                       std::span<const PointConstraint> constraints,
+                                                       const ManipulationOptions& options = {});
 
 // A bound skin vertex to move: its binding (u, v, d) (patch_binding.h) and the
 // requested displacement.
@@ -113,8 +113,8 @@ struct VertexEdit {
 
 // The edit of mesh vertex `mesh_vertex` from its record in `binding`. Fails
 // when the vertex is not bound to this patch.
-mocap::Result<VertexEdit> MakeVertexEdit(const PatchBinding& binding, int mesh_vertex,
-                                         const glm::dvec3& delta);
+base::Result<VertexEdit> MakeVertexEdit(const PatchBinding& binding, int mesh_vertex,
+                                        const glm::dvec3& delta);
 
 // Moves bound vertices p = s(u,v) + d n(u,v) by their deltas (4.2, last
 // paragraph): the surface points are first sent to s + D, then up to
@@ -122,11 +122,11 @@ mocap::Result<VertexEdit> MakeVertexEdit(const PatchBinding& binding, int mesh_v
 // (the normal turns as the surface moves). `keep` adds "keep here"
 // constraints. The result's residual and unsatisfied entries refer to the
 // vertices (then the keep constraints), measured on p, not on s.
-mocap::Result<ManipulationResult> MoveBoundVertices(const BSplineSurface& surface,
-                                                    std::span<const VertexEdit> edits,
-                                                    const ManipulationOptions& options = {},
-                                                    int iterations = 4,
-                                                    std::span<const PointConstraint> keep = {});
+base::Result<ManipulationResult> MoveBoundVertices(const BSplineSurface& surface,
+                                                   std::span<const VertexEdit> edits,
+                                                   const ManipulationOptions& options = {},
+                                                   int iterations = 4,
+                                                   std::span<const PointConstraint> keep = {});
 
 // The orthogonal polar factor of m (the rotation nearest m in the Frobenius
 // norm, U V^T of its SVD with the sign of the last singular vector flipped if
@@ -141,27 +141,26 @@ glm::dmat3 PolarRotationSvd(const glm::dmat3& m);
 // #C x influences control-point skin weights (ALGORITHMS.md 3.7). Writes #C
 // unit quaternions. kSizeMismatch / kOutOfRange on bad sizes or influences;
 // the indices are not checked (as SkinningJob).
-[[nodiscard]] mocap::JobStatus SsdControlRotations(std::span<const glm::mat4> model_from_bind,
-                                                   int influences,
-                                                   std::span<const std::uint16_t> joint_indices,
-                                                   std::span<const float> joint_weights,
-                                                   std::span<glm::quat> rotations);
+[[nodiscard]] base::JobStatus SsdControlRotations(std::span<const glm::mat4> model_from_bind,
+                                                  int influences,
+                                                  std::span<const std::uint16_t> joint_indices,
+                                                  std::span<const float> joint_weights,
+                                                  std::span<glm::quat> rotations);
 
 // 4.3, DQS: A_c = the normalized real part of the blended dual quaternion
 // (antipodality fixed relative to the most-weighted influence, as DqsJob).
-[[nodiscard]] mocap::JobStatus DqsControlRotations(std::span<const DualQuat> palette,
-                                                   int influences,
-                                                   std::span<const std::uint16_t> joint_indices,
-                                                   std::span<const float> joint_weights,
-                                                   std::span<glm::quat> rotations);
+[[nodiscard]] base::JobStatus DqsControlRotations(std::span<const DualQuat> palette, int influences,
+                                                  std::span<const std::uint16_t> joint_indices,
+                                                  std::span<const float> joint_weights,
+                                                  std::span<glm::quat> rotations);
 
 // 4.3: the example displacement in the local frames,
 // D_e,c = current_ds[c] + A_c^-1 world_delta[c]. current_ds = dS(theta_e) (#C,
 // local; zero for a new example), world_delta = dQ (#C, model space). Writes #C.
-[[nodiscard]] mocap::JobStatus StoreExampleDisplacement(std::span<const glm::quat> rotations,
-                                                        std::span<const glm::vec3> current_ds,
-                                                        std::span<const glm::dvec3> world_delta,
-                                                        std::span<glm::vec3> example);
+[[nodiscard]] base::JobStatus StoreExampleDisplacement(std::span<const glm::quat> rotations,
+                                                       std::span<const glm::vec3> current_ds,
+                                                       std::span<const glm::dvec3> world_delta,
+                                                       std::span<glm::vec3> example);
 
 // Per frame: Q_c = G_c + A_c dS_c(theta) (ALGORITHMS.md 0, step 2 without the
 // elastic term); where dS_c is exactly (0,0,0), Q_c = G_c without reading A_c
@@ -175,8 +174,8 @@ struct PoseSpaceApplyJob {
   // Output.
   std::span<glm::vec3> control{};  // #C Q (model); may alias `global`
 
-  [[nodiscard]] mocap::JobStatus Validate() const;
-  [[nodiscard]] mocap::JobStatus Run() const;
+  [[nodiscard]] base::JobStatus Validate() const;
+  [[nodiscard]] base::JobStatus Run() const;
 };
 
 }  // namespace deform

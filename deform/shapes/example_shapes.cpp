@@ -13,10 +13,10 @@
 namespace deform {
 namespace {
 
-using mocap::ErrorCode;
+using base::ErrorCode;
 
-mocap::Error EditError(const ExampleEdit& e, const std::string& message) {
-  return mocap::MakeError(ErrorCode::kInvalidArgument, e.loc, message);
+base::Error EditError(const ExampleEdit& e, const std::string& message) {
+  return base::MakeError(ErrorCode::kInvalidArgument, e.loc, message);
 }
 
 using internal::Finite;
@@ -26,36 +26,37 @@ glm::dmat3 Rotation3(const glm::mat4& m) { return glm::dmat3(glm::mat3(m)); }
 
 }  // namespace
 
-mocap::Result<SculptedExample> SculptExample(const PatchSetup& patch, const SkinnedMesh& mesh,
-                                             const ExamplePose& pose,
-                                             std::span<const ExampleEdit> edits,
-                                             const ManipulationOptions& options, int iterations) {
+base::Result<SculptedExample> SculptExample(const PatchSetup& patch, const SkinnedMesh& mesh,
+                                            const ExamplePose& pose,
+                                            std::span<const ExampleEdit> edits,
+                                            const ManipulationOptions& options, int iterations) {
   const int nc = patch.num_control();
   const std::size_t num_skin = mesh.skin_joints.size();
   if (pose.model_from_bind.size() != num_skin ||
       (!pose.dq_palette.empty() && pose.dq_palette.size() != num_skin)) {
-    return mocap::MakeError(ErrorCode::kInvalidArgument, {},
-                            "example pose: expected palettes of " + std::to_string(num_skin) +
-                                " skin joints, found " +
-                                std::to_string(pose.model_from_bind.size()));
+    return base::MakeError(ErrorCode::kInvalidArgument, {},
+                           "example pose: expected palettes of " + std::to_string(num_skin) +
+                               " skin joints, found " +
+                               std::to_string(pose.model_from_bind.size()));
   }
   if (edits.empty()) {
-    return mocap::MakeError(ErrorCode::kInvalidArgument, {}, "expected at least one edit, found none");
+    return base::MakeError(ErrorCode::kInvalidArgument, {},
+                           "expected at least one edit, found none");
   }
 
   // G: the control points carried to the example pose (float, as per frame).
   std::vector<glm::vec3> carried(static_cast<std::size_t>(nc));
-  mocap::JobStatus s = CarryControlPointsJob{.patch = &patch,
-                                             .model_from_bind = pose.dq_palette.empty()
-                                                                    ? pose.model_from_bind
-                                                                    : std::span<const glm::mat4>(),
-                                             .dq_palette = pose.dq_palette,
-                                             .control = carried}
-                           .Run();
-  if (!s) return mocap::MakeError(ErrorCode::kInvalidArgument, {}, s.what);
+  base::JobStatus s = CarryControlPointsJob{.patch = &patch,
+                                            .model_from_bind = pose.dq_palette.empty()
+                                                                   ? pose.model_from_bind
+                                                                   : std::span<const glm::mat4>(),
+                                            .dq_palette = pose.dq_palette,
+                                            .control = carried}
+                          .Run();
+  if (!s) return base::MakeError(ErrorCode::kInvalidArgument, {}, s.what);
   std::vector<glm::quat> rotations(static_cast<std::size_t>(nc));
   s = PatchControlRotations(patch, pose, rotations);
-  if (!s) return mocap::MakeError(ErrorCode::kInvalidArgument, {}, s.what);
+  if (!s) return base::MakeError(ErrorCode::kInvalidArgument, {}, s.what);
   BSplineSurface surface = patch.fit.surface;
   std::vector<glm::dvec3>& control = surface.mutable_control();
   for (int c = 0; c < nc; ++c) control[static_cast<std::size_t>(c)] = glm::dvec3(carried[static_cast<std::size_t>(c)]);
@@ -121,7 +122,7 @@ mocap::Result<SculptedExample> SculptExample(const PatchSetup& patch, const Skin
 
   bool brush = false;
   for (const ExampleEdit& e : edits) brush = brush || e.radius > 0.0;
-  mocap::Result<ManipulationResult> solved = ManipulationResult{};
+  base::Result<ManipulationResult> solved = ManipulationResult{};
   if (brush) {
     std::vector<BrushStroke> strokes;
     for (std::size_t k = 0; k < edits.size(); ++k) {
@@ -136,7 +137,7 @@ mocap::Result<SculptedExample> SculptExample(const PatchSetup& patch, const Skin
     solved = MoveBoundVertices(surface, targets, options, iterations);
   }
   if (!solved.ok()) {
-    mocap::Error err = std::move(solved).error();
+    base::Error err = std::move(solved).error();
     if (err.loc.file.empty()) err.loc = edits.front().loc;
     return err;
   }
@@ -154,7 +155,7 @@ mocap::Result<SculptedExample> SculptExample(const PatchSetup& patch, const Skin
   out.displacement.resize(static_cast<std::size_t>(nc));
   const std::vector<glm::vec3> zero(static_cast<std::size_t>(nc), glm::vec3(0.0f));
   s = StoreExampleDisplacement(rotations, zero, out.world_delta, out.displacement);
-  if (!s) return mocap::MakeError(ErrorCode::kInternal, {}, s.what);
+  if (!s) return base::MakeError(ErrorCode::kInternal, {}, s.what);
   return out;
 }
 

@@ -29,7 +29,7 @@
 #include "deform/mesh.h"
 #include "deform/patch/patch_layer.h"
 #include "deform/shapes/pose_space.h"
-#include "mocap/error.h"
+#include "base/error.h"
 
 namespace deform {
 
@@ -48,7 +48,7 @@ struct ExampleEdit {
   // surface around it with a smooth falloff over this radius (parameter
   // units). 0: the plain minimum-norm edit (4.2).
   double radius = 0.0;
-  mocap::FileLoc loc{};     // where it was defined (rig file field path), for messages
+  base::FileLoc loc{};  // where it was defined (rig file field path), for messages
 };
 
 // The example pose's global deformation, as the pipeline builds it.
@@ -63,7 +63,7 @@ struct SculptedExample {
   std::vector<glm::dvec3> world_delta;  // #C dQ (model space) at the example pose
   double max_residual = 0.0;            // max over edits of |missed move|, model units
   double condition = 0.0;               // condition number of the constraint system
-  std::vector<mocap::Warning> warnings; // edits left unsatisfied (coincident, too many)
+  std::vector<base::Warning> warnings;  // edits left unsatisfied (coincident, too many)
 };
 
 // Smallest border fade beta (3.8) an edited vertex may have: the patch layer
@@ -84,11 +84,11 @@ inline constexpr float kMinEditableBorderWeight = 0.05f;
 // (SolveBrushStrokes: field fit + smoothness, every edit's surface point
 // s(u,v) moved by its move as a heavy row; a vertex's offset d n is then not
 // re-solved for the turning normal); without one, exactly as before.
-mocap::Result<SculptedExample> SculptExample(const PatchSetup& patch, const SkinnedMesh& mesh,
-                                             const ExamplePose& pose,
-                                             std::span<const ExampleEdit> edits,
-                                             const ManipulationOptions& options = {},
-                                             int iterations = 4);
+base::Result<SculptedExample> SculptExample(const PatchSetup& patch, const SkinnedMesh& mesh,
+                                            const ExamplePose& pose,
+                                            std::span<const ExampleEdit> edits,
+                                            const ManipulationOptions& options = {},
+                                            int iterations = 4);
 
 // The rotations A_c (#C unit quaternions) the control points of `patch` move
 // with under the global layer: DqsControlRotations when pose.dq_palette is
@@ -113,10 +113,10 @@ mocap::Result<SculptedExample> SculptExample(const PatchSetup& patch, const Skin
 // kSizeMismatch on a `displacement` of another size; kOutOfRange on a
 // weighted joint index beyond the palette (rotations then unspecified).
 // Never allocates.
-[[nodiscard]] mocap::JobStatus PatchControlRotations(const PatchSetup& patch,
-                                                     const ExamplePose& pose,
-                                                     std::span<glm::quat> rotations,
-                                                     std::span<const glm::vec3> displacement = {});
+[[nodiscard]] base::JobStatus PatchControlRotations(const PatchSetup& patch,
+                                                    const ExamplePose& pose,
+                                                    std::span<glm::quat> rotations,
+                                                    std::span<const glm::vec3> displacement = {});
 
 // What one patch needs per frame for dS: which joints make theta and the
 // fitted interpolant. A default-constructed value (no model) means the patch

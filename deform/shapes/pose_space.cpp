@@ -13,8 +13,8 @@
 namespace deform {
 namespace {
 
-using mocap::ErrorCode;
-using mocap::JobStatus;
+using base::ErrorCode;
+using base::JobStatus;
 
 constexpr double kTwoPi = 2.0 * std::numbers::pi;
 
@@ -99,7 +99,7 @@ int PoseFeatureDimension(const mocap::Skeleton& skeleton, const PoseFeatureSpec&
   return dim;
 }
 
-mocap::Status CheckPoseFeatureSpec(const mocap::Skeleton& skeleton, const PoseFeatureSpec& spec) {
+base::Status CheckPoseFeatureSpec(const mocap::Skeleton& skeleton, const PoseFeatureSpec& spec) {
   if (spec.joints.empty()) return InvalidArgument("expected at least one pose joint, found none");
   for (size_t k = 0; k < spec.joints.size(); ++k) {
     const PoseFeatureJoint& j = spec.joints[k];
@@ -141,9 +141,9 @@ mocap::Status CheckPoseFeatureSpec(const mocap::Skeleton& skeleton, const PoseFe
   return {};
 }
 
-mocap::Status ComputePoseFeatures(const mocap::Skeleton& skeleton, const PoseFeatureSpec& spec,
-                                  std::span<const mocap::JointTransform> locals,
-                                  std::span<float> out) {
+base::Status ComputePoseFeatures(const mocap::Skeleton& skeleton, const PoseFeatureSpec& spec,
+                                 std::span<const mocap::JointTransform> locals,
+                                 std::span<float> out) {
   if (locals.size() != static_cast<size_t>(skeleton.num_joints())) {
     return InvalidArgument("expected " + std::to_string(skeleton.num_joints()) +
                            " local transforms");
@@ -182,9 +182,9 @@ mocap::Status ComputePoseFeatures(const mocap::Skeleton& skeleton, const PoseFea
   return {};
 }
 
-mocap::Result<std::vector<float>> PoseFeaturesAtFrame(const mocap::Skeleton& skeleton,
-                                                      const mocap::Motion& motion, int frame,
-                                                      const PoseFeatureSpec& spec) {
+base::Result<std::vector<float>> PoseFeaturesAtFrame(const mocap::Skeleton& skeleton,
+                                                     const mocap::Motion& motion, int frame,
+                                                     const PoseFeatureSpec& spec) {
   if (frame < 0 || frame >= motion.num_frames) {
     return InvalidArgument("expected a frame in 0.." + std::to_string(motion.num_frames - 1) +
                            ", found " + std::to_string(frame));
@@ -196,7 +196,7 @@ mocap::Result<std::vector<float>> PoseFeaturesAtFrame(const mocap::Skeleton& ske
   if (!status.ok())
     return InvalidArgument(std::string("motion does not fit the skeleton: ") + status.what);
   std::vector<float> features(static_cast<size_t>(PoseFeatureDimension(skeleton, spec)));
-  mocap::Status s = ComputePoseFeatures(skeleton, spec, locals, features);
+  base::Status s = ComputePoseFeatures(skeleton, spec, locals, features);
   if (!s.ok()) return s.error();
   return features;
 }
@@ -235,8 +235,8 @@ int AddOrUpdateExample(std::vector<PoseExample>& examples, PoseExample example,
   return static_cast<int>(examples.size()) - 1;
 }
 
-mocap::Result<RbfModel> RbfPoseSpace::Fit(std::span<const PoseExample> examples, int dimension,
-                                          int num_control, const RbfOptions& options) {
+base::Result<RbfModel> RbfPoseSpace::Fit(std::span<const PoseExample> examples, int dimension,
+                                         int num_control, const RbfOptions& options) {
   if (dimension < 1 || dimension > kMaxPoseFeatures) {
     return InvalidArgument("expected 1.." + std::to_string(kMaxPoseFeatures) +
                            " pose features, found " + std::to_string(dimension));
@@ -290,9 +290,9 @@ mocap::Result<RbfModel> RbfPoseSpace::Fit(std::span<const PoseExample> examples,
   }
   const int k_count = static_cast<int>(examples.size()) + (sculpted_at_rest ? 0 : 1);
   if (k_count > kMaxRbfCentres) {
-    return mocap::MakeError(ErrorCode::kLimitExceeded, {},
-                            "expected at most " + std::to_string(kMaxRbfCentres) +
-                                " pose centres, found " + std::to_string(k_count));
+    return base::MakeError(ErrorCode::kLimitExceeded, {},
+                           "expected at most " + std::to_string(kMaxRbfCentres) +
+                               " pose centres, found " + std::to_string(k_count));
   }
 
   RbfModel model;
@@ -419,8 +419,8 @@ mocap::Result<RbfModel> RbfPoseSpace::Fit(std::span<const PoseExample> examples,
             static_cast<float>(sol.at<double>(static_cast<int>(kk + c), static_cast<int>(v)));
     }
   } catch (const cv::Exception& e) {
-    return mocap::MakeError(ErrorCode::kInternal, {},
-                            std::string("pose-space solve failed: ") + e.what());
+    return base::MakeError(ErrorCode::kInternal, {},
+                           std::string("pose-space solve failed: ") + e.what());
   }
   return model;
 }
@@ -460,7 +460,7 @@ JobStatus PoseSpaceJob::Validate() const {
       model->weights.size() != static_cast<size_t>(model->num_centres) * displacement.size() * 3) {
     return {JobStatus::kOutOfRange, "model is not fitted"};
   }
-  return mocap::kJobOk;
+  return base::kJobOk;
 }
 
 JobStatus PoseSpaceJob::Run() const {
@@ -521,7 +521,7 @@ JobStatus PoseSpaceJob::Run() const {
       for (size_t v = 0; v < nv; ++v) out[v] += xd * row[v];
     }
   }
-  return mocap::kJobOk;
+  return base::kJobOk;
 }
 
 }  // namespace deform

@@ -27,7 +27,7 @@
 #include <string>
 #include <vector>
 
-#include "mocap/error.h"
+#include "base/error.h"
 #include "mocap/motion.h"
 #include "mocap/pose.h"
 #include "mocap/skeleton.h"
@@ -77,19 +77,19 @@ int PoseFeatureDimension(const mocap::Skeleton& skeleton, const PoseFeatureSpec&
 
 // Checks joints (in range, not a root, unique), weights (finite, > 0) and the
 // twist axes (unit within 1e-3) and the dimension (1..kMaxPoseFeatures).
-mocap::Status CheckPoseFeatureSpec(const mocap::Skeleton& skeleton, const PoseFeatureSpec& spec);
+base::Status CheckPoseFeatureSpec(const mocap::Skeleton& skeleton, const PoseFeatureSpec& spec);
 
 // Features of a pose from the #J local transforms (LocalPoseJob output).
 // Writes PoseFeatureDimension values; out must be that long (checked).
-mocap::Status ComputePoseFeatures(const mocap::Skeleton& skeleton, const PoseFeatureSpec& spec,
-                                  std::span<const mocap::JointTransform> locals,
-                                  std::span<float> out);
+base::Status ComputePoseFeatures(const mocap::Skeleton& skeleton, const PoseFeatureSpec& spec,
+                                 std::span<const mocap::JointTransform> locals,
+                                 std::span<float> out);
 
 // Features of frame `frame` of a motion (the pose of an example can be "a
 // frame of a motion"). Fails on a frame out of range or a mismatched motion.
-mocap::Result<std::vector<float>> PoseFeaturesAtFrame(const mocap::Skeleton& skeleton,
-                                                      const mocap::Motion& motion, int frame,
-                                                      const PoseFeatureSpec& spec);
+base::Result<std::vector<float>> PoseFeaturesAtFrame(const mocap::Skeleton& skeleton,
+                                                     const mocap::Motion& motion, int frame,
+                                                     const PoseFeatureSpec& spec);
 
 // Distance between two feature vectors: Euclidean, or with every component
 // difference wrapped into [-pi, pi] (delta = a - b - 2 pi round((a-b)/(2 pi)))
@@ -109,7 +109,7 @@ const char* RbfKernelName(RbfKernel kernel);
 // An example: the pose (features) and its displacements in the local frames.
 struct PoseExample {
   std::string name{};                     // for messages, e.g. "elbow_90"
-  mocap::FileLoc loc{};                   // where it was defined (rig file), optional
+  base::FileLoc loc{};                    // where it was defined (rig file), optional
   std::vector<float> features{};          // dimension of the model
   std::vector<glm::vec3> displacement{};  // #C D_e (local frames, model units)
 };
@@ -145,7 +145,7 @@ struct RbfModel {
   std::vector<float> poly;          // (1 + #X) x 3#C: constant row then linear rows, or empty
   std::vector<float> lower, upper;  // #X feature range of the centres (clamp for kPolyharmonic3)
   double condition = 1.0;           // 2-norm condition number of the solved system
-  std::vector<mocap::Warning> warnings;  // ill-conditioning, kernel fallback
+  std::vector<base::Warning> warnings;  // ill-conditioning, kernel fallback
 
   // Evaluation in double (for tests and tools; allocates): dS(x), 3#C values.
   std::vector<double> EvaluateReference(std::span<const float> features) const;
@@ -159,8 +159,8 @@ class RbfPoseSpace {
   // kMaxRbfCentres centres, two examples closer than duplicate_tol (naming
   // both), or a singular system. An example at the rest pose replaces the
   // rest centre (the user sculpted at rest).
-  static mocap::Result<RbfModel> Fit(std::span<const PoseExample> examples, int dimension,
-                                     int num_control, const RbfOptions& options = {});
+  static base::Result<RbfModel> Fit(std::span<const PoseExample> examples, int dimension,
+                                    int num_control, const RbfOptions& options = {});
 };
 
 // Per frame: dS(theta) into a caller span. Never allocates (kernel values on
@@ -170,8 +170,8 @@ struct PoseSpaceJob {
   std::span<const float> features{};    // #X pose features (ComputePoseFeatures)
   std::span<glm::vec3> displacement{};  // #C output dS, local frames
 
-  [[nodiscard]] mocap::JobStatus Validate() const;
-  [[nodiscard]] mocap::JobStatus Run() const;
+  [[nodiscard]] base::JobStatus Validate() const;
+  [[nodiscard]] base::JobStatus Run() const;
 };
 
 }  // namespace deform

@@ -82,7 +82,7 @@ class AsyncImageWriter {
   int peak_in_flight_ = 0;
   bool stopping_ = false;
   bool finished_ = false;
-  std::optional<mocap::Error> first_error_;
+  std::optional<base::Error> first_error_;
   std::int64_t first_error_sequence_ = 0;  // the earliest failing submission reported
   std::int64_t next_sequence_ = 0;
   std::int64_t frames_written_ = 0;

@@ -11,13 +11,13 @@
 namespace render {
 namespace {
 
-using mocap::ErrorCode;
-using mocap::FileLoc;
-using mocap::MakeError;
+using base::ErrorCode;
+using base::FileLoc;
+using base::MakeError;
 
 constexpr std::int64_t kMaxSheetPixels = std::int64_t{1} << 26;
 
-mocap::Error Invalid(const std::string& what) {
+base::Error Invalid(const std::string& what) {
   return MakeError(ErrorCode::kInvalidArgument, FileLoc{}, "contact sheet: " + what);
 }
 

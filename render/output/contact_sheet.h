@@ -17,13 +17,13 @@
 #include <memory>
 #include <span>
 
-#include "mocap/error.h"
+#include "base/error.h"
 #include "render/image.h"
 
 namespace render {
 
-using mocap::Result;
-using mocap::Status;
+using base::Result;
+using base::Status;
 
 struct ContactSheetOptions {
   int columns = 6;          // >= 1

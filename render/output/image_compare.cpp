@@ -13,11 +13,11 @@
 namespace render {
 namespace {
 
-using mocap::ErrorCode;
-using mocap::FileLoc;
-using mocap::MakeError;
+using base::ErrorCode;
+using base::FileLoc;
+using base::MakeError;
 
-mocap::Error SizeError(const Image& a, const Image& b) {
+base::Error SizeError(const Image& a, const Image& b) {
   return MakeError(ErrorCode::kInvalidArgument, FileLoc{},
                    "images differ in size: " + std::to_string(a.width) + "x" +
                        std::to_string(a.height) + " and " + std::to_string(b.width) + "x" +
@@ -30,13 +30,13 @@ bool Consistent(const Image& img) {
              static_cast<std::size_t>(img.width) * static_cast<std::size_t>(img.height);
 }
 
-mocap::Status CheckPair(const Image& a, const Image& b) {
+base::Status CheckPair(const Image& a, const Image& b) {
   if (!Consistent(a) || !Consistent(b)) {
     return MakeError(ErrorCode::kInvalidArgument, FileLoc{},
                      "cannot compare an empty or inconsistent image");
   }
   if (a.width != b.width || a.height != b.height) return SizeError(a, b);
-  return mocap::Status::Ok();
+  return base::Status::Ok();
 }
 
 // The values compared, interleaved RGBA floats.
@@ -56,7 +56,7 @@ std::vector<float> Values(const Image& img, CompareSpace space) {
 
 Result<CompareResult> Compare(const Image& a, const Image& b,
                               const CompareThresholds& thresholds) {
-  if (mocap::Status s = CheckPair(a, b); !s) return s.error();
+  if (base::Status s = CheckPair(a, b); !s) return s.error();
   std::vector<float> va = Values(a, thresholds.space);
   std::vector<float> vb = Values(b, thresholds.space);
   const OIIO::ImageSpec spec(a.width, a.height, 4, OIIO::TypeDesc::FLOAT);
@@ -91,7 +91,7 @@ Result<CompareResult> Compare(const Image& a, const Image& b,
 }
 
 Result<Image> MakeDiffImage(const Image& a, const Image& b, float scale, CompareSpace space) {
-  if (mocap::Status s = CheckPair(a, b); !s) return s.error();
+  if (base::Status s = CheckPair(a, b); !s) return s.error();
   const std::vector<float> va = Values(a, space);
   const std::vector<float> vb = Values(b, space);
   Image diff(a.width, a.height, glm::vec4(0.0f, 0.0f, 0.0f, 1.0f));

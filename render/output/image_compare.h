@@ -15,12 +15,12 @@
 
 #include <cstdint>
 
-#include "mocap/error.h"
+#include "base/error.h"
 #include "render/image.h"
 
 namespace render {
 
-using mocap::Result;
+using base::Result;
 
 // Which values are compared.
 enum class CompareSpace {

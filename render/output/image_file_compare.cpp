@@ -12,13 +12,13 @@
 namespace render {
 namespace {
 
-using mocap::ErrorCode;
-using mocap::FileLoc;
-using mocap::MakeError;
+using base::ErrorCode;
+using base::FileLoc;
+using base::MakeError;
 
 // Reads the first subimage of `path` as float, as idiff does (no colour
 // conversion, OIIO's default alpha handling).
-mocap::Result<OIIO::ImageBuf> ReadFloat(const std::string& path) {
+base::Result<OIIO::ImageBuf> ReadFloat(const std::string& path) {
   const FileLoc loc{path, 0, 0, {}};
   if (!std::filesystem::is_regular_file(path)) {
     return MakeError(ErrorCode::kIo, loc, "no such image file");
@@ -95,12 +95,12 @@ const char* VerdictName(CompareVerdict v) {
   return "?";
 }
 
-mocap::Result<FileCompareResult> CompareImageFiles(const std::string& path_a,
-                                                   const std::string& path_b,
-                                                   const IdiffThresholds& t) {
-  mocap::Result<OIIO::ImageBuf> a = ReadFloat(path_a);
+base::Result<FileCompareResult> CompareImageFiles(const std::string& path_a,
+                                                  const std::string& path_b,
+                                                  const IdiffThresholds& t) {
+  base::Result<OIIO::ImageBuf> a = ReadFloat(path_a);
   if (!a.ok()) return a.error();
-  mocap::Result<OIIO::ImageBuf> b = ReadFloat(path_b);
+  base::Result<OIIO::ImageBuf> b = ReadFloat(path_b);
   if (!b.ok()) return b.error();
   const OIIO::ImageSpec& sa = a->spec();
   const OIIO::ImageSpec& sb = b->spec();

@@ -26,7 +26,7 @@
 #include <string>
 #include <vector>
 
-#include "mocap/error.h"
+#include "base/error.h"
 
 namespace render {
 
@@ -66,7 +66,7 @@ struct FileCompareResult {
 
 // Compares the first subimage of the two files. Errors: kIo naming the file that
 // is missing or unreadable, kLimitExceeded for a file over kMaxReadSamples samples.
-[[nodiscard]] mocap::Result<FileCompareResult> CompareImageFiles(
+[[nodiscard]] base::Result<FileCompareResult> CompareImageFiles(
     const std::string& path_a, const std::string& path_b, const IdiffThresholds& thresholds = {});
 
 }  // namespace render

@@ -21,9 +21,9 @@
 namespace render {
 namespace {
 
-using mocap::ErrorCode;
-using mocap::FileLoc;
-using mocap::MakeError;
+using base::ErrorCode;
+using base::FileLoc;
+using base::MakeError;
 
 constexpr const char* kSoftware = "patchskin " PATCHSKIN_VERSION;
 
@@ -70,12 +70,12 @@ Status CheckImage(const Image& image, const std::string& path) {
   const auto pixels = static_cast<std::size_t>(std::max(image.width, 0)) *
                       static_cast<std::size_t>(std::max(image.height, 0));
   if (image.width <= 0 || image.height <= 0) {
-    return MakeError(ErrorCode::kInvalidArgument, mocap::InFile(path),
+    return MakeError(ErrorCode::kInvalidArgument, base::InFile(path),
                      "cannot write an empty image (" + std::to_string(image.width) + "x" +
                          std::to_string(image.height) + ")");
   }
   if (image.rgba.size() != pixels || (!image.depth.empty() && image.depth.size() != pixels)) {
-    return MakeError(ErrorCode::kInvalidArgument, mocap::InFile(path),
+    return MakeError(ErrorCode::kInvalidArgument, base::InFile(path),
                      "image buffers do not match its size " + std::to_string(image.width) + "x" +
                          std::to_string(image.height));
   }
@@ -84,7 +84,7 @@ Status CheckImage(const Image& image, const std::string& path) {
 
 Status CheckOptions(const WriteOptions& o, const std::string& path) {
   auto bad = [&](const std::string& what) {
-    return Status(MakeError(ErrorCode::kInvalidArgument, mocap::InFile(path), what));
+    return Status(MakeError(ErrorCode::kInvalidArgument, base::InFile(path), what));
   };
   if (o.png_compression < 0 || o.png_compression > 9) {
     return bad("PNG compression must be 0..9, found " + std::to_string(o.png_compression));
@@ -247,7 +247,7 @@ const char* OiioFormatName(ImageFormat format) {
 }
 
 Status IoError(const std::string& path, const std::string& what) {
-  return MakeError(ErrorCode::kIo, mocap::InFile(path), what);
+  return MakeError(ErrorCode::kIo, base::InFile(path), what);
 }
 
 }  // namespace
@@ -272,7 +272,7 @@ Result<ImageFormat> ImageFormatFromPath(const std::string& path) {
   if (ext == ".tif" || ext == ".tiff") return ImageFormat::kTiff;
   if (ext == ".jpg" || ext == ".jpeg") return ImageFormat::kJpeg;
   return MakeError(
-      ErrorCode::kUnsupported, mocap::InFile(path),
+      ErrorCode::kUnsupported, base::InFile(path),
       "expected an image extension .png, .exr, .tif, .tiff, .jpg or .jpeg, found '" + ext + "'");
 }
 
@@ -329,7 +329,7 @@ Status WriteImage(const Image& image, const std::string& path, const WriteOption
 }
 
 Result<Image> ReadImage(const std::string& path, ReadInfo* info) {
-  const FileLoc loc = mocap::InFile(path);
+  const FileLoc loc = base::InFile(path);
   if (!std::filesystem::is_regular_file(path)) {
     return MakeError(ErrorCode::kIo, loc, "no such image file");
   }
@@ -458,7 +458,7 @@ bool HasFramePlaceholder(const std::string& pattern) {
 Result<std::string> ExpandFramePattern(const std::string& pattern, int frame) {
   const std::vector<Placeholder> found = FindPlaceholders(pattern);
   if (found.size() != 1) {
-    return MakeError(ErrorCode::kInvalidArgument, mocap::InFile(pattern),
+    return MakeError(ErrorCode::kInvalidArgument, base::InFile(pattern),
                      "expected exactly one frame placeholder ('####' or '%04d') in the output "
                      "pattern, found " +
                          std::to_string(found.size()));

@@ -23,13 +23,13 @@
 #include <cstdint>
 #include <string>
 
-#include "mocap/error.h"
+#include "base/error.h"
 #include "render/image.h"
 
 namespace render {
 
-using mocap::Result;
-using mocap::Status;
+using base::Result;
+using base::Status;
 
 // The file formats WriteImage knows, chosen by extension (case-insensitive).
 enum class ImageFormat { kPng, kExr, kTiff, kJpeg };

@@ -13,11 +13,11 @@
 namespace render {
 namespace {
 
-using mocap::ErrorCode;
-using mocap::FileLoc;
-using mocap::MakeError;
+using base::ErrorCode;
+using base::FileLoc;
+using base::MakeError;
 
-mocap::Error Invalid(const std::string& what) {
+base::Error Invalid(const std::string& what) {
   return MakeError(ErrorCode::kInvalidArgument, FileLoc{}, "plot: " + what);
 }
 
@@ -47,7 +47,7 @@ constexpr int kFont = cv::FONT_HERSHEY_SIMPLEX;
 
 }  // namespace
 
-mocap::Result<Image> DrawTimePlot(const PlotOptions& options) {
+base::Result<Image> DrawTimePlot(const PlotOptions& options) {
   const int W = options.width, H = options.height;
   if (W < 200 || H < 200 || W > 4096 || H > 4096) return Invalid("size outside [200, 4096]");
   const std::vector<double>& t = options.times_s;

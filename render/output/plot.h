@@ -12,7 +12,7 @@
 
 #include <glm/glm.hpp>
 
-#include "mocap/error.h"
+#include "base/error.h"
 #include "render/image.h"
 
 namespace render {
@@ -40,6 +40,6 @@ struct PlotOptions {
 
 // Draws the plot. Errors: kInvalidArgument for sizes out of range, fewer than 2
 // times, times not increasing, an empty panel or a curve whose length is not #T.
-[[nodiscard]] mocap::Result<Image> DrawTimePlot(const PlotOptions& options);
+[[nodiscard]] base::Result<Image> DrawTimePlot(const PlotOptions& options);
 
 }  // namespace render

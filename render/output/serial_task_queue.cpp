@@ -12,11 +12,11 @@ SerialTaskQueue::SerialTaskQueue(SerialTaskQueueOptions options) : options_(opti
 
 SerialTaskQueue::~SerialTaskQueue() { (void)Finish(); }
 
-mocap::Status SerialTaskQueue::Submit(Task task) {
+base::Status SerialTaskQueue::Submit(Task task) {
   std::unique_lock<std::mutex> lock(mutex_);
   if (finished_) {
-    return mocap::MakeError(mocap::ErrorCode::kInvalidArgument, {},
-                            "task submitted after the queue finished");
+    return base::MakeError(base::ErrorCode::kInvalidArgument, {},
+                           "task submitted after the queue finished");
   }
   slot_free_.wait(lock, [&] { return pending_ < options_.max_queued || first_error_; });
   if (first_error_) return *first_error_;
@@ -24,10 +24,10 @@ mocap::Status SerialTaskQueue::Submit(Task task) {
   ++pending_;
   peak_pending_ = std::max(peak_pending_, pending_);
   work_ready_.notify_one();
-  return mocap::Status::Ok();
+  return base::Status::Ok();
 }
 
-mocap::Status SerialTaskQueue::Finish() {
+base::Status SerialTaskQueue::Finish() {
   {
     std::lock_guard<std::mutex> lock(mutex_);
     if (!finished_) {
@@ -39,7 +39,7 @@ mocap::Status SerialTaskQueue::Finish() {
   if (worker_.joinable()) worker_.join();
   std::lock_guard<std::mutex> lock(mutex_);
   if (first_error_) return *first_error_;
-  return mocap::Status::Ok();
+  return base::Status::Ok();
 }
 
 int SerialTaskQueue::peak_pending() const {
@@ -64,7 +64,7 @@ void SerialTaskQueue::WorkerLoop() {
       std::lock_guard<std::mutex> lock(mutex_);
       failed = first_error_.has_value();
     }
-    mocap::Status status = failed ? mocap::Status::Ok() : task();
+    base::Status status = failed ? base::Status::Ok() : task();
     task = nullptr;  // release what the task holds (a frame) before freeing its slot
     std::lock_guard<std::mutex> lock(mutex_);
     if (!status.ok() && !first_error_) first_error_ = status.error();

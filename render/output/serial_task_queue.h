@@ -21,7 +21,7 @@
 #include <optional>
 #include <thread>
 
-#include "mocap/error.h"
+#include "base/error.h"
 
 namespace render {
 
@@ -31,7 +31,7 @@ struct SerialTaskQueueOptions {
 
 class SerialTaskQueue {
  public:
-  using Task = std::function<mocap::Status()>;
+  using Task = std::function<base::Status()>;
 
   explicit SerialTaskQueue(SerialTaskQueueOptions options = {});
   ~SerialTaskQueue();  // Finish(); an error not yet returned is dropped
@@ -40,11 +40,11 @@ class SerialTaskQueue {
 
   // Queues `task`; blocks while max_queued tasks are pending. Returns the first
   // error of an earlier task (and then drops `task`), or an error after Finish.
-  [[nodiscard]] mocap::Status Submit(Task task);
+  [[nodiscard]] base::Status Submit(Task task);
 
   // Runs every queued task (until one fails), stops the thread and returns the
   // first error or Ok. Calling it again returns the same status.
-  [[nodiscard]] mocap::Status Finish();
+  [[nodiscard]] base::Status Finish();
 
   // Most tasks pending at once so far (<= max_queued; thread-safe).
   int peak_pending() const;
@@ -61,7 +61,7 @@ class SerialTaskQueue {
   int peak_pending_ = 0;
   bool stopping_ = false;
   bool finished_ = false;
-  std::optional<mocap::Error> first_error_;
+  std::optional<base::Error> first_error_;
   std::thread worker_;
 };
 

@@ -25,12 +25,12 @@ Result<Image> AsStored(const Image& image, ImageFormat format, const WriteOption
   Image out(image.width, image.height);
   switch (format) {
     case ImageFormat::kJpeg:
-      return mocap::MakeError(mocap::ErrorCode::kUnsupported, {},
-                              "JPEG is lossy: a frame read back differs from the one written");
+      return base::MakeError(base::ErrorCode::kUnsupported, {},
+                             "JPEG is lossy: a frame read back differs from the one written");
     case ImageFormat::kTiff:
       if (options.tiff_bits != 8) {
-        return mocap::MakeError(mocap::ErrorCode::kUnsupported, {},
-                                "16-bit TIFF round trip is not modelled");
+        return base::MakeError(base::ErrorCode::kUnsupported, {},
+                               "16-bit TIFF round trip is not modelled");
       }
       [[fallthrough]];
     case ImageFormat::kPng: {
@@ -58,7 +58,7 @@ Result<Image> AsStored(const Image& image, ImageFormat format, const WriteOption
       return out;
     }
   }
-  return mocap::MakeError(mocap::ErrorCode::kUnsupported, {}, "unknown image format");
+  return base::MakeError(base::ErrorCode::kUnsupported, {}, "unknown image format");
 }
 
 }  // namespace render

@@ -12,7 +12,7 @@
 //   JPEG, 16-bit TIFF  kUnsupported: JPEG is lossy and 16-bit codes go through
 //                    a different curve; callers keep the image as it is.
 
-#include "mocap/error.h"
+#include "base/error.h"
 #include "render/image.h"
 #include "render/output/image_io.h"
 

@@ -14,9 +14,9 @@
 namespace render {
 namespace {
 
-using mocap::ErrorCode;
-using mocap::FileLoc;
-using mocap::MakeError;
+using base::ErrorCode;
+using base::FileLoc;
+using base::MakeError;
 
 struct CodecInfo {
   const char* fourcc;
@@ -55,7 +55,7 @@ const char* VideoCodecName(VideoCodec codec) {
 
 Result<std::unique_ptr<VideoWriter>> VideoWriter::Open(const std::string& path, int width,
                                                        int height, const VideoOptions& options) {
-  const FileLoc loc = mocap::InFile(path);
+  const FileLoc loc = base::InFile(path);
   if (width <= 0 || height <= 0 || !(options.fps > 0.0)) {
     return MakeError(ErrorCode::kInvalidArgument, loc, "expected a positive size and fps");
   }
@@ -119,11 +119,11 @@ VideoWriter::~VideoWriter() {
 
 Status VideoWriter::AddFrame(const Image& frame) {
   if (!impl_->is_open()) {
-    return MakeError(ErrorCode::kIo, mocap::InFile(path_), "video is closed");
+    return MakeError(ErrorCode::kIo, base::InFile(path_), "video is closed");
   }
   if (frame.width < 1 || frame.height < 1 ||
       frame.rgba.size() != static_cast<std::size_t>(frame.width) * static_cast<std::size_t>(frame.height)) {
-    return MakeError(ErrorCode::kInvalidArgument, mocap::InFile(path_),
+    return MakeError(ErrorCode::kInvalidArgument, base::InFile(path_),
                      "expected a frame with pixels, found " + std::to_string(frame.width) + "x" +
                          std::to_string(frame.height));
   }
@@ -156,14 +156,14 @@ Status VideoWriter::AddFrame(const Image& frame) {
   if (impl_->h264 != nullptr) {
     std::string error;
     if (!impl_->h264->Write(bgr.ptr<std::uint8_t>(0), static_cast<int>(bgr.step[0]), &error))
-      return MakeError(ErrorCode::kIo, mocap::InFile(path_), "FFmpeg: " + error);
+      return MakeError(ErrorCode::kIo, base::InFile(path_), "FFmpeg: " + error);
     ++frames_;
     return Status::Ok();
   }
   try {
     impl_->writer.write(bgr);
   } catch (const cv::Exception& e) {
-    return MakeError(ErrorCode::kIo, mocap::InFile(path_), std::string("OpenCV: ") + e.what());
+    return MakeError(ErrorCode::kIo, base::InFile(path_), std::string("OpenCV: ") + e.what());
   }
   ++frames_;
   return Status::Ok();
@@ -171,7 +171,7 @@ Status VideoWriter::AddFrame(const Image& frame) {
 
 Status VideoWriter::Close() {
   if (!impl_->is_open()) {
-    return MakeError(ErrorCode::kIo, mocap::InFile(path_), "video is already closed");
+    return MakeError(ErrorCode::kIo, base::InFile(path_), "video is already closed");
   }
   if (impl_->h264 != nullptr) {
     std::string error;
@@ -180,7 +180,7 @@ Status VideoWriter::Close() {
     if (!closed) {
       std::error_code ignored;
       std::filesystem::remove(temp_path_, ignored);
-      return MakeError(ErrorCode::kIo, mocap::InFile(path_), "FFmpeg: " + error);
+      return MakeError(ErrorCode::kIo, base::InFile(path_), "FFmpeg: " + error);
     }
   }
   impl_->writer.release();
@@ -189,7 +189,7 @@ Status VideoWriter::Close() {
   if (ec) {
     std::error_code ignored;
     std::filesystem::remove(temp_path_, ignored);
-    return MakeError(ErrorCode::kIo, mocap::InFile(path_),
+    return MakeError(ErrorCode::kIo, base::InFile(path_),
                      "cannot rename the finished video into place: " + ec.message());
   }
   return Status::Ok();

@@ -16,13 +16,13 @@
 #include <string>
 #include <vector>
 
-#include "mocap/error.h"
+#include "base/error.h"
 #include "render/image.h"
 
 namespace render {
 
-using mocap::Result;
-using mocap::Status;
+using base::Result;
+using base::Status;
 
 enum class VideoCodec {
   kH264Mp4,   // "avc1" in .mp4

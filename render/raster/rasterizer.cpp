@@ -7,8 +7,8 @@
 #include <emmintrin.h>
 #endif
 
-#include "mocap/check.h"
-#include "render/internal/parallel.h"
+#include "base/check.h"
+#include "base/parallel.h"
 
 namespace render {
 namespace {
@@ -238,7 +238,7 @@ bool Rasterizer::Setup(std::span<const ClipMesh> meshes, const RasterSettings& s
   snapped_.resize(vertex_offsets_.back());
   outcodes_.resize(vertex_offsets_.back());
   const int vertex_threads = vertex_offsets_.back() > 16384 ? settings.threads : 1;
-  internal::RunOnThreads(vertex_threads, [&](int t) {
+  base::RunOnThreads(vertex_threads, [&](int t) {
     for (std::size_t m = 0; m < meshes.size(); ++m) {
       const std::span<const glm::vec4> clip = meshes[m].clip_positions;
       const std::size_t begin = clip.size() * static_cast<std::size_t>(t) / static_cast<std::size_t>(vertex_threads);
@@ -258,7 +258,7 @@ bool Rasterizer::Setup(std::span<const ClipMesh> meshes, const RasterSettings& s
       std::max<std::size_t>(1, std::min<std::size_t>(static_cast<std::size_t>(settings.threads),
                                                       total / 1024 + 1)));
   per_thread_.resize(static_cast<std::size_t>(threads));
-  internal::RunOnThreads(threads, [&](int t) {
+  base::RunOnThreads(threads, [&](int t) {
     const std::size_t begin = total * static_cast<std::size_t>(t) / static_cast<std::size_t>(threads);
     const std::size_t end =
         total * static_cast<std::size_t>(t + 1) / static_cast<std::size_t>(threads);
@@ -279,7 +279,7 @@ bool Rasterizer::Setup(std::span<const ClipMesh> meshes, const RasterSettings& s
   }
   tile_offsets_[tiles] = running;
   bins_.resize(running);
-  internal::RunOnThreads(threads, [&](int t) {
+  base::RunOnThreads(threads, [&](int t) {
     PerThread& part = per_thread_[static_cast<std::size_t>(t)];
     const std::uint32_t base = static_cast<std::uint32_t>(t) << kThreadShift;
     for (std::size_t i = 0; i < part.triangles.size(); ++i) {

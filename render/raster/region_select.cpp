@@ -11,17 +11,17 @@
 namespace render {
 namespace {
 
-mocap::Error Invalid(std::string message) {
-  return mocap::MakeError(mocap::ErrorCode::kInvalidArgument, {}, std::move(message));
+base::Error Invalid(std::string message) {
+  return base::MakeError(base::ErrorCode::kInvalidArgument, {}, std::move(message));
 }
 
 }  // namespace
 
-mocap::Result<std::vector<int>> SelectScreenRegion(const Camera& camera,
-                                                   std::span<const glm::vec3> positions,
-                                                   std::span<const glm::vec3> normals,
-                                                   std::span<const glm::uvec3> triangles,
-                                                   const ScreenRegionQuery& q) {
+base::Result<std::vector<int>> SelectScreenRegion(const Camera& camera,
+                                                  std::span<const glm::vec3> positions,
+                                                  std::span<const glm::vec3> normals,
+                                                  std::span<const glm::uvec3> triangles,
+                                                  const ScreenRegionQuery& q) {
   const glm::vec4 r = q.rect;
   if (!(r.x >= 0.0f && r.z <= 1.0f && r.y >= 0.0f && r.w <= 1.0f && r.x < r.z && r.y < r.w)) {
     return Invalid("screen region: expected a rectangle x0 < x1, y0 < y1 within [0,1]");
@@ -90,8 +90,8 @@ mocap::Result<std::vector<int>> SelectScreenRegion(const Camera& camera,
     if (d < best) best = d, seed = static_cast<int>(v);
   }
   if (seed < 0) {
-    return mocap::MakeError(mocap::ErrorCode::kNotFound, {},
-                            "screen region: no visible front-facing vertex inside the rectangle");
+    return base::MakeError(base::ErrorCode::kNotFound, {},
+                           "screen region: no visible front-facing vertex inside the rectangle");
   }
   // Union-find over edges of triangles between chosen vertices.
   std::vector<int> parent(positions.size());

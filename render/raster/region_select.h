@@ -11,7 +11,7 @@
 
 #include <glm/glm.hpp>
 
-#include "mocap/error.h"
+#include "base/error.h"
 #include "render/camera.h"
 
 namespace render {
@@ -27,10 +27,10 @@ struct ScreenRegionQuery {
 // them) and `triangles` (#T) of the mesh as it is seen. Errors
 // (kInvalidArgument): a bad rectangle or size, sizes that disagree; (kNotFound):
 // no visible front-facing vertex inside the rectangle.
-mocap::Result<std::vector<int>> SelectScreenRegion(const Camera& camera,
-                                                   std::span<const glm::vec3> positions,
-                                                   std::span<const glm::vec3> normals,
-                                                   std::span<const glm::uvec3> triangles,
-                                                   const ScreenRegionQuery& query);
+base::Result<std::vector<int>> SelectScreenRegion(const Camera& camera,
+                                                  std::span<const glm::vec3> positions,
+                                                  std::span<const glm::vec3> normals,
+                                                  std::span<const glm::uvec3> triangles,
+                                                  const ScreenRegionQuery& query);
 
 }  // namespace render

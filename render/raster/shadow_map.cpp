@@ -6,7 +6,7 @@
 #include <cmath>
 #include <limits>
 
-#include "render/internal/parallel.h"
+#include "base/parallel.h"
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -89,7 +89,7 @@ void ShadowMap::Build(const glm::vec3& light_dir, std::span<const ShadowCaster> 
   std::vector<Range> own(static_cast<std::size_t>(blocks_) * static_cast<std::size_t>(blocks_));
   // Bands of whole block rows: each thread fills its rows, then their block bounds.
   const int bands = std::clamp(settings.threads, 1, blocks_);
-  internal::RunOnThreads(bands, [&](int band) {
+  base::RunOnThreads(bands, [&](int band) {
     const int b0 = blocks_ * band / bands, b1 = blocks_ * (band + 1) / bands;
     RasterBand(projected, casters, b0 * kBlock, std::min(b1 * kBlock, size));
     BlockBounds(b0, b1, own);
@@ -198,7 +198,7 @@ void ShadowMap::NarrowMaxima(int threads) {
   const int rows = size_ + 6;
   std::vector<float> across(static_cast<std::size_t>(rows) * static_cast<std::size_t>(n));
   narrow_max_.resize(static_cast<std::size_t>(n) * static_cast<std::size_t>(n));
-  internal::RunOnThreads(threads, [&](int t) {
+  base::RunOnThreads(threads, [&](int t) {
     for (int j = -3 + rows * t / threads; j < -3 + rows * (t + 1) / threads; ++j) {
       const float* row = Row(j);
       float* out = across.data() + static_cast<std::size_t>(j + 3) * static_cast<std::size_t>(n);
@@ -208,7 +208,7 @@ void ShadowMap::NarrowMaxima(int threads) {
       }
     }
   });
-  internal::RunOnThreads(threads, [&](int t) {
+  base::RunOnThreads(threads, [&](int t) {
     for (int c = n * t / threads; c < n * (t + 1) / threads; ++c) {
       float* out = narrow_max_.data() + static_cast<std::size_t>(c) * static_cast<std::size_t>(n);
       const std::size_t step = static_cast<std::size_t>(n);

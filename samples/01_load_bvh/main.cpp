@@ -14,12 +14,12 @@ int main(int argc, char** argv) {
     return 1;
   }
   // Untrusted input comes back as a Result: a value, or an Error with file:line:column.
-  mocap::Result<mocap::BvhFile> file = mocap::ReadBvhFile(argv[1]);
+  base::Result<mocap::BvhFile> file = mocap::ReadBvhFile(argv[1]);
   if (!file.ok()) {
     std::fprintf(stderr, "%s\n", file.error().ToString().c_str());
     return 2;
   }
-  for (const mocap::Warning& w : file->warnings) std::fprintf(stderr, "%s\n", w.ToString().c_str());
+  for (const base::Warning& w : file->warnings) std::fprintf(stderr, "%s\n", w.ToString().c_str());
   const mocap::Skeleton& skeleton = file->skeleton;
   const mocap::Motion& motion = file->motion;
   std::printf("%d joints, %d channels, %d frames at %g fps, units %s\n", skeleton.num_joints(),

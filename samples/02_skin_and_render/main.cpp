@@ -29,7 +29,7 @@ std::vector<glm::mat4> Pose(const mocap::Skeleton& s, const mocap::Motion& m, in
   return model;
 }
 
-int Fail(const mocap::Error& e) {
+int Fail(const base::Error& e) {
   std::fprintf(stderr, "%s\n", e.ToString().c_str());
   return 2;
 }
@@ -43,7 +43,7 @@ int main(int argc, char** argv) {
   }
   mocap::BvhReadOptions options;
   options.convert_to_y_up = true;  // render with Y up
-  mocap::Result<mocap::BvhFile> file = mocap::ReadBvhFile(argv[1], options);
+  base::Result<mocap::BvhFile> file = mocap::ReadBvhFile(argv[1], options);
   if (!file.ok()) return Fail(file.error());
   const mocap::Skeleton& skeleton = file->skeleton;
   const mocap::Motion& motion = file->motion;
@@ -54,7 +54,8 @@ int main(int argc, char** argv) {
   }
 
   // A closed body with smooth weights, bound at the rest pose.
-  mocap::Result<deform::SkinnedMesh> body = deform::BuildMannequin(skeleton, Pose(skeleton, motion, -1));
+  base::Result<deform::SkinnedMesh> body =
+      deform::BuildMannequin(skeleton, Pose(skeleton, motion, -1));
   if (!body.ok()) return Fail(body.error());
 
   // SSD: palette = model_from_joint * joint_from_bind, then one job over all vertices.
@@ -63,15 +64,15 @@ int main(int argc, char** argv) {
   (void)deform::BuildSkinningPalette(model, *body, palette);
   std::vector<glm::vec3> positions(body->bind.positions.size());
   std::vector<glm::vec3> normals(positions.size());
-  const mocap::JobStatus skinned = deform::SkinningJob{
-      .model_from_bind = palette,
-      .influences = body->weights.influences,
-      .joint_indices = body->weights.joints,
-      .joint_weights = body->weights.weights,
-      .rest_positions = body->bind.positions,
-      .rest_normals = body->bind.normals,
-      .positions = positions,
-      .normals = normals}.Run();
+  const base::JobStatus skinned = deform::SkinningJob{.model_from_bind = palette,
+                                                      .influences = body->weights.influences,
+                                                      .joint_indices = body->weights.joints,
+                                                      .joint_weights = body->weights.weights,
+                                                      .rest_positions = body->bind.positions,
+                                                      .rest_normals = body->bind.normals,
+                                                      .positions = positions,
+                                                      .normals = normals}
+                                      .Run();
   if (!skinned) {
     std::fprintf(stderr, "internal error: %s\n", skinned.what);
     return 3;
@@ -88,7 +89,7 @@ int main(int argc, char** argv) {
   settings.height = 360;
   settings.supersample = 2;
   const render::Image image = render::Render(camera, {&mesh, 1}, {}, settings);
-  const mocap::Status written = render::WriteImage(image, argv[3]);
+  const base::Status written = render::WriteImage(image, argv[3]);
   if (!written.ok()) return Fail(written.error());
   std::printf("wrote %s (%zu vertices, %zu triangles)\n", argv[3], positions.size(),
               body->bind.triangles.size());

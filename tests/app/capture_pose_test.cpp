@@ -52,10 +52,10 @@ fs::path WriteCase(const UpCase& c) {
 // Height (Y, after loading Y-up) over depth (Z; the T-pose arms span X) of the
 // deformed body at frame 10: about 2.5 standing, below 1 lying on the floor.
 float Uprightness(const fs::path& bvh, std::optional<mocap::UpAxis> up = {}) {
-  mocap::Result<app::Character> ch = app::LoadCommandCharacter(bvh.string(), "", true, up);
+  base::Result<app::Character> ch = app::LoadCommandCharacter(bvh.string(), "", true, up);
   EXPECT_TRUE(ch.ok()) << ch.error().ToString();
   if (!ch.ok()) return 0.0f;
-  mocap::Result<app::FramePipeline> p = app::FramePipeline::Create(*ch, app::GlobalMethod::kSsd, 1);
+  base::Result<app::FramePipeline> p = app::FramePipeline::Create(*ch, app::GlobalMethod::kSsd, 1);
   EXPECT_TRUE(p.ok());
   if (!p.ok()) return 0.0f;
   app::DeformedFrame frame;
@@ -67,7 +67,7 @@ float Uprightness(const fs::path& bvh, std::optional<mocap::UpAxis> up = {}) {
 TEST(CapturePose, UpAxisComesFromTheAnimatedPoses) {
   for (const UpCase& c : kCases) {
     SCOPED_TRACE(c.name);
-    const mocap::Result<mocap::BvhFile> file =
+    const base::Result<mocap::BvhFile> file =
         mocap::ParseBvh(testsupport::HumanoidWalkBvh(c.z_up_offsets, c.root_x_deg), c.name);
     ASSERT_TRUE(file.ok()) << file.error().ToString();
     EXPECT_EQ(file->skeleton.info.up_axis, c.expected);
@@ -111,12 +111,13 @@ TEST(CapturePose, InspectSaysWhichUpAxisAndWhy) {
 // |x| or |y| in normalised device coordinates over a quarter of the body's
 // vertices, at every output frame (infinity when a vertex is behind the eye).
 float WorstFollowExtent(const app::Character& ch) {
-  mocap::Result<app::FramePipeline> p = app::FramePipeline::Create(ch, app::GlobalMethod::kSsd, 1);
+  base::Result<app::FramePipeline> p = app::FramePipeline::Create(ch, app::GlobalMethod::kSsd, 1);
   EXPECT_TRUE(p.ok());
-  mocap::Result<app::FramePlan> plan = app::PlanFrames(ch.motion, {.frames = "", .list_frames = false});
+  base::Result<app::FramePlan> plan =
+      app::PlanFrames(ch.motion, {.frames = "", .list_frames = false});
   EXPECT_TRUE(plan.ok());
   if (!p.ok() || !plan.ok()) return INFINITY;
-  mocap::Result<app::CameraPlan> cameras =
+  base::Result<app::CameraPlan> cameras =
       app::CameraPlan::Create(*p, *plan, "follow", 15.0f, {1280, 720});
   EXPECT_TRUE(cameras.ok());
   if (!cameras.ok()) return INFINITY;
@@ -153,7 +154,7 @@ TEST(CapturePose, FollowCameraKeepsGeneratedBodiesInFrame) {
     SCOPED_TRACE(c.name);
     const fs::path bvh = testsupport::TestOutputPath(std::string("capture_pose/") + c.name + ".bvh");
     std::ofstream(bvh) << c.text;
-    mocap::Result<app::Character> ch = app::LoadCommandCharacter(bvh.string(), "", true);
+    base::Result<app::Character> ch = app::LoadCommandCharacter(bvh.string(), "", true);
     ASSERT_TRUE(ch.ok()) << ch.error().ToString();
     EXPECT_EQ(ch->skeleton.info.up_axis_source, mocap::UpAxisSource::kAnimatedPoses);
     EXPECT_LE(WorstFollowExtent(*ch), kMaxFollowExtent);
@@ -167,7 +168,7 @@ TEST(CapturePose, FollowCameraKeepsEveryRealCaptureInFrame) {
     const std::string ext = e.path().extension().string();
     if (ext != ".bvh" && ext != ".glb" && ext != ".gltf") continue;
     SCOPED_TRACE(e.path().string());
-    mocap::Result<app::Character> ch = app::LoadCommandCharacter(e.path().string(), "", true);
+    base::Result<app::Character> ch = app::LoadCommandCharacter(e.path().string(), "", true);
     ASSERT_TRUE(ch.ok()) << ch.error().ToString();
     const float worst = WorstFollowExtent(*ch);
     EXPECT_LE(worst, kMaxFollowExtent);
@@ -187,9 +188,10 @@ TEST(CapturePose, BandaiPositioningRootGrowsNoLimb) {
     const fs::path bvh = testsupport::SharedDataPath(std::string("bvh/bandai_namco/") + name);
     if (!fs::exists(bvh)) continue;
     SCOPED_TRACE(name);
-    mocap::Result<app::Character> ch = app::LoadCommandCharacter(bvh.string(), "", true);
+    base::Result<app::Character> ch = app::LoadCommandCharacter(bvh.string(), "", true);
     ASSERT_TRUE(ch.ok()) << ch.error().ToString();
-    mocap::Result<app::FramePipeline> p = app::FramePipeline::Create(*ch, app::GlobalMethod::kSsd, 1);
+    base::Result<app::FramePipeline> p =
+        app::FramePipeline::Create(*ch, app::GlobalMethod::kSsd, 1);
     ASSERT_TRUE(p.ok());
     app::DeformedFrame frame;
     for (int f = 0; f < ch->motion.num_frames; f += 10) {
@@ -234,7 +236,7 @@ void ExpectBodyOfThePlainWalk(const std::string& bvh_text, const char* file,
                               std::initializer_list<const char*> not_body, float lift) {
   const fs::path bvh = testsupport::TestDir("capture_pose") / file;
   std::ofstream(bvh) << bvh_text;
-  mocap::Result<app::Character> ch = app::LoadCommandCharacter(bvh.string(), "", true);
+  base::Result<app::Character> ch = app::LoadCommandCharacter(bvh.string(), "", true);
   ASSERT_TRUE(ch.ok()) << ch.error().ToString();
   for (const char* name : not_body) {
     const int j = ch->skeleton.FindJoint(name);
@@ -244,10 +246,11 @@ void ExpectBodyOfThePlainWalk(const std::string& bvh_text, const char* file,
   }
   const fs::path plain_bvh = testsupport::TestDir("capture_pose") / "plain_walk.bvh";
   std::ofstream(plain_bvh) << testsupport::HumanoidWalkBvh(false, 0.0f, 90);
-  mocap::Result<app::Character> plain = app::LoadCommandCharacter(plain_bvh.string(), "", true);
+  base::Result<app::Character> plain = app::LoadCommandCharacter(plain_bvh.string(), "", true);
   ASSERT_TRUE(plain.ok()) << plain.error().ToString();
-  mocap::Result<app::FramePipeline> p = app::FramePipeline::Create(*ch, app::GlobalMethod::kSsd, 1);
-  mocap::Result<app::FramePipeline> q = app::FramePipeline::Create(*plain, app::GlobalMethod::kSsd, 1);
+  base::Result<app::FramePipeline> p = app::FramePipeline::Create(*ch, app::GlobalMethod::kSsd, 1);
+  base::Result<app::FramePipeline> q =
+      app::FramePipeline::Create(*plain, app::GlobalMethod::kSsd, 1);
   ASSERT_TRUE(p.ok() && q.ok());
   app::DeformedFrame frame, plain_frame;
   for (int f = 0; f < ch->motion.num_frames; f += 10) {

@@ -340,7 +340,7 @@ TEST(CheckCommand, ReportInChromiumShowsTheFailingCaseFirst) {
 
   // The screenshot: down the left edge of the cases, the first status colour is
   // the failure's red (#c62828), and a pass's green (#2e7d32) follows below it.
-  mocap::Result<render::Image> img = render::ReadImage(shot.string());
+  base::Result<render::Image> img = render::ReadImage(shot.string());
   ASSERT_TRUE(img.ok()) << img.error().ToString();
   ASSERT_EQ(img->width, 1000);
   int first_red = -1, first_green = -1;

@@ -151,7 +151,7 @@ TEST(CliBadRig, ParseRigAnswersEveryCorpusFileWithAnError) {
     SCOPED_TRACE(c.file);
     std::ifstream in(BadRigPath(c.file), std::ios::binary);
     const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-    const mocap::Result<app::Rig> rig = app::ParseRig(text, "r.json");
+    const base::Result<app::Rig> rig = app::ParseRig(text, "r.json");
     // The motion and the frame range are checked when rendering, not parsing.
     const std::string name = c.file;
     if (name.rfind("motion_", 0) == 0 || name == "frames_reversed.json") {

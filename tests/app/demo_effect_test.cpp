@@ -63,7 +63,7 @@ EffectMeasure Measure(const std::string& demo) {
   auto layered = app::FramePipeline::Create(*ch, *method, 1);
   EXPECT_TRUE(global.ok() && layered.ok());
   if (!global.ok() || !layered.ok()) return m;
-  const mocap::Status layers = app::ApplyRigLayers(*rig, *ch, *layered);
+  const base::Status layers = app::ApplyRigLayers(*rig, *ch, *layered);
   EXPECT_TRUE(layers.ok()) << layers.error().ToString();
   if (!layers.ok()) return m;
 
@@ -93,7 +93,7 @@ EffectMeasure Measure(const std::string& demo) {
   spec.azimuth_deg = rig->render.azimuth_deg;
   spec.distance = rig->render.distance;
   spec.zoom = rig->render.zoom;
-  const mocap::Status look = app::ResolveLookAt(rig->render.look_at, &*rig, *ch, spec);
+  const base::Status look = app::ResolveLookAt(rig->render.look_at, &*rig, *ch, spec);
   EXPECT_TRUE(look.ok()) << look.error().ToString();
   const glm::ivec2 size = rig->render.size;
   auto cameras = app::CameraPlan::Create(*global, *plan, spec, {size.x / 2, size.y});
@@ -139,8 +139,8 @@ EffectMeasure Measure(const std::string& demo) {
   app::FrameDrawOptions draw;
   draw.frame_number = of.number;
   draw.side_by_side = true;
-  const mocap::Status drawn = app::DrawCharacterFrame(*ch, g, &l, camera, settings, draw, left_renderer,
-                                                      right_renderer, scratch, frame);
+  const base::Status drawn = app::DrawCharacterFrame(*ch, g, &l, camera, settings, draw,
+                                                     left_renderer, right_renderer, scratch, frame);
   EXPECT_TRUE(drawn.ok());
   const int half = size.x / 2;
   int differing = 0;

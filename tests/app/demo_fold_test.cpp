@@ -42,7 +42,7 @@ TEST_P(DemoFoldTest, TheLayerAddsNoFold) {
   auto global = app::FramePipeline::Create(*ch, *method, 1);
   auto layered = app::FramePipeline::Create(*ch, *method, 1);
   ASSERT_TRUE(global.ok() && layered.ok());
-  const mocap::Status layers = app::ApplyRigLayers(*rig, *ch, *layered);
+  const base::Status layers = app::ApplyRigLayers(*rig, *ch, *layered);
   ASSERT_TRUE(layers.ok()) << layers.error().ToString();
 
   auto patches = app::BuildRigPatches(*rig, *ch);

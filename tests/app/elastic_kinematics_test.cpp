@@ -90,7 +90,7 @@ TEST(ElasticKinematics, RefusesAnEmptyRepeatedOrOutOfRangeJointList) {
        {std::vector<int>{}, std::vector<int>{1, 1}, std::vector<int>{nj}, std::vector<int>{-1}}) {
     auto k = app::DrivingKinematicsOf(c.skeleton, c.motion, joints, 10.0);
     ASSERT_FALSE(k.ok());
-    EXPECT_EQ(k.error().code, mocap::ErrorCode::kInvalidArgument);
+    EXPECT_EQ(k.error().code, base::ErrorCode::kInvalidArgument);
     EXPECT_NE(k.error().message.find("joint"), std::string::npos) << k.error().message;
   }
 }

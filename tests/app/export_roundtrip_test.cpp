@@ -77,7 +77,7 @@ RigRun LoadRigRun(const fs::path& rig_path) {
   return r;
 }
 
-mocap::Result<deform::GltfModel> ReadExport(const fs::path& glb) {
+base::Result<deform::GltfModel> ReadExport(const fs::path& glb) {
   deform::GltfReadOptions options;
   options.require_skin = false;  // an export holds plain (morphed or per-frame) meshes
   return deform::ReadGltf(glb.string(), options);

@@ -35,9 +35,10 @@ namespace fs = std::filesystem;
 app::Character Demo() {
   app::MotionSourceOptions load;
   load.y_up = true;
-  mocap::Result<app::MotionSource> src = app::LoadBvhText(app::DemoBvhText(), "demo_walk.bvh", load);
+  base::Result<app::MotionSource> src = app::LoadBvhText(app::DemoBvhText(), "demo_walk.bvh", load);
   EXPECT_TRUE(src.ok());
-  mocap::Result<app::Character> ch = app::MakeCharacter(std::move(*src), {}, app::BodyKind::kGenerated);  // export's default body
+  base::Result<app::Character> ch =
+      app::MakeCharacter(std::move(*src), {}, app::BodyKind::kGenerated);  // export's default body
   EXPECT_TRUE(ch.ok());
   return std::move(*ch);
 }
@@ -73,13 +74,13 @@ TEST(ExportCommand, ObjFramesAreThePipelineFramesAndCamerasAreRenders) {
       << testsupport::SlurpFile(dir / "stderr.txt");
 
   const app::Character ch = Demo();
-  mocap::Result<app::FramePlan> plan = app::PlanFrames(ch.motion, {.frames = "10:40:10"});
+  base::Result<app::FramePlan> plan = app::PlanFrames(ch.motion, {.frames = "10:40:10"});
   ASSERT_TRUE(plan.ok());
   ASSERT_EQ(plan->frames.size(), 4u);
-  mocap::Result<app::FramePipeline> pipeline =
+  base::Result<app::FramePipeline> pipeline =
       app::FramePipeline::Create(ch, app::GlobalMethod::kDqs, 1);
   ASSERT_TRUE(pipeline.ok());
-  mocap::Result<app::CameraPlan> cameras =
+  base::Result<app::CameraPlan> cameras =
       app::CameraPlan::Create(*pipeline, *plan, "follow", 15.0f, {320, 200});
   ASSERT_TRUE(cameras.ok());
 
@@ -138,9 +139,9 @@ TEST(ExportCommand, GlbGivesEachFrameAtItsTime) {
   ASSERT_TRUE(testsupport::LoadGlb((dir / "walk.glb").string(), m, msg)) << msg;
 
   const app::Character ch = Demo();
-  mocap::Result<app::FramePlan> plan = app::PlanFrames(ch.motion, {.frames = "0:20:4"});
+  base::Result<app::FramePlan> plan = app::PlanFrames(ch.motion, {.frames = "0:20:4"});
   ASSERT_TRUE(plan.ok());
-  mocap::Result<app::FramePipeline> pipeline =
+  base::Result<app::FramePipeline> pipeline =
       app::FramePipeline::Create(ch, app::GlobalMethod::kSsd, 1);
   ASSERT_TRUE(pipeline.ok());
   app::DeformedFrame frame;
@@ -208,8 +209,8 @@ TEST(ExportCommand, ObjDrawnWithItsCameraJsonIsTheRenderedFrame) {
   ASSERT_TRUE(renderer.Render(cam, {&body, 1}, overlays, settings, image));
   ASSERT_TRUE(render::WriteImage(image, (dir / "from_obj.png").string(), {}));
 
-  mocap::Result<render::Image> a = render::ReadImage((dir / "frame_0012.png").string());
-  mocap::Result<render::Image> b = render::ReadImage((dir / "from_obj.png").string());
+  base::Result<render::Image> a = render::ReadImage((dir / "frame_0012.png").string());
+  base::Result<render::Image> b = render::ReadImage((dir / "from_obj.png").string());
   ASSERT_TRUE(a.ok() && b.ok());
   ASSERT_EQ(a->width, b->width);
   ASSERT_EQ(a->height, b->height);

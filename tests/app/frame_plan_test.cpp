@@ -29,11 +29,11 @@ TEST(FramePlan, AtGivesTheListedFrames) {
       {.frames = "3", .turntable = true, .turntable_frames = 36},
   };
   for (const app::FramePlanOptions& o : cases) {
-    const mocap::Result<app::FramePlan> listed = app::PlanFrames(motion, o);
+    const base::Result<app::FramePlan> listed = app::PlanFrames(motion, o);
     ASSERT_TRUE(listed.ok()) << listed.error().ToString();
     app::FramePlanOptions lazy = o;
     lazy.list_frames = false;
-    const mocap::Result<app::FramePlan> walked = app::PlanFrames(motion, lazy);
+    const base::Result<app::FramePlan> walked = app::PlanFrames(motion, lazy);
     ASSERT_TRUE(walked.ok());
     EXPECT_TRUE(walked->frames.empty()) << o.frames;
     ASSERT_EQ(walked->count(), listed->frames.size()) << o.frames;
@@ -49,7 +49,7 @@ TEST(FramePlan, AtGivesTheListedFrames) {
 
 TEST(FramePlan, AnHourAt120FpsIsCountedNotListed) {
   const mocap::Motion motion = TimingOnly(432000, 1.0 / 120.0);
-  const mocap::Result<app::FramePlan> plan =
+  const base::Result<app::FramePlan> plan =
       app::PlanFrames(motion, {.frames = "1:431999:2", .list_frames = false});
   ASSERT_TRUE(plan.ok());
   EXPECT_TRUE(plan->frames.empty());

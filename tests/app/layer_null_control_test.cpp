@@ -60,7 +60,7 @@ void LoadBodies(const std::string& demo, Edit edit, Bodies& b) {
   ASSERT_TRUE(global.ok() && layered.ok());
   b.global.emplace(std::move(*global));
   b.layered.emplace(std::move(*layered));
-  const mocap::Status s = app::ApplyRigLayers(b.rig, *b.character, *b.layered);
+  const base::Status s = app::ApplyRigLayers(b.rig, *b.character, *b.layered);
   ASSERT_TRUE(s.ok()) << s.error().ToString();
   ASSERT_GT(b.layered->num_patches(), 0);
 }
@@ -82,8 +82,8 @@ render::Image Draw(const app::Character& ch, const app::DeformedFrame& f, const 
   }
   render::Renderer renderer, unused_renderer;
   render::Image image, unused;
-  const mocap::Status s = app::DrawCharacterFrame(ch, f, nullptr, camera, settings, {}, renderer,
-                                                  unused_renderer, unused, image);
+  const base::Status s = app::DrawCharacterFrame(ch, f, nullptr, camera, settings, {}, renderer,
+                                                 unused_renderer, unused, image);
   EXPECT_TRUE(s.ok());
   return image;
 }

@@ -16,20 +16,20 @@ namespace {
 namespace fs = std::filesystem;
 
 TEST(CheckRigOutputPattern, AcceptsRelativePatternsInsideTheFolder) {
-  const mocap::FileLoc where{"walk.rig.json", 0, 0, "render.output"};
+  const base::FileLoc where{"walk.rig.json", 0, 0, "render.output"};
   EXPECT_TRUE(app::CheckRigOutputPattern("frames/walk_####.png", where).ok());
   EXPECT_TRUE(app::CheckRigOutputPattern("walk..v2_####.png", where).ok());
   EXPECT_TRUE(app::CheckRigOutputPattern("a/..b/####.png", where).ok());
 }
 
 TEST(CheckRigOutputPattern, RefusesEscapes) {
-  const mocap::FileLoc where{"walk.rig.json", 0, 0, "render.output"};
+  const base::FileLoc where{"walk.rig.json", 0, 0, "render.output"};
   for (const char* bad : {"../####.png", "frames/../../####.png", "frames/..", "..\\x\\####.png",
                           "/tmp/####.png", "~/####.png", "C:/x/####.png", ""}) {
     SCOPED_TRACE(bad);
-    const mocap::Status s = app::CheckRigOutputPattern(bad, where);
+    const base::Status s = app::CheckRigOutputPattern(bad, where);
     ASSERT_FALSE(s.ok());
-    EXPECT_EQ(s.error().code, mocap::ErrorCode::kInvalidArgument);
+    EXPECT_EQ(s.error().code, base::ErrorCode::kInvalidArgument);
     EXPECT_EQ(s.error().loc.field_path, "render.output");
     EXPECT_NE(s.error().message.find("expected a relative path inside"), std::string::npos);
   }
@@ -64,7 +64,7 @@ TEST_F(OutputGuardTest, ExistingFrameIsRefusedWithCount) {
   Touch(paths_[1]);
   Touch(paths_[3]);
   app::OutputGuard guard({});
-  const mocap::Status s = guard.Plan(paths_, {});
+  const base::Status s = guard.Plan(paths_, {});
   ASSERT_FALSE(s.ok());
   EXPECT_EQ(s.error().loc.file, paths_[1]);
   EXPECT_NE(s.error().message.find("2 of this render's 4 outputs"), std::string::npos)

@@ -86,14 +86,14 @@ struct Evaluated {
   std::vector<glm::vec3> with_examples;   // patches + dS
 };
 
-mocap::Result<app::FramePipeline> MakePipeline(const ElbowFixture& f, const app::Rig* rig) {
+base::Result<app::FramePipeline> MakePipeline(const ElbowFixture& f, const app::Rig* rig) {
   auto pipeline = app::FramePipeline::Create(f.character, app::GlobalMethod::kSsd, 1);
   if (!pipeline.ok()) return pipeline;
-  if (mocap::Status s = pipeline->SetPatches(f.patches); !s.ok()) return s.error();
+  if (base::Status s = pipeline->SetPatches(f.patches); !s.ok()) return s.error();
   if (rig) {
     auto spaces = app::BuildRigPoseSpaces(*rig, f.character, f.patches, app::GlobalMethod::kSsd);
     if (!spaces.ok()) return std::move(spaces).error();
-    if (mocap::Status s = pipeline->SetPoseSpaces(std::move(spaces->patches)); !s.ok()) {
+    if (base::Status s = pipeline->SetPoseSpaces(std::move(spaces->patches)); !s.ok()) {
       return s.error();
     }
   }

@@ -35,7 +35,7 @@ constexpr const char* kGood = R"({
 })";
 
 TEST(RigFile, ParsesEveryFieldAndResolvesPathsAgainstTheRigFolder) {
-  const mocap::Result<app::Rig> rig = app::ParseRig(kGood, "samples/data/rig.json");
+  const base::Result<app::Rig> rig = app::ParseRig(kGood, "samples/data/rig.json");
   ASSERT_TRUE(rig.ok()) << rig.error().ToString();
   EXPECT_EQ(rig->character, "mannequin");
   EXPECT_EQ(rig->motion, "samples/data/bend.bvh");
@@ -319,7 +319,7 @@ TEST(RigFile, ElasticDefaultsAndEveryField) {
 
 TEST(RigFile, BadRigsGiveExactMessages) {
   for (const BadRig& bad : kBadRigs) {
-    const mocap::Result<app::Rig> rig = app::ParseRig(bad.text, "r.json");
+    const base::Result<app::Rig> rig = app::ParseRig(bad.text, "r.json");
     ASSERT_FALSE(rig.ok()) << bad.text;
     EXPECT_EQ(rig.error().ToString(), bad.message) << bad.text;
   }
@@ -328,7 +328,7 @@ TEST(RigFile, BadRigsGiveExactMessages) {
 TEST(RigFile, MissingFileIsAnIoError) {
   const auto rig = app::LoadRig("/nonexistent/rig.json");
   ASSERT_FALSE(rig.ok());
-  EXPECT_EQ(rig.error().code, mocap::ErrorCode::kIo);
+  EXPECT_EQ(rig.error().code, base::ErrorCode::kIo);
 }
 
 namespace fs = std::filesystem;

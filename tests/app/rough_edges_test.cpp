@@ -47,7 +47,7 @@ TEST(RoughEdges, OddSizeRendersFramesAndVideo) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
   EXPECT_TRUE(fs::exists(out / "preview.mp4"));
-  const mocap::Result<render::Image> frame = render::ReadImage((out / "f_0003.png").string());
+  const base::Result<render::Image> frame = render::ReadImage((out / "f_0003.png").string());
   ASSERT_TRUE(frame.ok()) << frame.error().ToString();
   EXPECT_EQ(frame->width, 101);
   EXPECT_EQ(frame->height, 57);
@@ -263,7 +263,7 @@ TEST(RoughEdges, TurntableOfARigHonoursItsOptions) {
                       "1001", "--quiet", "--no-video", "--no-sheet"});
     ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_EQ(Names(out), (std::vector<std::string>{"t_1001.png", "t_1002.png", "t_1003.png"}));
-    const mocap::Result<render::Image> img = render::ReadImage((out / "t_1001.png").string());
+    const base::Result<render::Image> img = render::ReadImage((out / "t_1001.png").string());
     ASSERT_TRUE(img.ok()) << img.error().ToString();
     EXPECT_EQ(img->width, 96);
     EXPECT_EQ(img->height, 64);

@@ -100,7 +100,7 @@ void CheckCharacter(const app::Character& c, const std::string& what, float max_
     EXPECT_LT(err / std::max({e.x, e.y, e.z}), testsupport::kSwdRebuildRelTol) << what;
   }
   ExpectClosed(c.mesh.bind, what);
-  const mocap::Status w = deform::CheckSkinWeights(
+  const base::Status w = deform::CheckSkinWeights(
       c.mesh.weights, static_cast<int>(c.mesh.skin_joints.size()), c.mesh.bind.num_vertices());
   EXPECT_TRUE(w.ok()) << what << ": " << w.error().ToString();
   auto one = app::FramePipeline::Create(c, app::GlobalMethod::kSwd, 1);

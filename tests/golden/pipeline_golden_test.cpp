@@ -102,11 +102,11 @@ render::Image Render(const app::Character& c, int frame, bool split,
                                       .right_label = !split    ? ""
                                                      : layered ? "swd + patches"
                                                                : "swd"};
-  const mocap::Status s =
-      split ? app::DrawCharacterFrame(c, left, &right, camera, settings, options, renderer,
-                                      right_renderer, scratch, image)
-            : app::DrawCharacterFrame(c, right, nullptr, camera, settings, options, renderer,
-                                      right_renderer, scratch, image);
+  const base::Status s = split
+                             ? app::DrawCharacterFrame(c, left, &right, camera, settings, options,
+                                                       renderer, right_renderer, scratch, image)
+                             : app::DrawCharacterFrame(c, right, nullptr, camera, settings, options,
+                                                       renderer, right_renderer, scratch, image);
   EXPECT_TRUE(s.ok());
   return image;
 }

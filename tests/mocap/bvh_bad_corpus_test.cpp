@@ -14,7 +14,7 @@
 
 namespace {
 
-using mocap::ErrorCode;
+using base::ErrorCode;
 
 struct BadCase {
   const char* file;
@@ -77,8 +77,8 @@ TEST_P(BvhBadCorpus, FailsWithDocumentedCodeAndLocation) {
   ASSERT_TRUE(std::filesystem::exists(path)) << path;
   auto result = mocap::ReadBvhFile(path);
   ASSERT_FALSE(result.ok()) << c.file << " loaded but should fail";
-  const mocap::Error& e = result.error();
-  EXPECT_EQ(mocap::ErrorCodeName(e.code), mocap::ErrorCodeName(c.code)) << e.ToString();
+  const base::Error& e = result.error();
+  EXPECT_EQ(base::ErrorCodeName(e.code), base::ErrorCodeName(c.code)) << e.ToString();
   EXPECT_EQ(e.loc.line, c.line) << e.ToString();
   EXPECT_EQ(e.loc.column, c.column) << e.ToString();
   EXPECT_EQ(e.loc.file, path);
@@ -118,7 +118,7 @@ TEST(BvhBadCorpusIndex, FolderTableAndReadmeAgree) {
     const std::size_t at = text.find(row);
     ASSERT_NE(at, std::string::npos) << c.file << " has no README row";
     const std::string line = text.substr(at, text.find('\n', at) - at);
-    const std::string tail = " | " + std::string(mocap::ErrorCodeName(c.code)) + " | " +
+    const std::string tail = " | " + std::string(base::ErrorCodeName(c.code)) + " | " +
                              std::to_string(c.line) + ":" + std::to_string(c.column) + " |";
     EXPECT_EQ(line.substr(line.size() - tail.size()), tail) << line;
   }

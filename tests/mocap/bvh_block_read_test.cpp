@@ -39,7 +39,7 @@ mocap::BvhReadOptions Blocks(std::size_t block_bytes, bool two_threads) {
 }
 
 // The reference: one sequential pass over in-memory text in one block.
-mocap::Result<mocap::BvhFile> Reference(const std::string& text, const std::string& name) {
+base::Result<mocap::BvhFile> Reference(const std::string& text, const std::string& name) {
   return mocap::ParseBvh(text, name, Blocks(std::numeric_limits<std::size_t>::max(), false));
 }
 

@@ -19,10 +19,10 @@
 
 namespace {
 
+using base::ErrorCode;
 using mocap::BvhFile;
 using mocap::BvhReadOptions;
 using mocap::ChannelType;
-using mocap::ErrorCode;
 using mocap::ParseBvh;
 
 // Two joints, an end site, 6 + 3 channels, two frames.

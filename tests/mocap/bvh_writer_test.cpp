@@ -115,17 +115,17 @@ TEST(BvhWriter, RejectsWhatBvhCannotHold) {
   quat.skeleton.channels[1].types[0] = mocap::ChannelType::kQuatX;
   auto a = mocap::FormatBvh(quat.skeleton, quat.motion);
   ASSERT_FALSE(a.ok());
-  EXPECT_EQ(a.error().code, mocap::ErrorCode::kUnsupported);
+  EXPECT_EQ(a.error().code, base::ErrorCode::kUnsupported);
   mocap::BvhFile named = *file;
   named.skeleton.names[0] = "bad{name";
   auto b = mocap::FormatBvh(named.skeleton, named.motion);
   ASSERT_FALSE(b.ok());
-  EXPECT_EQ(b.error().code, mocap::ErrorCode::kUnsupported);
+  EXPECT_EQ(b.error().code, base::ErrorCode::kUnsupported);
   mocap::BvhFile sized = *file;
   sized.motion.values.pop_back();
   auto c = mocap::FormatBvh(sized.skeleton, sized.motion);
   ASSERT_FALSE(c.ok());
-  EXPECT_EQ(c.error().code, mocap::ErrorCode::kInvalidArgument);
+  EXPECT_EQ(c.error().code, base::ErrorCode::kInvalidArgument);
 }
 
 TEST(BvhWriter, WritesFileAtomically) {
@@ -137,10 +137,10 @@ TEST(BvhWriter, WritesFileAtomically) {
   auto back = mocap::ReadBvhFile(path.string());
   ASSERT_TRUE(back.ok()) << back.error().ToString();
   ExpectSame(*file, *back);
-  const mocap::Status bad =
+  const base::Status bad =
       mocap::WriteBvhFile("/nonexistent/dir/x.bvh", file->skeleton, file->motion);
   ASSERT_FALSE(bad.ok());
-  EXPECT_EQ(bad.error().code, mocap::ErrorCode::kIo);
+  EXPECT_EQ(bad.error().code, base::ErrorCode::kIo);
 }
 
 TEST(BvhWriter, RealCapturesRoundTrip) {

@@ -60,7 +60,7 @@ Frame Time: 0.0333333
 TEST(ChannelUse, TellsRotationsAndPositioningLinksApart) {
   mocap::BvhReadOptions read;
   read.scale = 1.0f;
-  mocap::Result<mocap::BvhFile> file = mocap::ParseBvh(kBvh, "use.bvh", read);
+  base::Result<mocap::BvhFile> file = mocap::ParseBvh(kBvh, "use.bvh", read);
   ASSERT_TRUE(file.ok()) << file.error().ToString();
   const mocap::Skeleton& s = file->skeleton;
   const std::vector<std::uint8_t> use = mocap::ChannelUse(s, file->motion);
@@ -76,7 +76,7 @@ TEST(ChannelUse, TellsRotationsAndPositioningLinksApart) {
 TEST(ChannelUse, EmptyWhenTheMotionDoesNotFitTheSkeleton) {
   mocap::BvhReadOptions read;
   read.scale = 1.0f;
-  mocap::Result<mocap::BvhFile> file = mocap::ParseBvh(kBvh, "use.bvh", read);
+  base::Result<mocap::BvhFile> file = mocap::ParseBvh(kBvh, "use.bvh", read);
   ASSERT_TRUE(file.ok());
   mocap::Motion other = file->motion;
   other.num_channels -= 1;

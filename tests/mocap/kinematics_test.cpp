@@ -142,17 +142,17 @@ TEST(KinematicsJob, Validity) {
                  .model_from_joint = model, .num_joints = 0, .frame_time_s = 0.1, .output = out})
                 .Validate()
                 .code,
-            mocap::JobStatus::kMissingInput);
+            base::JobStatus::kMissingInput);
   EXPECT_EQ((mocap::KinematicsJob{
                  .model_from_joint = model, .num_joints = 2, .frame_time_s = 0.1, .output = odd})
                 .Validate()
                 .code,
-            mocap::JobStatus::kSizeMismatch);
+            base::JobStatus::kSizeMismatch);
   EXPECT_EQ((mocap::KinematicsJob{
                  .model_from_joint = model, .num_joints = 2, .frame_time_s = 0.0, .output = out})
                 .Validate()
                 .code,
-            mocap::JobStatus::kOutOfRange);
+            base::JobStatus::kOutOfRange);
   EXPECT_EQ((mocap::KinematicsJob{.model_from_joint = model,
                                   .num_joints = 2,
                                   .frame_time_s = 0.1,
@@ -160,7 +160,7 @@ TEST(KinematicsJob, Validity) {
                                   .output = out})
                 .Validate()
                 .code,
-            mocap::JobStatus::kOutOfRange);
+            base::JobStatus::kOutOfRange);
   EXPECT_TRUE((mocap::KinematicsJob{
                    .model_from_joint = model, .num_joints = 2, .frame_time_s = 0.1, .output = out})
                   .Run()
@@ -174,7 +174,7 @@ TEST(KinematicsJob, Validity) {
                  .skeleton = &s, .motion = &m, .locals = few, .model_from_joint = mats})
                 .Validate()
                 .code,
-            mocap::JobStatus::kSizeMismatch);
+            base::JobStatus::kSizeMismatch);
   EXPECT_EQ((mocap::ModelMatricesJob{.skeleton = &s,
                                      .motion = &m,
                                      .first_frame = m.num_frames - 2,
@@ -182,12 +182,12 @@ TEST(KinematicsJob, Validity) {
                                      .model_from_joint = mats})
                 .Validate()
                 .code,
-            mocap::JobStatus::kOutOfRange);
+            base::JobStatus::kOutOfRange);
   EXPECT_EQ((mocap::ModelMatricesJob{
                  .skeleton = nullptr, .motion = &m, .locals = locals, .model_from_joint = mats})
                 .Validate()
                 .code,
-            mocap::JobStatus::kMissingInput);
+            base::JobStatus::kMissingInput);
 }
 
 TEST(KinematicsJob, MatchesAnalyticDerivativesAtInteriorFrames) {
@@ -368,7 +368,7 @@ TEST(KinematicsJob, ShortMotions) {
   mocap::Motion none = one;
   none.num_frames = 0;
   none.values.clear();
-  EXPECT_EQ(mocap::ComputeKinematics(s, none).error().code, mocap::ErrorCode::kInvalidArgument);
+  EXPECT_EQ(mocap::ComputeKinematics(s, none).error().code, base::ErrorCode::kInvalidArgument);
 }
 
 TEST(SmoothTrajectoriesJob, Validity) {
@@ -380,12 +380,12 @@ TEST(SmoothTrajectoriesJob, Validity) {
                                           .output = out})
                 .Validate()
                 .code,
-            mocap::JobStatus::kOutOfRange);
+            base::JobStatus::kOutOfRange);
   EXPECT_EQ((mocap::SmoothTrajectoriesJob{
                  .model_from_joint = model, .num_joints = 2, .frame_time_s = 0.1, .output = odd})
                 .Validate()
                 .code,
-            mocap::JobStatus::kSizeMismatch);
+            base::JobStatus::kSizeMismatch);
   EXPECT_EQ((mocap::SmoothTrajectoriesJob{.model_from_joint = model,
                                           .num_joints = 2,
                                           .frame_time_s = 0.1,
@@ -393,7 +393,7 @@ TEST(SmoothTrajectoriesJob, Validity) {
                                           .output = out})
                 .Validate()
                 .code,
-            mocap::JobStatus::kOutOfRange);
+            base::JobStatus::kOutOfRange);
   EXPECT_TRUE((mocap::SmoothTrajectoriesJob{
                    .model_from_joint = model, .num_joints = 2, .frame_time_s = 0.1, .output = out})
                   .Run()
@@ -464,11 +464,11 @@ TEST(SampleJointKinematics, ExactAtFramesAndCloseBetween) {
   const double h = m.frame_time_s;
   mocap::JointKinematics out;
   EXPECT_EQ(mocap::SampleJointKinematics(*k, 3, 3, h, 0.0, &out).code,
-            mocap::JobStatus::kOutOfRange);
+            base::JobStatus::kOutOfRange);
   EXPECT_EQ(mocap::SampleJointKinematics(std::span(*k).first(5), 3, 0, h, 0.0, &out).code,
-            mocap::JobStatus::kSizeMismatch);
+            base::JobStatus::kSizeMismatch);
   EXPECT_EQ(mocap::SampleJointKinematics(*k, 3, 0, h, 0.0, nullptr).code,
-            mocap::JobStatus::kMissingInput);
+            base::JobStatus::kMissingInput);
   ASSERT_TRUE(mocap::SampleJointKinematics(*k, 3, 2, h, 7 * h, &out).ok());
   EXPECT_EQ(out.linear_acceleration, (*k)[7 * 3 + 2].linear_acceleration);
   // Between frames (RK4 stage times): linear interpolation adds h^2/8 max|x'''| to

@@ -31,9 +31,10 @@ TEST(LocalPoseJob, Validity) {
   std::vector<float> frame(9, 0.0f);
   std::vector<mocap::JointTransform> locals(2);
   EXPECT_EQ((mocap::LocalPoseJob{nullptr, frame, locals}).Validate().code,
-            mocap::JobStatus::kMissingInput);
-  EXPECT_EQ((mocap::LocalPoseJob{&s, std::span<const float>(frame).first(8), locals}).Validate().code,
-            mocap::JobStatus::kSizeMismatch);
+            base::JobStatus::kMissingInput);
+  EXPECT_EQ(
+      (mocap::LocalPoseJob{&s, std::span<const float>(frame).first(8), locals}).Validate().code,
+      base::JobStatus::kSizeMismatch);
   EXPECT_TRUE((mocap::LocalPoseJob{&s, frame, locals}).Run().ok());
 }
 

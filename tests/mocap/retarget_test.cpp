@@ -105,7 +105,7 @@ TEST(Retarget, NamesUnmappedRequiredJoints) {
              std::vector<glm::quat>(3, glm::quat(1, 0, 0, 0)));
   const auto r = mocap::RetargetMotion(target, bvh.skeleton, bvh.motion, "body.glb", "motion.bvh");
   ASSERT_FALSE(r.ok());
-  EXPECT_EQ(r.error().code, mocap::ErrorCode::kInvalidArgument);
+  EXPECT_EQ(r.error().code, base::ErrorCode::kInvalidArgument);
   EXPECT_NE(r.error().message.find("found none for: Chest"), std::string::npos) << r.error().ToString();
   EXPECT_EQ(r.error().loc.file, "motion.bvh");
 

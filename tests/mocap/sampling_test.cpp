@@ -107,31 +107,31 @@ TEST(SampleLocalsJob, Validity) {
                  .skeleton = nullptr, .motion = &m, .scratch = scratch, .locals = locals})
                 .Validate()
                 .code,
-            mocap::JobStatus::kMissingInput);
+            base::JobStatus::kMissingInput);
   EXPECT_EQ(
       (mocap::SampleLocalsJob{.skeleton = &s, .motion = &m, .scratch = small, .locals = locals})
           .Validate()
           .code,
-      mocap::JobStatus::kSizeMismatch);
+      base::JobStatus::kSizeMismatch);
   EXPECT_EQ(
       (mocap::SampleLocalsJob{.skeleton = &s, .motion = &m, .scratch = scratch, .locals = small})
           .Validate()
           .code,
-      mocap::JobStatus::kSizeMismatch);
+      base::JobStatus::kSizeMismatch);
   mocap::Motion bad_time = m;
   bad_time.frame_time_s = 0.0;
   EXPECT_EQ((mocap::SampleLocalsJob{
                  .skeleton = &s, .motion = &bad_time, .scratch = scratch, .locals = locals})
                 .Validate()
                 .code,
-            mocap::JobStatus::kOutOfRange);
+            base::JobStatus::kOutOfRange);
   mocap::Motion empty = m;
   empty.num_frames = 0;
   EXPECT_EQ((mocap::SampleLocalsJob{
                  .skeleton = &s, .motion = &empty, .scratch = scratch, .locals = locals})
                 .Run()
                 .code,
-            mocap::JobStatus::kMissingInput);
+            base::JobStatus::kMissingInput);
   EXPECT_TRUE(
       (mocap::SampleLocalsJob{.skeleton = &s, .motion = &m, .scratch = scratch, .locals = locals})
           .Run()
@@ -234,15 +234,15 @@ TEST(Resample, EulerChannelsStayContinuous) {
 TEST(Resample, RejectsBadInput) {
   const mocap::Skeleton s = ThreeJoints();
   const mocap::Motion m = Wander(5, 0.1);
-  EXPECT_EQ(mocap::Resample(s, m, 0.0).error().code, mocap::ErrorCode::kInvalidArgument);
-  EXPECT_EQ(mocap::Resample(s, m, std::nan("")).error().code, mocap::ErrorCode::kInvalidArgument);
-  EXPECT_EQ(mocap::Resample(s, m, 1e-12).error().code, mocap::ErrorCode::kLimitExceeded);
+  EXPECT_EQ(mocap::Resample(s, m, 0.0).error().code, base::ErrorCode::kInvalidArgument);
+  EXPECT_EQ(mocap::Resample(s, m, std::nan("")).error().code, base::ErrorCode::kInvalidArgument);
+  EXPECT_EQ(mocap::Resample(s, m, 1e-12).error().code, base::ErrorCode::kLimitExceeded);
   mocap::Motion short_rows = m;
   short_rows.values.pop_back();
-  EXPECT_EQ(mocap::Resample(s, short_rows, 0.05).error().code, mocap::ErrorCode::kInvalidArgument);
+  EXPECT_EQ(mocap::Resample(s, short_rows, 0.05).error().code, base::ErrorCode::kInvalidArgument);
   mocap::Skeleton other = s;
   other.num_channels = 12;
-  EXPECT_EQ(mocap::Resample(other, m, 0.05).error().code, mocap::ErrorCode::kInvalidArgument);
+  EXPECT_EQ(mocap::Resample(other, m, 0.05).error().code, base::ErrorCode::kInvalidArgument);
 }
 
 // FindFrameBlend (truncation instead of floor and round) against its definition

@@ -251,22 +251,22 @@ TEST(Synthetic, JumpHasAnAccelerationSpikeAndFreeFall) {
 TEST(Synthetic, GeneratorsRejectBadInput) {
   const mocap::Skeleton s = mocap::MakeHumanoidSkeleton();
   EXPECT_EQ(mocap::MakeBendRamp(s, 150.0f, 2.0, 0.0).error().code,
-            mocap::ErrorCode::kInvalidArgument);
+            base::ErrorCode::kInvalidArgument);
   EXPECT_EQ(mocap::MakeWalkMotion(s, {.step_length_cm = 90.0}).error().code,
-            mocap::ErrorCode::kInvalidArgument);
+            base::ErrorCode::kInvalidArgument);
   EXPECT_EQ(mocap::MakeWalkMotion(s, {.num_cycles = 0}).error().code,
-            mocap::ErrorCode::kInvalidArgument);
+            base::ErrorCode::kInvalidArgument);
   EXPECT_EQ(mocap::MakeJumpMotion(s, {.crouch_cm = 100.0}).error().code,
-            mocap::ErrorCode::kInvalidArgument);
+            base::ErrorCode::kInvalidArgument);
   auto chain = mocap::MakeChainSkeleton(5);
   ASSERT_TRUE(chain.ok());
   const auto missing = mocap::MakeTwistRamp(*chain);
   ASSERT_FALSE(missing.ok());
-  EXPECT_EQ(missing.error().code, mocap::ErrorCode::kNotFound);
+  EXPECT_EQ(missing.error().code, base::ErrorCode::kNotFound);
   EXPECT_NE(missing.error().message.find("Hips"), std::string::npos);
-  EXPECT_EQ(mocap::MakeChainSkeleton(0).error().code, mocap::ErrorCode::kInvalidArgument);
+  EXPECT_EQ(mocap::MakeChainSkeleton(0).error().code, base::ErrorCode::kInvalidArgument);
   EXPECT_EQ(mocap::MakeChainSkeleton(mocap::kMaxJoints + 1).error().code,
-            mocap::ErrorCode::kInvalidArgument);
+            base::ErrorCode::kInvalidArgument);
 }
 
 TEST(Synthetic, GeneratorsFollowAnyChannelOrder) {

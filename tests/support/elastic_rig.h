@@ -67,7 +67,7 @@ inline RigPipeline LoadRigPipeline(const app::Rig& rig, int threads = 1,
   }
   l.layered.emplace(std::move(*layered));
   l.global.emplace(std::move(*global));
-  mocap::Status s = l.layered->SetPatches(std::move(*patches));
+  base::Status s = l.layered->SetPatches(std::move(*patches));
   if (s.ok()) s = l.layered->SetElastic(std::move(*specs));
   if (!s.ok()) ADD_FAILURE() << s.error().ToString();
   return l;

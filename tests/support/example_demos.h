@@ -38,7 +38,7 @@ struct Demo {
 // Loads samples/data/<name>.json. Any failure is returned in Demo::error.
 inline std::unique_ptr<Demo> LoadDemo(const std::string& name) {
   auto demo = std::make_unique<Demo>();
-  auto fail = [&](const mocap::Error& e) {
+  auto fail = [&](const base::Error& e) {
     demo->error = e.ToString();
     return std::move(demo);
   };
@@ -61,8 +61,8 @@ inline std::unique_ptr<Demo> LoadDemo(const std::string& name) {
   auto layered = app::FramePipeline::Create(demo->character, *method, 1);
   if (!global.ok()) return fail(global.error());
   if (!layered.ok()) return fail(layered.error());
-  if (mocap::Status s = layered->SetPatches(demo->patches); !s.ok()) return fail(s.error());
-  if (mocap::Status s = layered->SetPoseSpaces(spaces->patches); !s.ok()) return fail(s.error());
+  if (base::Status s = layered->SetPatches(demo->patches); !s.ok()) return fail(s.error());
+  if (base::Status s = layered->SetPoseSpaces(spaces->patches); !s.ok()) return fail(s.error());
   demo->spaces = std::move(*spaces);
   demo->global.emplace(std::move(*global));
   demo->layered.emplace(std::move(*layered));

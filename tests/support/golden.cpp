@@ -54,7 +54,7 @@ GoldenOutcome CheckGolden(const render::Image& actual, const std::string& case_n
 
   if (dirs.update) {
     fs::create_directories(dirs.ref_dir);
-    const mocap::Status s = render::WriteImage(quantized, out.reference.string(), png);
+    const base::Status s = render::WriteImage(quantized, out.reference.string(), png);
     out.passed = s.ok();
     out.updated = s.ok();
     out.message = s.ok() ? "golden " + case_name + ": updated reference " + out.reference.string()
@@ -84,13 +84,13 @@ GoldenOutcome CheckGolden(const render::Image& actual, const std::string& case_n
     out.message = msg.str();
     return out;
   }
-  mocap::Result<render::Image> ref = render::ReadImage(out.reference.string());
+  base::Result<render::Image> ref = render::ReadImage(out.reference.string());
   if (!ref.ok()) {
     msg << "cannot read the reference: " << ref.error().ToString();
     out.message = msg.str();
     return out;
   }
-  mocap::Result<render::CompareResult> cmp = render::Compare(quantized, *ref, thresholds);
+  base::Result<render::CompareResult> cmp = render::Compare(quantized, *ref, thresholds);
   if (!cmp.ok()) {
     write_actual();
     msg << cmp.error().message << "\n  reference: " << out.reference.string()
@@ -109,7 +109,7 @@ GoldenOutcome CheckGolden(const render::Image& actual, const std::string& case_n
   out.passed = r.passed;
   if (!r.passed) {
     write_actual();
-    mocap::Result<render::Image> diff =
+    base::Result<render::Image> diff =
         render::MakeDiffImage(quantized, *ref, kGoldenDiffScale, thresholds.space);
     if (diff.ok()) {
       out.diff_path = case_dir / "diff.png";

@@ -17,7 +17,7 @@ inline bool LongCaptureMotion(int frames, mocap::Skeleton* skeleton, mocap::Moti
   mocap::WalkOptions walk;
   walk.frame_time_s = 1.0 / 120.0;
   walk.num_cycles = frames / 120 + 1;  // cycle_s = 1: 120 frames per cycle
-  mocap::Result<mocap::Motion> made = mocap::MakeWalkMotion(*skeleton, walk);
+  base::Result<mocap::Motion> made = mocap::MakeWalkMotion(*skeleton, walk);
   if (!made.ok() || made->num_frames < frames) return false;
   *motion = std::move(made).value();
   motion->num_frames = frames;
@@ -40,7 +40,7 @@ inline std::string LongCaptureText(int frames) {
   mocap::Skeleton skeleton;
   mocap::Motion motion;
   if (!LongCaptureMotion(frames, &skeleton, &motion)) return {};
-  mocap::Result<std::string> text = mocap::FormatBvh(skeleton, motion);
+  base::Result<std::string> text = mocap::FormatBvh(skeleton, motion);
   return text.ok() ? std::move(text).value() : std::string();
 }
 

@@ -55,13 +55,17 @@ struct PatchSpec {
   glm::vec3 side;
 };
 
-inline mocap::Result<deform::PatchSetup> MakePatch(const LayeredBody& b, const PatchSpec& spec,
-                                                   float border_width = 0.1f) {
+inline base::Result<deform::PatchSetup> MakePatch(const LayeredBody& b, const PatchSpec& spec,
+                                                  float border_width = 0.1f) {
   const glm::vec3 j = JointPos(b.rest_model, spec.joint);
   const glm::vec3 p = JointPos(b.rest_model, spec.parent);
-  mocap::Result<std::vector<int>> region = deform::SelectJointRegion(
-      b.mesh, {.bone_joints = {spec.parent, spec.joint}, .centre = j, .radius = spec.radius,
-               .min_bone_weight = 0.5f, .side = spec.side, .half_angle_deg = 120.0f});
+  base::Result<std::vector<int>> region =
+      deform::SelectJointRegion(b.mesh, {.bone_joints = {spec.parent, spec.joint},
+                                         .centre = j,
+                                         .radius = spec.radius,
+                                         .min_bone_weight = 0.5f,
+                                         .side = spec.side,
+                                         .half_angle_deg = 120.0f});
   if (!region.ok()) return std::move(region).error();
   return deform::BuildPatchSetup(
       b.mesh, *region,

@@ -70,16 +70,17 @@ int ComponentBytes(int component_type) {
   }
 }
 
-mocap::Result<std::vector<float>> ReadFloats(const AccessorView& v, bool normalize, const std::string& path) {
+base::Result<std::vector<float>> ReadFloats(const AccessorView& v, bool normalize,
+                                            const std::string& path) {
   const auto width = static_cast<std::size_t>(v.components);
   std::vector<float> out(v.count * width);
   for (std::size_t i = 0; i < v.count; ++i) {
     for (int c = 0; c < v.components; ++c) {
       const double x = Component(v, i, c, normalize);
       if (!std::isfinite(x)) {
-        return mocap::MakeError(
-            mocap::ErrorCode::kNonFinite, {path, 0, 0, AccessorField(v.index)},
-            "non-finite value at element " + std::to_string(i) + ", component " + std::to_string(c));
+        return base::MakeError(base::ErrorCode::kNonFinite, {path, 0, 0, AccessorField(v.index)},
+                               "non-finite value at element " + std::to_string(i) + ", component " +
+                                   std::to_string(c));
       }
       out[i * width + static_cast<std::size_t>(c)] = static_cast<float>(x);
     }
@@ -87,18 +88,19 @@ mocap::Result<std::vector<float>> ReadFloats(const AccessorView& v, bool normali
   return out;
 }
 
-mocap::Result<std::vector<std::uint32_t>> ReadUints(const AccessorView& v, std::uint64_t limit,
-                                                    const std::string& what, const std::string& path) {
+base::Result<std::vector<std::uint32_t>> ReadUints(const AccessorView& v, std::uint64_t limit,
+                                                   const std::string& what,
+                                                   const std::string& path) {
   const auto width = static_cast<std::size_t>(v.components);
   std::vector<std::uint32_t> out(v.count * width);
   for (std::size_t i = 0; i < out.size(); ++i) {
     const std::size_t element = i / width;
     const auto x = static_cast<std::uint32_t>(Component(v, element, static_cast<int>(i % width), false));
     if (x >= limit) {
-      return mocap::MakeError(mocap::ErrorCode::kCountMismatch, {path, 0, 0, AccessorField(v.index)},
-                              what + " " + std::to_string(x) + " at element " + std::to_string(element) +
-                                  " past the " + std::to_string(limit) + " " +
-                                  (what == "joint index" ? "joints of the skin" : "vertices"));
+      return base::MakeError(base::ErrorCode::kCountMismatch, {path, 0, 0, AccessorField(v.index)},
+                             what + " " + std::to_string(x) + " at element " +
+                                 std::to_string(element) + " past the " + std::to_string(limit) +
+                                 " " + (what == "joint index" ? "joints of the skin" : "vertices"));
     }
     out[i] = x;
   }

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "mocap/error.h"
+#include "base/error.h"
 
 namespace deform::internal {
 
@@ -28,13 +28,14 @@ int ComponentBytes(int component_type);
 // All components as floats; integer types are normalized to [0,1] / [-1,1]
 // when `normalize` (glTF's normalized-integer rule). NaN/inf give kNonFinite
 // naming "accessors[i]" of file `path`.
-mocap::Result<std::vector<float>> ReadFloats(const AccessorView& view, bool normalize,
-                                             const std::string& path);
+base::Result<std::vector<float>> ReadFloats(const AccessorView& view, bool normalize,
+                                            const std::string& path);
 
 // All components as unsigned integers, each below `limit` (else
 // kCountMismatch: "<what> 5 at element 3 past the 2 joints of the skin").
 // `what` is "joint index" or "index".
-mocap::Result<std::vector<std::uint32_t>> ReadUints(const AccessorView& view, std::uint64_t limit,
-                                                    const std::string& what, const std::string& path);
+base::Result<std::vector<std::uint32_t>> ReadUints(const AccessorView& view, std::uint64_t limit,
+                                                   const std::string& what,
+                                                   const std::string& path);
 
 }  // namespace deform::internal

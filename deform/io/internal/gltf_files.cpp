@@ -8,26 +8,27 @@
 namespace deform::internal {
 
 namespace fs = std::filesystem;
-using mocap::ErrorCode;
-using mocap::Result;
+using base::ErrorCode;
+using base::Result;
 
 Result<std::vector<unsigned char>> ReadFileBounded(const std::string& path, std::size_t max_bytes) {
   std::error_code ec;
   const auto size = fs::file_size(path, ec);
   if (ec)
-    return mocap::MakeError(ErrorCode::kIo, mocap::FileLoc{path, 0, 0, {}},
-                            "cannot open file: " + ec.message());
+    return base::MakeError(ErrorCode::kIo, base::FileLoc{path, 0, 0, {}},
+                           "cannot open file: " + ec.message());
   if (size > max_bytes) {
-    return mocap::MakeError(
-        ErrorCode::kLimitExceeded, mocap::FileLoc{path, 0, 0, {}},
-        "file has " + std::to_string(size) + " bytes, more than the limit of " + std::to_string(max_bytes));
+    return base::MakeError(ErrorCode::kLimitExceeded, base::FileLoc{path, 0, 0, {}},
+                           "file has " + std::to_string(size) + " bytes, more than the limit of " +
+                               std::to_string(max_bytes));
   }
   std::ifstream in(path, std::ios::binary);
-  if (!in) return mocap::MakeError(ErrorCode::kIo, mocap::FileLoc{path, 0, 0, {}}, "cannot open file");
+  if (!in)
+    return base::MakeError(ErrorCode::kIo, base::FileLoc{path, 0, 0, {}}, "cannot open file");
   std::vector<unsigned char> bytes(static_cast<std::size_t>(size));
   in.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(size));
   if (static_cast<std::uintmax_t>(in.gcount()) != size) {
-    return mocap::MakeError(ErrorCode::kIo, mocap::FileLoc{path, 0, 0, {}}, "short read");
+    return base::MakeError(ErrorCode::kIo, base::FileLoc{path, 0, 0, {}}, "short read");
   }
   return bytes;
 }
@@ -87,7 +88,7 @@ static std::uint32_t ReadU32(const unsigned char* p) {
 // Checks the GLB container before tinygltf sees it and returns its JSON chunk.
 Result<std::string> GlbJson(const std::string& path, const std::vector<unsigned char>& bytes) {
   auto fail = [&](const char* field, std::string message) {
-    return mocap::MakeError(ErrorCode::kCountMismatch, {path, 0, 0, field}, std::move(message));
+    return base::MakeError(ErrorCode::kCountMismatch, {path, 0, 0, field}, std::move(message));
   };
   if (bytes.size() < 20) {
     return fail("glb header", "expected at least 20 bytes (header and JSON chunk header), found " +
@@ -96,8 +97,8 @@ Result<std::string> GlbJson(const std::string& path, const std::vector<unsigned 
   const std::uint32_t version = ReadU32(bytes.data() + 4);
   const std::uint32_t length = ReadU32(bytes.data() + 8);
   if (version != 2) {
-    return mocap::MakeError(ErrorCode::kUnsupported, {path, 0, 0, "glb header.version"},
-                            "expected GLB version 2, found " + std::to_string(version));
+    return base::MakeError(ErrorCode::kUnsupported, {path, 0, 0, "glb header.version"},
+                           "expected GLB version 2, found " + std::to_string(version));
   }
   if (length != bytes.size()) {
     return fail("glb header.length", "header declares " + std::to_string(length) + " bytes, file has " +
@@ -106,8 +107,8 @@ Result<std::string> GlbJson(const std::string& path, const std::vector<unsigned 
   }
   const std::uint32_t json_length = ReadU32(bytes.data() + 12);
   if (ReadU32(bytes.data() + 16) != 0x4E4F534Au) {
-    return mocap::MakeError(ErrorCode::kSyntax, {path, 0, 0, "glb chunks[0].type"},
-                            "expected the JSON chunk first");
+    return base::MakeError(ErrorCode::kSyntax, {path, 0, 0, "glb chunks[0].type"},
+                           "expected the JSON chunk first");
   }
   if (json_length > bytes.size() - 20) {
     return fail("glb chunks[0].length",
@@ -126,9 +127,9 @@ Result<std::string> GlbJson(const std::string& path, const std::vector<unsigned 
 }
 
 // Rejects buffer and image URIs that leave the folder, naming the JSON field.
-mocap::Status CheckUris(const std::string& path, const std::string& json_text) {
+base::Status CheckUris(const std::string& path, const std::string& json_text) {
   const nlohmann::json doc = nlohmann::json::parse(json_text, nullptr, false);
-  if (doc.is_discarded() || !doc.is_object()) return mocap::Status::Ok();  // tinygltf reports it
+  if (doc.is_discarded() || !doc.is_object()) return base::Status::Ok();  // tinygltf reports it
   for (const char* array : {"buffers", "images"}) {
     const auto it = doc.find(array);
     if (it == doc.end() || !it->is_array()) continue;
@@ -138,13 +139,13 @@ mocap::Status CheckUris(const std::string& path, const std::string& json_text) {
       const std::string uri = item["uri"].get<std::string>();
       const std::string problem = UriProblem(uri);
       if (!problem.empty()) {
-        return mocap::MakeError(ErrorCode::kUnsupported,
-                                {path, 0, 0, std::string(array) + "[" + std::to_string(i) + "].uri"},
-                                "URI '" + uri.substr(0, 200) + "' " + problem);
+        return base::MakeError(ErrorCode::kUnsupported,
+                               {path, 0, 0, std::string(array) + "[" + std::to_string(i) + "].uri"},
+                               "URI '" + uri.substr(0, 200) + "' " + problem);
       }
     }
   }
-  return mocap::Status::Ok();
+  return base::Status::Ok();
 }
 
 }  // namespace deform::internal

@@ -7,12 +7,13 @@
 #include <string>
 #include <vector>
 
-#include "mocap/error.h"
+#include "base/error.h"
 
 namespace deform::internal {
 
 // The whole file, refusing files larger than max_bytes (kIo, kLimitExceeded).
-mocap::Result<std::vector<unsigned char>> ReadFileBounded(const std::string& path, std::size_t max_bytes);
+base::Result<std::vector<unsigned char>> ReadFileBounded(const std::string& path,
+                                                         std::size_t max_bytes);
 
 // Why a buffer/image URI may not be read ("is an absolute path; ..."), or empty
 // when it is a data: URI or a relative path without ".." segments (after
@@ -25,10 +26,10 @@ bool InsideFolder(const std::filesystem::path& folder, const std::string& path);
 // Checks a GLB container (header, version 2, declared length == file size,
 // chunk lengths within the file) and returns its JSON chunk. Errors name the
 // part, e.g. field "glb header.length".
-mocap::Result<std::string> GlbJson(const std::string& path, const std::vector<unsigned char>& bytes);
+base::Result<std::string> GlbJson(const std::string& path, const std::vector<unsigned char>& bytes);
 
 // Rejects buffers[i].uri / images[i].uri that UriProblem refuses, naming the
 // field. Unparsable JSON is left for tinygltf to report.
-mocap::Status CheckUris(const std::string& path, const std::string& json_text);
+base::Status CheckUris(const std::string& path, const std::string& json_text);
 
 }  // namespace deform::internal

@@ -15,7 +15,7 @@
 namespace deform::internal {
 namespace {
 
-using mocap::ErrorCode;
+using base::ErrorCode;
 
 constexpr int kMaxTextureSide = 8192;  // 8192^2 texels: 768 MiB of linear floats
 
@@ -44,9 +44,9 @@ float SrgbToLinear(float encoded) {
   return static_cast<float>(c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4));
 }
 
-mocap::Result<TextureImage> DecodeTextureImage(std::span<const unsigned char> bytes,
-                                               const std::string& mime_type, const std::string& file,
-                                               const std::string& field) {
+base::Result<TextureImage> DecodeTextureImage(std::span<const unsigned char> bytes,
+                                              const std::string& mime_type, const std::string& file,
+                                              const std::string& field) {
   static constexpr unsigned char kPng[] = {0x89, 'P', 'N', 'G'};
   static constexpr unsigned char kJpeg[] = {0xff, 0xd8, 0xff};
   const char* name = nullptr;  // OpenImageIO picks its reader from the extension
@@ -109,7 +109,7 @@ mocap::Result<TextureImage> DecodeTextureImage(std::span<const unsigned char> by
 GltfMaterialReader::GltfMaterialReader(const tinygltf::Model& model, const std::string& path)
     : m_(model), path_(path), image_slot_(model.images.size(), -1) {}
 
-mocap::Result<int> GltfMaterialReader::Image(int image, std::vector<mocap::Warning>& warnings) {
+base::Result<int> GltfMaterialReader::Image(int image, std::vector<base::Warning>& warnings) {
   const std::string at = Indexed("images", image);
   if (image < 0 || image >= static_cast<int>(m_.images.size())) {
     return GltfError(path_, ErrorCode::kNotFound, at,
@@ -150,8 +150,9 @@ mocap::Result<int> GltfMaterialReader::Image(int image, std::vector<mocap::Warni
   return slot;
 }
 
-mocap::Result<Material> GltfMaterialReader::Read(int index, bool has_uvs, const std::string& primitive_field,
-                                                 std::vector<mocap::Warning>& warnings) {
+base::Result<Material> GltfMaterialReader::Read(int index, bool has_uvs,
+                                                const std::string& primitive_field,
+                                                std::vector<base::Warning>& warnings) {
   Material out;
   if (index < 0) return out;
   const std::string at = Indexed("materials", index);

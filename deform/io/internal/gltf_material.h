@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "deform/mesh.h"
-#include "mocap/error.h"
+#include "base/error.h"
 
 namespace tinygltf {
 class Model;
@@ -28,9 +28,9 @@ float SrgbToLinear(float encoded);
 // base colour texture is sRGB) and converted to linear. `encoded` and
 // `mime_type` are kept in the result. Errors name `file` and `field`
 // (kSyntax: not a decodable image; kLimitExceeded: over 8192 texels a side).
-mocap::Result<TextureImage> DecodeTextureImage(std::span<const unsigned char> bytes,
-                                               const std::string& mime_type, const std::string& file,
-                                               const std::string& field);
+base::Result<TextureImage> DecodeTextureImage(std::span<const unsigned char> bytes,
+                                              const std::string& mime_type, const std::string& file,
+                                              const std::string& field);
 
 // A material of the file turned into a deform::Material, decoding its base
 // colour texture once per image (cache in `images`, `image_slots`).
@@ -44,13 +44,13 @@ class GltfMaterialReader {
   // error (naming the field) when an index is out of range or the image bytes
   // do not decode. `has_uvs`: whether the primitive has TEXCOORD_0; without
   // them the texture is dropped with a warning.
-  mocap::Result<Material> Read(int index, bool has_uvs, const std::string& primitive_field,
-                               std::vector<mocap::Warning>& warnings);
+  base::Result<Material> Read(int index, bool has_uvs, const std::string& primitive_field,
+                              std::vector<base::Warning>& warnings);
 
   std::vector<std::shared_ptr<const TextureImage>>& images() { return images_; }
 
  private:
-  mocap::Result<int> Image(int image, std::vector<mocap::Warning>& warnings);
+  base::Result<int> Image(int image, std::vector<base::Warning>& warnings);
 
   const tinygltf::Model& m_;
   std::string path_;

@@ -10,14 +10,15 @@
 namespace deform::internal {
 namespace {
 
-using mocap::ErrorCode;
-using mocap::Result;
+using base::ErrorCode;
+using base::Result;
 
 }  // namespace
 
-Result<PrimitiveTargets> ReadPrimitiveTargets(const tinygltf::Model& m, const std::string& path, int mesh,
-                                              int prim, std::size_t num_vertices, std::size_t max_values,
-                                              std::vector<mocap::Warning>& warnings) {
+Result<PrimitiveTargets> ReadPrimitiveTargets(const tinygltf::Model& m, const std::string& path,
+                                              int mesh, int prim, std::size_t num_vertices,
+                                              std::size_t max_values,
+                                              std::vector<base::Warning>& warnings) {
   const tinygltf::Primitive& p =
       m.meshes[static_cast<std::size_t>(mesh)].primitives[static_cast<std::size_t>(prim)];
   const std::string at = Indexed("meshes", mesh) + ".primitives[" + std::to_string(prim) + "].targets";

@@ -11,7 +11,7 @@
 #include <glm/glm.hpp>
 
 #include "deform/io/gltf_import.h"
-#include "mocap/error.h"
+#include "base/error.h"
 
 namespace tinygltf {
 class Model;
@@ -31,25 +31,25 @@ struct PrimitiveTargets {
 // with one element per vertex, dense, sparse, or without a buffer view
 // (zeros). TANGENT and other attributes are skipped with a warning.
 // kLimitExceeded when #K x #V exceeds max_values (checked before allocating).
-mocap::Result<PrimitiveTargets> ReadPrimitiveTargets(const tinygltf::Model& model,
-                                                     const std::string& path, int mesh, int prim,
-                                                     std::size_t num_vertices,
-                                                     std::size_t max_values,
-                                                     std::vector<mocap::Warning>& warnings);
+base::Result<PrimitiveTargets> ReadPrimitiveTargets(const tinygltf::Model& model,
+                                                    const std::string& path, int mesh, int prim,
+                                                    std::size_t num_vertices,
+                                                    std::size_t max_values,
+                                                    std::vector<base::Warning>& warnings);
 
 // The default weights of meshes[mesh]: its `weights` (exactly num_targets
 // finite numbers) or zeros when absent.
-mocap::Result<std::vector<float>> ReadDefaultWeights(const tinygltf::Model& model,
-                                                     const std::string& path, int mesh,
-                                                     int num_targets);
+base::Result<std::vector<float>> ReadDefaultWeights(const tinygltf::Model& model,
+                                                    const std::string& path, int mesh,
+                                                    int num_targets);
 
 // Reads the sampler of a channel whose target.path is "weights": input key
 // times (float SCALAR, >= 0, non-decreasing) and output values (float or
 // normalized integer SCALAR, #keys x num_targets, x 3 for CUBICSPLINE).
 // Errors name the sampler ("animations[0].samplers[1]"). Fills
 // everything of the channel except first_target.
-mocap::Result<GltfWeightsChannel> ReadWeightsSampler(const tinygltf::Model& model,
-                                                     const std::string& path, int animation,
-                                                     int sampler, int num_targets);
+base::Result<GltfWeightsChannel> ReadWeightsSampler(const tinygltf::Model& model,
+                                                    const std::string& path, int animation,
+                                                    int sampler, int num_targets);
 
 }  // namespace deform::internal

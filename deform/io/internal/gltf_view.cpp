@@ -7,8 +7,8 @@
 namespace deform::internal {
 namespace {
 
-using mocap::ErrorCode;
-using mocap::Result;
+using base::ErrorCode;
+using base::Result;
 
 // The byte range [offset, offset + (count-1)*stride + element) of a buffer
 // view, checked against the view and the view against its buffer. `at` names
@@ -86,9 +86,9 @@ Result<const tinygltf::Accessor*> CheckedAccessor(const tinygltf::Model& m, cons
 
 }  // namespace
 
-mocap::Error GltfError(const std::string& path, mocap::ErrorCode code, std::string field,
-                       std::string message) {
-  return mocap::MakeError(code, {path, 0, 0, std::move(field)}, std::move(message));
+base::Error GltfError(const std::string& path, base::ErrorCode code, std::string field,
+                      std::string message) {
+  return base::MakeError(code, {path, 0, 0, std::move(field)}, std::move(message));
 }
 
 std::string Indexed(const char* array, int i) { return std::string(array) + "[" + std::to_string(i) + "]"; }

@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "deform/io/internal/gltf_accessor.h"
-#include "mocap/error.h"
+#include "base/error.h"
 
 namespace tinygltf {
 class Model;
@@ -20,8 +20,8 @@ class Model;
 namespace deform::internal {
 
 // The error of a glTF reader: `message` about `field` of the file at `path`.
-mocap::Error GltfError(const std::string& path, mocap::ErrorCode code, std::string field,
-                       std::string message);
+base::Error GltfError(const std::string& path, base::ErrorCode code, std::string field,
+                      std::string message);
 
 // "accessors[3]"-style field names.
 std::string Indexed(const char* array, int index);
@@ -37,9 +37,9 @@ const char* GltfTypeName(int type);
 // Sparse accessors and accessors without a buffer view are refused
 // (kUnsupported, kNotFound): use ReadFloatsAllowingSparse where the
 // specification allows them.
-mocap::Result<AccessorView> CheckedView(const tinygltf::Model& model, const std::string& path,
-                                        int index, const std::string& user, int type,
-                                        std::initializer_list<int> component_types);
+base::Result<AccessorView> CheckedView(const tinygltf::Model& model, const std::string& path,
+                                       int index, const std::string& user, int type,
+                                       std::initializer_list<int> component_types);
 
 // All components of accessors[index] as floats (integer types normalized when
 // `normalize`), with the two forms glTF allows for morph-target data:
@@ -50,10 +50,8 @@ mocap::Result<AccessorView> CheckedView(const tinygltf::Model& model, const std:
 // Same checks as CheckedView for every view involved; values must be finite.
 // The caller bounds count * components before calling (no buffer view means
 // the file's size does not bound the allocation).
-mocap::Result<std::vector<float>> ReadFloatsAllowingSparse(const tinygltf::Model& model,
-                                                          const std::string& path, int index,
-                                                          const std::string& user, int type,
-                                                          std::initializer_list<int> component_types,
-                                                          bool normalize);
+base::Result<std::vector<float>> ReadFloatsAllowingSparse(
+    const tinygltf::Model& model, const std::string& path, int index, const std::string& user,
+    int type, std::initializer_list<int> component_types, bool normalize);
 
 }  // namespace deform::internal

@@ -104,7 +104,8 @@ mocap::BvhFile Parse(const BodyOptions& o, const std::vector<Frame>& frames) {
   return file.ok() ? std::move(file).value() : mocap::BvhFile{};
 }
 
-mocap::Result<deform::HumanoidMatch> Match(const mocap::BvhFile& target, const mocap::BvhFile& source) {
+base::Result<deform::HumanoidMatch> Match(const mocap::BvhFile& target,
+                                          const mocap::BvhFile& source) {
   return deform::MatchHumanoids(target.skeleton, source.skeleton, source.motion, {}, "target.bvh",
                                 "source.bvh", "");
 }

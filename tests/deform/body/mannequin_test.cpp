@@ -151,7 +151,7 @@ TEST(Mannequin, PositioningRootFarFromTheBodyIsIgnored) {
   // where the body was bound while the hips walk on (issue 27's 4 m tail).
   const int root = b.skeleton.FindJoint("joint_Root");
   EXPECT_EQ(std::find(m.skin_joints.begin(), m.skin_joints.end(), root), m.skin_joints.end());
-  const mocap::Result<std::vector<std::uint8_t>> parts =
+  const base::Result<std::vector<std::uint8_t>> parts =
       deform::BodyPartJoints(b.skeleton, b.model_from_joint, 0.15f);
   ASSERT_TRUE(parts.ok());
   for (int j = 0; j < b.skeleton.num_joints(); ++j) {
@@ -288,7 +288,7 @@ TEST(Mannequin, DegenerateSkeletonsGiveClearErrors) {
   const BuiltSkeleton single = SkeletonFrom({{"root", -1, {1, 2, 3}}}, false, 0.0f);
   auto r = deform::BuildMannequin(single.skeleton, single.model_from_joint);
   ASSERT_FALSE(r.ok());
-  EXPECT_EQ(r.error().code, mocap::ErrorCode::kInvalidArgument);
+  EXPECT_EQ(r.error().code, base::ErrorCode::kInvalidArgument);
   EXPECT_NE(r.error().message.find("non-zero length"), std::string::npos);
   const BuiltSkeleton point = SkeletonFrom(
       {{"a", -1, {1, 1, 1}}, {"b", 0, {1, 1, 1}}, {"c", 1, {1, 1, 1}}}, false, 0.0f);
@@ -297,13 +297,16 @@ TEST(Mannequin, DegenerateSkeletonsGiveClearErrors) {
   const BuiltSkeleton stub = SkeletonFrom({{"a", -1, {0, 0, 0}}, {"b", 0, {0, 10, 0}}}, false, 2.0f);
   ExpectValidBody(stub, Build(stub), false);
   // Matrix count and options are checked.
-  EXPECT_EQ(deform::BuildMannequin(stub.skeleton, std::span(stub.model_from_joint).first(1)).error().code,
-            mocap::ErrorCode::kCountMismatch);
-  EXPECT_EQ(deform::BuildMannequin(stub.skeleton, stub.model_from_joint, {.ring_vertices = 3}).error().code,
-            mocap::ErrorCode::kInvalidArgument);
+  EXPECT_EQ(
+      deform::BuildMannequin(stub.skeleton, std::span(stub.model_from_joint).first(1)).error().code,
+      base::ErrorCode::kCountMismatch);
+  EXPECT_EQ(deform::BuildMannequin(stub.skeleton, stub.model_from_joint, {.ring_vertices = 3})
+                .error()
+                .code,
+            base::ErrorCode::kInvalidArgument);
   std::vector<glm::mat4> nan = stub.model_from_joint;
   nan[1][3].x = std::nanf("");
-  EXPECT_EQ(deform::BuildMannequin(stub.skeleton, nan).error().code, mocap::ErrorCode::kNonFinite);
+  EXPECT_EQ(deform::BuildMannequin(stub.skeleton, nan).error().code, base::ErrorCode::kNonFinite);
 }
 
 TEST(Mannequin, HugeSkeletonsGiveAValidMeshOrALimitError) {
@@ -319,7 +322,7 @@ TEST(Mannequin, HugeSkeletonsGiveAValidMeshOrALimitError) {
   const BuiltSkeleton b = SkeletonFrom(star, false, 0.0f);
   auto r = deform::BuildMannequin(b.skeleton, b.model_from_joint);
   ASSERT_FALSE(r.ok());
-  EXPECT_EQ(r.error().code, mocap::ErrorCode::kLimitExceeded);
+  EXPECT_EQ(r.error().code, base::ErrorCode::kLimitExceeded);
   EXPECT_NE(r.error().message.find("chains"), std::string::npos) << r.error().message;
 }
 

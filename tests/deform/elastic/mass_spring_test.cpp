@@ -24,6 +24,7 @@
 
 namespace {
 
+using base::JobStatus;
 using deform::BuildMassSpringNetwork;
 using deform::DrivingFrame;
 using deform::MassSpringNetwork;
@@ -31,7 +32,6 @@ using deform::MassSpringParams;
 using deform::MassSpringSetup;
 using deform::MassSpringState;
 using deform::MassSpringStepJob;
-using mocap::JobStatus;
 using namespace testsupport;
 
 using DriveFn = std::function<DrivingFrame(double)>;

@@ -13,9 +13,9 @@
 
 namespace {
 
+using base::ErrorCode;
 using deform::ArtifactRing;
 using deform::RingPlane;
-using mocap::ErrorCode;
 using testsupport::kAreaRatioTol;
 
 constexpr double kPi = 3.14159265358979323846;

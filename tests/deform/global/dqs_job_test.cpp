@@ -13,9 +13,9 @@
 
 namespace {
 
+using base::JobStatus;
 using deform::DqsJob;
 using deform::DualQuat;
-using mocap::JobStatus;
 
 glm::mat4 RandomRigid(std::mt19937& rng) {
   std::uniform_real_distribution<float> u(-1.0f, 1.0f);

@@ -76,7 +76,7 @@ TEST(RigArtifacts, ErrorsForForeignRigs) {
   auto r = deform::MeasureLimbArtifacts(b.skeleton, std::span(b.bind).first(3), b.mesh, b.rig,
                                         bends, {});
   ASSERT_FALSE(r.ok());
-  EXPECT_EQ(r.error().code, mocap::ErrorCode::kCountMismatch);
+  EXPECT_EQ(r.error().code, base::ErrorCode::kCountMismatch);
 }
 
 }  // namespace

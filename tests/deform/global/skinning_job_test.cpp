@@ -12,9 +12,9 @@
 
 namespace {
 
+using base::JobStatus;
 using deform::SkinningJob;
 using deform::SkinWeights;
-using mocap::JobStatus;
 
 // A random mesh with random weights over `joints` joints, normalized the way
 // the importers and the mannequin do it.
@@ -111,10 +111,10 @@ TEST(SkinningJob, CheckSkinWeightsFindsBadRows) {
   EXPECT_TRUE(deform::CheckSkinWeights(s.weights, 3, 4).ok());
   EXPECT_FALSE(deform::CheckSkinWeights(s.weights, 3, 5).ok());
   s.weights.joints[5] = 3;
-  EXPECT_EQ(deform::CheckSkinWeights(s.weights, 3).error().code, mocap::ErrorCode::kInvalidArgument);
+  EXPECT_EQ(deform::CheckSkinWeights(s.weights, 3).error().code, base::ErrorCode::kInvalidArgument);
   s.weights.joints[5] = 0;
   s.weights.weights[6] += 0.5f;
-  EXPECT_EQ(deform::CheckSkinWeights(s.weights, 3).error().code, mocap::ErrorCode::kInvalidArgument);
+  EXPECT_EQ(deform::CheckSkinWeights(s.weights, 3).error().code, base::ErrorCode::kInvalidArgument);
 }
 
 // Result: small cases worked out by hand.

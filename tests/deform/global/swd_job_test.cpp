@@ -12,10 +12,10 @@
 
 namespace {
 
+using base::JobStatus;
+using deform::SwdJob;
 using deform::SweepChain;
 using deform::SweepVertexBinding;
-using deform::SwdJob;
-using mocap::JobStatus;
 using testsupport::kAreaRatioTol;
 using testsupport::kFloatTol;
 using testsupport::kSwdRebuildRelTol;

@@ -67,7 +67,7 @@ std::vector<glm::vec3> Deform(const deform::SwdRig& rig, std::span<const glm::ma
     const int begin = nv * p / pieces;
     const int end = nv * (p + 1) / pieces;
     const auto n = static_cast<std::size_t>(end - begin);
-    const mocap::JobStatus s =
+    const base::JobStatus s =
         deform::SwdRigJob{.rig = &rig,
                           .model_from_joint = model,
                           .vertex_begin = begin,
@@ -337,17 +337,19 @@ TEST(SwdRig, PointsBoundLikeVerticesMatchTheVertexBindings) {
   }
   // Errors.
   EXPECT_EQ(deform::BindPointsLikeVertices(r.rig, points, std::span(guides).first(1)).error().code,
-            mocap::ErrorCode::kInvalidArgument);
+            base::ErrorCode::kInvalidArgument);
   std::vector<int> bad = guides;
   bad[0] = r.rig.num_vertices();
   EXPECT_EQ(deform::BindPointsLikeVertices(r.rig, points, bad).error().code,
-            mocap::ErrorCode::kInvalidArgument);
+            base::ErrorCode::kInvalidArgument);
   std::vector<glm::vec3> nan = points;
   nan[0].x = std::nanf("");
   EXPECT_EQ(deform::BindPointsLikeVertices(r.rig, nan, guides).error().code,
-            mocap::ErrorCode::kInvalidArgument);
-  EXPECT_EQ(deform::ComputeSwdJointState(r.rig, std::span(r.b.model_from_joint).first(2), rot, joints).code,
-            mocap::JobStatus::kSizeMismatch);
+            base::ErrorCode::kInvalidArgument);
+  EXPECT_EQ(
+      deform::ComputeSwdJointState(r.rig, std::span(r.b.model_from_joint).first(2), rot, joints)
+          .code,
+      base::JobStatus::kSizeMismatch);
 }
 
 TEST(SwdRig, ClearErrors) {
@@ -358,30 +360,38 @@ TEST(SwdRig, ClearErrors) {
   ASSERT_TRUE(mesh.ok());
   auto big = deform::BuildSwdRig(chain.skeleton, chain.model_from_joint, mesh->bind);
   ASSERT_FALSE(big.ok());
-  EXPECT_EQ(big.error().code, mocap::ErrorCode::kLimitExceeded);
+  EXPECT_EQ(big.error().code, base::ErrorCode::kLimitExceeded);
   EXPECT_NE(big.error().message.find("sweeps"), std::string::npos);
   // No bone at all.
   const BuiltSkeleton point = SkeletonFrom({{"a", -1, {1, 1, 1}}, {"b", 0, {1, 1, 1}}}, false, 0.0f);
   auto none = deform::BuildSwdRig(point.skeleton, point.model_from_joint, r.mesh.bind);
   ASSERT_FALSE(none.ok());
-  EXPECT_EQ(none.error().code, mocap::ErrorCode::kInvalidArgument);
+  EXPECT_EQ(none.error().code, base::ErrorCode::kInvalidArgument);
   // Bad job inputs.
   std::vector<glm::quat> rot(r.b.model_from_joint.size());
   std::vector<glm::vec3> joints(rot.size()), pos(4);
-  EXPECT_EQ((deform::SwdRigJob{.rig = &r.rig, .model_from_joint = r.b.model_from_joint,
-                              .vertex_begin = r.rig.num_vertices() - 2, .joint_rotations = rot,
-                              .joint_positions = joints, .keep_volume = false, .positions = pos,
-                              .normals = {}}
-                .Run()
-                .code),
-            mocap::JobStatus::kOutOfRange);
   EXPECT_EQ((deform::SwdRigJob{.rig = &r.rig,
-                              .model_from_joint = std::span(r.b.model_from_joint).first(2),
-                              .vertex_begin = 0, .joint_rotations = rot, .joint_positions = joints,
-                              .keep_volume = false, .positions = pos, .normals = {}}
-                .Run()
-                .code),
-            mocap::JobStatus::kSizeMismatch);
+                               .model_from_joint = r.b.model_from_joint,
+                               .vertex_begin = r.rig.num_vertices() - 2,
+                               .joint_rotations = rot,
+                               .joint_positions = joints,
+                               .keep_volume = false,
+                               .positions = pos,
+                               .normals = {}}
+                 .Run()
+                 .code),
+            base::JobStatus::kOutOfRange);
+  EXPECT_EQ((deform::SwdRigJob{.rig = &r.rig,
+                               .model_from_joint = std::span(r.b.model_from_joint).first(2),
+                               .vertex_begin = 0,
+                               .joint_rotations = rot,
+                               .joint_positions = joints,
+                               .keep_volume = false,
+                               .positions = pos,
+                               .normals = {}}
+                 .Run()
+                 .code),
+            base::JobStatus::kSizeMismatch);
 }
 
 }  // namespace
@@ -483,7 +493,7 @@ TEST(SwdRig, BodyChainCoordsThatDoNotFitAreRefused) {
   coords.pop_back();
   auto short_list = deform::BuildSwdRig(b.skeleton, b.model_from_joint, mesh->bind, {.vertex_chains = coords});
   ASSERT_FALSE(short_list.ok());
-  EXPECT_EQ(short_list.error().code, mocap::ErrorCode::kInvalidArgument);
+  EXPECT_EQ(short_list.error().code, base::ErrorCode::kInvalidArgument);
   coords = mesh->body_chain_coords;
   coords[0].chain = 99;  // a chain this skeleton does not have
   auto wrong = deform::BuildSwdRig(b.skeleton, b.model_from_joint, mesh->bind, {.vertex_chains = coords});

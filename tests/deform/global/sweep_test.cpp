@@ -11,10 +11,10 @@
 
 namespace {
 
+using base::ErrorCode;
 using deform::BasicSweepPose;
 using deform::SweepChain;
 using deform::SweepChainSpec;
-using mocap::ErrorCode;
 using testsupport::kCurveDirectionTol;
 using testsupport::kCurveStep;
 using testsupport::kDoubleTol;

@@ -308,7 +308,7 @@ TEST(GltfImport, RejectsSymlinkLeavingTheFolder) {
   fs::remove(folder / "buffer.bin");
   auto model = deform::ReadGltf(path);
   ASSERT_FALSE(model.ok());
-  EXPECT_EQ(model.error().code, mocap::ErrorCode::kUnsupported) << model.error().ToString();
+  EXPECT_EQ(model.error().code, base::ErrorCode::kUnsupported) << model.error().ToString();
   EXPECT_NE(model.error().message.find("outside the model's folder"), std::string::npos)
       << model.error().ToString();
 }

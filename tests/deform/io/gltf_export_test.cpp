@@ -70,7 +70,7 @@ fs::path Write(const Flag& flag, int frames, deform::GltfExportOptions options, 
     EXPECT_TRUE(w->AddFrame(flag.Positions(k), flag.Normals(k)));
   }
   EXPECT_EQ(w->frames_added(), frames);
-  const mocap::Status s = w->Finish(path.string());
+  const base::Status s = w->Finish(path.string());
   EXPECT_TRUE(s) << (s ? "" : s.error().ToString());
   if (chosen) *chosen = w->layout();
   return path;
@@ -228,7 +228,7 @@ TEST(GltfExport, BadInputIsRefused) {
   EXPECT_FALSE(w->AddFrame(p, flag.Normals(0)));
   ASSERT_TRUE(w->AddFrame(flag.Positions(0), flag.Normals(0)));
   const fs::path dir = testsupport::FreshOutputDir("gltf_export/bad");
-  const mocap::Status s = w->Finish((dir / "short.glb").string());
+  const base::Status s = w->Finish((dir / "short.glb").string());
   ASSERT_FALSE(s);
   EXPECT_NE(s.error().ToString().find("short.glb"), std::string::npos);
   EXPECT_FALSE(fs::exists(dir / "short.glb"));

@@ -218,19 +218,19 @@ TEST(ReadGltf, CesiumManJointsSitBelowZUpAndArmature) {
 
 struct BadFile {
   const char* file;
-  mocap::ErrorCode code;
+  base::ErrorCode code;
   const char* field;
 };
 
 constexpr BadFile kBadFiles[] = {
-    {"uri_dotdot.gltf", mocap::ErrorCode::kUnsupported, "buffers[0].uri"},
-    {"uri_absolute.gltf", mocap::ErrorCode::kUnsupported, "buffers[0].uri"},
-    {"accessor_out_of_range.gltf", mocap::ErrorCode::kCountMismatch, "accessors[0].count"},
-    {"nan_position.gltf", mocap::ErrorCode::kNonFinite, "accessors[0]"},
-    {"joint_past_skin.gltf", mocap::ErrorCode::kCountMismatch, "accessors[1]"},
-    {"node_cycle.gltf", mocap::ErrorCode::kSyntax, "nodes"},
-    {"truncated.glb", mocap::ErrorCode::kCountMismatch, "glb header.length"},
-    {"broken_json.gltf", mocap::ErrorCode::kSyntax, ""},
+    {"uri_dotdot.gltf", base::ErrorCode::kUnsupported, "buffers[0].uri"},
+    {"uri_absolute.gltf", base::ErrorCode::kUnsupported, "buffers[0].uri"},
+    {"accessor_out_of_range.gltf", base::ErrorCode::kCountMismatch, "accessors[0].count"},
+    {"nan_position.gltf", base::ErrorCode::kNonFinite, "accessors[0]"},
+    {"joint_past_skin.gltf", base::ErrorCode::kCountMismatch, "accessors[1]"},
+    {"node_cycle.gltf", base::ErrorCode::kSyntax, "nodes"},
+    {"truncated.glb", base::ErrorCode::kCountMismatch, "glb header.length"},
+    {"broken_json.gltf", base::ErrorCode::kSyntax, ""},
 };
 
 class BadGltf : public testing::TestWithParam<BadFile> {};
@@ -239,7 +239,7 @@ TEST_P(BadGltf, GivesExpectedError) {
   const std::string path = testsupport::TestDataPath(std::string("gltf/bad/") + GetParam().file).string();
   auto model = ReadGltf(path);
   ASSERT_FALSE(model.ok());
-  EXPECT_EQ(mocap::ErrorCodeName(model.error().code), mocap::ErrorCodeName(GetParam().code))
+  EXPECT_EQ(base::ErrorCodeName(model.error().code), base::ErrorCodeName(GetParam().code))
       << model.error().ToString();
   EXPECT_EQ(model.error().loc.file, path);
   EXPECT_EQ(model.error().loc.field_path, GetParam().field) << model.error().ToString();
@@ -258,7 +258,7 @@ INSTANTIATE_TEST_SUITE_P(BadFiles, BadGltf, testing::ValuesIn(kBadFiles),
 TEST(ReadGltf, MissingFileIsAnIoError) {
   auto model = ReadGltf(testsupport::TestDataPath("gltf/bad/does_not_exist.gltf").string());
   ASSERT_FALSE(model.ok());
-  EXPECT_EQ(model.error().code, mocap::ErrorCode::kIo);
+  EXPECT_EQ(model.error().code, base::ErrorCode::kIo);
 }
 
 }  // namespace

@@ -85,7 +85,7 @@ int AddWeights(GltfWriter& w, int node, const std::string& interpolation, const 
   return static_cast<int>(w.doc["animations"].size()) - 1;
 }
 
-mocap::Result<GltfModel> Read(GltfWriter& w, const std::string& name, bool require_skin = false) {
+base::Result<GltfModel> Read(GltfWriter& w, const std::string& name, bool require_skin = false) {
   const std::string path = w.Write(testsupport::TestOutputPath("gltf_morph/" + name).string());
   deform::GltfReadOptions options;
   options.require_skin = require_skin;
@@ -232,7 +232,7 @@ TEST(GltfMorphImport, MorphsBeforeSkinning) {
 struct BadCase {
   const char* name;
   void (*edit)(GltfWriter&);
-  mocap::ErrorCode code;
+  base::ErrorCode code;
   const char* field;
 };
 
@@ -252,24 +252,24 @@ INSTANTIATE_TEST_SUITE_P(
     Cases, GltfMorphBadFile,
     ::testing::Values(
         BadCase{"target_count", [](GltfWriter& w) { w.doc["accessors"][2]["count"] = 2; },
-                mocap::ErrorCode::kCountMismatch, "accessors[2].count"},
+                base::ErrorCode::kCountMismatch, "accessors[2].count"},
         BadCase{"target_type", [](GltfWriter& w) { w.doc["accessors"][2]["type"] = "VEC4"; },
-                mocap::ErrorCode::kUnsupported, "accessors[2].type"},
+                base::ErrorCode::kUnsupported, "accessors[2].type"},
         BadCase{"target_nan",
                 [](GltfWriter& w) {
                   const float nan = std::numeric_limits<float>::quiet_NaN();
                   w.doc["accessors"][2]["bufferView"] =
                       w.Accessor(std::vector<float>{0, 0, 0, nan, 0, 0, 0, 0, 0}, GltfWriter::kFloat, "VEC3", 3);
                 },
-                mocap::ErrorCode::kNonFinite, "accessors["},
+                base::ErrorCode::kNonFinite, "accessors["},
         BadCase{"mesh_weights", [](GltfWriter& w) { w.doc["meshes"][0]["weights"] = {1.0}; },
-                mocap::ErrorCode::kCountMismatch, "meshes[0].weights"},
+                base::ErrorCode::kCountMismatch, "meshes[0].weights"},
         BadCase{"sparse_index_past_count",
                 [](GltfWriter& w) {
                   w.doc["accessors"][6]["sparse"]["indices"]["bufferView"] =
                       w.Accessor(std::vector<std::uint16_t>{3, 0}, GltfWriter::kUnsignedShort, "SCALAR", 1);
                 },
-                mocap::ErrorCode::kCountMismatch, "accessors[6]"},
+                base::ErrorCode::kCountMismatch, "accessors[6]"},
         BadCase{"sparse_not_increasing",
                 [](GltfWriter& w) {
                   w.doc["accessors"][6]["sparse"]["count"] = 2;
@@ -278,35 +278,41 @@ INSTANTIATE_TEST_SUITE_P(
                   w.doc["accessors"][6]["sparse"]["values"]["bufferView"] =
                       w.Accessor(std::vector<float>(6, 0.0f), GltfWriter::kFloat, "VEC3", 2);
                 },
-                mocap::ErrorCode::kBadNumber, "accessors[6].sparse.indices"},
+                base::ErrorCode::kBadNumber, "accessors[6].sparse.indices"},
         BadCase{"sparse_values_short",
                 [](GltfWriter& w) {
                   w.doc["accessors"][6]["sparse"]["count"] = 2;
                   w.doc["accessors"][6]["sparse"]["indices"]["bufferView"] =
                       w.Accessor(std::vector<std::uint16_t>{0, 2}, GltfWriter::kUnsignedShort, "SCALAR", 2);
                 },
-                mocap::ErrorCode::kCountMismatch, "accessors[6].sparse.values"},
+                base::ErrorCode::kCountMismatch, "accessors[6].sparse.values"},
         BadCase{"weights_output_count",
-                [](GltfWriter& w) { AddWeights(w, 1, "LINEAR", {0, 1}, {0, 0, 1}); },
-                mocap::ErrorCode::kCountMismatch, ".count"},
+                [](GltfWriter& w) {
+                  AddWeights(w, 1, "LINEAR", {0, 1}, {0, 0, 1});
+                },
+                base::ErrorCode::kCountMismatch, ".count"},
         BadCase{"weights_output_nan",
                 [](GltfWriter& w) {
                   AddWeights(w, 1, "LINEAR", {0, 1}, {0, 0, std::numeric_limits<float>::infinity(), 0});
                 },
-                mocap::ErrorCode::kNonFinite, "accessors["},
+                base::ErrorCode::kNonFinite, "accessors["},
         BadCase{"weights_times_decrease",
-                [](GltfWriter& w) { AddWeights(w, 1, "STEP", {1, 0}, {0, 0, 1, 0}); },
-                mocap::ErrorCode::kBadNumber, "accessors["},
+                [](GltfWriter& w) {
+                  AddWeights(w, 1, "STEP", {1, 0}, {0, 0, 1, 0});
+                },
+                base::ErrorCode::kBadNumber, "accessors["},
         BadCase{"weights_interpolation",
-                [](GltfWriter& w) { AddWeights(w, 1, "SMOOTH", {0, 1}, {0, 0, 1, 0}); },
-                mocap::ErrorCode::kUnsupported, "animations[0].samplers[0].interpolation"},
+                [](GltfWriter& w) {
+                  AddWeights(w, 1, "SMOOTH", {0, 1}, {0, 0, 1, 0});
+                },
+                base::ErrorCode::kUnsupported, "animations[0].samplers[0].interpolation"},
         BadCase{"primitives_disagree",
                 [](GltfWriter& w) {
                   nlohmann::json second = w.doc["meshes"][0]["primitives"][0];
                   second["targets"].erase(1);
                   w.doc["meshes"][0]["primitives"].push_back(second);
                 },
-                mocap::ErrorCode::kCountMismatch, "meshes[0].primitives"}),
+                base::ErrorCode::kCountMismatch, "meshes[0].primitives"}),
     [](const ::testing::TestParamInfo<BadCase>& p) { return std::string(p.param.name); });
 
 TEST(GltfMorphImport, MorphDeltasAreBoundedBeforeAllocating) {
@@ -317,7 +323,7 @@ TEST(GltfMorphImport, MorphDeltasAreBoundedBeforeAllocating) {
   options.max_morph_values = 5;  // 2 targets x 3 vertices = 6
   auto model = deform::ReadGltf(path, options);
   ASSERT_FALSE(model.ok());
-  EXPECT_EQ(model.error().code, mocap::ErrorCode::kLimitExceeded) << model.error().ToString();
+  EXPECT_EQ(model.error().code, base::ErrorCode::kLimitExceeded) << model.error().ToString();
   options.max_morph_values = 6;
   EXPECT_TRUE(deform::ReadGltf(path, options).ok());
 }
@@ -326,7 +332,7 @@ TEST(GltfMorphImport, UnskinnedFilesNeedTheOption) {
   MorphFile f = TriangleWithTargets();
   auto model = Read(f.w, "unskinned.gltf", /*require_skin=*/true);
   ASSERT_FALSE(model.ok());
-  EXPECT_EQ(model.error().code, mocap::ErrorCode::kNotFound);
+  EXPECT_EQ(model.error().code, base::ErrorCode::kNotFound);
   EXPECT_EQ(model.error().loc.field_path, "skins");
 }
 

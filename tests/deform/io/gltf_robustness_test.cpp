@@ -22,7 +22,7 @@ std::string ReadText(const std::string& path) {
 }
 
 // A loaded model must be internally consistent, or the error must name the file.
-void ExpectSane(const mocap::Result<deform::GltfModel>& model, const std::string& path,
+void ExpectSane(const base::Result<deform::GltfModel>& model, const std::string& path,
                 const std::string& what) {
   if (!model.ok()) {
     EXPECT_EQ(model.error().loc.file, path) << what;

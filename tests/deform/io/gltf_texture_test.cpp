@@ -207,7 +207,7 @@ TEST(GltfTexture, MissingImageFileWarnsAndLeavesTheTextureOut) {
   ASSERT_TRUE(model.ok()) << model.error().ToString();
   EXPECT_FALSE(model->mesh.materials.textured());
   bool warned = false;
-  for (const mocap::Warning& w : model->warnings)
+  for (const base::Warning& w : model->warnings)
     warned = warned || w.ToString().find("absent.png' could not be read") != std::string::npos;
   EXPECT_TRUE(warned);
 }
@@ -302,13 +302,14 @@ TEST(GltfTexture, ImagesWiderThanTheLimitAreRefused) {
   ASSERT_FALSE(wide.empty());
   auto image = deform::internal::DecodeTextureImage(wide, "image/png", "w.glb", "images[0]");
   ASSERT_FALSE(image.ok());
-  EXPECT_EQ(image.error().code, mocap::ErrorCode::kLimitExceeded);
+  EXPECT_EQ(image.error().code, base::ErrorCode::kLimitExceeded);
   EXPECT_NE(image.error().ToString().find("8193 x 1 x 3"), std::string::npos) << image.error().ToString();
 }
 
 // Exports `mesh` (its bind pose as two frames) to a .glb and reads it back
 // (no skin in an export: each mesh node is rigid).
-mocap::Result<deform::GltfModel> ExportAndReimport(const deform::SkinnedMesh& mesh, const std::string& name,
+base::Result<deform::GltfModel> ExportAndReimport(const deform::SkinnedMesh& mesh,
+                                                  const std::string& name,
                                                   deform::GltfExportLayout layout) {
   deform::GltfExportOptions options;
   options.layout = layout;

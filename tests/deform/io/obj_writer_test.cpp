@@ -83,9 +83,9 @@ TEST(ObjWriter, BadInputIsAnErrorAndWritesNothing) {
 
   std::vector<glm::uvec3> tris = s.triangles;
   tris[1].z = static_cast<unsigned>(s.positions.size());
-  mocap::Status st = w.Write({.positions = s.positions, .triangles = tris}, path);
+  base::Status st = w.Write({.positions = s.positions, .triangles = tris}, path);
   ASSERT_FALSE(st);
-  EXPECT_EQ(st.error().code, mocap::ErrorCode::kInvalidArgument);
+  EXPECT_EQ(st.error().code, base::ErrorCode::kInvalidArgument);
   EXPECT_NE(st.error().ToString().find("bad.obj"), std::string::npos);
   EXPECT_NE(st.error().message.find("triangle 1"), std::string::npos);
 
@@ -106,9 +106,9 @@ TEST(ObjWriter, MissingFolderIsAnIoErrorNamingTheFile) {
   const Strip s = MakeStrip(3, 0.0f);
   deform::ObjSequenceWriter w;
   const std::string path = (dir / "no" / "such" / "a.obj").string();
-  const mocap::Status st = w.Write({.positions = s.positions, .triangles = s.triangles}, path);
+  const base::Status st = w.Write({.positions = s.positions, .triangles = s.triangles}, path);
   ASSERT_FALSE(st);
-  EXPECT_EQ(st.error().code, mocap::ErrorCode::kIo);
+  EXPECT_EQ(st.error().code, base::ErrorCode::kIo);
   EXPECT_NE(st.error().ToString().find("a.obj"), std::string::npos);
 }
 

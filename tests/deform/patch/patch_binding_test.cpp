@@ -11,9 +11,9 @@
 
 namespace {
 
+using base::JobStatus;
 using deform::BSplineSurface;
 using deform::PatchRebuildJob;
-using mocap::JobStatus;
 using testsupport::kProjectionTol;
 using testsupport::kRebuildRelTol;
 
@@ -260,13 +260,13 @@ TEST(PatchBinding, RejectsBadInput) {
   const std::vector<int> bad = {0, 1000};
   auto r = deform::BindPatch(f.surface, cap.positions, bad, {});
   ASSERT_FALSE(r.ok());
-  EXPECT_EQ(r.error().code, mocap::ErrorCode::kInvalidArgument);
+  EXPECT_EQ(r.error().code, base::ErrorCode::kInvalidArgument);
   const std::vector<glm::dvec2> uv(3);
   EXPECT_FALSE(deform::BindPatch(f.surface, cap.positions, region, uv).ok());
   auto quad = BSplineSurface::CreateUniform(4, 4, std::vector<glm::dvec3>(16), 2);
   ASSERT_TRUE(quad.ok());
   EXPECT_EQ(deform::BindPatch(*quad, cap.positions, region, {}).error().code,
-            mocap::ErrorCode::kUnsupported);
+            base::ErrorCode::kUnsupported);
   EXPECT_EQ(deform::PatchBinding::kStoredBytesPerVertex, 42);
 }
 

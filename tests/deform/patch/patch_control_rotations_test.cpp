@@ -154,7 +154,7 @@ TEST(PatchControlRotations, AWeightedJointBeyondThePaletteIsRefused) {
       ASSERT_NE(p.control_weights.weights[slot], 0.0f);
       p.control_weights.joints[slot] = beyond;
       EXPECT_EQ(deform::PatchControlRotations(p, {.model_from_bind = palette}, out).code,
-                mocap::JobStatus::kOutOfRange)
+                base::JobStatus::kOutOfRange)
           << influences << " " << beyond;
       // Not looked at where that control point does not move.
       std::vector<glm::vec3> ds(20, glm::vec3(1.0f, 0.0f, 0.0f));

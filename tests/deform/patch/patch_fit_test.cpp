@@ -11,9 +11,9 @@
 
 namespace {
 
+using base::ErrorCode;
 using deform::FitOptions;
 using deform::PatchSamples;
-using mocap::ErrorCode;
 using testsupport::kDoubleTol;
 
 PatchSamples RandomSamples(int s, int t, unsigned seed) {

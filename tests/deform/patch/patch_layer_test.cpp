@@ -66,17 +66,16 @@ TEST(PatchRegion, JointRadiusKeepsNearVerticesOnTheBonesAndTheSide) {
 TEST(PatchRegion, JointRadiusErrors) {
   const LayeredBody& b = Body();
   EXPECT_EQ(deform::SelectJointRegion(b.mesh, {.bone_joints = {}, .radius = 1.0f}).error().code,
-            mocap::ErrorCode::kInvalidArgument);
-  EXPECT_EQ(deform::SelectJointRegion(b.mesh, {.bone_joints = {b.elbow}, .radius = -1.0f})
-                .error()
-                .code,
-            mocap::ErrorCode::kInvalidArgument);
+            base::ErrorCode::kInvalidArgument);
+  EXPECT_EQ(
+      deform::SelectJointRegion(b.mesh, {.bone_joints = {b.elbow}, .radius = -1.0f}).error().code,
+      base::ErrorCode::kInvalidArgument);
   // Far from any vertex: nothing qualifies.
   EXPECT_EQ(deform::SelectJointRegion(
                 b.mesh, {.bone_joints = {b.elbow}, .centre = {0, 1000, 0}, .radius = 1.0f})
                 .error()
                 .code,
-            mocap::ErrorCode::kNotFound);
+            base::ErrorCode::kNotFound);
 }
 
 TEST(PatchRegion, ExplicitListIsCheckedAndSorted) {
@@ -104,7 +103,7 @@ TEST(PatchLayer, ControlPointWeightsAreValidAndFollowTheBones) {
   const LayeredBody& b = Body();
   for (const deform::PatchSetup& p : Patches()) {
     ASSERT_GT(p.num_bound(), 100);
-    const mocap::Status s = deform::CheckSkinWeights(
+    const base::Status s = deform::CheckSkinWeights(
         p.control_weights, static_cast<int>(b.mesh.skin_joints.size()), p.num_control());
     EXPECT_TRUE(s.ok()) << s.error().ToString();
   }

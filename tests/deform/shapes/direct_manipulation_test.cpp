@@ -331,7 +331,7 @@ TEST(ControlFrames, SsdAndDqsRotationsOfEqualInfluences) {
     EXPECT_NEAR(std::abs(glm::dot(dqs[static_cast<size_t>(c)], q)), 1.0f, kRotationTol);
   }
   EXPECT_EQ(deform::SsdControlRotations(palette, 2, joints, std::span(weights).first(3), ssd).code,
-            mocap::JobStatus::kSizeMismatch);
+            base::JobStatus::kSizeMismatch);
 }
 
 // Examples stored in the local frames stay attached when the whole body turns:

@@ -191,8 +191,9 @@ TEST(PatchControlRotations, SkipsOnlyControlPointsWhoseDisplacementIsZero) {
   }
   // A displacement span of the wrong size is refused.
   EXPECT_EQ(deform::PatchControlRotations(p, {.model_from_bind = palette}, masked,
-                                          std::span(ds).first(10)).code,
-            mocap::JobStatus::kSizeMismatch);
+                                          std::span(ds).first(10))
+                .code,
+            base::JobStatus::kSizeMismatch);
 }
 
 }  // namespace

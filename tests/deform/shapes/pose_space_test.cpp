@@ -155,7 +155,7 @@ TEST(RbfPoseSpace, DuplicateRejectedNamingBoth) {
   examples[3].loc.line = 14;
   auto model = RbfPoseSpace::Fit(examples, 3, kControl);
   ASSERT_FALSE(model.ok());
-  EXPECT_EQ(model.error().code, mocap::ErrorCode::kInvalidArgument);
+  EXPECT_EQ(model.error().code, base::ErrorCode::kInvalidArgument);
   const std::string msg = model.error().ToString();
   EXPECT_NE(msg.find("rig.json:14"), std::string::npos) << msg;
   EXPECT_NE(msg.find("'elbow_again' (index 3)"), std::string::npos) << msg;
@@ -223,15 +223,15 @@ TEST(PoseSpaceJob, Validity) {
   std::vector<glm::vec3> out(kControl);
   std::vector<float> x(3, 0.0f), short_x(2, 0.0f);
   EXPECT_EQ((PoseSpaceJob{.features = x, .displacement = out}.Validate().code),
-            mocap::JobStatus::kMissingInput);
+            base::JobStatus::kMissingInput);
   EXPECT_EQ(
       (PoseSpaceJob{.model = &*model, .features = short_x, .displacement = out}.Validate().code),
-      mocap::JobStatus::kSizeMismatch);
+      base::JobStatus::kSizeMismatch);
   EXPECT_EQ((PoseSpaceJob{
                 .model = &*model, .features = x, .displacement = std::span(out).first(kControl - 1)}
                  .Validate()
                  .code),
-            mocap::JobStatus::kSizeMismatch);
+            base::JobStatus::kSizeMismatch);
   EXPECT_TRUE((PoseSpaceJob{.model = &*model, .features = x, .displacement = out}.Validate().ok()));
 }
 

@@ -83,7 +83,7 @@ TEST(AsyncImageWriter, ReportsAFailedFrameOnFinish) {
   ASSERT_TRUE(writer.Submit(Frame(1), (dir / "missing" / "b.png").string()));
   const Status s = writer.Finish();
   ASSERT_FALSE(s.ok());
-  EXPECT_EQ(s.error().code, mocap::ErrorCode::kIo);
+  EXPECT_EQ(s.error().code, base::ErrorCode::kIo);
   EXPECT_NE(s.error().ToString().find("b.png"), std::string::npos);
   EXPECT_TRUE(fs::exists(dir / "a.png")) << "the good frame is still written";
   EXPECT_FALSE(writer.Finish().ok()) << "Finish keeps returning the error";

@@ -77,7 +77,7 @@ TEST(ContactSheetLayout, RejectsBadArguments) {
   o.thumb_width = 100000;
   auto huge = ComputeContactSheetLayout(1000, 80, 60, o);
   ASSERT_FALSE(huge.ok());
-  EXPECT_EQ(huge.error().code, mocap::ErrorCode::kInvalidArgument);
+  EXPECT_EQ(huge.error().code, base::ErrorCode::kInvalidArgument);
 }
 
 TEST(ContactSheet, PlacesThumbnailsRowByRowWithLabels) {

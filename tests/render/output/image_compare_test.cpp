@@ -117,7 +117,7 @@ TEST(Compare, SrgbSpaceComparesEncodedValues) {
 TEST(Compare, RejectsDifferentSizes) {
   auto r = Compare(Image(4, 4), Image(4, 5));
   ASSERT_FALSE(r.ok());
-  EXPECT_EQ(r.error().code, mocap::ErrorCode::kInvalidArgument);
+  EXPECT_EQ(r.error().code, base::ErrorCode::kInvalidArgument);
   EXPECT_NE(r.error().message.find("4x4 and 4x5"), std::string::npos);
   EXPECT_FALSE(Compare(Image(), Image()).ok());
   EXPECT_FALSE(MakeDiffImage(Image(2, 2), Image(3, 2)).ok());

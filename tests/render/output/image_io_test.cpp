@@ -86,7 +86,7 @@ TEST(ImageFormat, FollowsTheExtension) {
   EXPECT_EQ(*ImageFormatFromPath("f.jpeg"), ImageFormat::kJpeg);
   const auto bad = ImageFormatFromPath("f.bmp");
   ASSERT_FALSE(bad.ok());
-  EXPECT_EQ(bad.error().code, mocap::ErrorCode::kUnsupported);
+  EXPECT_EQ(bad.error().code, base::ErrorCode::kUnsupported);
   EXPECT_NE(bad.error().message.find(".bmp"), std::string::npos);
 }
 
@@ -270,7 +270,7 @@ TEST(WriteImage, IsAtomicAndLeavesNoTemporaryFile) {
   // Missing folder: fails, creates nothing.
   const Status missing = WriteImage(TestPattern(8, 8), (dir / "nope" / "f.png").string());
   ASSERT_FALSE(missing.ok());
-  EXPECT_EQ(missing.error().code, mocap::ErrorCode::kIo);
+  EXPECT_EQ(missing.error().code, base::ErrorCode::kIo);
   EXPECT_FALSE(fs::exists(dir / "nope"));
 
   // The final name is taken by a non-empty folder: the encoder finishes the
@@ -278,7 +278,7 @@ TEST(WriteImage, IsAtomicAndLeavesNoTemporaryFile) {
   fs::create_directories(dir / "taken.exr" / "child");
   const Status taken = WriteImage(TestPattern(8, 8), (dir / "taken.exr").string());
   ASSERT_FALSE(taken.ok());
-  EXPECT_EQ(taken.error().code, mocap::ErrorCode::kIo);
+  EXPECT_EQ(taken.error().code, base::ErrorCode::kIo);
   EXPECT_NE(taken.error().ToString().find("taken.exr"), std::string::npos);
   EXPECT_TRUE(fs::is_directory(dir / "taken.exr" / "child"));
   EXPECT_EQ(CountEntries(dir), 2u) << "ok.png and taken.exr only";
@@ -287,17 +287,17 @@ TEST(WriteImage, IsAtomicAndLeavesNoTemporaryFile) {
 TEST(WriteImage, RejectsBadImagesAndOptions) {
   const fs::path dir = testsupport::FreshOutputDir("image_io/reject");
   EXPECT_EQ(WriteImage(Image(), (dir / "e.png").string()).error().code,
-            mocap::ErrorCode::kInvalidArgument);
+            base::ErrorCode::kInvalidArgument);
   Image broken(4, 4);
   broken.depth.resize(3);
   EXPECT_EQ(WriteImage(broken, (dir / "b.exr").string()).error().code,
-            mocap::ErrorCode::kInvalidArgument);
+            base::ErrorCode::kInvalidArgument);
   WriteOptions o;
   o.png_compression = 10;
   EXPECT_EQ(WriteImage(Image(2, 2), (dir / "o.png").string(), o).error().code,
-            mocap::ErrorCode::kInvalidArgument);
+            base::ErrorCode::kInvalidArgument);
   EXPECT_EQ(WriteImage(Image(2, 2), (dir / "x.gif").string()).error().code,
-            mocap::ErrorCode::kUnsupported);
+            base::ErrorCode::kUnsupported);
   EXPECT_EQ(CountEntries(dir), 0u);
 }
 
@@ -305,12 +305,12 @@ TEST(ReadImage, ReportsMissingAndCorruptFiles) {
   const fs::path dir = testsupport::FreshOutputDir("image_io/read_bad");
   auto missing = ReadImage((dir / "none.png").string());
   ASSERT_FALSE(missing.ok());
-  EXPECT_EQ(missing.error().code, mocap::ErrorCode::kIo);
+  EXPECT_EQ(missing.error().code, base::ErrorCode::kIo);
   EXPECT_NE(missing.error().ToString().find("none.png"), std::string::npos);
   std::ofstream(dir / "junk.png") << "not a png at all";
   auto junk = ReadImage((dir / "junk.png").string());
   ASSERT_FALSE(junk.ok());
-  EXPECT_EQ(junk.error().code, mocap::ErrorCode::kIo);
+  EXPECT_EQ(junk.error().code, base::ErrorCode::kIo);
 }
 
 // CRC-32 as PNG chunks use it (ISO 3309, reflected polynomial 0xEDB88320).
@@ -340,7 +340,7 @@ TEST(ReadImage, RefusesHugeDimensionsBeforeAllocating) {
   std::ofstream(dir / "huge.png", std::ios::binary) << png;
   auto r = ReadImage((dir / "huge.png").string());
   ASSERT_FALSE(r.ok());
-  EXPECT_EQ(r.error().code, mocap::ErrorCode::kLimitExceeded) << r.error().ToString();
+  EXPECT_EQ(r.error().code, base::ErrorCode::kLimitExceeded) << r.error().ToString();
   EXPECT_NE(r.error().message.find("100000x100000x4"), std::string::npos);
 }
 
@@ -360,7 +360,7 @@ TEST(ExpandFramePattern, RejectsMissingOrRepeatedPlaceholders) {
   for (const char* bad : {"still.png", "a_##_##.png", "a_%04d_####.png", "a_%4d.png"}) {
     auto r = ExpandFramePattern(bad, 1);
     ASSERT_FALSE(r.ok()) << bad;
-    EXPECT_EQ(r.error().code, mocap::ErrorCode::kInvalidArgument);
+    EXPECT_EQ(r.error().code, base::ErrorCode::kInvalidArgument);
     EXPECT_NE(r.error().message.find("placeholder"), std::string::npos);
   }
 }

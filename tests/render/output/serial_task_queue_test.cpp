@@ -22,7 +22,7 @@ TEST(SerialTaskQueue, RunsTasksOneAtATimeInSubmissionOrder) {
       if (i % 7 == 0) std::this_thread::sleep_for(std::chrono::milliseconds(1));
       order.push_back(i);
       running.fetch_sub(1);
-      return mocap::Status::Ok();
+      return base::Status::Ok();
     }).ok());
   }
   ASSERT_TRUE(queue.Finish().ok());
@@ -38,13 +38,13 @@ TEST(SerialTaskQueue, SubmitBlocksWhileTheQueueIsFull) {
   render::SerialTaskQueue queue({.max_queued = 2});
   const auto wait = [&] {
     while (!release.load()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
-    return mocap::Status::Ok();
+    return base::Status::Ok();
   };
   ASSERT_TRUE(queue.Submit(wait).ok());
   ASSERT_TRUE(queue.Submit(wait).ok());
   std::atomic<bool> third_queued{false};
   std::thread submitter([&] {
-    EXPECT_TRUE(queue.Submit([] { return mocap::Status::Ok(); }).ok());
+    EXPECT_TRUE(queue.Submit([] { return base::Status::Ok(); }).ok());
     third_queued = true;
   });
   std::this_thread::sleep_for(std::chrono::milliseconds(50));
@@ -59,22 +59,23 @@ TEST(SerialTaskQueue, SubmitBlocksWhileTheQueueIsFull) {
 TEST(SerialTaskQueue, FirstErrorStopsLaterTasksAndIsReturnedByFinish) {
   std::atomic<int> ran{0};
   render::SerialTaskQueue queue({.max_queued = 1});
-  mocap::Status last = mocap::Status::Ok();
+  base::Status last = base::Status::Ok();
   for (int i = 0; i < 10 && last.ok(); ++i) {
-    last = queue.Submit([&, i]() -> mocap::Status {
+    last = queue.Submit([&, i]() -> base::Status {
       ran.fetch_add(1);
-      if (i == 3) return mocap::MakeError(mocap::ErrorCode::kIo, {"video.mp4", 0, 0, {}}, "disk full");
-      return mocap::Status::Ok();
+      if (i == 3)
+        return base::MakeError(base::ErrorCode::kIo, {"video.mp4", 0, 0, {}}, "disk full");
+      return base::Status::Ok();
     });
   }
   // With one slot, the submission after task 3 fails waits until task 3 ran.
   ASSERT_FALSE(last.ok());
-  EXPECT_EQ(last.error().code, mocap::ErrorCode::kIo);
-  const mocap::Status finished = queue.Finish();
+  EXPECT_EQ(last.error().code, base::ErrorCode::kIo);
+  const base::Status finished = queue.Finish();
   ASSERT_FALSE(finished.ok());
   EXPECT_NE(finished.error().ToString().find("disk full"), std::string::npos);
   EXPECT_EQ(ran.load(), 4);  // tasks 0..3; nothing after the failure ran
-  EXPECT_FALSE(queue.Submit([] { return mocap::Status::Ok(); }).ok());  // after Finish
+  EXPECT_FALSE(queue.Submit([] { return base::Status::Ok(); }).ok());  // after Finish
 }
 
 }  // namespace

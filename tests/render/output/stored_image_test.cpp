@@ -38,9 +38,9 @@ void ExpectRoundTripMatches(const std::string& extension, render::ImageFormat fo
   const std::string path =
       testsupport::TestOutputPath("stored_image/frame." + extension).string();
   ASSERT_TRUE(render::WriteImage(image, path).ok());
-  const mocap::Result<render::Image> read = render::ReadImage(path);
+  const base::Result<render::Image> read = render::ReadImage(path);
   ASSERT_TRUE(read.ok()) << read.error().ToString();
-  const mocap::Result<render::Image> stored = render::AsStored(image, format);
+  const base::Result<render::Image> stored = render::AsStored(image, format);
   ASSERT_TRUE(stored.ok()) << stored.error().ToString();
   ASSERT_EQ(stored->width, read->width);
   ASSERT_EQ(stored->height, read->height);
@@ -72,9 +72,10 @@ TEST(AsStored, ExrMatchesTheFileReadBack) {
 }
 
 TEST(AsStored, JpegIsRefusedAsLossy) {
-  const mocap::Result<render::Image> stored = render::AsStored(TestFrame(), render::ImageFormat::kJpeg);
+  const base::Result<render::Image> stored =
+      render::AsStored(TestFrame(), render::ImageFormat::kJpeg);
   ASSERT_FALSE(stored.ok());
-  EXPECT_EQ(stored.error().code, mocap::ErrorCode::kUnsupported);
+  EXPECT_EQ(stored.error().code, base::ErrorCode::kUnsupported);
 }
 
 }  // namespace
@@ -94,9 +95,9 @@ TEST(AsStored, ContactSheetFromStoredValuesEqualsOneFromFramesReadBack) {
   }
   const std::string path = testsupport::TestOutputPath("stored_image/sheet_frame.png").string();
   ASSERT_TRUE(render::WriteImage(frame, path).ok());
-  const mocap::Result<render::Image> read = render::ReadImage(path);
+  const base::Result<render::Image> read = render::ReadImage(path);
   ASSERT_TRUE(read.ok());
-  const mocap::Result<render::Image> stored = render::AsStored(frame, render::ImageFormat::kPng);
+  const base::Result<render::Image> stored = render::AsStored(frame, render::ImageFormat::kPng);
   ASSERT_TRUE(stored.ok());
 
   auto sheet_of = [](const render::Image& image) {

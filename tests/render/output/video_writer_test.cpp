@@ -99,14 +99,14 @@ TEST(VideoWriter, CropsAFrameOnePixelLargerThanTheVideo) {
 }
 
 TEST(VideoWriter, RejectsBadArgumentsAndUnwritablePaths) {
-  EXPECT_EQ(VideoWriter::Open("x.mp4", 0, 10).error().code, mocap::ErrorCode::kInvalidArgument);
+  EXPECT_EQ(VideoWriter::Open("x.mp4", 0, 10).error().code, base::ErrorCode::kInvalidArgument);
   VideoOptions none;
   none.codecs.clear();
   EXPECT_FALSE(VideoWriter::Open("x.mp4", 16, 16, none).ok());
   const fs::path dir = testsupport::FreshOutputDir("video/bad");
   auto r = VideoWriter::Open((dir / "missing" / "v.mp4").string(), 16, 16);
   ASSERT_FALSE(r.ok());
-  EXPECT_EQ(r.error().code, mocap::ErrorCode::kIo);
+  EXPECT_EQ(r.error().code, base::ErrorCode::kIo);
   EXPECT_NE(r.error().ToString().find("v.mp4"), std::string::npos);
 }
 

@@ -107,12 +107,12 @@ TEST(SelectScreenRegion, Errors) {
                                        {.rect = {0.5f, 0, 0.2f, 1}})
                 .error()
                 .code,
-            mocap::ErrorCode::kInvalidArgument);
+            base::ErrorCode::kInvalidArgument);
   EXPECT_EQ(render::SelectScreenRegion(LookDownZ({100, 0, 0}), s.positions, {}, s.triangles,
                                        {.rect = {0.4f, 0.4f, 0.6f, 0.6f}})
                 .error()
                 .code,
-            mocap::ErrorCode::kNotFound);
+            base::ErrorCode::kNotFound);
 }
 
 }  // namespace

@@ -12,7 +12,7 @@
 #include <variant>
 #include <vector>
 
-namespace mocap {
+namespace base {
 
 enum class ErrorCode {
   kOk = 0,
@@ -35,7 +35,7 @@ std::string_view ErrorCodeName(ErrorCode code);
 // A position in an input file. line and column are 1-based; 0 means unknown
 // (a whole-file error has neither, a field-path error in JSON uses field_path).
 struct FileLoc {
-  std::string file;        // as given by the user (not made absolute)
+  std::string file;  // as given by the user (not made absolute)
   int line = 0;
   int column = 0;
   std::string field_path;  // e.g. "patches[2].sampling.s" for JSON inputs, else empty
@@ -67,8 +67,8 @@ struct Warning {
 template <typename T>
 class [[nodiscard]] Result {
  public:
-  Result(T value) : v_(std::move(value)) {}          // NOLINT: implicit by design
-  Result(Error error) : v_(std::move(error)) {}      // NOLINT: implicit by design
+  Result(T value) : v_(std::move(value)) {}      // NOLINT: implicit by design
+  Result(Error error) : v_(std::move(error)) {}  // NOLINT: implicit by design
 
   bool ok() const { return v_.index() == 0; }
   explicit operator bool() const { return ok(); }
@@ -112,10 +112,10 @@ Error MakeError(ErrorCode code, FileLoc loc, std::string message);
 struct JobStatus {
   enum Code {
     kOk = 0,
-    kSizeMismatch,     // two spans that must have the same length do not
-    kMissingOutput,    // an optional input is set but its output is not
-    kMissingInput,     // a required input is empty
-    kOutOfRange,       // a parameter is outside its documented range
+    kSizeMismatch,   // two spans that must have the same length do not
+    kMissingOutput,  // an optional input is set but its output is not
+    kMissingInput,   // a required input is empty
+    kOutOfRange,     // a parameter is outside its documented range
   };
   Code code = kOk;
   const char* what = "ok";  // static string, never freed
@@ -126,4 +126,4 @@ struct JobStatus {
 
 inline constexpr JobStatus kJobOk{};
 
-}  // namespace mocap
+}  // namespace base

@@ -1,6 +1,6 @@
-#include "mocap/error.h"
+#include "base/error.h"
 
-namespace mocap {
+namespace base {
 
 std::string_view ErrorCodeName(ErrorCode code) {
   switch (code) {
@@ -38,4 +38,4 @@ Error MakeError(ErrorCode code, FileLoc loc, std::string message) {
   return Error{code, std::move(loc), std::move(message)};
 }
 
-}  // namespace mocap
+}  // namespace base
