@@ -42,7 +42,7 @@
 #include "deform/global/skinning_job.h"
 #include "mocap/bvh_reader.h"
 #include "mocap/bvh_writer.h"
-#include "mocap/synthetic.h"
+#include "tools/synthetic.h"
 #include "render/output/async_writer.h"
 #include "render/output/contact_sheet.h"
 #include "render/output/serial_task_queue.h"
@@ -71,11 +71,11 @@ using bench::Table1Row;
 // ------------------------------------------------------------ workloads ---
 
 std::string GeneratedBvh(int frames) {
-  const mocap::Skeleton skel = mocap::MakeHumanoidSkeleton();
-  mocap::WalkOptions walk;
+  const mocap::Skeleton skel = synthetic::MakeHumanoidSkeleton();
+  synthetic::WalkOptions walk;
   walk.frame_time_s = 1.0 / 120.0;
   walk.num_cycles = std::max(1, frames / 120);
-  const base::Result<mocap::Motion> motion = mocap::MakeWalkMotion(skel, walk);
+  const base::Result<mocap::Motion> motion = synthetic::MakeWalkMotion(skel, walk);
   if (!motion.ok()) return {};
   base::Result<std::string> text = mocap::FormatBvh(skel, *motion);
   return text.ok() ? std::move(*text) : std::string();

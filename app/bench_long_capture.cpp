@@ -11,7 +11,7 @@
 #include <iterator>
 
 #include "mocap/bvh_writer.h"
-#include "mocap/synthetic.h"
+#include "tools/synthetic.h"
 
 extern char** environ;
 
@@ -22,11 +22,11 @@ namespace fs = std::filesystem;
 
 // Writes the walk cut to exactly `frames` frames; returns its channel count, 0 on failure.
 int WriteCapture(const fs::path& path, int frames) {
-  const mocap::Skeleton skeleton = mocap::MakeHumanoidSkeleton();
-  mocap::WalkOptions walk;
+  const mocap::Skeleton skeleton = synthetic::MakeHumanoidSkeleton();
+  synthetic::WalkOptions walk;
   walk.frame_time_s = 1.0 / 120.0;
   walk.num_cycles = frames / 120 + 1;  // one cycle per second: 120 frames
-  base::Result<mocap::Motion> motion = mocap::MakeWalkMotion(skeleton, walk);
+  base::Result<mocap::Motion> motion = synthetic::MakeWalkMotion(skeleton, walk);
   if (!motion.ok() || motion->num_frames < frames) return 0;
   motion->num_frames = frames;
   motion->values.resize(static_cast<std::size_t>(frames) *

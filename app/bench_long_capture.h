@@ -2,7 +2,7 @@
 // Long captures in bounded memory (issue 8), for `patchskin bench`: captures
 // of 1,000, 10,000 and 100,000 frames (and 430,000, an hour at 120 fps,
 // unless --quick) are generated into a temporary folder (the synthetic
-// humanoid walk of mocap/synthetic.h, 75 channels, ~450 bytes of text a
+// humanoid walk of tools/synthetic.h, 75 channels, ~450 bytes of text a
 // frame), and each is rendered by a child `patchskin render FILE --frames 0:0
 // --size 160x90 --supersample 1 --threads 1 --stats` (this executable,
 // /proc/self/exe), which prints its own figures. Rows per capture:

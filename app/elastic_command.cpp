@@ -9,7 +9,7 @@
 #include "app/motion_source.h"
 #include "deform/elastic/mass_spring.h"
 #include "mocap/kinematics.h"
-#include "mocap/synthetic.h"
+#include "tools/synthetic.h"
 #include "render/output/image_io.h"
 #include "render/output/plot.h"
 
@@ -60,10 +60,10 @@ int RunElastic(const ElasticOptions& o) {
   float upm = o.units_per_metre;
   std::string source = "built-in jump";
   if (o.file.empty()) {
-    skel = mocap::MakeHumanoidSkeleton();
-    mocap::JumpOptions jump;
+    skel = synthetic::MakeHumanoidSkeleton();
+    synthetic::JumpOptions jump;
     jump.frame_time_s = 1.0 / 60.0;
-    auto m = mocap::MakeJumpMotion(skel, jump);
+    auto m = synthetic::MakeJumpMotion(skel, jump);
     if (!m.ok()) return Fail(m.error(), 3);
     motion = std::move(m).value();
     if (upm <= 0.0f) upm = 100.0f;

@@ -10,7 +10,7 @@
 #include "mocap/joint_angles.h"
 #include "mocap/kinematics.h"
 #include "mocap/sampling.h"
-#include "mocap/synthetic.h"
+#include "tools/synthetic.h"
 
 namespace {
 
@@ -25,7 +25,7 @@ struct Clip {
 // A 60-joint chain whose joints wave with different phases.
 const Clip& ChainClip() {
   static const Clip clip = [] {
-    Clip c{*mocap::MakeChainSkeleton(60, 5.0f), {}};
+    Clip c{*synthetic::MakeChainSkeleton(60, 5.0f), {}};
     c.motion.frame_time_s = kFrameTime;
     c.motion.num_frames = static_cast<int>(kClipSeconds / kFrameTime) + 1;
     c.motion.num_channels = c.skeleton.num_channels;
@@ -42,8 +42,9 @@ const Clip& ChainClip() {
 
 const Clip& WalkClip() {
   static const Clip clip = [] {
-    Clip c{mocap::MakeHumanoidSkeleton(), {}};
-    c.motion = *mocap::MakeWalkMotion(c.skeleton, {.frame_time_s = kFrameTime, .num_cycles = 30});
+    Clip c{synthetic::MakeHumanoidSkeleton(), {}};
+    c.motion =
+        *synthetic::MakeWalkMotion(c.skeleton, {.frame_time_s = kFrameTime, .num_cycles = 30});
     return c;
   }();
   return clip;

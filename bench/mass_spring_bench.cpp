@@ -13,7 +13,7 @@
 
 #include "deform/elastic/mass_spring.h"
 #include "mocap/kinematics.h"
-#include "mocap/synthetic.h"
+#include "tools/synthetic.h"
 
 namespace {
 
@@ -142,16 +142,16 @@ void BM_MassSpringAtRest(benchmark::State& bench, int size) {
 
 // The generated jump at 120 fps and its per-frame kinematics.
 struct JumpClip {
-  mocap::Skeleton skel = mocap::MakeHumanoidSkeleton();
+  mocap::Skeleton skel = synthetic::MakeHumanoidSkeleton();
   int hips = skel.FindJoint("Hips");  // the rows' driving joint
   double frame_time_s = 1.0 / 120;
   std::vector<mocap::JointKinematics> kin;
   int frames30 = 0;  // whole 30 fps frames in the clip
 
   JumpClip() {
-    mocap::JumpOptions options;
+    synthetic::JumpOptions options;
     options.frame_time_s = frame_time_s;
-    const mocap::Motion motion = mocap::MakeJumpMotion(skel, options).value();
+    const mocap::Motion motion = synthetic::MakeJumpMotion(skel, options).value();
     kin = mocap::ComputeKinematics(skel, motion).value();
     frames30 = static_cast<int>(motion.duration_s() * 30.0);
   }

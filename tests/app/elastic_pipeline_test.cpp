@@ -16,7 +16,7 @@
 
 #include "app/elastic_layer.h"
 #include "mocap/bvh_writer.h"
-#include "mocap/synthetic.h"
+#include "tools/synthetic.h"
 #include "support/data_paths.h"
 #include "support/elastic_rig.h"
 #include "support/run_process.h"
@@ -47,7 +47,7 @@ TEST(ElasticPipeline, SampleBellyJigglesAfterLandingThenSettles) {
   testsupport::RigPipeline l = LoadSampleRig("belly_jump.json");
   ASSERT_FALSE(HasFailure());
   const mocap::Motion& m = l.character->motion;
-  const mocap::JumpTimeline jump = mocap::MakeJumpTimeline({});
+  const synthetic::JumpTimeline jump = synthetic::MakeJumpTimeline({});
   const double dt = m.frame_time_s;
   std::vector<float> e(static_cast<std::size_t>(m.num_frames));
   app::DeformedFrame layered, global;

@@ -26,7 +26,7 @@
 #include "app/pipeline.h"
 #include "deform/global/skinning_job.h"
 #include "deform/global/swd_rig.h"
-#include "mocap/synthetic.h"
+#include "tools/synthetic.h"
 #include "support/body_checks.h"
 #include "support/data_paths.h"
 #include "support/tolerances.h"
@@ -147,8 +147,9 @@ TEST(SwdPipeline, SyntheticHumanoidWalkAndBend) {
   for (int which = 0; which < 2; ++which) {
     app::MotionSource src;
     src.format = "bvh";
-    src.skeleton = mocap::MakeHumanoidSkeleton();
-    auto motion = which == 0 ? mocap::MakeWalkMotion(src.skeleton) : mocap::MakeBendRamp(src.skeleton);
+    src.skeleton = synthetic::MakeHumanoidSkeleton();
+    auto motion = which == 0 ? synthetic::MakeWalkMotion(src.skeleton)
+                             : synthetic::MakeBendRamp(src.skeleton);
     ASSERT_TRUE(motion.ok());
     src.motion = std::move(*motion);
     auto c = app::MakeCharacter(std::move(src));

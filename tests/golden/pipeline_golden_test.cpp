@@ -22,7 +22,7 @@
 #include "app/pipeline.h"
 #include "app/rig_file.h"
 #include "app/rig_patches.h"
-#include "mocap/synthetic.h"
+#include "tools/synthetic.h"
 #include "render/camera.h"
 #include "support/golden.h"
 
@@ -44,8 +44,8 @@ app::Character Demo() {
 app::Character BendRamp() {
   app::MotionSource src;
   src.format = "bvh";
-  src.skeleton = mocap::MakeHumanoidSkeleton();
-  auto motion = mocap::MakeBendRamp(src.skeleton);
+  src.skeleton = synthetic::MakeHumanoidSkeleton();
+  auto motion = synthetic::MakeBendRamp(src.skeleton);
   EXPECT_TRUE(motion.ok());
   src.motion = std::move(*motion);
   auto c = app::MakeCharacter(std::move(src));

@@ -1,23 +1,23 @@
 #pragma once
 // Long captures for the memory and start-up tests: the synthetic humanoid's
-// walk (mocap/synthetic.h) at 120 fps, cut to exactly `frames` frames and
+// walk (tools/synthetic.h) at 120 fps, cut to exactly `frames` frames and
 // written as a BVH file. 100,000 frames make a ~50 MB file in about a second.
 
 #include <string>
 #include <utility>
 
 #include "mocap/bvh_writer.h"
-#include "mocap/synthetic.h"
+#include "tools/synthetic.h"
 
 namespace testsupport {
 
 // The capture's skeleton and motion; false if the walk could not be made that long.
 inline bool LongCaptureMotion(int frames, mocap::Skeleton* skeleton, mocap::Motion* motion) {
-  *skeleton = mocap::MakeHumanoidSkeleton();
-  mocap::WalkOptions walk;
+  *skeleton = synthetic::MakeHumanoidSkeleton();
+  synthetic::WalkOptions walk;
   walk.frame_time_s = 1.0 / 120.0;
   walk.num_cycles = frames / 120 + 1;  // cycle_s = 1: 120 frames per cycle
-  base::Result<mocap::Motion> made = mocap::MakeWalkMotion(*skeleton, walk);
+  base::Result<mocap::Motion> made = synthetic::MakeWalkMotion(*skeleton, walk);
   if (!made.ok() || made->num_frames < frames) return false;
   *motion = std::move(made).value();
   motion->num_frames = frames;

@@ -1,6 +1,6 @@
 #pragma once
 // The mannequin of the synthetic humanoid with patches on the left elbow and
-// left knee, posed by the elbow/knee bend ramp (mocap/synthetic.h), shared by
+// left knee, posed by the elbow/knee bend ramp (tools/synthetic.h), shared by
 // the patch layer tests.
 
 #include <cmath>
@@ -13,7 +13,7 @@
 #include "deform/patch/patch_region.h"
 #include "deform/global/skinning_job.h"
 #include "mocap/pose.h"
-#include "mocap/synthetic.h"
+#include "tools/synthetic.h"
 
 namespace testfixture {
 
@@ -26,7 +26,7 @@ struct LayeredBody {
 
 inline LayeredBody MakeLayeredBody() {
   LayeredBody b;
-  b.skeleton = mocap::MakeHumanoidSkeleton();
+  b.skeleton = synthetic::MakeHumanoidSkeleton();
   std::vector<mocap::JointTransform> locals(static_cast<std::size_t>(b.skeleton.num_joints()));
   mocap::RestPose(b.skeleton, locals);
   b.rest_model.resize(locals.size());
@@ -83,7 +83,7 @@ inline PatchSpec KneeSpec(const LayeredBody& b) {
 
 // The pose of the bend ramp (elbows and left knee) at `angle_deg` <= 150.
 inline std::vector<glm::mat4> BendPose(const LayeredBody& b, float angle_deg) {
-  const mocap::Motion ramp = *mocap::MakeBendRamp(b.skeleton, angle_deg, 1.0, 1.0);
+  const mocap::Motion ramp = *synthetic::MakeBendRamp(b.skeleton, angle_deg, 1.0, 1.0);
   std::vector<mocap::JointTransform> locals(static_cast<std::size_t>(b.skeleton.num_joints()));
   (void)mocap::LocalPoseJob{&b.skeleton, ramp.frame(ramp.num_frames - 1), locals}.Run();
   std::vector<glm::mat4> model(locals.size());

@@ -2,15 +2,15 @@
 
 #include <gtest/gtest.h>
 
-#include "mocap/synthetic.h"
+#include "tools/synthetic.h"
 #include "support/test_skeletons.h"
 #include "support/tolerances.h"
 
 namespace {
 
 TEST(BindPose, StandingRestPoseIsKept) {
-  const mocap::Skeleton s = mocap::MakeHumanoidSkeleton();
-  auto walk = mocap::MakeWalkMotion(s);
+  const mocap::Skeleton s = synthetic::MakeHumanoidSkeleton();
+  auto walk = synthetic::MakeWalkMotion(s);
   ASSERT_TRUE(walk.ok());
   auto choice = deform::ChooseBindPose(s, *walk);
   ASSERT_TRUE(choice.ok()) << choice.error().ToString();

@@ -19,7 +19,7 @@
 #include "mocap/bvh_reader.h"
 #include "mocap/channel_use.h"
 #include "mocap/pose.h"
-#include "mocap/synthetic.h"
+#include "tools/synthetic.h"
 #include "support/data_paths.h"
 #include "support/test_skeletons.h"
 #include "support/body_checks.h"
@@ -328,7 +328,7 @@ double SsdVolume(const deform::SkinnedMesh& mesh, std::span<const glm::mat4> mod
 // tube mannequin (printed; the figures go in the report). The new body must lose volume
 // where SSD is known to collapse it (a 150 degree elbow or knee).
 TEST(GeneratedBody, SsdVolumeLossAgainstTheTubeBody) {
-  const mocap::Skeleton s = mocap::MakeHumanoidSkeleton();
+  const mocap::Skeleton s = synthetic::MakeHumanoidSkeleton();
   const std::vector<glm::mat4> rest = RestMatrices(s);
   auto generated = deform::BuildGeneratedBody(s, rest);
   auto tubes = deform::BuildMannequin(s, rest);

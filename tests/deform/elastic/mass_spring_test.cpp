@@ -18,7 +18,7 @@
 
 #include "mocap/bvh_reader.h"
 #include "mocap/kinematics.h"
-#include "mocap/synthetic.h"
+#include "tools/synthetic.h"
 #include "support/data_paths.h"
 #include "support/tolerances.h"
 
@@ -386,10 +386,10 @@ std::vector<mocap::JointKinematics> SmoothedKinematics(const mocap::Skeleton& sk
 // Hips-driven 5x5 patch over the synthetic jump sampled at `fps` (10 Hz low-pass); the centre
 // point's displacement at every 1/30 s.
 std::vector<glm::vec3> JumpResponse(double fps) {
-  const mocap::Skeleton skel = mocap::MakeHumanoidSkeleton();
-  mocap::JumpOptions options;
+  const mocap::Skeleton skel = synthetic::MakeHumanoidSkeleton();
+  synthetic::JumpOptions options;
   options.frame_time_s = 1.0 / fps;
-  auto motion = mocap::MakeJumpMotion(skel, options);
+  auto motion = synthetic::MakeJumpMotion(skel, options);
   EXPECT_TRUE(motion.ok());
   const std::vector<mocap::JointKinematics> kin = SmoothedKinematics(skel, *motion);
   const int hips = skel.FindJoint("Hips");

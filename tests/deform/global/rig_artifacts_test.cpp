@@ -8,7 +8,7 @@
 #include "deform/body/mannequin.h"
 #include "deform/global/swd_rig.h"
 #include "mocap/pose.h"
-#include "mocap/synthetic.h"
+#include "tools/synthetic.h"
 #include "support/tolerances.h"
 
 namespace {
@@ -22,7 +22,7 @@ struct Body {
 
 Body SyntheticHumanoidBody() {
   Body b;
-  b.skeleton = mocap::MakeHumanoidSkeleton();
+  b.skeleton = synthetic::MakeHumanoidSkeleton();
   std::vector<mocap::JointTransform> locals(static_cast<std::size_t>(b.skeleton.num_joints()));
   mocap::RestPose(b.skeleton, locals);
   b.bind.resize(locals.size());

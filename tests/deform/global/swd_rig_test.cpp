@@ -17,7 +17,7 @@
 #include "deform/body/mannequin.h"
 #include "deform/global/swd_job.h"
 #include "mocap/pose.h"
-#include "mocap/synthetic.h"
+#include "tools/synthetic.h"
 #include "support/test_skeletons.h"
 #include "support/tolerances.h"
 
@@ -45,7 +45,7 @@ Rigged MakeRigged(BuiltSkeleton b) {
 
 BuiltSkeleton SyntheticHumanoid() {
   BuiltSkeleton b;
-  b.skeleton = mocap::MakeHumanoidSkeleton();
+  b.skeleton = synthetic::MakeHumanoidSkeleton();
   std::vector<mocap::JointTransform> locals(static_cast<std::size_t>(b.skeleton.num_joints()));
   mocap::RestPose(b.skeleton, locals);
   b.model_from_joint.resize(locals.size());
@@ -261,7 +261,7 @@ TEST(SwdRig, ChainsLongerThanOneSweepAreCutWithJunctions) {
 
 TEST(SwdRig, AnySplitOfTheVerticesGivesTheSameBits) {
   const Rigged r = MakeRigged(SyntheticHumanoid());
-  auto walk = mocap::MakeWalkMotion(r.b.skeleton);
+  auto walk = synthetic::MakeWalkMotion(r.b.skeleton);
   ASSERT_TRUE(walk.ok());
   std::vector<mocap::JointTransform> locals(r.b.model_from_joint.size());
   std::vector<glm::mat4> model(locals.size());

@@ -1,4 +1,4 @@
-#include "mocap/synthetic.h"
+#include "tools/synthetic.h"
 
 #include <algorithm>
 #include <cmath>
@@ -55,7 +55,7 @@ float LowestFootY(const Probe& pr, int f, const char* side) {
 }
 
 TEST(Synthetic, HumanoidSkeletonLooksLikeACapture) {
-  const mocap::Skeleton s = mocap::MakeHumanoidSkeleton();
+  const mocap::Skeleton s = synthetic::MakeHumanoidSkeleton();
   ASSERT_TRUE(s.Check().ok());
   EXPECT_EQ(s.num_joints(), 24);
   EXPECT_EQ(s.num_channels, 6 + 23 * 3);
@@ -85,8 +85,8 @@ TEST(Synthetic, HumanoidSkeletonLooksLikeACapture) {
 }
 
 TEST(Synthetic, WalkKeepsFeetOnTheGroundAndMovesForward) {
-  const mocap::Skeleton s = mocap::MakeHumanoidSkeleton();
-  auto m = mocap::MakeWalkMotion(s);
+  const mocap::Skeleton s = synthetic::MakeHumanoidSkeleton();
+  auto m = synthetic::MakeWalkMotion(s);
   ASSERT_TRUE(m.ok()) << m.error().ToString();
   ExpectWellFormed(s, *m);
   EXPECT_EQ(m->num_frames, 90);
@@ -117,8 +117,8 @@ TEST(Synthetic, WalkKeepsFeetOnTheGroundAndMovesForward) {
 }
 
 TEST(Synthetic, WalkPlantsTheStanceFootAndMovesSmoothly) {
-  const mocap::Skeleton s = mocap::MakeHumanoidSkeleton();
-  auto m = mocap::MakeWalkMotion(s);
+  const mocap::Skeleton s = synthetic::MakeHumanoidSkeleton();
+  auto m = synthetic::MakeWalkMotion(s);
   ASSERT_TRUE(m.ok());
   const Probe pr{s, Positions(s, *m)};
   int planted_pairs = 0;
@@ -142,14 +142,14 @@ TEST(Synthetic, WalkPlantsTheStanceFootAndMovesSmoothly) {
   ASSERT_TRUE(k.ok());
   for (int f = 0; f < m->num_frames; ++f) {
     EXPECT_LT(std::abs((*k)[static_cast<std::size_t>(f * s.num_joints())].linear_acceleration.y),
-              0.5 * mocap::kGravityCmPerS2)
+              0.5 * synthetic::kGravityCmPerS2)
         << "frame " << f;
   }
 }
 
 TEST(Synthetic, WalkLoops) {
-  const mocap::Skeleton s = mocap::MakeHumanoidSkeleton();
-  auto m = mocap::MakeWalkMotion(s, {.num_cycles = 2});
+  const mocap::Skeleton s = synthetic::MakeHumanoidSkeleton();
+  auto m = synthetic::MakeWalkMotion(s, {.num_cycles = 2});
   ASSERT_TRUE(m.ok());
   const int cycle = m->num_frames / 2;
   for (int c = 3; c < m->num_channels; ++c) {  // all but the root position
@@ -157,13 +157,13 @@ TEST(Synthetic, WalkLoops) {
         << "channel " << c;
   }
   EXPECT_NEAR(m->frame(cycle)[1], m->frame(0)[1], testsupport::kResampleChannelTol);
-  auto again = mocap::MakeWalkMotion(s, {.num_cycles = 2});
+  auto again = synthetic::MakeWalkMotion(s, {.num_cycles = 2});
   EXPECT_EQ(again->values, m->values);  // deterministic
 }
 
 TEST(Synthetic, BendRampReaches150Degrees) {
-  const mocap::Skeleton s = mocap::MakeHumanoidSkeleton();
-  auto m = mocap::MakeBendRamp(s);
+  const mocap::Skeleton s = synthetic::MakeHumanoidSkeleton();
+  auto m = synthetic::MakeBendRamp(s);
   ASSERT_TRUE(m.ok());
   ExpectWellFormed(s, *m);
   const Probe pr{s, Positions(s, *m)};
@@ -190,8 +190,8 @@ TEST(Synthetic, BendRampReaches150Degrees) {
 }
 
 TEST(Synthetic, TwistRampTurnsTheForearmsAboutTheirAxis) {
-  const mocap::Skeleton s = mocap::MakeHumanoidSkeleton();
-  auto m = mocap::MakeTwistRamp(s);
+  const mocap::Skeleton s = synthetic::MakeHumanoidSkeleton();
+  auto m = synthetic::MakeTwistRamp(s);
   ASSERT_TRUE(m.ok());
   ExpectWellFormed(s, *m);
   const int fore = s.FindJoint("LeftForeArm");
@@ -214,12 +214,12 @@ TEST(Synthetic, TwistRampTurnsTheForearmsAboutTheirAxis) {
 }
 
 TEST(Synthetic, JumpHasAnAccelerationSpikeAndFreeFall) {
-  const mocap::Skeleton s = mocap::MakeHumanoidSkeleton();
-  const mocap::JumpOptions options{.frame_time_s = 1.0 / 120.0};
-  auto m = mocap::MakeJumpMotion(s, options);
+  const mocap::Skeleton s = synthetic::MakeHumanoidSkeleton();
+  const synthetic::JumpOptions options{.frame_time_s = 1.0 / 120.0};
+  auto m = synthetic::MakeJumpMotion(s, options);
   ASSERT_TRUE(m.ok());
   ExpectWellFormed(s, *m);
-  const mocap::JumpTimeline tl = mocap::MakeJumpTimeline(options);
+  const synthetic::JumpTimeline tl = synthetic::MakeJumpTimeline(options);
   auto k = mocap::ComputeKinematics(s, *m);
   ASSERT_TRUE(k.ok());
   const int nj = s.num_joints();
@@ -232,7 +232,7 @@ TEST(Synthetic, JumpHasAnAccelerationSpikeAndFreeFall) {
     // Whole flight and push intervals, away from the kinks where the central
     // difference straddles two phases.
     if (t > tl.takeoff_s + h && t < tl.touchdown_s - h) {
-      EXPECT_NEAR(ay, -mocap::kGravityCmPerS2, testsupport::kJumpAccelTolCmPerS2) << "t " << t;
+      EXPECT_NEAR(ay, -synthetic::kGravityCmPerS2, testsupport::kJumpAccelTolCmPerS2) << "t " << t;
       EXPECT_GT(LowestFootY(pr, f, "Left"), 0.0f);
     }
     if (t > tl.push_start_s + h && t < tl.takeoff_s - h) {
@@ -245,40 +245,40 @@ TEST(Synthetic, JumpHasAnAccelerationSpikeAndFreeFall) {
     apex = std::max(apex, pr.At(f, "Hips").y - s.rest_translations[0].y);
   }
   EXPECT_NEAR(apex, options.height_cm, testsupport::kJumpApexTolCm);
-  EXPECT_GT(tl.push_acceleration_cm_per_s2, mocap::kGravityCmPerS2);  // a real spike
+  EXPECT_GT(tl.push_acceleration_cm_per_s2, synthetic::kGravityCmPerS2);  // a real spike
 }
 
 TEST(Synthetic, GeneratorsRejectBadInput) {
-  const mocap::Skeleton s = mocap::MakeHumanoidSkeleton();
-  EXPECT_EQ(mocap::MakeBendRamp(s, 150.0f, 2.0, 0.0).error().code,
+  const mocap::Skeleton s = synthetic::MakeHumanoidSkeleton();
+  EXPECT_EQ(synthetic::MakeBendRamp(s, 150.0f, 2.0, 0.0).error().code,
             base::ErrorCode::kInvalidArgument);
-  EXPECT_EQ(mocap::MakeWalkMotion(s, {.step_length_cm = 90.0}).error().code,
+  EXPECT_EQ(synthetic::MakeWalkMotion(s, {.step_length_cm = 90.0}).error().code,
             base::ErrorCode::kInvalidArgument);
-  EXPECT_EQ(mocap::MakeWalkMotion(s, {.num_cycles = 0}).error().code,
+  EXPECT_EQ(synthetic::MakeWalkMotion(s, {.num_cycles = 0}).error().code,
             base::ErrorCode::kInvalidArgument);
-  EXPECT_EQ(mocap::MakeJumpMotion(s, {.crouch_cm = 100.0}).error().code,
+  EXPECT_EQ(synthetic::MakeJumpMotion(s, {.crouch_cm = 100.0}).error().code,
             base::ErrorCode::kInvalidArgument);
-  auto chain = mocap::MakeChainSkeleton(5);
+  auto chain = synthetic::MakeChainSkeleton(5);
   ASSERT_TRUE(chain.ok());
-  const auto missing = mocap::MakeTwistRamp(*chain);
+  const auto missing = synthetic::MakeTwistRamp(*chain);
   ASSERT_FALSE(missing.ok());
   EXPECT_EQ(missing.error().code, base::ErrorCode::kNotFound);
   EXPECT_NE(missing.error().message.find("Hips"), std::string::npos);
-  EXPECT_EQ(mocap::MakeChainSkeleton(0).error().code, base::ErrorCode::kInvalidArgument);
-  EXPECT_EQ(mocap::MakeChainSkeleton(mocap::kMaxJoints + 1).error().code,
+  EXPECT_EQ(synthetic::MakeChainSkeleton(0).error().code, base::ErrorCode::kInvalidArgument);
+  EXPECT_EQ(synthetic::MakeChainSkeleton(mocap::kMaxJoints + 1).error().code,
             base::ErrorCode::kInvalidArgument);
 }
 
 TEST(Synthetic, GeneratorsFollowAnyChannelOrder) {
-  mocap::Skeleton s = mocap::MakeHumanoidSkeleton();
+  mocap::Skeleton s = synthetic::MakeHumanoidSkeleton();
   const mocap::Skeleton zxy = s;
   for (std::size_t j = 1; j < s.channels.size(); ++j) {  // XYZ everywhere but the root
     s.channels[j].types[0] = mocap::ChannelType::kXRotation;
     s.channels[j].types[1] = mocap::ChannelType::kYRotation;
     s.channels[j].types[2] = mocap::ChannelType::kZRotation;
   }
-  auto a = mocap::MakeWalkMotion(zxy);
-  auto b = mocap::MakeWalkMotion(s);
+  auto a = synthetic::MakeWalkMotion(zxy);
+  auto b = synthetic::MakeWalkMotion(s);
   ASSERT_TRUE(a.ok() && b.ok());
   const std::vector<glm::vec3> pa = Positions(zxy, *a);
   const std::vector<glm::vec3> pb = Positions(s, *b);
@@ -288,13 +288,13 @@ TEST(Synthetic, GeneratorsFollowAnyChannelOrder) {
 }
 
 TEST(Synthetic, ChainAndQuadrupedSkeletons) {
-  auto chain = mocap::MakeChainSkeleton(12, 5.0f);
+  auto chain = synthetic::MakeChainSkeleton(12, 5.0f);
   ASSERT_TRUE(chain.ok());
   ASSERT_TRUE(chain->Check().ok());
   EXPECT_EQ(chain->num_joints(), 12);
   EXPECT_EQ(chain->num_channels, 6 + 11 * 3);
   EXPECT_EQ(chain->names[11], "Chain11");
-  const mocap::Skeleton q = mocap::MakeQuadrupedSkeleton();
+  const mocap::Skeleton q = synthetic::MakeQuadrupedSkeleton();
   ASSERT_TRUE(q.Check().ok());
   EXPECT_EQ(q.num_joints(), 23);
   mocap::Motion rest;

@@ -23,13 +23,13 @@
 #include "mocap/motion.h"
 #include "mocap/skeleton.h"
 
-namespace mocap {
+namespace synthetic {
 
 // Standard gravity in the humanoid's units (cm/s^2), used by the jump.
 inline constexpr double kGravityCmPerS2 = 981.0;
 
 // The humanoid described above, in its T-pose rest.
-Skeleton MakeHumanoidSkeleton();
+mocap::Skeleton MakeHumanoidSkeleton();
 
 // A looping walk cycle at constant speed along +Z. Each ankle follows a
 // prescribed path relative to its hip joint and the legs are solved by two-bone
@@ -54,14 +54,15 @@ struct WalkOptions {
   float arm_swing_deg = 15.0f;   // upper-arm swing amplitude
   float elbow_peak_deg = 45.0f;  // elbow flexion with the arm fully forward (<= 120)
 };
-base::Result<Motion> MakeWalkMotion(const Skeleton& humanoid, const WalkOptions& options = {});
+base::Result<mocap::Motion> MakeWalkMotion(const mocap::Skeleton& humanoid,
+                                           const WalkOptions& options = {});
 
 // Elbows (both, arms in T-pose, forearms bending forward) and the left knee
 // (the thigh flexing forward to 0.4x the knee angle, so the shin stays clear of
 // the body) bend linearly from 0 to end_deg over duration_s; the right leg
 // stands still. num_frames = round(duration_s / frame_time_s) + 1.
-base::Result<Motion> MakeBendRamp(const Skeleton& humanoid, float end_deg = 150.0f,
-                                  double duration_s = 2.0, double frame_time_s = 1.0 / 30.0);
+base::Result<mocap::Motion> MakeBendRamp(const mocap::Skeleton& humanoid, float end_deg = 150.0f,
+                                         double duration_s = 2.0, double frame_time_s = 1.0 / 30.0);
 
 // The left upper arm (joint LeftArm) visits five poses, returning to the
 // T-pose between them: down at the side (Z -75), raised (Z +60), forward
@@ -70,21 +71,23 @@ base::Result<Motion> MakeBendRamp(const Skeleton& humanoid, float end_deg = 150.
 // (zero speed at both ends), so pose k (0..4) is reached exactly at
 // (2k + 1) * segment_s and the motion lasts 10 * segment_s. Angles in degrees
 // about the joint's own axes, composed in its ZXY order (pose.h).
-base::Result<Motion> MakeShoulderSweep(const Skeleton& humanoid, double segment_s = 0.5,
-                                       double frame_time_s = 1.0 / 30.0);
+base::Result<mocap::Motion> MakeShoulderSweep(const mocap::Skeleton& humanoid,
+                                              double segment_s = 0.5,
+                                              double frame_time_s = 1.0 / 30.0);
 
 // The left leg stretches back (thigh 40 degrees behind, knee straight), returns
 // to standing, lifts forward (thigh 80 degrees forward, knee 90 degrees bent)
 // and returns; the foot follows the shin (ankle and right leg still). Each move takes
 // segment_s with a cosine ease; the stretched-back pose is reached exactly at
 // segment_s and the lifted pose at 3 * segment_s; 4 * segment_s in all.
-base::Result<Motion> MakeHipSwing(const Skeleton& humanoid, double segment_s = 0.5,
-                                  double frame_time_s = 1.0 / 30.0);
+base::Result<mocap::Motion> MakeHipSwing(const mocap::Skeleton& humanoid, double segment_s = 0.5,
+                                         double frame_time_s = 1.0 / 30.0);
 
 // Both forearms twist about their bone axis (X) linearly from 0 to end_deg
 // (mirrored: the right forearm by -end_deg about +X), arms in T-pose.
-base::Result<Motion> MakeTwistRamp(const Skeleton& humanoid, float end_deg = 180.0f,
-                                   double duration_s = 2.0, double frame_time_s = 1.0 / 30.0);
+base::Result<mocap::Motion> MakeTwistRamp(const mocap::Skeleton& humanoid, float end_deg = 180.0f,
+                                          double duration_s = 2.0,
+                                          double frame_time_s = 1.0 / 30.0);
 
 // A standing vertical jump: stand, crouch (cosine ease), push with constant
 // upward hip acceleration v0^2 / (2 crouch) until the legs are straight at
@@ -99,7 +102,8 @@ struct JumpOptions {
   double crouch_cm = 25.0;          // hip drop before take-off (< 84, the leg length)
   double landing_crouch_cm = 20.0;  // hip drop while landing
 };
-base::Result<Motion> MakeJumpMotion(const Skeleton& humanoid, const JumpOptions& options = {});
+base::Result<mocap::Motion> MakeJumpMotion(const mocap::Skeleton& humanoid,
+                                           const JumpOptions& options = {});
 
 // Times (seconds from the first frame) of the jump's phases, for tests.
 struct JumpTimeline {
@@ -114,11 +118,11 @@ JumpTimeline MakeJumpTimeline(const JumpOptions& options);
 // is the root at (0, 50, 0) with position channels, every next joint is
 // segment_length_cm further along -Z; all ZXY rotation channels; an end site.
 // kInvalidArgument unless 1 <= num_joints <= kMaxJoints and the length is > 0.
-base::Result<Skeleton> MakeChainSkeleton(int num_joints, float segment_length_cm = 10.0f);
+base::Result<mocap::Skeleton> MakeChainSkeleton(int num_joints, float segment_length_cm = 10.0f);
 
 // A simple quadruped standing on y = 0, facing +Z, in cm: Hips (root), Spine,
 // Chest, Neck, Head, four legs {Left,Right}{Front,Hind}{UpLeg,Leg,Foot,ToeBase}
 // and a two-joint tail (Tail, Tail1); 23 joints, ZXY channels.
-Skeleton MakeQuadrupedSkeleton();
+mocap::Skeleton MakeQuadrupedSkeleton();
 
-}  // namespace mocap
+}  // namespace synthetic

@@ -1,5 +1,5 @@
 // Writes the motions the project ships in samples/data, from the synthetic
-// humanoid (mocap/synthetic.h), as BVH:
+// humanoid (tools/synthetic.h), as BVH:
 //   generate_demo_data OUT.bvh              three cycles of the walk (the built-in demo)
 //   generate_demo_data --bend OUT.bvh       elbows and left knee bending 0 -> 150 degrees
 //                                           over 2 s (samples/data/bend.bvh: the
@@ -24,7 +24,7 @@
 #include <string>
 
 #include "mocap/bvh_writer.h"
-#include "mocap/synthetic.h"
+#include "tools/synthetic.h"
 
 namespace {
 
@@ -56,9 +56,9 @@ int YRotationChannel(const mocap::Skeleton& s, const char* joint) {
 
 // Standing (the jump's first frame) with a head shake; see the file comment.
 base::Result<mocap::Motion> MakeHeadShake(const mocap::Skeleton& skeleton) {
-  mocap::JumpOptions jump;
+  synthetic::JumpOptions jump;
   jump.frame_time_s = 1.0 / 60.0;
-  base::Result<mocap::Motion> stand = mocap::MakeJumpMotion(skeleton, jump);
+  base::Result<mocap::Motion> stand = synthetic::MakeJumpMotion(skeleton, jump);
   if (!stand.ok()) return stand;
   mocap::Motion m = std::move(*stand);
   m.values.resize(static_cast<std::size_t>(m.num_channels));  // frame 0 only
@@ -86,19 +86,21 @@ int main(int argc, char** argv) {
   const std::string mode = argc == 3 ? std::string(argv[1]) : std::string();
   if (argc != 2 && mode != "--bend" && mode != "--jump" && mode != "--shake" &&
       mode != "--shoulder" && mode != "--hip") {
-    std::fprintf(stderr, "usage: generate_demo_data [--bend | --jump | --shake | --shoulder | --hip] OUT.bvh\n");
+    std::fprintf(
+        stderr,
+        "usage: generate_demo_data [--bend | --jump | --shake | --shoulder | --hip] OUT.bvh\n");
     return 1;
   }
-  const mocap::Skeleton skeleton = mocap::MakeHumanoidSkeleton();
-  mocap::WalkOptions walk;
+  const mocap::Skeleton skeleton = synthetic::MakeHumanoidSkeleton();
+  synthetic::WalkOptions walk;
   walk.num_cycles = 3;
-  base::Result<mocap::Motion> motion = mocap::MakeWalkMotion(skeleton, walk);
-  if (mode == "--bend") motion = mocap::MakeBendRamp(skeleton, 150.0f, 2.0);
-  if (mode == "--shoulder") motion = mocap::MakeShoulderSweep(skeleton);
-  if (mode == "--hip") motion = mocap::MakeHipSwing(skeleton);
+  base::Result<mocap::Motion> motion = synthetic::MakeWalkMotion(skeleton, walk);
+  if (mode == "--bend") motion = synthetic::MakeBendRamp(skeleton, 150.0f, 2.0);
+  if (mode == "--shoulder") motion = synthetic::MakeShoulderSweep(skeleton);
+  if (mode == "--hip") motion = synthetic::MakeHipSwing(skeleton);
   if (mode == "--shake") motion = MakeHeadShake(skeleton);
   if (mode == "--jump") {
-    motion = mocap::MakeJumpMotion(skeleton, {});
+    motion = synthetic::MakeJumpMotion(skeleton, {});
     if (motion.ok()) HoldLastFrame(*motion, kStillAfterS);
   }
   if (!motion.ok()) {

@@ -1,4 +1,4 @@
-#include "mocap/synthetic.h"
+#include "tools/synthetic.h"
 
 #include <algorithm>
 #include <array>
@@ -10,7 +10,19 @@
 #include "mocap/joint_angles.h"
 #include "mocap/pose.h"
 
-namespace mocap {
+namespace synthetic {
+
+using mocap::ChannelType;
+using mocap::EulerToQuat;
+using mocap::JointChannels;
+using mocap::kMaxJoints;
+using mocap::kNoParent;
+using mocap::Motion;
+using mocap::PositionChannelMode;
+using mocap::QuatToEulerNear;
+using mocap::Skeleton;
+using mocap::UpAxis;
+
 namespace {
 
 constexpr double kPi = std::numbers::pi;
@@ -388,7 +400,8 @@ base::Result<Motion> MakeHipSwing(const Skeleton& humanoid, double segment_s, do
     return base::MakeError(base::ErrorCode::kInvalidArgument, {}, "expected segment_s > 0");
   // (thigh X, knee X) in degrees: stand, stretched back, stand, lifted, stand.
   const double keys[5][2] = {{0, 0}, {40, 0}, {0, 0}, {-80, 90}, {0, 0}};
-  auto writer = MotionWriter::Create(humanoid, frame_time_s, FramesFor(4 * segment_s, frame_time_s));
+  auto writer =
+      MotionWriter::Create(humanoid, frame_time_s, FramesFor(4 * segment_s, frame_time_s));
   if (!writer.ok()) return std::move(writer).error();
   for (int f = 0; f < writer->num_frames(); ++f) {
     const auto [k, w] = EasedSegment(f * frame_time_s, segment_s, 5);
@@ -538,4 +551,4 @@ Skeleton MakeQuadrupedSkeleton() {
   return s;
 }
 
-}  // namespace mocap
+}  // namespace synthetic
