@@ -21,37 +21,6 @@ int Fail(const base::Error& e, int code) {
   return code;
 }
 
-// Per-frame kinematics of every joint, low-passed first when cutoff_hz > 0.
-base::Result<std::vector<mocap::JointKinematics>> Kinematics(const mocap::Skeleton& skel,
-                                                             const mocap::Motion& motion,
-                                                             double cutoff_hz) {
-  if (cutoff_hz <= 0.0) return mocap::ComputeKinematics(skel, motion);
-  const std::size_t nj = static_cast<std::size_t>(skel.num_joints());
-  const std::size_t nf = static_cast<std::size_t>(motion.num_frames);
-  std::vector<mocap::JointTransform> locals(nj);
-  std::vector<glm::mat4> raw(nj * nf), smooth(nj * nf);
-  std::vector<mocap::JointKinematics> kin(nj * nf);
-  const base::JobStatus s1 =
-      mocap::ModelMatricesJob{
-          .skeleton = &skel, .motion = &motion, .locals = locals, .model_from_joint = raw}
-          .Run();
-  const base::JobStatus s2 = mocap::SmoothTrajectoriesJob{.model_from_joint = raw,
-                                                          .num_joints = skel.num_joints(),
-                                                          .frame_time_s = motion.frame_time_s,
-                                                          .cutoff_hz = cutoff_hz,
-                                                          .output = smooth}
-                                 .Run();
-  const base::JobStatus s3 = mocap::KinematicsJob{.model_from_joint = smooth,
-                                                  .num_joints = skel.num_joints(),
-                                                  .frame_time_s = motion.frame_time_s,
-                                                  .output = kin}
-                                 .Run();
-  for (const base::JobStatus& s : {s1, s2, s3}) {
-    if (!s) return base::MakeError(base::ErrorCode::kInvalidArgument, base::FileLoc(), s.what);
-  }
-  return kin;
-}
-
 }  // namespace
 
 int RunElastic(const ElasticOptions& o) {
@@ -88,7 +57,7 @@ int RunElastic(const ElasticOptions& o) {
     return Fail(
         base::MakeError(base::ErrorCode::kInvalidArgument, loc, "expected at least 2 frames"), 2);
   }
-  auto kin = Kinematics(skel, motion, o.cutoff_hz);
+  auto kin = mocap::ComputeKinematics(skel, motion, o.cutoff_hz);
   if (!kin.ok()) return Fail(kin.error(), 2);
   const std::size_t nj = static_cast<std::size_t>(skel.num_joints());
   float max_w = 0.0f;

@@ -42,114 +42,6 @@ int DominantJoint(const Character& c, const deform::PatchSetup& patch) {
 
 }  // namespace
 
-base::Result<std::vector<mocap::JointKinematics>> DrivingKinematics(
-    const mocap::Skeleton& skeleton, const mocap::Motion& motion, double cutoff_hz,
-    const glm::mat4& model_from_root) {
-  const std::size_t nj = static_cast<std::size_t>(skeleton.num_joints());
-  const std::size_t nf = static_cast<std::size_t>(motion.num_frames);
-  std::vector<mocap::JointTransform> locals(nj);
-  std::vector<glm::mat4> raw(nj * nf);
-  std::vector<mocap::JointKinematics> kin(nj * nf);
-  std::vector<base::JobStatus> statuses;
-  statuses.push_back(mocap::ModelMatricesJob{.skeleton = &skeleton, .motion = &motion,
-                                             .model_from_root = model_from_root,
-                                             .locals = locals, .model_from_joint = raw}
-                         .Run());
-  if (cutoff_hz > 0.0 && statuses.back()) {
-    std::vector<glm::mat4> smooth(nj * nf);
-    statuses.push_back(mocap::SmoothTrajectoriesJob{.model_from_joint = raw,
-                                                    .num_joints = skeleton.num_joints(),
-                                                    .frame_time_s = motion.frame_time_s,
-                                                    .cutoff_hz = cutoff_hz,
-                                                    .output = smooth}
-                           .Run());
-    raw = std::move(smooth);
-  }
-  if (statuses.back()) {
-    statuses.push_back(mocap::KinematicsJob{.model_from_joint = raw,
-                                            .num_joints = skeleton.num_joints(),
-                                            .frame_time_s = motion.frame_time_s,
-                                            .output = kin}
-                           .Run());
-  }
-  for (const base::JobStatus& s : statuses) {
-    if (!s) {
-      return base::MakeError(base::ErrorCode::kInvalidArgument,
-                             {skeleton.info.source_file, 0, 0, {}},
-                             std::string("joint kinematics: ") + s.what);
-    }
-  }
-  return kin;
-}
-
-base::Result<std::vector<mocap::JointKinematics>> DrivingKinematicsOf(
-    const mocap::Skeleton& skeleton, const mocap::Motion& motion, std::span<const int> joints,
-    double cutoff_hz, const glm::mat4& model_from_root) {
-  const auto fail = [&](const std::string& what) {
-    return base::MakeError(base::ErrorCode::kInvalidArgument, {skeleton.info.source_file, 0, 0, {}},
-                           "joint kinematics: " + what);
-  };
-  const std::size_t nj = static_cast<std::size_t>(skeleton.num_joints());
-  const std::size_t nd = joints.size();
-  if (nd == 0) return fail("no driving joints");
-  for (std::size_t d = 0; d < nd; ++d) {
-    if (joints[d] < 0 || static_cast<std::size_t>(joints[d]) >= nj) {
-      return fail("driving joint " + std::to_string(joints[d]) + " out of range");
-    }
-    if (std::find(joints.begin(), joints.begin() + static_cast<std::ptrdiff_t>(d), joints[d]) !=
-        joints.begin() + static_cast<std::ptrdiff_t>(d)) {
-      return fail("driving joint " + std::to_string(joints[d]) + " listed twice");
-    }
-  }
-  if (motion.num_frames < 1) return fail("motion has no frames");
-  const std::size_t nf = static_cast<std::size_t>(motion.num_frames);
-  // Model matrices of every joint, a chunk of frames at a time; keep the
-  // driving columns. Each frame's matrices depend on that frame alone.
-  constexpr std::size_t kChunkFrames = 256;
-  std::vector<mocap::JointTransform> locals(nj);
-  std::vector<glm::mat4> chunk(nj * std::min(kChunkFrames, nf));
-  std::vector<glm::mat4> raw(nd * nf);
-  for (std::size_t first = 0; first < nf; first += kChunkFrames) {
-    const std::size_t count = std::min(kChunkFrames, nf - first);
-    const std::span<glm::mat4> out = std::span(chunk).first(count * nj);
-    const base::JobStatus s = mocap::ModelMatricesJob{.skeleton = &skeleton,
-                                                      .motion = &motion,
-                                                      .first_frame = static_cast<int>(first),
-                                                      .model_from_root = model_from_root,
-                                                      .locals = locals,
-                                                      .model_from_joint = out}
-                                  .Run();
-    if (!s) return fail(s.what);
-    for (std::size_t k = 0; k < count; ++k) {
-      for (std::size_t d = 0; d < nd; ++d) {
-        raw[(first + k) * nd + d] = out[k * nj + static_cast<std::size_t>(joints[d])];
-      }
-    }
-  }
-  chunk = {};
-  locals = {};
-  const int num_columns = static_cast<int>(nd);
-  if (cutoff_hz > 0.0) {
-    std::vector<glm::mat4> smooth(nd * nf);
-    const base::JobStatus s = mocap::SmoothTrajectoriesJob{.model_from_joint = raw,
-                                                           .num_joints = num_columns,
-                                                           .frame_time_s = motion.frame_time_s,
-                                                           .cutoff_hz = cutoff_hz,
-                                                           .output = smooth}
-                                  .Run();
-    if (!s) return fail(s.what);
-    raw = std::move(smooth);  // frees the unsmoothed columns before kin is allocated
-  }
-  std::vector<mocap::JointKinematics> kin(nd * nf);
-  const base::JobStatus s = mocap::KinematicsJob{.model_from_joint = raw,
-                                                 .num_joints = num_columns,
-                                                 .frame_time_s = motion.frame_time_s,
-                                                 .output = kin}
-                                .Run();
-  if (!s) return fail(s.what);
-  return kin;
-}
-
 base::Result<std::vector<ElasticPatchSpec>> ResolveRigElastic(
     const Rig& rig, const Character& character, std::span<const deform::PatchSetup> patches) {
   std::vector<ElasticPatchSpec> specs;
@@ -216,7 +108,8 @@ base::Result<std::unique_ptr<ElasticLayer>> ElasticLayer::Create(
     }
   }
   for (Kinematics& k : layer->kinematics_) {
-    auto kin = DrivingKinematicsOf(c.skeleton, c.motion, k.joints, k.cutoff_hz, c.world_from_model);
+    auto kin =
+        mocap::ComputeKinematicsOf(c.skeleton, c.motion, k.joints, k.cutoff_hz, c.world_from_model);
     if (!kin.ok()) return std::move(kin).error();
     k.frames = std::move(*kin);
   }

@@ -108,25 +108,4 @@ class ElasticLayer {
   double piece_s_ = 0.25;   // longest single advance (below every max_time_gap_s)
 };
 
-// Per-frame kinematics of every joint over the whole motion (#F x #J), the
-// joint paths low-passed at cutoff_hz first when it is > 0
-// (mocap::SmoothTrajectoriesJob), as the elastic layer and `patchskin elastic`
-// drive their networks.
-base::Result<std::vector<mocap::JointKinematics>> DrivingKinematics(
-    const mocap::Skeleton& skeleton, const mocap::Motion& motion, double cutoff_hz,
-    const glm::mat4& model_from_root = glm::mat4(1.0f));
-
-// The same kinematics for the listed joints only: a compact #F x #D table,
-// frame-major, column d holding joints[d] (any order, no repeats, each in
-// [0, #J)). Bit-identical to the matching entries of DrivingKinematics: the
-// smoothing and the differences work per joint column. Memory: the model
-// matrices are evaluated CHUNK frames at a time (#J x 64 B x chunk) and only
-// the listed columns kept, so the peak is #F x #D x (64 + 124) B plus a
-// constant, instead of #F x #J x 252 B. Errors (kInvalidArgument) as
-// DrivingKinematics, and for a joint list that is empty, repeats a joint or
-// holds one out of range.
-base::Result<std::vector<mocap::JointKinematics>> DrivingKinematicsOf(
-    const mocap::Skeleton& skeleton, const mocap::Motion& motion, std::span<const int> joints,
-    double cutoff_hz, const glm::mat4& model_from_root = glm::mat4(1.0f));
-
 }  // namespace app

@@ -228,7 +228,8 @@ base::JobStatus SmoothTrajectoriesJob::Run() const {
 }
 
 base::Result<std::vector<JointKinematics>> ComputeKinematics(const Skeleton& skeleton,
-                                                             const Motion& motion) {
+                                                             const Motion& motion, double cutoff_hz,
+                                                             const glm::mat4& model_from_root) {
   const base::FileLoc loc{skeleton.info.source_file, 0, 0, {}};
   const std::size_t nj = static_cast<std::size_t>(skeleton.num_joints());
   if (nj == 0 || motion.num_frames < 1 || motion.num_channels != skeleton.num_channels ||
@@ -240,22 +241,109 @@ base::Result<std::vector<JointKinematics>> ComputeKinematics(const Skeleton& ske
                                std::to_string(skeleton.num_channels) + " channels per frame for " +
                                std::to_string(nj) + " joints");
   }
+  const auto fail = [&](const char* what) {
+    return base::MakeError(base::ErrorCode::kInvalidArgument, loc,
+                           std::string("joint kinematics: ") + what);
+  };
   const std::size_t frames = static_cast<std::size_t>(motion.num_frames);
   std::vector<JointTransform> locals(nj);
   std::vector<glm::mat4> model(frames * nj);
-  const base::JobStatus m =
-      ModelMatricesJob{
-          .skeleton = &skeleton, .motion = &motion, .locals = locals, .model_from_joint = model}
-          .Run();
-  if (!m) return base::MakeError(base::ErrorCode::kInternal, loc, m.what);
+  const base::JobStatus m = ModelMatricesJob{.skeleton = &skeleton,
+                                             .motion = &motion,
+                                             .model_from_root = model_from_root,
+                                             .locals = locals,
+                                             .model_from_joint = model}
+                                .Run();
+  if (!m) return fail(m.what);
+  if (cutoff_hz > 0.0) {
+    std::vector<glm::mat4> smooth(frames * nj);
+    const base::JobStatus s = SmoothTrajectoriesJob{.model_from_joint = model,
+                                                    .num_joints = static_cast<int>(nj),
+                                                    .frame_time_s = motion.frame_time_s,
+                                                    .cutoff_hz = cutoff_hz,
+                                                    .output = smooth}
+                                  .Run();
+    if (!s) return fail(s.what);
+    model = std::move(smooth);
+  }
   std::vector<JointKinematics> out(frames * nj);
   const base::JobStatus k = KinematicsJob{.model_from_joint = model,
                                           .num_joints = static_cast<int>(nj),
                                           .frame_time_s = motion.frame_time_s,
                                           .output = out}
                                 .Run();
-  if (!k) return base::MakeError(base::ErrorCode::kInternal, loc, k.what);
+  if (!k) return fail(k.what);
   return out;
+}
+
+base::Result<std::vector<JointKinematics>> ComputeKinematicsOf(const Skeleton& skeleton,
+                                                               const Motion& motion,
+                                                               std::span<const int> joints,
+                                                               double cutoff_hz,
+                                                               const glm::mat4& model_from_root) {
+  const auto fail = [&](const std::string& what) {
+    return base::MakeError(base::ErrorCode::kInvalidArgument, {skeleton.info.source_file, 0, 0, {}},
+                           "joint kinematics: " + what);
+  };
+  const std::size_t nj = static_cast<std::size_t>(skeleton.num_joints());
+  const std::size_t nd = joints.size();
+  if (nd == 0) return fail("no driving joints");
+  for (std::size_t d = 0; d < nd; ++d) {
+    if (joints[d] < 0 || static_cast<std::size_t>(joints[d]) >= nj) {
+      return fail("driving joint " + std::to_string(joints[d]) + " out of range");
+    }
+    if (std::find(joints.begin(), joints.begin() + static_cast<std::ptrdiff_t>(d), joints[d]) !=
+        joints.begin() + static_cast<std::ptrdiff_t>(d)) {
+      return fail("driving joint " + std::to_string(joints[d]) + " listed twice");
+    }
+  }
+  if (motion.num_frames < 1) return fail("motion has no frames");
+  const std::size_t nf = static_cast<std::size_t>(motion.num_frames);
+  // Model matrices of every joint, a chunk of frames at a time; keep the
+  // driving columns. Each frame's matrices depend on that frame alone.
+  constexpr std::size_t kChunkFrames = 256;
+  std::vector<JointTransform> locals(nj);
+  std::vector<glm::mat4> chunk(nj * std::min(kChunkFrames, nf));
+  std::vector<glm::mat4> raw(nd * nf);
+  for (std::size_t first = 0; first < nf; first += kChunkFrames) {
+    const std::size_t count = std::min(kChunkFrames, nf - first);
+    const std::span<glm::mat4> out = std::span(chunk).first(count * nj);
+    const base::JobStatus s = ModelMatricesJob{.skeleton = &skeleton,
+                                               .motion = &motion,
+                                               .first_frame = static_cast<int>(first),
+                                               .model_from_root = model_from_root,
+                                               .locals = locals,
+                                               .model_from_joint = out}
+                                  .Run();
+    if (!s) return fail(s.what);
+    for (std::size_t k = 0; k < count; ++k) {
+      for (std::size_t d = 0; d < nd; ++d) {
+        raw[(first + k) * nd + d] = out[k * nj + static_cast<std::size_t>(joints[d])];
+      }
+    }
+  }
+  chunk = {};
+  locals = {};
+  const int num_columns = static_cast<int>(nd);
+  if (cutoff_hz > 0.0) {
+    std::vector<glm::mat4> smooth(nd * nf);
+    const base::JobStatus s = SmoothTrajectoriesJob{.model_from_joint = raw,
+                                                    .num_joints = num_columns,
+                                                    .frame_time_s = motion.frame_time_s,
+                                                    .cutoff_hz = cutoff_hz,
+                                                    .output = smooth}
+                                  .Run();
+    if (!s) return fail(s.what);
+    raw = std::move(smooth);  // frees the unsmoothed columns before kin is allocated
+  }
+  std::vector<JointKinematics> kin(nd * nf);
+  const base::JobStatus s = KinematicsJob{.model_from_joint = raw,
+                                          .num_joints = num_columns,
+                                          .frame_time_s = motion.frame_time_s,
+                                          .output = kin}
+                                .Run();
+  if (!s) return fail(s.what);
+  return kin;
 }
 
 base::JobStatus SampleJointKinematics(std::span<const JointKinematics> kinematics, int num_joints,

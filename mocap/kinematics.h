@@ -117,11 +117,27 @@ struct SmoothTrajectoriesJob {
   [[nodiscard]] base::JobStatus Run() const;  // no allocation; splitting ranges gives the same bits
 };
 
-// Convenience: model matrices and kinematics of all frames (#F x #J, frame-major),
-// allocated once. Errors (kInvalidArgument) for a motion that does not match the
-// skeleton or has no frames or a non-positive frame time.
-base::Result<std::vector<JointKinematics>> ComputeKinematics(const Skeleton& skeleton,
-                                                             const Motion& motion);
+// Kinematics of all frames (#F x #J, frame-major), allocated once, in the model
+// space model_from_root puts the root in; the joint paths are low-passed at
+// cutoff_hz first (SmoothTrajectoriesJob) when it is > 0, as the elastic layer
+// and `patchskin elastic` drive their networks. Errors (kInvalidArgument) for a
+// motion that does not match the skeleton or has no frames or a non-positive
+// frame time, and for a cutoff the low-pass refuses.
+base::Result<std::vector<JointKinematics>> ComputeKinematics(
+    const Skeleton& skeleton, const Motion& motion, double cutoff_hz = 0.0,
+    const glm::mat4& model_from_root = glm::mat4(1.0f));
+
+// The same kinematics for the listed joints only: a compact #F x #D table,
+// frame-major, column d holding joints[d] (any order, no repeats, each in
+// [0, #J)). Bit-identical to the matching entries of ComputeKinematics: the
+// smoothing and the differences work per joint column. Memory: the model
+// matrices are evaluated 256 frames at a time (#J x 64 B each) and only the
+// listed columns kept, so the peak is #F x #D x (64 + 124) B plus a constant,
+// instead of #F x #J x 252 B. Errors (kInvalidArgument) as ComputeKinematics,
+// and for a joint list that is empty, repeats a joint or holds one out of range.
+base::Result<std::vector<JointKinematics>> ComputeKinematicsOf(
+    const Skeleton& skeleton, const Motion& motion, std::span<const int> joints,
+    double cutoff_hz = 0.0, const glm::mat4& model_from_root = glm::mat4(1.0f));
 
 // Kinematics of ONE joint at any time t (seconds), e.g. an RK4 stage time, from
 // the two frames around t in a per-frame buffer (as KinematicsJob fills it, for

@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include "app/elastic_layer.h"
+#include "mocap/kinematics.h"
 #include "app/rig_file.h"
 #include "app/rig_patches.h"
 #include "support/elastic_rig.h"
@@ -26,9 +27,9 @@ void ExpectCompactEqualsFull(const app::Character& c, const std::vector<int>& jo
                              double cutoff_hz) {
   const std::size_t nj = static_cast<std::size_t>(c.skeleton.num_joints());
   const std::size_t nf = static_cast<std::size_t>(c.motion.num_frames);
-  auto full = app::DrivingKinematics(c.skeleton, c.motion, cutoff_hz, c.world_from_model);
-  auto compact = app::DrivingKinematicsOf(c.skeleton, c.motion, joints, cutoff_hz,
-                                          c.world_from_model);
+  auto full = mocap::ComputeKinematics(c.skeleton, c.motion, cutoff_hz, c.world_from_model);
+  auto compact =
+      mocap::ComputeKinematicsOf(c.skeleton, c.motion, joints, cutoff_hz, c.world_from_model);
   ASSERT_TRUE(full.ok()) << full.error().ToString();
   ASSERT_TRUE(compact.ok()) << compact.error().ToString();
   ASSERT_EQ(full->size(), nf * nj);
@@ -88,7 +89,7 @@ TEST(ElasticKinematics, RefusesAnEmptyRepeatedOrOutOfRangeJointList) {
   const int nj = c.skeleton.num_joints();
   for (const std::vector<int>& joints :
        {std::vector<int>{}, std::vector<int>{1, 1}, std::vector<int>{nj}, std::vector<int>{-1}}) {
-    auto k = app::DrivingKinematicsOf(c.skeleton, c.motion, joints, 10.0);
+    auto k = mocap::ComputeKinematicsOf(c.skeleton, c.motion, joints, 10.0);
     ASSERT_FALSE(k.ok());
     EXPECT_EQ(k.error().code, base::ErrorCode::kInvalidArgument);
     EXPECT_NE(k.error().message.find("joint"), std::string::npos) << k.error().message;
