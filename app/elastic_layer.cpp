@@ -27,19 +27,6 @@ glm::quat RotationOf(const glm::mat4& m) {
   return glm::normalize(glm::quat_cast(r));
 }
 
-// The skeleton joint whose bones carry the largest total weight over the
-// patch's control points (ALGORITHMS.md 6 default driving joint).
-int DominantJoint(const Character& c, const deform::PatchSetup& patch) {
-  std::vector<double> total(c.mesh.skin_joints.size(), 0.0);
-  const deform::SkinWeights& w = patch.control_weights;
-  for (std::size_t i = 0; i < w.weights.size(); ++i) {
-    if (w.joints[i] < total.size()) total[w.joints[i]] += w.weights[i];
-  }
-  const auto best = std::max_element(total.begin(), total.end());
-  if (best == total.end()) return 0;
-  return c.mesh.skin_joints[static_cast<std::size_t>(best - total.begin())];
-}
-
 }  // namespace
 
 base::Result<std::vector<ElasticPatchSpec>> ResolveRigElastic(
@@ -61,7 +48,7 @@ base::Result<std::vector<ElasticPatchSpec>> ResolveRigElastic(
                               : p.region.kind == RigRegion::Kind::kJoint ? p.region.joint
                                                                           : std::string();
     if (name.empty()) {
-      spec.joint = DominantJoint(character, patches[i]);
+      spec.joint = deform::DominantJoint(character.mesh, patches[i]);
     } else {
       spec.joint = character.skeleton.FindJoint(name);
       if (spec.joint < 0) {

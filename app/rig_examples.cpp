@@ -9,6 +9,7 @@
 #include "deform/shapes/corrective_example.h"
 #include "deform/shapes/example_shapes.h"
 #include "deform/global/skinning_job.h"
+#include "mocap/joint_angles.h"
 #include "mocap/pose.h"
 
 namespace app {
@@ -55,31 +56,7 @@ base::Status ExampleLocals(const Rig& rig, const Character& ch, const RigExample
                              {rig.file, 0, 0, ex.path + ".pose.joints." + name},
                              "expected a joint of " + ch.source + ", found \"" + name + "\"");
     }
-    // The joint's Euler channel order, then any axis it lacks (ZXY order for none).
-    mocap::ChannelType axes[3];
-    int n = 0;
-    const mocap::JointChannels& jc = s.channels[static_cast<std::size_t>(j)];
-    for (int k = 0; k < jc.count && n < 3; ++k) {
-      const mocap::ChannelType t = jc.types[static_cast<std::size_t>(k)];
-      if (t == mocap::ChannelType::kXRotation || t == mocap::ChannelType::kYRotation ||
-          t == mocap::ChannelType::kZRotation) {
-        axes[n++] = t;
-      }
-    }
-    for (mocap::ChannelType t : {mocap::ChannelType::kZRotation, mocap::ChannelType::kXRotation,
-                                 mocap::ChannelType::kYRotation}) {
-      bool have = false;
-      for (int k = 0; k < n; ++k) have = have || axes[k] == t;
-      if (!have) axes[n++] = t;
-    }
-    float angles[3];
-    for (int k = 0; k < 3; ++k) {
-      angles[k] = axes[k] == mocap::ChannelType::kXRotation   ? xyz.x
-                  : axes[k] == mocap::ChannelType::kYRotation ? xyz.y
-                                                              : xyz.z;
-    }
-    locals[static_cast<std::size_t>(j)].rotation =
-        s.rest_rotations[static_cast<std::size_t>(j)] * mocap::EulerToQuat(axes, angles, 3);
+    locals[static_cast<std::size_t>(j)].rotation = mocap::JointRotationFromAngles(s, j, xyz);
   }
   return base::Status::Ok();
 }

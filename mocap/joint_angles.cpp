@@ -144,6 +144,24 @@ int JointEulerAngles(const Skeleton& skeleton, int joint, const glm::quat& local
   return n;
 }
 
+glm::quat JointRotationFromAngles(const Skeleton& skeleton, int joint, const glm::vec3& xyz_deg) {
+  const std::size_t j = static_cast<std::size_t>(joint);
+  const JointChannels& ch = skeleton.channels[j];
+  ChannelType axes[3];
+  int n = 0;
+  for (int c = 0; c < ch.count && n < 3; ++c) {
+    if (AxisIndex(ch.types[static_cast<std::size_t>(c)]) >= 0)
+      axes[n++] = ch.types[static_cast<std::size_t>(c)];
+  }
+  for (ChannelType t :
+       {ChannelType::kZRotation, ChannelType::kXRotation, ChannelType::kYRotation}) {
+    if (std::find(axes, axes + n, t) == axes + n) axes[n++] = t;
+  }
+  float angles[3];
+  for (int k = 0; k < 3; ++k) angles[k] = xyz_deg[AxisIndex(axes[k])];
+  return skeleton.rest_rotations[j] * EulerToQuat(axes, angles, 3);
+}
+
 glm::vec3 QuatToRotationVector(const glm::quat& q) {
   glm::dquat qd(q.w, q.x, q.y, q.z);
   if (qd.w < 0.0) qd = -qd;

@@ -48,6 +48,13 @@ void QuatToEulerNear(const glm::quat& q, const ChannelType* axes, int count,
 int JointEulerAngles(const Skeleton& skeleton, int joint, const glm::quat& local_rotation,
                      float* angles_deg, const float* reference_deg = nullptr);
 
+// The local rotation of `joint` for angles (x, y, z) in degrees about its X, Y
+// and Z axes: rest_rotation * the axis rotations composed in the joint's own
+// channel order (as LocalPoseJob builds it), the axes it has no channel for
+// following in Z, X, Y order. For a joint with three rotation channels this
+// inverts JointEulerAngles (angles in its range). joint must be in range.
+glm::quat JointRotationFromAngles(const Skeleton& skeleton, int joint, const glm::vec3& xyz_deg);
+
 // Rotation vector (axis * angle, radians) of a unit quaternion, on the shorter
 // arc: q is first negated if w < 0, so |r| <= pi. r = 2 atan2(|v|, w) v/|v|,
 // and r = 2 v when |v| < 1e-12 (ALGORITHMS.md 5.1).

@@ -312,4 +312,15 @@ base::Status ApplyPatchLayer(std::span<const PatchSetup> patches,
   return base::Status::Ok();
 }
 
+int DominantJoint(const SkinnedMesh& mesh, const PatchSetup& patch) {
+  std::vector<double> total(mesh.skin_joints.size(), 0.0);
+  const SkinWeights& w = patch.control_weights;
+  for (std::size_t i = 0; i < w.weights.size(); ++i) {
+    if (w.joints[i] < total.size()) total[w.joints[i]] += w.weights[i];
+  }
+  const auto best = std::max_element(total.begin(), total.end());
+  if (best == total.end() || *best <= 0.0) return 0;
+  return mesh.skin_joints[static_cast<std::size_t>(best - total.begin())];
+}
+
 }  // namespace deform

@@ -78,6 +78,11 @@ SkinWeights ControlPointWeights(const SkinnedMesh& mesh, const BSplineSurface& s
                                 const PatchBinding& binding, std::span<const int> region,
                                 int influences = 4);
 
+// The skeleton joint whose bones carry the largest total weight over the
+// patch's control points: the default driving joint of its elastic network
+// (ALGORITHMS.md 6). The first such joint on a tie; 0 when there is no weight.
+int DominantJoint(const SkinnedMesh& mesh, const PatchSetup& patch);
+
 // Border fade beta = sm(min(u, 1-u, v, 1-v) / width); width 0 gives 1.
 float BorderWeight(float u, float v, float width);
 

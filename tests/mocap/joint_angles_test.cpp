@@ -91,7 +91,9 @@ TEST(QuatToEulerNear, AvoidsJumpsAcross180) {
   for (int i = 0; i < 3; ++i) EXPECT_NEAR(out[i], past_pole[i], testsupport::kEulerRoundTripTolDeg);
 }
 
-TEST(JointEulerAngles, GivesBackTheChannelValuesOfAPose) {
+// A root with position channels only, a YXZ joint with a rest rotation, and a
+// two-axis XZ joint.
+mocap::Skeleton MixedOrderSkeleton() {
   mocap::Skeleton s;
   s.names = {"root", "yxz", "xz"};
   s.parents = {mocap::kNoParent, 0, 1};
@@ -106,6 +108,11 @@ TEST(JointEulerAngles, GivesBackTheChannelValuesOfAPose) {
   s.channels[1] = {3, 3, {kY, kX, kZ}};
   s.channels[2] = {6, 2, {kX, kZ}};
   s.num_channels = 8;
+  return s;
+}
+
+TEST(JointEulerAngles, GivesBackTheChannelValuesOfAPose) {
+  const mocap::Skeleton s = MixedOrderSkeleton();
   const std::vector<float> frame = {1, 2, 3, 40, -25, 130, -60, 75};
   std::vector<mocap::JointTransform> locals(3);
   ASSERT_TRUE((mocap::LocalPoseJob{&s, frame, locals}).Run().ok());
@@ -120,6 +127,37 @@ TEST(JointEulerAngles, GivesBackTheChannelValuesOfAPose) {
   const float reference[2] = {300.0f, 75.0f};  // continue a joint that has turned past 180
   ASSERT_EQ(mocap::JointEulerAngles(s, 2, locals[2].rotation, angles, reference), 2);
   EXPECT_NEAR(angles[0], 300.0f, testsupport::kEulerRoundTripTolDeg);
+}
+
+TEST(JointRotationFromAngles, ComposesInTheJointsChannelOrder) {
+  const mocap::Skeleton s = MixedOrderSkeleton();
+  // Where the joint has the channels, the rotation LocalPoseJob builds.
+  const std::vector<float> frame = {1, 2, 3, 40, -25, 130, -60, 75};
+  std::vector<mocap::JointTransform> locals(3);
+  ASSERT_TRUE((mocap::LocalPoseJob{&s, frame, locals}).Run().ok());
+  EXPECT_LT(
+      RotationDistance(mocap::JointRotationFromAngles(s, 1, {-25, 40, 130}), locals[1].rotation),
+      1e-6f);
+  EXPECT_LT(
+      RotationDistance(mocap::JointRotationFromAngles(s, 2, {-60, 0, 75}), locals[2].rotation),
+      1e-6f);
+  // A missing axis follows the joint's own ones (XZ, then Y); with none, Z X Y.
+  const auto r = [](float deg, glm::vec3 axis) { return glm::angleAxis(glm::radians(deg), axis); };
+  const glm::vec3 x(1, 0, 0), y(0, 1, 0), z(0, 0, 1);
+  EXPECT_LT(RotationDistance(mocap::JointRotationFromAngles(s, 2, {-60, 35, 75}),
+                             r(-60, x) * r(75, z) * r(35, y)),
+            1e-6f);
+  EXPECT_LT(RotationDistance(mocap::JointRotationFromAngles(s, 0, {10, 20, 30}),
+                             r(30, z) * r(10, x) * r(20, y)),
+            1e-6f);
+  // And JointEulerAngles reads the angles back in channel order (Y, X, Z).
+  float angles[3];
+  ASSERT_EQ(
+      mocap::JointEulerAngles(s, 1, mocap::JointRotationFromAngles(s, 1, {15, -70, 100}), angles),
+      3);
+  EXPECT_NEAR(angles[0], -70.0f, testsupport::kEulerRoundTripTolDeg);
+  EXPECT_NEAR(angles[1], 15.0f, testsupport::kEulerRoundTripTolDeg);
+  EXPECT_NEAR(angles[2], 100.0f, testsupport::kEulerRoundTripTolDeg);
 }
 
 TEST(RotationVector, MatchesAxisAngleAndRoundTrips) {

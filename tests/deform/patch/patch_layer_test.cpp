@@ -99,6 +99,24 @@ TEST(PatchLayer, BorderWeightIsASmoothstepOfTheBorderDistance) {
   EXPECT_EQ(deform::BorderWeight(0.0f, 0.0f, 0.0f), 1.0f);  // width 0: no fade
 }
 
+TEST(PatchLayer, DominantJointCarriesTheMostControlWeight) {
+  deform::SkinnedMesh mesh;
+  mesh.skin_joints = {7, 3, 9};  // skin joint -> skeleton joint
+  deform::PatchSetup patch;
+  patch.control_weights.influences = 2;
+  // Skin joint 1 (skeleton 3) carries 0.6 + 0.6 = 1.2, skin joint 0 carries 0.8.
+  patch.control_weights.joints = {0, 1, 1, 2, 1, 0};
+  patch.control_weights.weights = {0.4f, 0.6f, 0.6f, 0.4f, 0.0f, 0.4f};
+  EXPECT_EQ(deform::DominantJoint(mesh, patch), 3);
+  patch.control_weights.weights = {0.9f, 0.1f, 0.1f, 0.9f, 0.1f, 0.9f};  // skin joint 0: 1.8
+  EXPECT_EQ(deform::DominantJoint(mesh, patch), 7);
+  patch.control_weights.joints = {0, 1, 0, 1, 0, 1};  // a tie goes to the first
+  patch.control_weights.weights.assign(6, 0.5f);
+  EXPECT_EQ(deform::DominantJoint(mesh, patch), 7);
+  patch.control_weights = {};
+  EXPECT_EQ(deform::DominantJoint(mesh, patch), 0);
+}
+
 TEST(PatchLayer, ControlPointWeightsAreValidAndFollowTheBones) {
   const LayeredBody& b = Body();
   for (const deform::PatchSetup& p : Patches()) {
