@@ -68,9 +68,9 @@ void AddOutputFlags(CLI::App& cmd, RenderOptions& o) {
 }
 
 // Records which options were given: with a rig file they override its settings.
-void RecordGivenOptions(CLI::App* cmd, RenderOptions& o) {
+void RecordGivenOptions(CLI::App* cmd, std::set<std::string>& given) {
   for (const CLI::Option* opt : cmd->get_options()) {
-    if (opt->count() > 0) o.given.insert(opt->get_name());
+    if (opt->count() > 0) given.insert(opt->get_name());
   }
 }
 
@@ -159,7 +159,7 @@ CLI::App* AddRenderCommand(CLI::App& parent, RenderOptions& o) {
                   "auto: place the paper's patches (elbows, knees, shoulders, hips, elastic belly "
                   "and jowl) from the skeleton, as `patchskin rig auto` writes them");
   AddOutputFlags(*cmd, o);
-  cmd->callback([&o, cmd] { RecordGivenOptions(cmd, o); });
+  cmd->callback([&o, cmd] { RecordGivenOptions(cmd, o.given); });
   return cmd;
 }
 
@@ -189,7 +189,7 @@ CLI::App* AddTurntableCommand(CLI::App& parent, RenderOptions& o) {
   // A turntable of a rig keeps the rig's settings except those given here,
   // and is a turntable whatever camera the rig asks for.
   cmd->callback([&o, cmd] {
-    RecordGivenOptions(cmd, o);
+    RecordGivenOptions(cmd, o.given);
     o.camera = "turntable";
     o.given.insert("--camera");
   });
@@ -243,6 +243,7 @@ CLI::App* AddExportCommand(CLI::App& parent, ExportOptions& o) {
                 "the missing ones; every frame is still evaluated in order");
   cmd->add_option("--layer", o.layer,
                   "auto: the patch layer placed from the skeleton (as render --layer auto)");
+  cmd->callback([&o, cmd] { RecordGivenOptions(cmd, o.given); });
   return cmd;
 }
 

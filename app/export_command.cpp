@@ -115,27 +115,19 @@ int RunExport(const ExportOptions& options) {
   ExportOptions o = options;
   std::optional<Rig> rig;
   if (!o.layer.empty()) {
-    // --layer auto: the rig `patchskin rig auto` writes; the options given here stay.
+    // --layer auto: the rig `patchskin rig auto` writes, used as if read.
     base::Result<Rig> made = AutoRigForCommand(o.layer, o.input, o.motion, o.body, o.up, o.quiet);
     if (!made.ok()) return ReportError(made.error());
     rig = std::move(*made);
-    o.input = RigInputFile(*rig);
-    if (!IsBuiltInBody(rig->character)) o.motion = rig->motion;
   } else if (Lower(std::filesystem::path(o.input).extension().string()) == ".json") {
     base::Result<Rig> loaded = LoadRig(o.input);
     if (!loaded.ok()) return ReportError(loaded.error());
     rig = std::move(*loaded);
-    o.input = RigInputFile(*rig);
-    if (!IsBuiltInBody(rig->character) && o.motion.empty()) {
-      o.motion = rig->motion;
-      if (o.joint_map.empty()) o.joint_map = rig->joint_map;
-    }
-    o.global = rig->global;
-    o.fps = rig->fps;
-    if (o.up.empty()) o.up = rig->up;
-    o.size = std::to_string(rig->render.size.x) + "x" + std::to_string(rig->render.size.y);
-    if (rig->render.camera != "turntable") o.camera = rig->render.camera;
-    if (o.frames.empty()) o.frames = rig->render.frames;
+  }
+  if (rig) {
+    ApplyRigSettings(*rig, o);
+    // The camera JSON has no orbit: a turntable rig's export follows the body.
+    if (o.given.count("--camera") == 0 && o.camera == "turntable") o.camera = "follow";
   }
 
   // --- Arguments -------------------------------------------------------------

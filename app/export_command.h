@@ -15,6 +15,7 @@
 // --with-camera also writes camera_####.json per frame next to the output: the
 // camera `render` would use for that frame (see CameraJson).
 
+#include <set>
 #include <string>
 
 #include <glm/glm.hpp>
@@ -48,6 +49,9 @@ struct ExportOptions {
   bool resume = false;            // OBJ: keep the frame files already written, write the others
   int start_number = 0;           // file number of motion frame 0 (OBJ and camera JSON)
   std::string up;                 // --up y|z: a BVH's up axis; empty = detected
+  // Long names ("--size") of the options given on the command line, filled by
+  // the parser: with a rig file they win over its settings (ApplyRigSettings).
+  std::set<std::string> given;
 };
 
 // Runs an export. Exit code: 0 ok, 2 bad input, 3 internal error, 128 + signal

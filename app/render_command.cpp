@@ -193,19 +193,8 @@ int RunRender(const RenderOptions& options) {
   }
   if (rig) {
     // The rig sets what the command line leaves out; an option given wins.
+    ApplyRigSettings(*rig, o);
     const auto given = [&o](const char* name) { return o.given.count(name) > 0; };
-    o.input = RigInputFile(*rig);
-    if (!IsBuiltInBody(rig->character) && !rig->motion.empty() && !given("--motion")) {
-      o.motion = rig->motion;
-      if (!given("--joint-map")) o.joint_map = rig->joint_map;
-    }
-    if (!given("--global")) o.global = rig->global;
-    if (!given("--fps")) o.fps = rig->fps;
-    if (!given("--up")) o.up = rig->up;
-    if (!given("--size")) {
-      o.size = std::to_string(rig->render.size.x) + "x" + std::to_string(rig->render.size.y);
-    }
-    if (!given("--camera")) o.camera = rig->render.camera;
     if (!given("--azimuth") && rig->render.azimuth_deg) o.azimuth_deg = rig->render.azimuth_deg;
     if (!given("--elevation") && rig->render.elevation_deg) o.elevation_deg = *rig->render.elevation_deg;
     if (!given("--distance")) o.distance = rig->render.distance;
@@ -216,7 +205,6 @@ int RunRender(const RenderOptions& options) {
       for (const std::string& item : rig->render.overlays) o.overlay += item + ",";
     }
     if (!given("--out") || o.out.empty()) o.out = rig->render.output;
-    if (!given("--frames") || o.frames.empty()) o.frames = rig->render.frames;
   }
 
   // --- Arguments -------------------------------------------------------------

@@ -20,6 +20,29 @@ namespace app {
 // character (driven by rig.motion when that is set, else by its own animation).
 std::string RigInputFile(const Rig& rig);
 
+// The one rule render, turntable and export follow for a rig file
+// (docs/command-line.md, "With a rig file"): each setting the rig carries
+// (the input; the motion and its joint map, for a glTF character; global, fps,
+// up, size, camera, frames) applies unless its option was given on the command
+// line (`o.given`, long names). The command then applies its own fields.
+template <class Options>
+void ApplyRigSettings(const Rig& rig, Options& o) {
+  const auto given = [&o](const char* name) { return o.given.count(name) > 0; };
+  o.input = RigInputFile(rig);
+  if (!IsBuiltInBody(rig.character) && !rig.motion.empty() && !given("--motion")) {
+    o.motion = rig.motion;
+    if (!given("--joint-map")) o.joint_map = rig.joint_map;
+  }
+  if (!given("--global")) o.global = rig.global;
+  if (!given("--fps")) o.fps = rig.fps;
+  if (!given("--up")) o.up = rig.up;
+  if (!given("--size")) {
+    o.size = std::to_string(rig.render.size.x) + "x" + std::to_string(rig.render.size.y);
+  }
+  if (!given("--camera")) o.camera = rig.render.camera;
+  if (!given("--frames") || o.frames.empty()) o.frames = rig.render.frames;
+}
+
 // The built-in body a rig names: "generated", else the tube body ("tubes" or
 // "mannequin"). Meaningless for a glTF character.
 BodyKind RigBodyKind(const Rig& rig);

@@ -27,6 +27,7 @@
 
 namespace {
 
+using testsupport::SampleDataPath;
 using testsupport::TestDir;
 
 namespace fs = std::filesystem;
@@ -125,6 +126,43 @@ TEST(ExportCommand, ObjFramesAreThePipelineFramesAndCamerasAreRenders) {
   for (const auto& e : fs::directory_iterator(dir)) {
     EXPECT_EQ(e.path().filename().string().find(".tmp-"), std::string::npos) << e.path();
   }
+}
+
+// One rule for a rig's settings, as render's: the rig's size, frames and
+// method apply unless the option is given, and then the option wins.
+TEST(ExportCommand, ARigsSettingsApplyUnlessTheOptionIsGiven) {
+  const fs::path dir = TestDir();
+  const fs::path rig = dir / "bend_tubes.json";
+  std::ofstream(rig)
+      << R"({"character": "tubes", "motion": {"file": ")" << SampleDataPath("bend.bvh").string()
+      << R"("}, "global": "ssd", "render": {"size": [640, 360], "frames": "20:21"}})";
+  const auto run = [&](const std::string& options, const std::string& out) {
+    return PatchskinExit("export '" + rig.string() + "' --with-camera --quiet " + options +
+                             " --out '" + (dir / out / "mesh_####.obj").string() + "'",
+                         dir);
+  };
+  ASSERT_EQ(run("", "rig"), 0) << testsupport::SlurpFile(dir / "stderr.txt");
+  EXPECT_EQ(testsupport::FilesIn(dir / "rig").size(), 4u);  // frames 20 and 21, mesh and camera
+  const nlohmann::json rig_camera =
+      nlohmann::json::parse(testsupport::SlurpFile(dir / "rig" / "camera_0021.json"));
+  EXPECT_EQ(rig_camera["width"].get<int>(), 640);
+  EXPECT_EQ(rig_camera["height"].get<int>(), 360);
+
+  ASSERT_EQ(run("--size 320x200 --frames 21:21 --global dqs", "given"), 0)
+      << testsupport::SlurpFile(dir / "stderr.txt");
+  EXPECT_EQ(testsupport::FilesIn(dir / "given").size(), 2u);
+  const nlohmann::json given_camera =
+      nlohmann::json::parse(testsupport::SlurpFile(dir / "given" / "camera_0021.json"));
+  EXPECT_EQ(given_camera["width"].get<int>(), 320);
+  EXPECT_EQ(given_camera["height"].get<int>(), 200);
+  // The elbows are bent by frame 21: DQS moves the skin differently from SSD.
+  const testsupport::ParsedObj ssd =
+      testsupport::ParseObjFile((dir / "rig" / "mesh_0021.obj").string());
+  const testsupport::ParsedObj dqs =
+      testsupport::ParseObjFile((dir / "given" / "mesh_0021.obj").string());
+  ASSERT_TRUE(ssd.error.empty() && dqs.error.empty()) << ssd.error << dqs.error;
+  ASSERT_EQ(ssd.positions.size(), dqs.positions.size());
+  EXPECT_NE(ssd.positions, dqs.positions);
 }
 
 TEST(ExportCommand, GlbGivesEachFrameAtItsTime) {
