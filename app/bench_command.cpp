@@ -217,8 +217,7 @@ nlohmann::json RowJson(const Row& r) {
 }  // namespace
 
 int RunBench(const BenchOptions& o) {
-  if (o.threads < 0 || o.threads > 256)
-    return ReportError(ArgError("--threads", "expected 0..256"));
+  if (const auto bad = CheckThreads(o.threads)) return ReportError(*bad);
 #ifndef NDEBUG
   std::fprintf(stderr,
                "bench: WARNING: this is not a Release build (%s, assertions on); its figures are "

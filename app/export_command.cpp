@@ -136,10 +136,8 @@ int RunExport(const ExportOptions& options) {
   if (o.camera != "follow" && o.camera != "fixed") {
     return ReportError(ArgError("--camera", "expected follow or fixed, found '" + o.camera + "'"));
   }
-  if (o.threads < 0 || o.threads > 256)
-    return ReportError(ArgError("--threads", "expected 0..256"));
-  if (!(o.fps >= 0.0) || o.fps > 10000.0)
-    return ReportError(ArgError("--fps", "expected 0 < fps <= 10000"));
+  if (const auto bad = CheckThreads(o.threads)) return ReportError(*bad);
+  if (const auto bad = CheckFps(o.fps)) return ReportError(*bad);
   if (!(o.scale == 0.0f || (o.scale >= 1e-6f && o.scale <= 1e6f))) {
     return ReportError(ArgError(
         "--scale", "expected 0 (detected units to metres) or a factor in 1e-6..1e6, found " +

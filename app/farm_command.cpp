@@ -108,8 +108,7 @@ int RunFarm(const FarmOptions& o) {
     if (pattern.empty()) pattern = rig->render.output;
     if (fps <= 0.0) fps = rig->fps;
   }
-  if (!(fps >= 0.0) || fps > 10000.0)
-    return ReportError(ArgError("--fps", "expected 0 < fps <= 10000"));
+  if (const auto bad = CheckFps(fps)) return ReportError(*bad);
   MotionSourceOptions load;
   load.y_up = true;
   base::Result<MotionSource> src = LoadMotionSource(motion_path, load);

@@ -18,6 +18,16 @@ base::Error ArgError(const std::string& option, const std::string& message) {
   return base::MakeError(base::ErrorCode::kInvalidArgument, {option, 0, 0, {}}, message);
 }
 
+std::optional<base::Error> CheckThreads(int threads) {
+  if (threads < 0 || threads > 256) return ArgError("--threads", "expected 0..256");
+  return std::nullopt;
+}
+
+std::optional<base::Error> CheckFps(double fps) {
+  if (!(fps >= 0.0) || fps > 10000.0) return ArgError("--fps", "expected 0 < fps <= 10000");
+  return std::nullopt;
+}
+
 base::Result<glm::ivec2> ParseSize(const std::string& text) {
   int w = 0, h = 0;
   char x = 0, extra = 0;

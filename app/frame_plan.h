@@ -27,6 +27,11 @@ inline constexpr float kMaxElevationDeg = 89.0f;
 // kInvalidArgument naming the command-line option, e.g. "--frames: error: ...".
 base::Error ArgError(const std::string& option, const std::string& message);
 
+// The ranges commands share: --threads 0 (every core) .. 256; --fps 0 (the
+// motion's own rate) .. 10000. An error naming the option, else nothing.
+std::optional<base::Error> CheckThreads(int threads);
+std::optional<base::Error> CheckFps(double fps);
+
 // "WxH" with both sides in 16..16384.
 base::Result<glm::ivec2> ParseSize(const std::string& text);
 

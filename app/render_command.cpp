@@ -249,10 +249,8 @@ int RunRender(const RenderOptions& options) {
   if (o.turntable_frames < 1 || o.turntable_frames > 100000) {
     return ReportError(ArgError("--turntable-frames", "expected 1..100000"));
   }
-  if (o.threads < 0 || o.threads > 256)
-    return ReportError(ArgError("--threads", "expected 0..256"));
-  if (!(o.fps >= 0.0) || o.fps > 10000.0)
-    return ReportError(ArgError("--fps", "expected 0 < fps <= 10000"));
+  if (const auto bad = CheckThreads(o.threads)) return ReportError(*bad);
+  if (const auto bad = CheckFps(o.fps)) return ReportError(*bad);
   bool overlay_skeleton = false, overlay_wire = false, overlay_patches = false, overlay_delta = false;
   for (const std::string& item : SplitList(o.overlay)) {
     if (item == "skeleton") overlay_skeleton = true;
