@@ -25,6 +25,16 @@ int AxisIndex(ChannelType type) {
   }
 }
 
+// The rotation channels of a joint in channel order (at most 3); returns how many.
+int RotationAxes(const JointChannels& ch, ChannelType* axes) {
+  int n = 0;
+  for (int c = 0; c < ch.count && n < 3; ++c) {
+    if (AxisIndex(ch.types[static_cast<std::size_t>(c)]) >= 0)
+      axes[n++] = ch.types[static_cast<std::size_t>(c)];
+  }
+  return n;
+}
+
 glm::dvec3 UnitAxis(int i) {
   glm::dvec3 e(0.0);
   e[i] = 1.0;
@@ -127,13 +137,8 @@ void QuatToEulerNear(const glm::quat& q, const ChannelType* axes, int count,
 int JointEulerAngles(const Skeleton& skeleton, int joint, const glm::quat& local_rotation,
                      float* angles_deg, const float* reference_deg) {
   const std::size_t j = static_cast<std::size_t>(joint);
-  const JointChannels& ch = skeleton.channels[j];
   ChannelType axes[3];
-  int n = 0;
-  for (int c = 0; c < ch.count && n < 3; ++c) {
-    if (AxisIndex(ch.types[static_cast<std::size_t>(c)]) >= 0)
-      axes[n++] = ch.types[static_cast<std::size_t>(c)];
-  }
+  const int n = RotationAxes(skeleton.channels[j], axes);
   if (n == 0) return 0;
   const glm::quat euler = glm::conjugate(skeleton.rest_rotations[j]) * local_rotation;
   if (reference_deg != nullptr) {
@@ -146,13 +151,8 @@ int JointEulerAngles(const Skeleton& skeleton, int joint, const glm::quat& local
 
 glm::quat JointRotationFromAngles(const Skeleton& skeleton, int joint, const glm::vec3& xyz_deg) {
   const std::size_t j = static_cast<std::size_t>(joint);
-  const JointChannels& ch = skeleton.channels[j];
   ChannelType axes[3];
-  int n = 0;
-  for (int c = 0; c < ch.count && n < 3; ++c) {
-    if (AxisIndex(ch.types[static_cast<std::size_t>(c)]) >= 0)
-      axes[n++] = ch.types[static_cast<std::size_t>(c)];
-  }
+  int n = RotationAxes(skeleton.channels[j], axes);
   for (ChannelType t :
        {ChannelType::kZRotation, ChannelType::kXRotation, ChannelType::kYRotation}) {
     if (std::find(axes, axes + n, t) == axes + n) axes[n++] = t;
