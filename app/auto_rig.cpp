@@ -428,7 +428,7 @@ void KeepBuildable(const Character& character, AutoRig& out) {
 
 base::Result<AutoRig> BuildAutoRig(const Character& character, const std::string& character_name,
                                    const std::string& motion_file, const std::string& label) {
-  base::Result<std::vector<glm::mat4>> bind = BindModelFromJoint(character);
+  base::Result<std::vector<glm::mat4>> bind = deform::BindModelFromJoint(character);
   if (!bind.ok()) return std::move(bind).error();
   AutoRig out;
   out.rig.file = label;

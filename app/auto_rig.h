@@ -33,7 +33,7 @@
 #include <utility>
 #include <vector>
 
-#include "app/pipeline.h"
+#include "app/character.h"
 #include "app/rig_file.h"
 #include "base/error.h"
 
@@ -48,7 +48,7 @@ struct AutoRig {
 
 // `character_name`: "generated", "tubes" or the glTF path (Rig::character);
 // `motion_file`: the capture (Rig::motion); `label` names the rig in messages
-// and output folders (Rig::file). Errors: BindModelFromJoint's.
+// and output folders (Rig::file). Errors: deform::BindModelFromJoint's.
 base::Result<AutoRig> BuildAutoRig(const Character& character, const std::string& character_name,
                                    const std::string& motion_file, const std::string& label);
 

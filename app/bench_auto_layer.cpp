@@ -7,7 +7,8 @@
 #include "app/bench_frame.h"
 #include "app/demo_data.h"
 #include "app/motion_source.h"
-#include "app/pipeline.h"
+#include "app/character.h"
+#include "deform/pipeline/frame_pipeline.h"
 #include "app/rig_setup.h"
 
 namespace app::bench {
@@ -27,19 +28,21 @@ void AddAutoLayerRows(const Budget& b, int frames, std::vector<Row>& rows, bool*
   base::Result<Character> character = MakeCharacter(std::move(*src), {}, BodyKind::kGenerated);
   if (!character.ok()) return void(ReportAutoLayer(character.error(), failed));
   const Character& ch = *character;
-  base::Result<FramePipeline> global = FramePipeline::Create(ch, GlobalMethod::kSsd, 1);
+  base::Result<deform::FramePipeline> global =
+      deform::FramePipeline::Create(ch, deform::GlobalMethod::kSsd, 1);
   if (!global.ok()) return void(ReportAutoLayer(global.error(), failed));
 
   Row setup{"auto_layer_setup_s", "s", Clock::kCpu, {}, 1.0, "limit",
             "BuildAutoRig + ApplyRigLayers, demo walk (" + std::to_string(ch.skeleton.num_joints()) +
                 " joints), generated body"};
-  std::optional<FramePipeline> layered;
+  std::optional<deform::FramePipeline> layered;
   std::size_t patches = 0;
   for (int r = 0; r < b.runs; ++r) {
     const double t0 = Now(Clock::kCpu);
     base::Result<AutoRig> made = BuildAutoRig(ch, "generated", "demo_walk.bvh", "demo");
     if (!made.ok()) return void(ReportAutoLayer(made.error(), failed));
-    base::Result<FramePipeline> p = FramePipeline::Create(ch, GlobalMethod::kSsd, 1);
+    base::Result<deform::FramePipeline> p =
+        deform::FramePipeline::Create(ch, deform::GlobalMethod::kSsd, 1);
     if (!p.ok()) return void(ReportAutoLayer(p.error(), failed));
     if (base::Status s = ApplyRigLayers(made->rig, ch, *p); !s.ok()) {
       return void(ReportAutoLayer(s.error(), failed));
@@ -51,12 +54,12 @@ void AddAutoLayerRows(const Budget& b, int frames, std::vector<Row>& rows, bool*
   if (!layered) return;
   setup.note += ", " + std::to_string(patches) + " patches";
 
-  DeformedFrame frame;
+  deform::DeformedFrame frame;
   if (base::Status s = global->Evaluate(0.0, frame); !s.ok())
     return void(ReportAutoLayer(s.error(), failed));
   EndToEndFrame end_to_end(ch, frame, "auto");
   // CPU seconds of `frames` end-to-end frames of `pipeline`, from the start of the clip.
-  const auto time_frames = [&](FramePipeline& pipeline) {
+  const auto time_frames = [&](deform::FramePipeline& pipeline) {
     const double t0 = Now(Clock::kCpu);
     for (int f = 0; f < frames && !*failed; ++f) {
       const double time_s = f / 30.0;

@@ -35,7 +35,8 @@
 #include "app/frame_plan.h"
 #include "app/frame_render.h"
 #include "app/motion_source.h"
-#include "app/pipeline.h"
+#include "app/character.h"
+#include "deform/pipeline/frame_pipeline.h"
 #include "app/exit_code.h"
 #include "base/parallel.h"
 #include "deform/patch/patch_binding.h"
@@ -316,12 +317,13 @@ int RunBench(const BenchOptions& o) {
   base::Result<FramePlan> plan =
       PlanFrames(ch.motion, {.frames = "0:" + std::to_string(e2e_frames - 1)});
   if (!plan.ok()) return ReportError(plan.error());
-  base::Result<FramePipeline> pipeline = FramePipeline::Create(ch, GlobalMethod::kSsd, threads);
+  base::Result<deform::FramePipeline> pipeline =
+      deform::FramePipeline::Create(ch, deform::GlobalMethod::kSsd, threads);
   if (!pipeline.ok()) return ReportError(pipeline.error());
   base::Result<CameraPlan> cameras =
       CameraPlan::Create(*pipeline, *plan, "follow", 15.0f, {1280, 720});
   if (!cameras.ok()) return ReportError(cameras.error());
-  DeformedFrame frame;
+  deform::DeformedFrame frame;
   if (base::Status s = pipeline->Evaluate(0.0, frame); !s.ok()) return ReportError(s.error());
   render::Renderer renderer, right_renderer;
   render::Image image, scratch;
@@ -354,7 +356,7 @@ int RunBench(const BenchOptions& o) {
   // on, alternating, per CPU second of all threads (insensitive to load).
   {
     const int n = o.quick ? 2 : 8;
-    std::vector<DeformedFrame> posed(static_cast<std::size_t>(n));
+    std::vector<deform::DeformedFrame> posed(static_cast<std::size_t>(n));
     for (int i = 0; i < n; ++i) {
       const double t = plan->frames[static_cast<std::size_t>(i % e2e_frames)].time_s;
       if (base::Status s = pipeline->Evaluate(t, posed[static_cast<std::size_t>(i)]); !s.ok())

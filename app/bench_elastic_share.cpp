@@ -9,9 +9,10 @@
 
 #include "app/bench_frame.h"
 #include "app/demo_data.h"
-#include "app/elastic_layer.h"
+#include "deform/pipeline/elastic_layer.h"
 #include "app/motion_source.h"
-#include "app/pipeline.h"
+#include "app/character.h"
+#include "deform/pipeline/frame_pipeline.h"
 #include "app/rig_file.h"
 #include "app/rig_patches.h"
 #include "app/rig_setup.h"
@@ -53,7 +54,8 @@ void AddElasticShareRow(const Budget& b, int frames, std::vector<Row>& rows, boo
   const Character& ch = *character;
   base::Result<Rig> rig = ParseRig(kTwoPatchRig, "bench_two_elastic_patches.json");
   if (!rig.ok()) return void(ReportElasticShare(rig.error(), failed));
-  base::Result<FramePipeline> pipeline = FramePipeline::Create(ch, GlobalMethod::kSsd, 1);
+  base::Result<deform::FramePipeline> pipeline =
+      deform::FramePipeline::Create(ch, deform::GlobalMethod::kSsd, 1);
   if (!pipeline.ok()) return void(ReportElasticShare(pipeline.error(), failed));
   if (base::Status s = ApplyRigLayers(*rig, ch, *pipeline); !s.ok()) {
     return void(ReportElasticShare(s.error(), failed));
@@ -61,10 +63,10 @@ void AddElasticShareRow(const Budget& b, int frames, std::vector<Row>& rows, boo
   // The same two networks again, advanced on their own.
   base::Result<std::vector<deform::PatchSetup>> patches = BuildRigPatches(*rig, ch);
   if (!patches.ok()) return void(ReportElasticShare(patches.error(), failed));
-  base::Result<std::vector<ElasticPatchSpec>> specs = ResolveRigElastic(*rig, ch, *patches);
+  base::Result<std::vector<deform::ElasticPatchSpec>> specs = ResolveRigElastic(*rig, ch, *patches);
   if (!specs.ok()) return void(ReportElasticShare(specs.error(), failed));
-  base::Result<std::unique_ptr<ElasticLayer>> layer =
-      ElasticLayer::Create(ch, *patches, std::move(*specs));
+  base::Result<std::unique_ptr<deform::ElasticLayer>> layer =
+      deform::ElasticLayer::Create(ch, *patches, std::move(*specs));
   if (!layer.ok()) return void(ReportElasticShare(layer.error(), failed));
   if ((*layer)->num_patches() != 2) {
     return void(ReportElasticShare(base::MakeError(base::ErrorCode::kInternal, {"bench", 0, 0, {}},
@@ -86,7 +88,7 @@ void AddElasticShareRow(const Budget& b, int frames, std::vector<Row>& rows, boo
         base::MakeError(base::ErrorCode::kInternal, {"bench", 0, 0, {}}, s.what), failed));
   }
 
-  DeformedFrame frame;
+  deform::DeformedFrame frame;
   if (base::Status s = pipeline->Evaluate(0.0, frame); !s.ok())
     return void(ReportElasticShare(s.error(), failed));
   EndToEndFrame end_to_end(ch, frame, "share");

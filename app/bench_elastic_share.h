@@ -4,7 +4,7 @@
 // 5x5 jowl driven by Head, the sample rigs' parameters), 30 fps. Per frame, on
 // the thread's CPU clock: the layered pipeline's Evaluate (both networks
 // included), the render at 1280x720 with 2x2 samples on one thread, and the
-// PNG write (level 1): the end-to-end frame; and a second ElasticLayer
+// PNG write (level 1): the end-to-end frame; and a second deform::ElasticLayer
 // advancing copies of the two networks to the same time: the elastic layer
 // alone. Row elastic_share_two_patches: elastic / end-to-end, in percent, one
 // value per repetition of `frames` frames (the requirement: at most 1 %).

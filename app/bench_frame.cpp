@@ -8,9 +8,11 @@
 
 namespace app::bench {
 
-EndToEndFrame::EndToEndFrame(const Character& character, const DeformedFrame& first, const std::string& tag)
+EndToEndFrame::EndToEndFrame(const Character& character, const deform::DeformedFrame& first,
+                             const std::string& tag)
     : character_(character),
-      camera_(render::FrameBounds(first.bounds, 35.0f, 1280.0f / 720.0f, glm::vec3(0.0f, 0.0f, -1.0f))),
+      camera_(
+          render::FrameBounds(first.bounds, 35.0f, 1280.0f / 720.0f, glm::vec3(0.0f, 0.0f, -1.0f))),
       path_((std::filesystem::temp_directory_path() /
              ("patchskin_bench_" + tag + "_" + std::to_string(getpid()) + ".png"))
                 .string()) {
@@ -26,7 +28,7 @@ EndToEndFrame::~EndToEndFrame() {
   std::filesystem::remove(path_, ec);
 }
 
-base::Status EndToEndFrame::Draw(const DeformedFrame& frame, int number) {
+base::Status EndToEndFrame::Draw(const deform::DeformedFrame& frame, int number) {
   FrameDrawOptions draw;
   draw.frame_number = number;
   base::Status s = DrawCharacterFrame(character_, frame, nullptr, camera_, settings_, draw,

@@ -8,7 +8,8 @@
 
 #include <string>
 
-#include "app/pipeline.h"
+#include "app/character.h"
+#include "deform/pipeline/frame_pipeline.h"
 #include "base/error.h"
 #include "render/camera.h"
 #include "render/output/image_io.h"
@@ -19,13 +20,14 @@ namespace app::bench {
 class EndToEndFrame {
  public:
   // `first`: the frame whose bounds fix the camera; `tag` names the scratch file.
-  EndToEndFrame(const Character& character, const DeformedFrame& first, const std::string& tag);
+  EndToEndFrame(const Character& character, const deform::DeformedFrame& first,
+                const std::string& tag);
   ~EndToEndFrame();
   EndToEndFrame(const EndToEndFrame&) = delete;
   EndToEndFrame& operator=(const EndToEndFrame&) = delete;
 
   // Draws `frame` (labelled `number`) and writes it. Errors: the renderer's or the writer's.
-  base::Status Draw(const DeformedFrame& frame, int number);
+  base::Status Draw(const deform::DeformedFrame& frame, int number);
 
  private:
   const Character& character_;

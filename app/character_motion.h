@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "app/motion_source.h"
-#include "app/pipeline.h"
+#include "app/character.h"
 #include "deform/body/humanoid_map.h"
 #include "base/error.h"
 

@@ -23,12 +23,6 @@ int Error(const base::Error& e) {
   return kCheckError;
 }
 
-std::string Num(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), "%g", v);
-  return buf;
-}
-
 // Sends this process's stderr to a temporary file while alive; Text() returns
 // what was written. The render reports its errors there, and check puts them in
 // its reports (and passes them on to the real stderr).
@@ -148,11 +142,13 @@ void Judge(int unrendered, CaseCheck& c) {
     if (r.max_error == 0.0) {
       s += (c.frames.size() > 1 ? ", all identical" : ", identical");
     } else {
-      s += "; worst frame " + std::to_string(w.number) + ": max error " + Num(r.max_error) + " @ (" +
-           std::to_string(r.max_x) + ", " + std::to_string(r.max_y) + ", " +
-           r.channels[static_cast<std::size_t>(r.max_channel)] + "), " +
-           Num(100.0 * static_cast<double>(r.num_fail) / static_cast<double>(r.num_pixels)) +
-           "% pixels over " + Num(c.thresholds.fail);
+      s += "; worst frame " + std::to_string(w.number) + ": max error " +
+           FormatNumber(r.max_error) + " @ (" + std::to_string(r.max_x) + ", " +
+           std::to_string(r.max_y) + ", " + r.channels[static_cast<std::size_t>(r.max_channel)] +
+           "), " +
+           FormatNumber(100.0 * static_cast<double>(r.num_fail) /
+                        static_cast<double>(r.num_pixels)) +
+           "% pixels over " + FormatNumber(c.thresholds.fail);
     }
     if (!r.same_size) {
       s += "; size " + std::to_string(r.width_a) + "x" + std::to_string(r.height_a) +

@@ -10,6 +10,13 @@
 #include "render/output/image_io.h"
 
 namespace app {
+
+std::string FormatNumber(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%g", v);
+  return buf;
+}
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -82,12 +89,6 @@ base::Status WriteAtomically(const std::string& path, const std::string& text) {
   return base::Status::Ok();
 }
 
-std::string Num(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), "%g", v);
-  return buf;
-}
-
 const char* StatusClass(CaseStatus s) {
   switch (s) {
     case CaseStatus::kError: return "error";
@@ -115,13 +116,13 @@ std::string FrameRow(const FrameCheck& f, bool worst) {
     const double over = r.num_pixels > 0 ? 100.0 * static_cast<double>(r.num_fail) /
                                                static_cast<double>(r.num_pixels)
                                          : 0.0;
-    s << "<td>" << Num(r.max_error);
+    s << "<td>" << FormatNumber(r.max_error);
     if (r.max_error > 0.0) {
       s << " @ (" << r.max_x << ", " << r.max_y << ", "
         << Escape(r.channels[static_cast<std::size_t>(r.max_channel)]) << ")";
     }
-    s << "</td><td>" << Num(r.mean_error) << "</td><td>" << Num(r.psnr_db) << "</td><td>"
-      << r.num_fail << " (" << Num(over) << "%)</td>";
+    s << "</td><td>" << FormatNumber(r.mean_error) << "</td><td>" << FormatNumber(r.psnr_db)
+      << "</td><td>" << r.num_fail << " (" << FormatNumber(over) << "%)</td>";
   } else {
     s << "<td colspan=\"4\"></td>";
   }
@@ -161,7 +162,7 @@ std::string CaseSection(const CaseCheck& c) {
     const std::string frame = " (frame " + std::to_string(f.number) + ")";
     s << "<div class=\"images\">\n"
       << Figure(ref, "reference" + frame, w) << Figure(neu, "new" + frame, w)
-      << Figure(DataUri(f.diff_path), "difference x" + Num(f.diff_scale), w);
+      << Figure(DataUri(f.diff_path), "difference x" + FormatNumber(f.diff_scale), w);
     if (!ref.empty() && !neu.empty()) {
       // The new frame over the reference, uncovered from the slider's position on.
       s << "<figure><div class=\"swipe\"><img style=\"width:" << w << "px\" src=\"" << ref
@@ -265,7 +266,7 @@ base::Status WriteCheckJUnit(const CheckRun& run, const std::string& path) {
     std::string details;
     for (const FrameCheck& f : c.frames) {
       details += "frame " + std::to_string(f.number) + ": " + FrameVerdict(f);
-      if (f.result) details += ", max error " + Num(f.result->max_error);
+      if (f.result) details += ", max error " + FormatNumber(f.result->max_error);
       details += "\n";
     }
     switch (c.status) {

@@ -60,6 +60,9 @@ struct CheckRun {
 // Cases in report order (severity, then manifest order), as indices.
 std::vector<std::size_t> ReportOrder(const CheckRun& run);
 
+// A number as the reports print it (printf %g).
+std::string FormatNumber(double v);
+
 [[nodiscard]] base::Status WriteCheckHtml(const CheckRun& run, const std::string& path);
 [[nodiscard]] base::Status WriteCheckJUnit(const CheckRun& run, const std::string& path);
 

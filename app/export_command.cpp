@@ -14,7 +14,8 @@
 #include "app/frame_plan.h"
 #include "app/motion_source.h"
 #include "app/output_guard.h"
-#include "app/pipeline.h"
+#include "app/character.h"
+#include "deform/pipeline/frame_pipeline.h"
 #include "app/progress.h"
 #include "app/auto_rig.h"
 #include "app/rig_file.h"
@@ -143,7 +144,7 @@ int RunExport(const ExportOptions& options) {
         "--scale", "expected 0 (detected units to metres) or a factor in 1e-6..1e6, found " +
                        std::to_string(o.scale)));
   }
-  const base::Result<GlobalMethod> method = ParseGlobalMethod(o.global);
+  const base::Result<deform::GlobalMethod> method = ParseGlobalMethod(o.global);
   if (!method.ok()) return ReportError(method.error());
   const base::Result<deform::GltfExportLayout> layout = ParseLayout(o.layout);
   if (!layout.ok()) return ReportError(layout.error());
@@ -199,7 +200,8 @@ int RunExport(const ExportOptions& options) {
   // --- Pipeline and cameras ----------------------------------------------------------
   // The layered result: with a rig, every layer it asks for (render draws the
   // same pipeline, or its right half when the rig splits the view).
-  base::Result<FramePipeline> pipeline = FramePipeline::Create(ch, *method, o.threads);
+  base::Result<deform::FramePipeline> pipeline =
+      deform::FramePipeline::Create(ch, *method, o.threads);
   if (!pipeline.ok()) return ReportError(pipeline.error());
   if (rig) {
     if (base::Status s = ApplyRigLayers(*rig, ch, *pipeline); !s) return ReportError(s.error());
@@ -219,7 +221,7 @@ int RunExport(const ExportOptions& options) {
     go.frame_time_s = plan->frame_time_s * plan->range.step;
     go.layout = *layout;
     go.step_interpolation = o.step;
-    go.generator = "patchskin export (" + std::string(GlobalMethodName(*method)) + ")";
+    go.generator = "patchskin export (" + std::string(deform::GlobalMethodName(*method)) + ")";
     go.scratch_dir = out_dir.empty() ? "." : out_dir.string();
     if (cameras) {  // the lens is the same at every frame; the scale moves the planes with the scene
       const render::Camera first = cameras->At(plan->At(0));
@@ -243,7 +245,7 @@ int RunExport(const ExportOptions& options) {
   // does, so state carried from frame to frame (the elastic layer) is the same.
   Progress progress(demo ? "export demo" : "export " + name, static_cast<int>(plan->count()),
                     o.quiet);
-  DeformedFrame frame;
+  deform::DeformedFrame frame;
   std::vector<glm::vec3> scaled;  // --scale: the positions written (#V, reused)
   deform::ObjSequenceWriter obj;
   ObjMaterials obj_materials;
@@ -289,7 +291,7 @@ int RunExport(const ExportOptions& options) {
       if (!path.ok()) return ReportError(path.error());
       char comment[160];
       std::snprintf(comment, sizeof(comment), "frame %d, t = %.6f s, %s skinning", of.number,
-                    of.time_s, GlobalMethodName(*method));
+                    of.time_s, deform::GlobalMethodName(*method));
       s = obj.Write({.positions = positions, .normals = frame.normals,
                      .triangles = bind.triangles,
                      .comment = "patchskin export of " + source + "\n" + comment,

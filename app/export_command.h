@@ -1,6 +1,6 @@
 #pragma once
 // `patchskin export [INPUT] --out PATTERN`: the deformed mesh of every output
-// frame as geometry other tools open, evaluated by the same FramePipeline,
+// frame as geometry other tools open, evaluated by the same deform::FramePipeline,
 // frame plan and options as `render` (so frame N of an export is exactly the
 // mesh `render` draws as frame N). A rig file (.json) as input sets the
 // motion or character, the global method, fps, frames, camera and size as it

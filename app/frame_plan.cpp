@@ -123,7 +123,7 @@ OutputFrame FramePlan::At(std::size_t i) const {
   return {start_number + f, f * frame_time_s, f};
 }
 
-base::Result<CameraPlan> CameraPlan::Create(FramePipeline& pipeline, const FramePlan& plan,
+base::Result<CameraPlan> CameraPlan::Create(deform::FramePipeline& pipeline, const FramePlan& plan,
                                             const std::string& mode, float elevation_deg,
                                             glm::ivec2 size) {
   CameraSpec spec;
@@ -132,7 +132,7 @@ base::Result<CameraPlan> CameraPlan::Create(FramePipeline& pipeline, const Frame
   return Create(pipeline, plan, spec, size);
 }
 
-glm::vec3 CameraPlan::LookPoint(const DeformedFrame& f) const {
+glm::vec3 CameraPlan::LookPoint(const deform::DeformedFrame& f) const {
   if (look_joint_ >= 0) return f.joint_positions[static_cast<std::size_t>(look_joint_)];
   if (look_region_.empty()) return f.bounds.center();
   glm::dvec3 sum(0.0);
@@ -170,7 +170,7 @@ void ApplyDistance(const CameraSpec& spec, float body_extent, render::Camera& c)
 
 }  // namespace
 
-base::Result<CameraPlan> CameraPlan::Create(FramePipeline& pipeline, const FramePlan& plan,
+base::Result<CameraPlan> CameraPlan::Create(deform::FramePipeline& pipeline, const FramePlan& plan,
                                             const CameraSpec& spec, glm::ivec2 size) {
   const std::string& mode = spec.mode;
   const float elevation_deg = spec.elevation_deg;
@@ -183,7 +183,7 @@ base::Result<CameraPlan> CameraPlan::Create(FramePipeline& pipeline, const Frame
   if (!(spec.zoom > 0.0f) || !(spec.zoom <= 1000.0f)) {
     return ArgError("--zoom", "expected a factor in (0, 1000]");
   }
-  const Character& character = pipeline.character();
+  const deform::Character& character = pipeline.character();
   if (spec.look_joint >= character.skeleton.num_joints()) {
     return ArgError("--look-at", "joint index out of range");
   }
@@ -209,13 +209,13 @@ base::Result<CameraPlan> CameraPlan::Create(FramePipeline& pipeline, const Frame
   cp.look_region_ = spec.look_region;
   const bool look = spec.look_joint >= 0 || !spec.look_region.empty();
   cp.frame_time_s_ = plan.frame_time_s;
-  base::Result<FramePipeline> tracker =
-      FramePipeline::Create(pipeline.character(), GlobalMethod::kSsd, pipeline.threads());
+  base::Result<deform::FramePipeline> tracker = deform::FramePipeline::Create(
+      pipeline.character(), deform::GlobalMethod::kSsd, pipeline.threads());
   if (!tracker.ok()) return std::move(tracker).error();
-  cp.tracker_ = std::make_unique<FramePipeline>(std::move(*tracker));
+  cp.tracker_ = std::make_unique<deform::FramePipeline>(std::move(*tracker));
   // Framing: output frames spread evenly over the whole motion, both ends
   // included, the same whatever --frames asks for.
-  DeformedFrame& frame = cp.scratch_;
+  deform::DeformedFrame& frame = cp.scratch_;
   deform::Bounds all_bounds;
   glm::vec3 largest_extent(0.0f);
   float ground_y = 1e30f;

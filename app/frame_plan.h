@@ -11,7 +11,8 @@
 
 #include <glm/glm.hpp>
 
-#include "app/pipeline.h"
+#include "app/character.h"
+#include "deform/pipeline/frame_pipeline.h"
 #include "base/error.h"
 #include "mocap/motion.h"
 #include "mocap/skeleton.h"
@@ -147,12 +148,12 @@ class CameraPlan {
   // `pipeline` only supplies the character and thread count; it must outlive
   // nothing here (the character must outlive the CameraPlan).
   // Errors: kInvalidArgument (mode), and the pipeline's errors.
-  static base::Result<CameraPlan> Create(FramePipeline& pipeline, const FramePlan& plan,
+  static base::Result<CameraPlan> Create(deform::FramePipeline& pipeline, const FramePlan& plan,
                                          const std::string& mode, float elevation_deg,
                                          glm::ivec2 size);
   // The same with every camera setting (CameraSpec); kInvalidArgument naming
   // --azimuth, --distance, --zoom or --look-at for values out of range.
-  static base::Result<CameraPlan> Create(FramePipeline& pipeline, const FramePlan& plan,
+  static base::Result<CameraPlan> Create(deform::FramePipeline& pipeline, const FramePlan& plan,
                                          const CameraSpec& spec, glm::ivec2 size);
 
   // The camera of `frame` (one of the plan's frames). Follow: evaluates the
@@ -169,17 +170,17 @@ class CameraPlan {
 
   // The point the camera follows in `f`: the look-at joint, the look-at
   // region's centroid, or the bounds centre.
-  glm::vec3 LookPoint(const DeformedFrame& f) const;
+  glm::vec3 LookPoint(const deform::DeformedFrame& f) const;
   std::string mode_;
   std::vector<render::Camera> turntable_;
   render::Camera fixed_;
   render::FollowCamera follow_;
   double frame_time_s_ = 1.0 / 30.0;           // output frame f is at f * frame_time_s_
-  std::unique_ptr<FramePipeline> tracker_;     // global-only SSD body for bounds
+  std::unique_ptr<deform::FramePipeline> tracker_;  // global-only SSD body for bounds
   mutable std::vector<glm::vec3> centres_;     // follow: bounds centres of frames centre_base_..
   mutable std::vector<deform::Bounds> boxes_;  // follow: their bounds
   mutable int centre_base_ = 0;
-  mutable DeformedFrame scratch_;
+  mutable deform::DeformedFrame scratch_;
   float ground_y_ = 0.0f;
   int look_joint_ = -1;
   std::vector<int> look_region_;

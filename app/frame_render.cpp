@@ -12,7 +12,7 @@
 namespace app {
 namespace {
 
-void AddSkeleton(const DeformedFrame& f, const mocap::Skeleton& s, render::Overlays& o) {
+void AddSkeleton(const deform::DeformedFrame& f, const mocap::Skeleton& s, render::Overlays& o) {
   render::LineOverlay bones;
   bones.depth_test = false;
   render::AppendSkeletonLines(f.joint_positions, s.parents, bones);
@@ -73,10 +73,11 @@ void DrawColorBar(float scale, render::Image& image) {
   render::DrawText({.text = "|d|", .origin_px = {x0 - 10, y0 - 8}, .scale = size}, image);
 }
 
-base::Status DrawOne(const Character& ch, const DeformedFrame& f, const render::Camera& camera,
-                     const render::RenderSettings& settings, const FrameDrawOptions& o,
-                     const std::string& label, int label_x, bool frame_label,
-                     std::span<const glm::vec3> colors, render::Renderer& r, render::Image& into) {
+base::Status DrawOne(const Character& ch, const deform::DeformedFrame& f,
+                     const render::Camera& camera, const render::RenderSettings& settings,
+                     const FrameDrawOptions& o, const std::string& label, int label_x,
+                     bool frame_label, std::span<const glm::vec3> colors, render::Renderer& r,
+                     render::Image& into) {
   const deform::Mesh& bind = ch.mesh.bind;
   render::SceneMesh body{.positions = f.positions, .normals = f.normals,
                          .triangles = bind.triangles,
@@ -114,8 +115,8 @@ base::Status DrawOne(const Character& ch, const DeformedFrame& f, const render::
 
 }  // namespace
 
-base::Status DrawCharacterFrame(const Character& character, const DeformedFrame& frame,
-                                const DeformedFrame* right, const render::Camera& camera,
+base::Status DrawCharacterFrame(const Character& character, const deform::DeformedFrame& frame,
+                                const deform::DeformedFrame* right, const render::Camera& camera,
                                 const render::RenderSettings& settings,
                                 const FrameDrawOptions& options, render::Renderer& renderer,
                                 render::Renderer& right_renderer, render::Image& scratch,

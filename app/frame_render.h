@@ -1,7 +1,7 @@
 #pragma once
 // Drawing one evaluated frame of a character (or a split view of two), shared by
 // `patchskin render` and the golden-image tests so both go through the same
-// FramePipeline -> render::Renderer path.
+// deform::FramePipeline -> render::Renderer path.
 
 #include <cstdint>
 #include <memory>
@@ -12,7 +12,8 @@
 
 #include <glm/glm.hpp>
 
-#include "app/pipeline.h"
+#include "app/character.h"
+#include "deform/pipeline/frame_pipeline.h"
 #include "deform/patch/patch_layer.h"
 #include "base/error.h"
 #include "render/camera.h"
@@ -78,8 +79,8 @@ float NiceScale(float value);
 // `right` is set, `frame` and `right` side by side or as a wipe, with a
 // divider. `right_renderer` and `scratch` are only used for two bodies.
 // Errors: kInternal when the renderer refuses the frame.
-base::Status DrawCharacterFrame(const Character& character, const DeformedFrame& frame,
-                                const DeformedFrame* right, const render::Camera& camera,
+base::Status DrawCharacterFrame(const Character& character, const deform::DeformedFrame& frame,
+                                const deform::DeformedFrame* right, const render::Camera& camera,
                                 const render::RenderSettings& settings,
                                 const FrameDrawOptions& options, render::Renderer& renderer,
                                 render::Renderer& right_renderer, render::Image& scratch,

@@ -10,7 +10,7 @@
 #include "app/frame_plan.h"
 #include "app/character_motion.h"
 #include "app/motion_source.h"
-#include "app/pipeline.h"
+#include "app/character.h"
 #include "deform/global/rig_artifacts.h"
 #include "deform/global/swd_rig.h"
 #include "mocap/joint_angles.h"
@@ -178,7 +178,7 @@ int PrintArtifacts(MotionSource&& src, const std::string& file) {
     std::fprintf(stderr, "%s\n", ch.error().ToString().c_str());
     return 2;
   }
-  base::Result<std::vector<glm::mat4>> bind = BindModelFromJoint(*ch);
+  base::Result<std::vector<glm::mat4>> bind = deform::BindModelFromJoint(*ch);
   base::Result<deform::SwdRig> rig =
       bind.ok() ? deform::BuildSwdRig(ch->skeleton, *bind, ch->mesh.bind,
                                       {.vertex_chains = ch->mesh.body_chain_coords})

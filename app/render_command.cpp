@@ -17,7 +17,8 @@
 #include "app/frame_render.h"
 #include "app/motion_source.h"
 #include "app/output_guard.h"
-#include "app/pipeline.h"
+#include "app/character.h"
+#include "deform/pipeline/frame_pipeline.h"
 #include "app/progress.h"
 #include "app/rig_examples.h"
 #include "app/rig_file.h"
@@ -56,10 +57,10 @@ std::vector<std::string> SplitList(const std::string& text) {
 
 // One body of a comparison: a global method, with or without the rig's patch layer.
 struct BodySpec {
-  GlobalMethod method = GlobalMethod::kSsd;
+  deform::GlobalMethod method = deform::GlobalMethod::kSsd;
   bool patches = false;
   std::string Label() const {
-    return std::string(GlobalMethodName(method)) + (patches ? " + patches" : "");
+    return std::string(deform::GlobalMethodName(method)) + (patches ? " + patches" : "");
   }
 };
 
@@ -72,7 +73,7 @@ base::Result<BodySpec> ParseBodySpec(std::string text, const std::string& option
     spec.patches = true;
     text.resize(text.size() - suffix.size());
   }
-  base::Result<GlobalMethod> method = ParseGlobalMethod(text);
+  base::Result<deform::GlobalMethod> method = ParseGlobalMethod(text);
   if (!method.ok()) {
     return ArgError(option, "expected ssd, dqs or swd, optionally with +patches, found '" + text + "'");
   }
@@ -92,7 +93,7 @@ struct TwoBodies {
 // the same method and its patches, side by side, unless it asks for a wipe
 // or "split": false), else one body.
 base::Result<TwoBodies> ChooseTwoBodies(const RenderOptions& o, const Rig* rig,
-                                        GlobalMethod global) {
+                                        deform::GlobalMethod global) {
   const bool has_layers = rig != nullptr && !rig->patches.empty();
   TwoBodies two;
   std::string pair_text, option = "--compare";
@@ -112,9 +113,10 @@ base::Result<TwoBodies> ChooseTwoBodies(const RenderOptions& o, const Rig* rig,
   }
   std::vector<std::string> pair = SplitList(pair_text);
   if (pair.empty()) {
-    const std::string g = GlobalMethodName(global);
-    pair = has_layers ? std::vector<std::string>{g, g + "+patches"}
-                      : std::vector<std::string>{"ssd", global == GlobalMethod::kSsd ? "dqs" : g};
+    const std::string g = deform::GlobalMethodName(global);
+    pair = has_layers
+               ? std::vector<std::string>{g, g + "+patches"}
+               : std::vector<std::string>{"ssd", global == deform::GlobalMethod::kSsd ? "dqs" : g};
   }
   // Errors name the option, or the rig file and its field.
   const auto fail = [&](base::Error e) {
@@ -270,7 +272,7 @@ int RunRender(const RenderOptions& options) {
     return ReportError(
         ArgError("--background", "expected gradient or transparent, found '" + o.background + "'"));
   }
-  const base::Result<GlobalMethod> method = ParseGlobalMethod(o.global);
+  const base::Result<deform::GlobalMethod> method = ParseGlobalMethod(o.global);
   if (!method.ok()) return ReportError(method.error());
   base::Result<TwoBodies> two = ChooseTwoBodies(o, rig ? &*rig : nullptr, *method);
   if (!two.ok()) return ReportError(two.error());
@@ -371,15 +373,17 @@ int RunRender(const RenderOptions& options) {
   const bool has_layers = rig && !rig->patches.empty();
   const BodySpec main_body = two->view != View::kOne ? two->sides[0]
                                                      : BodySpec{*method, has_layers};
-  base::Result<FramePipeline> pipeline = FramePipeline::Create(ch, main_body.method, o.threads);
+  base::Result<deform::FramePipeline> pipeline =
+      deform::FramePipeline::Create(ch, main_body.method, o.threads);
   if (!pipeline.ok()) return ReportError(pipeline.error());
-  std::optional<FramePipeline> right_pipeline;
+  std::optional<deform::FramePipeline> right_pipeline;
   if (two->view != View::kOne) {
-    base::Result<FramePipeline> p = FramePipeline::Create(ch, two->sides[1].method, o.threads);
+    base::Result<deform::FramePipeline> p =
+        deform::FramePipeline::Create(ch, two->sides[1].method, o.threads);
     if (!p.ok()) return ReportError(p.error());
     right_pipeline.emplace(std::move(*p));
   }
-  const std::pair<FramePipeline*, bool> bodies[] = {
+  const std::pair<deform::FramePipeline*, bool> bodies[] = {
       {&*pipeline, main_body.patches},
       {right_pipeline ? &*right_pipeline : nullptr, right_pipeline && two->sides[1].patches}};
   for (const auto& [body, layered] : bodies) {
@@ -409,21 +413,24 @@ int RunRender(const RenderOptions& options) {
     tint = PatchTint(*patches, ch.mesh.bind.num_vertices(), ch.mesh.bind.colors);
   }
   struct DeltaBody {
-    std::optional<FramePipeline> base;  // the same method without the layer
-    DeformedFrame base_frame;
+    std::optional<deform::FramePipeline> base;  // the same method without the layer
+    deform::DeformedFrame base_frame;
     std::vector<glm::vec3> colors;
   };
   DeltaBody delta[2];
   for (int side = 0; side < 2 && overlay_delta; ++side) {
-    const FramePipeline* body = side == 0 ? &*pipeline : right_pipeline ? &*right_pipeline : nullptr;
+    const deform::FramePipeline* body = side == 0        ? &*pipeline
+                                        : right_pipeline ? &*right_pipeline
+                                                         : nullptr;
     if (body == nullptr || body->num_patches() == 0) continue;
-    base::Result<FramePipeline> base = FramePipeline::Create(ch, body->method(), o.threads);
+    base::Result<deform::FramePipeline> base =
+        deform::FramePipeline::Create(ch, body->method(), o.threads);
     if (!base.ok()) return ReportError(base.error());
     delta[side].base.emplace(std::move(*base));
   }
 
   // --- Framing (app/frame_plan.h) ------------------------------------------------
-  DeformedFrame frame, right_frame;
+  deform::DeformedFrame frame, right_frame;
   base::Result<FramePlan> framing = plan;
   if (!o.framing.empty() && !turntable) {
     framing = PlanFrames(ch.motion, {.frames = o.framing, .fps = o.fps,
@@ -580,7 +587,7 @@ int RunRender(const RenderOptions& options) {
       if (!delta[b].base) continue;
       s = delta[b].base->Evaluate(of.time_s, delta[b].base_frame);
       if (!s.ok()) return ReportError(s.error());
-      const DeformedFrame& layered = b == 0 ? frame : right_frame;
+      const deform::DeformedFrame& layered = b == 0 ? frame : right_frame;
       for (std::size_t v = 0; v < layered.positions.size(); ++v) {
         delta_scale = std::max(delta_scale,
                                glm::length(layered.positions[v] - delta[b].base_frame.positions[v]));
@@ -647,9 +654,9 @@ int RunRender(const RenderOptions& options) {
     return guard.exit_code();
   }
   // The elastic layer says when it had to limit anything (ALGORITHMS.md 6).
-  for (const FramePipeline* p : {&*pipeline, right_pipeline ? &*right_pipeline : nullptr}) {
+  for (const deform::FramePipeline* p : {&*pipeline, right_pipeline ? &*right_pipeline : nullptr}) {
     if (p == nullptr) continue;
-    for (const ElasticPatchReport& r : p->elastic_report()) {
+    for (const deform::ElasticPatchReport& r : p->elastic_report()) {
       if (r.counters.any_limit() == 0) continue;
       std::fprintf(stderr,
                    "%s: warning: elastic patch \"%s\" was limited: %lld acceleration clamps, "

@@ -3,7 +3,7 @@
 // field is documented in docs/rig-file.md, "Elastic"). Parsed by ParseRigElastic
 // (app/internal/rig_elastic_parse.h), hooked into rig_file.cpp's patch parser;
 // resolved against a loaded character (driving joint, model units) by
-// ResolveRigElastic (app/elastic_layer.h).
+// ResolveRigElastic (app/rig_setup.h).
 //
 //   "elastic": {"joint": "Hips", "frequency_hz": 3, "damping_ratio": 0.15,
 //               "gain": 1, "preroll_s": 1, ...}

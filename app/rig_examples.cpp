@@ -3,7 +3,7 @@
 #include <cmath>
 #include <sstream>
 
-#include "app/pipeline.h"
+#include "app/character.h"
 #include "app/rig_file.h"
 #include "deform/global/dqs_job.h"
 #include "deform/shapes/corrective_example.h"
@@ -108,7 +108,7 @@ deform::RbfKernel Kernel(const std::string& name) {
 
 base::Result<RigPoseSpaces> BuildRigPoseSpaces(const Rig& rig, const Character& ch,
                                                const std::vector<deform::PatchSetup>& patches,
-                                               GlobalMethod method) {
+                                               deform::GlobalMethod method) {
   RigPoseSpaces out;
   out.patches.resize(rig.patches.size());
   if (patches.size() != rig.patches.size()) {
@@ -125,7 +125,7 @@ base::Result<RigPoseSpaces> BuildRigPoseSpaces(const Rig& rig, const Character& 
     const RigPatch& rp = rig.patches[i];
     if (rp.examples.empty()) continue;
     const std::string path = "patches[" + std::to_string(i) + "]";
-    if (method == GlobalMethod::kSwd) {
+    if (method == deform::GlobalMethod::kSwd) {
       // dS lives in control-point frames A (ALGORITHMS.md 4.3), defined here
       // for SSD and DQS only: say so instead of dropping the examples.
       return base::MakeError(base::ErrorCode::kUnsupported, {rig.file, 0, 0, path + ".examples"},
@@ -145,13 +145,14 @@ base::Result<RigPoseSpaces> BuildRigPoseSpaces(const Rig& rig, const Character& 
                                                   .model_from_joint = model}
                                .Run();
       if (js) js = deform::BuildSkinningPalette(model, ch.mesh, palette);
-      if (js && method == GlobalMethod::kDqs) js = deform::BuildDualQuatPalette(palette, dq);
+      if (js && method == deform::GlobalMethod::kDqs)
+        js = deform::BuildDualQuatPalette(palette, dq);
       if (!js)
         return base::MakeError(base::ErrorCode::kInternal, {rig.file, 0, 0, ex.path}, js.what);
-      const deform::ExamplePose pose{
-          .model_from_bind = palette,
-          .dq_palette = method == GlobalMethod::kDqs ? std::span<const deform::DualQuat>(dq)
-                                                     : std::span<const deform::DualQuat>()};
+      const deform::ExamplePose pose{.model_from_bind = palette,
+                                     .dq_palette = method == deform::GlobalMethod::kDqs
+                                                       ? std::span<const deform::DualQuat>(dq)
+                                                       : std::span<const deform::DualQuat>()};
       base::Result<deform::SculptedExample> sculpted = deform::SculptedExample{};
       if (!ex.auto_kind.empty()) {
         // Computed at load, once (deform/shapes/corrective_example.h).

@@ -25,13 +25,13 @@
 namespace deform {
 struct PatchSetup;
 struct PatchPoseSpace;
+enum class GlobalMethod;
 }  // namespace deform
 
 namespace app {
 
 struct Character;
 struct Rig;
-enum class GlobalMethod;
 
 // One edit at an example pose (deform::ExampleEdit).
 struct RigEdit {
@@ -90,6 +90,6 @@ struct RigPoseSpaces {
 // examples), a feature spec over kMaxPoseFeatures.
 base::Result<RigPoseSpaces> BuildRigPoseSpaces(const Rig& rig, const Character& character,
                                                const std::vector<deform::PatchSetup>& patches,
-                                               GlobalMethod method);
+                                               deform::GlobalMethod method);
 
 }  // namespace app

@@ -6,7 +6,7 @@
 
 #include <vector>
 
-#include "app/pipeline.h"
+#include "app/character.h"
 #include "app/rig_file.h"
 #include "deform/patch/patch_layer.h"
 #include "base/error.h"

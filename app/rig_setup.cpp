@@ -1,6 +1,5 @@
 #include "app/rig_setup.h"
 
-#include "app/elastic_layer.h"
 #include "app/rig_examples.h"
 #include "app/rig_patches.h"
 
@@ -14,8 +13,41 @@ BodyKind RigBodyKind(const Rig& rig) {
   return rig.character == "generated" ? BodyKind::kGenerated : BodyKind::kTubes;
 }
 
-base::Status ApplyRigLayers(const Rig& rig, const Character& character, FramePipeline& pipeline,
-                            std::vector<std::string>* notes) {
+base::Result<std::vector<deform::ElasticPatchSpec>> ResolveRigElastic(
+    const Rig& rig, const Character& character, std::span<const deform::PatchSetup> patches) {
+  std::vector<deform::ElasticPatchSpec> specs;
+  for (std::size_t i = 0; i < rig.patches.size() && i < patches.size(); ++i) {
+    const RigPatch& p = rig.patches[i];
+    if (!p.elastic) continue;
+    const std::string field = "patches[" + std::to_string(i) + "].elastic.joint";
+    deform::ElasticPatchSpec spec;
+    spec.patch = static_cast<int>(i);
+    spec.cutoff_hz = p.elastic->cutoff_hz;
+    spec.params = p.elastic->params;
+    spec.params.units_per_metre = p.elastic->units_per_metre > 0.0f
+                                      ? p.elastic->units_per_metre
+                                      : UnitsPerMetre(character.skeleton.info.detected_units,
+                                                      character.skeleton.info.rest_height);
+    const std::string& name = !p.elastic->joint.empty()                  ? p.elastic->joint
+                              : p.region.kind == RigRegion::Kind::kJoint ? p.region.joint
+                                                                         : std::string();
+    if (name.empty()) {
+      spec.joint = deform::DominantJoint(character.mesh, patches[i]);
+    } else {
+      spec.joint = character.skeleton.FindJoint(name);
+      if (spec.joint < 0) {
+        return base::MakeError(
+            base::ErrorCode::kNotFound, {rig.file, 0, 0, field},
+            "expected a joint of " + character.source + ", found \"" + name + "\"");
+      }
+    }
+    specs.push_back(spec);
+  }
+  return specs;
+}
+
+base::Status ApplyRigLayers(const Rig& rig, const Character& character,
+                            deform::FramePipeline& pipeline, std::vector<std::string>* notes) {
   base::Result<std::vector<deform::PatchSetup>> patches = BuildRigPatches(rig, character);
   if (!patches.ok()) return std::move(patches).error();
   if (patches->empty()) return base::Status::Ok();
@@ -24,7 +56,8 @@ base::Status ApplyRigLayers(const Rig& rig, const Character& character, FramePip
   base::Result<RigPoseSpaces> spaces =
       BuildRigPoseSpaces(rig, character, *patches, pipeline.method());
   if (!spaces.ok()) return std::move(spaces).error();
-  base::Result<std::vector<ElasticPatchSpec>> elastic = ResolveRigElastic(rig, character, *patches);
+  base::Result<std::vector<deform::ElasticPatchSpec>> elastic =
+      ResolveRigElastic(rig, character, *patches);
   if (!elastic.ok()) return std::move(elastic).error();
   if (base::Status s = pipeline.SetPatches(std::move(*patches)); !s.ok()) return s;
   if (base::Status s = pipeline.SetPoseSpaces(std::move(spaces->patches)); !s.ok()) return s;
@@ -32,7 +65,7 @@ base::Status ApplyRigLayers(const Rig& rig, const Character& character, FramePip
   if (notes != nullptr) {
     for (const std::string& note : spaces->notes) notes->push_back("examples: " + note);
     for (const base::Warning& w : spaces->warnings) notes->push_back(w.ToString());
-    for (const ElasticPatchReport& r : pipeline.elastic_report()) {
+    for (const deform::ElasticPatchReport& r : pipeline.elastic_report()) {
       for (const std::string& note : r.messages) {
         notes->push_back(rig.file + ": patches[" + std::to_string(r.patch) +
                          "].elastic: note: " + note);

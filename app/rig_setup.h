@@ -2,7 +2,7 @@
 // What a rig file (rig_file.h) asks of the commands that evaluate frames, in
 // one place so `export` follows the same rules as `render`:
 //   * which input to load (the mannequin's motion, or the glTF character);
-//   * the layers to put on a FramePipeline: the patches, their example shapes
+//   * the layers to put on a deform::FramePipeline: the patches, their example shapes
 //     (pose-space dS) and their elastic networks (dE). `render` puts them on
 //     the right half's pipeline of a split view, `export` on its only one.
 
@@ -10,7 +10,8 @@
 #include <vector>
 
 #include "app/frame_plan.h"
-#include "app/pipeline.h"
+#include "app/character.h"
+#include "deform/pipeline/frame_pipeline.h"
 #include "app/rig_file.h"
 #include "base/error.h"
 
@@ -47,12 +48,21 @@ void ApplyRigSettings(const Rig& rig, Options& o) {
 // "mannequin"). Meaningless for a glTF character.
 BodyKind RigBodyKind(const Rig& rig);
 
+// The rig's elastic patches on a character whose patches (one per rig patch,
+// in order) were built by BuildRigPatches. Driving joint: the rig's
+// `elastic.joint`, else the region's joint, else the joint with the largest
+// total skin weight on the patch's control points. Errors (kNotFound) name
+// "patches[i].elastic.joint".
+base::Result<std::vector<deform::ElasticPatchSpec>> ResolveRigElastic(
+    const Rig& rig, const Character& character, std::span<const deform::PatchSetup> patches);
+
 // Builds the rig's layers on `character` (BuildRigPatches, BuildRigPoseSpaces
 // for pipeline.method(), ResolveRigElastic) and installs them on `pipeline`,
 // which must evaluate that character. Errors name the rig file and the field
 // path. `notes` (optional) receives the lines worth printing: condition
 // numbers of the example fits, their warnings, elastic step notes.
-base::Status ApplyRigLayers(const Rig& rig, const Character& character, FramePipeline& pipeline,
+base::Status ApplyRigLayers(const Rig& rig, const Character& character,
+                            deform::FramePipeline& pipeline,
                             std::vector<std::string>* notes = nullptr);
 
 // Resolves a camera's look-at text into `spec`: a joint of the character

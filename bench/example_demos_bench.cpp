@@ -24,7 +24,7 @@
 #include <vector>
 
 #include "app/motion_source.h"
-#include "app/pipeline.h"
+#include "app/character.h"
 #include "app/rig_examples.h"
 #include "app/rig_file.h"
 #include "app/rig_patches.h"
@@ -59,7 +59,7 @@ std::unique_ptr<DemoScene> LoadScene(const std::string& name, int frame) {
   if (!patches.ok()) return s->error = patches.error().ToString(), std::move(s);
   s->patches = std::move(*patches);
   auto spaces =
-      app::BuildRigPoseSpaces(s->rig, s->character, s->patches, app::GlobalMethod::kSsd);
+      app::BuildRigPoseSpaces(s->rig, s->character, s->patches, deform::GlobalMethod::kSsd);
   if (!spaces.ok()) return s->error = spaces.error().ToString(), std::move(s);
   s->spaces = std::move(*spaces);
   const mocap::Skeleton& sk = s->character.skeleton;

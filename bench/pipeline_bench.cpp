@@ -22,9 +22,10 @@
 
 #include "app/demo_data.h"
 #include "app/motion_source.h"
-#include "app/elastic_layer.h"
+#include "deform/pipeline/elastic_layer.h"
 #include "app/frame_render.h"
-#include "app/pipeline.h"
+#include "app/character.h"
+#include "deform/pipeline/frame_pipeline.h"
 #include "app/rig_file.h"
 #include "app/rig_patches.h"
 #include "mocap/kinematics.h"
@@ -47,14 +48,14 @@ const app::Character& DemoCharacter() {
   return character;
 }
 
-void BM_Evaluate(benchmark::State& state, app::GlobalMethod method) {
+void BM_Evaluate(benchmark::State& state, deform::GlobalMethod method) {
   const app::Character& c = DemoCharacter();
-  auto pipeline = app::FramePipeline::Create(c, method, static_cast<int>(state.range(0)));
+  auto pipeline = deform::FramePipeline::Create(c, method, static_cast<int>(state.range(0)));
   if (!pipeline.ok()) {
     state.SkipWithError(pipeline.error().ToString().c_str());
     return;
   }
-  app::DeformedFrame frame;
+  deform::DeformedFrame frame;
   const double duration = c.motion.duration_s();
   double t = 0.0;
   for (auto _ : state) {
@@ -70,9 +71,21 @@ void BM_Evaluate(benchmark::State& state, app::GlobalMethod method) {
   state.counters["vertices"] = c.mesh.bind.num_vertices();
 }
 
-BENCHMARK_CAPTURE(BM_Evaluate, ssd, app::GlobalMethod::kSsd)->Arg(1)->Arg(2)->Unit(benchmark::kMicrosecond)->UseRealTime();
-BENCHMARK_CAPTURE(BM_Evaluate, dqs, app::GlobalMethod::kDqs)->Arg(1)->Arg(2)->Unit(benchmark::kMicrosecond)->UseRealTime();
-BENCHMARK_CAPTURE(BM_Evaluate, swd, app::GlobalMethod::kSwd)->Arg(1)->Arg(2)->Unit(benchmark::kMicrosecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_Evaluate, ssd, deform::GlobalMethod::kSsd)
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMicrosecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_Evaluate, dqs, deform::GlobalMethod::kDqs)
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMicrosecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_Evaluate, swd, deform::GlobalMethod::kSwd)
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMicrosecond)
+    ->UseRealTime();
 
 // The belly_jump sample rig on the mannequin: its character, patches and
 // resolved elastic specs. Skips the benchmark if the rig is missing.
@@ -80,7 +93,7 @@ struct BellyScene {
   app::Rig rig;
   app::Character character;
   std::vector<deform::PatchSetup> patches;
-  std::vector<app::ElasticPatchSpec> specs;
+  std::vector<deform::ElasticPatchSpec> specs;
 };
 
 std::optional<BellyScene> LoadBelly(benchmark::State& state) {
@@ -104,11 +117,11 @@ void BM_EvaluateBelly(benchmark::State& state, bool elastic) {
   std::optional<BellyScene> scene = LoadBelly(state);
   if (!scene) return;
   const app::Character* c = &scene->character;
-  auto pipeline = app::FramePipeline::Create(*c, app::GlobalMethod::kSsd, 1);
+  auto pipeline = deform::FramePipeline::Create(*c, deform::GlobalMethod::kSsd, 1);
   if (!pipeline.ok()) std::abort();
   if (!pipeline->SetPatches(std::move(scene->patches)).ok()) std::abort();
   if (elastic && !pipeline->SetElastic(std::move(scene->specs)).ok()) std::abort();
-  app::DeformedFrame frame;
+  deform::DeformedFrame frame;
   const double dt = c->motion.frame_time_s;
   int f = 0;
   for (auto _ : state) {
@@ -143,9 +156,9 @@ void BM_BellyFrameShare(benchmark::State& state) {
   if (!scene) return;
   const app::Rig* rig = &scene->rig;
   const app::Character* c = &scene->character;
-  auto pipeline = app::FramePipeline::Create(*c, app::GlobalMethod::kSsd, 1);
+  auto pipeline = deform::FramePipeline::Create(*c, deform::GlobalMethod::kSsd, 1);
   if (!pipeline.ok()) std::abort();
-  auto layer = app::ElasticLayer::Create(*c, scene->patches, scene->specs);
+  auto layer = deform::ElasticLayer::Create(*c, scene->patches, scene->specs);
   if (!layer.ok()) std::abort();
   if (!pipeline->SetPatches(std::move(scene->patches)).ok()) std::abort();
   if (!pipeline->SetElastic(std::move(scene->specs)).ok()) std::abort();
@@ -159,7 +172,7 @@ void BM_BellyFrameShare(benchmark::State& state) {
            .Run()) {
     std::abort();
   }
-  app::DeformedFrame frame;
+  deform::DeformedFrame frame;
   if (!pipeline->Evaluate(0.0, frame).ok()) std::abort();
   render::RenderSettings settings;  // 1280 x 720
   settings.supersample = 2;

@@ -298,7 +298,7 @@ base::Status Converter::BuildSkeleton(int skin) {
       if (needed[static_cast<std::size_t>(*it)]) stack.push_back(*it);
   }
   sk.info.source_file = path_;
-  sk.info.detected_units = "m";
+  sk.info.detected_units = std::string("m");  // = "m" trips GCC 12 -Wrestrict
   for (int j : leaves) out_.mesh.skin_joints.push_back(node_joint_[static_cast<std::size_t>(j)]);
   return base::Status::Ok();
 }

@@ -14,7 +14,8 @@
 
 #include "app/frame_plan.h"
 #include "app/motion_source.h"
-#include "app/pipeline.h"
+#include "app/character.h"
+#include "deform/pipeline/frame_pipeline.h"
 #include "render/camera.h"
 #include "support/example_demos.h"
 
@@ -32,14 +33,14 @@ app::Character WalkCharacter() {
 struct Scene {
   app::Character character = WalkCharacter();
   app::FramePlan plan;
-  std::optional<app::FramePipeline> pipeline;
+  std::optional<deform::FramePipeline> pipeline;
   Scene() {
     app::FramePlanOptions options;
     options.list_frames = false;
     auto p = app::PlanFrames(character.motion, options);
     EXPECT_TRUE(p.ok());
     plan = *p;
-    auto pipe = app::FramePipeline::Create(character, app::GlobalMethod::kSsd, 1);
+    auto pipe = deform::FramePipeline::Create(character, deform::GlobalMethod::kSsd, 1);
     EXPECT_TRUE(pipe.ok());
     pipeline.emplace(std::move(*pipe));
   }
@@ -82,12 +83,12 @@ TEST(CameraAim, LookAtFollowsTheJointAndTheRegionWithTheFollowSmoothing) {
   const int joint = s.character.skeleton.FindJoint("LeftForeArm");
   std::vector<int> region;
   for (int v = 0; v < s.character.mesh.bind.num_vertices(); v += 97) region.push_back(v);
-  auto twin = app::FramePipeline::Create(s.character, app::GlobalMethod::kSsd, 1);
+  auto twin = deform::FramePipeline::Create(s.character, deform::GlobalMethod::kSsd, 1);
   ASSERT_TRUE(twin.ok());
   const int frames = static_cast<int>(s.plan.count());
   ASSERT_GT(frames, 62);
   std::vector<glm::vec3> joint_points, region_points;
-  app::DeformedFrame f;
+  deform::DeformedFrame f;
   for (int i = 0; i < frames; ++i) {
     ASSERT_TRUE(twin->Evaluate(s.plan.At(static_cast<std::size_t>(i)).time_s, f).ok());
     joint_points.push_back(f.joint_positions[static_cast<std::size_t>(joint)]);

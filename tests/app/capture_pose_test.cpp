@@ -16,7 +16,8 @@
 
 #include "app/character_motion.h"
 #include "app/frame_plan.h"
-#include "app/pipeline.h"
+#include "app/character.h"
+#include "deform/pipeline/frame_pipeline.h"
 #include "mocap/bvh_reader.h"
 #include "support/data_paths.h"
 #include "support/posed_bvh.h"
@@ -55,10 +56,11 @@ float Uprightness(const fs::path& bvh, std::optional<mocap::UpAxis> up = {}) {
   base::Result<app::Character> ch = app::LoadCommandCharacter(bvh.string(), "", true, up);
   EXPECT_TRUE(ch.ok()) << ch.error().ToString();
   if (!ch.ok()) return 0.0f;
-  base::Result<app::FramePipeline> p = app::FramePipeline::Create(*ch, app::GlobalMethod::kSsd, 1);
+  base::Result<deform::FramePipeline> p =
+      deform::FramePipeline::Create(*ch, deform::GlobalMethod::kSsd, 1);
   EXPECT_TRUE(p.ok());
   if (!p.ok()) return 0.0f;
-  app::DeformedFrame frame;
+  deform::DeformedFrame frame;
   EXPECT_TRUE(p->Evaluate(10.0 / 30.0, frame).ok());
   const glm::vec3 size = frame.bounds.size();
   return size.y / size.z;
@@ -111,7 +113,8 @@ TEST(CapturePose, InspectSaysWhichUpAxisAndWhy) {
 // |x| or |y| in normalised device coordinates over a quarter of the body's
 // vertices, at every output frame (infinity when a vertex is behind the eye).
 float WorstFollowExtent(const app::Character& ch) {
-  base::Result<app::FramePipeline> p = app::FramePipeline::Create(ch, app::GlobalMethod::kSsd, 1);
+  base::Result<deform::FramePipeline> p =
+      deform::FramePipeline::Create(ch, deform::GlobalMethod::kSsd, 1);
   EXPECT_TRUE(p.ok());
   base::Result<app::FramePlan> plan =
       app::PlanFrames(ch.motion, {.frames = "", .list_frames = false});
@@ -121,7 +124,7 @@ float WorstFollowExtent(const app::Character& ch) {
       app::CameraPlan::Create(*p, *plan, "follow", 15.0f, {1280, 720});
   EXPECT_TRUE(cameras.ok());
   if (!cameras.ok()) return INFINITY;
-  app::DeformedFrame frame;
+  deform::DeformedFrame frame;
   float worst = 0.0f;
   for (std::size_t i = 0; i < plan->count(); ++i) {
     const app::OutputFrame of = plan->At(i);
@@ -190,10 +193,10 @@ TEST(CapturePose, BandaiPositioningRootGrowsNoLimb) {
     SCOPED_TRACE(name);
     base::Result<app::Character> ch = app::LoadCommandCharacter(bvh.string(), "", true);
     ASSERT_TRUE(ch.ok()) << ch.error().ToString();
-    base::Result<app::FramePipeline> p =
-        app::FramePipeline::Create(*ch, app::GlobalMethod::kSsd, 1);
+    base::Result<deform::FramePipeline> p =
+        deform::FramePipeline::Create(*ch, deform::GlobalMethod::kSsd, 1);
     ASSERT_TRUE(p.ok());
-    app::DeformedFrame frame;
+    deform::DeformedFrame frame;
     for (int f = 0; f < ch->motion.num_frames; f += 10) {
       ASSERT_TRUE(p->Evaluate(f * ch->motion.frame_time_s, frame).ok());
       const glm::vec3 size = frame.bounds.size();  // centimetres
@@ -248,11 +251,12 @@ void ExpectBodyOfThePlainWalk(const std::string& bvh_text, const char* file,
   std::ofstream(plain_bvh) << testsupport::HumanoidWalkBvh(false, 0.0f, 90);
   base::Result<app::Character> plain = app::LoadCommandCharacter(plain_bvh.string(), "", true);
   ASSERT_TRUE(plain.ok()) << plain.error().ToString();
-  base::Result<app::FramePipeline> p = app::FramePipeline::Create(*ch, app::GlobalMethod::kSsd, 1);
-  base::Result<app::FramePipeline> q =
-      app::FramePipeline::Create(*plain, app::GlobalMethod::kSsd, 1);
+  base::Result<deform::FramePipeline> p =
+      deform::FramePipeline::Create(*ch, deform::GlobalMethod::kSsd, 1);
+  base::Result<deform::FramePipeline> q =
+      deform::FramePipeline::Create(*plain, deform::GlobalMethod::kSsd, 1);
   ASSERT_TRUE(p.ok() && q.ok());
-  app::DeformedFrame frame, plain_frame;
+  deform::DeformedFrame frame, plain_frame;
   for (int f = 0; f < ch->motion.num_frames; f += 10) {
     ASSERT_TRUE(p->Evaluate(f * ch->motion.frame_time_s, frame).ok());
     ASSERT_TRUE(q->Evaluate(f * ch->motion.frame_time_s, plain_frame).ok());

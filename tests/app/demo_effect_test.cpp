@@ -21,7 +21,8 @@
 #include "app/frame_plan.h"
 #include "app/frame_render.h"
 #include "app/motion_source.h"
-#include "app/pipeline.h"
+#include "app/character.h"
+#include "deform/pipeline/frame_pipeline.h"
 #include "app/rig_file.h"
 #include "app/rig_patches.h"
 #include "app/rig_setup.h"
@@ -59,8 +60,8 @@ EffectMeasure Measure(const std::string& demo) {
   EXPECT_TRUE(ch.ok());
   if (!ch.ok()) return m;
   const auto method = app::ParseGlobalMethod(rig->global);
-  auto global = app::FramePipeline::Create(*ch, *method, 1);
-  auto layered = app::FramePipeline::Create(*ch, *method, 1);
+  auto global = deform::FramePipeline::Create(*ch, *method, 1);
+  auto layered = deform::FramePipeline::Create(*ch, *method, 1);
   EXPECT_TRUE(global.ok() && layered.ok());
   if (!global.ok() || !layered.ok()) return m;
   const base::Status layers = app::ApplyRigLayers(*rig, *ch, *layered);
@@ -74,7 +75,7 @@ EffectMeasure Measure(const std::string& demo) {
   EXPECT_TRUE(plan.ok());
   if (!plan.ok()) return m;
   // The frame where the layer moves the skin most.
-  app::DeformedFrame g, l;
+  deform::DeformedFrame g, l;
   for (std::size_t i = 0; i < plan->count(); ++i) {
     const double t = plan->At(i).time_s;
     EXPECT_TRUE(global->Evaluate(t, g).ok() && layered->Evaluate(t, l).ok());
@@ -122,7 +123,7 @@ EffectMeasure Measure(const std::string& demo) {
     if (in_region[v]) red[v] = glm::vec3(1.0f, 0.0f, 0.0f);
   }
   std::vector<bool> mask(static_cast<std::size_t>(settings.width) * settings.height, false);
-  for (const app::DeformedFrame* f : {&g, &l}) {
+  for (const deform::DeformedFrame* f : {&g, &l}) {
     render::SceneMesh a{.positions = f->positions, .normals = f->normals,
                         .triangles = ch->mesh.bind.triangles, .vertex_colors = plain};
     render::SceneMesh b = a;

@@ -16,7 +16,8 @@
 
 #include "app/frame_plan.h"
 #include "app/motion_source.h"
-#include "app/pipeline.h"
+#include "app/character.h"
+#include "deform/pipeline/frame_pipeline.h"
 #include "app/rig_file.h"
 #include "app/rig_patches.h"
 #include "app/rig_setup.h"
@@ -39,8 +40,8 @@ TEST_P(DemoFoldTest, TheLayerAddsNoFold) {
   ASSERT_TRUE(ch.ok());
   const auto method = app::ParseGlobalMethod(rig->global);
   ASSERT_TRUE(method.ok());
-  auto global = app::FramePipeline::Create(*ch, *method, 1);
-  auto layered = app::FramePipeline::Create(*ch, *method, 1);
+  auto global = deform::FramePipeline::Create(*ch, *method, 1);
+  auto layered = deform::FramePipeline::Create(*ch, *method, 1);
   ASSERT_TRUE(global.ok() && layered.ok());
   const base::Status layers = app::ApplyRigLayers(*rig, *ch, *layered);
   ASSERT_TRUE(layers.ok()) << layers.error().ToString();
@@ -57,7 +58,7 @@ TEST_P(DemoFoldTest, TheLayerAddsNoFold) {
   options.list_frames = false;
   auto plan = app::PlanFrames(ch->motion, options);
   ASSERT_TRUE(plan.ok());
-  app::DeformedFrame g, l;
+  deform::DeformedFrame g, l;
   double worst_added = -180.0, worst_global = 0.0, worst_layered = 0.0, moved = 0.0, local = -180.0;
   int worst_frame = 0;
   for (std::size_t i = 0; i < plan->count(); ++i) {

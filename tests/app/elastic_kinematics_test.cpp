@@ -9,7 +9,7 @@
 
 #include <gtest/gtest.h>
 
-#include "app/elastic_layer.h"
+#include "deform/pipeline/elastic_layer.h"
 #include "mocap/kinematics.h"
 #include "app/rig_file.h"
 #include "app/rig_patches.h"
@@ -53,7 +53,7 @@ TEST(ElasticKinematics, CompactTableEqualsTheFullTableRowsOfTheDrivingJoints) {
   auto specs = app::ResolveRigElastic(l.rig, c, *patches);
   ASSERT_TRUE(specs.ok()) << specs.error().ToString();
   ASSERT_EQ(specs->size(), 1u);
-  const app::ElasticPatchSpec& spec = specs->front();
+  const deform::ElasticPatchSpec& spec = specs->front();
   // The rig's own driving joint at its cutoff, and unsmoothed.
   ExpectCompactEqualsFull(c, {spec.joint}, spec.cutoff_hz);
   ExpectCompactEqualsFull(c, {spec.joint}, 0.0);

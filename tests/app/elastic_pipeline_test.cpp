@@ -14,7 +14,7 @@
 
 #include <gtest/gtest.h>
 
-#include "app/elastic_layer.h"
+#include "deform/pipeline/elastic_layer.h"
 #include "mocap/bvh_writer.h"
 #include "tools/synthetic.h"
 #include "support/data_paths.h"
@@ -50,12 +50,12 @@ TEST(ElasticPipeline, SampleBellyJigglesAfterLandingThenSettles) {
   const synthetic::JumpTimeline jump = synthetic::MakeJumpTimeline({});
   const double dt = m.frame_time_s;
   std::vector<float> e(static_cast<std::size_t>(m.num_frames));
-  app::DeformedFrame layered, global;
+  deform::DeformedFrame layered, global;
   float e_max = 0.0f;
   for (int f = 0; f < m.num_frames; ++f) {
     ASSERT_TRUE(l.layered->Evaluate(f * dt, layered).ok());
     ASSERT_TRUE(l.global->Evaluate(f * dt, global).ok());
-    const std::vector<app::ElasticPatchReport> report = l.layered->elastic_report();
+    const std::vector<deform::ElasticPatchReport> report = l.layered->elastic_report();
     ASSERT_EQ(report.size(), 1u);
     e[static_cast<std::size_t>(f)] = report[0].displacement;
     e_max = report[0].max_displacement;
@@ -103,7 +103,7 @@ TEST(ElasticPipeline, FramesDependOnTimeAloneWhateverTheOrderRangeOrThreads) {
   ASSERT_FALSE(HasFailure());
   const double dt = whole.character->motion.frame_time_s;
   std::vector<std::vector<glm::vec3>> expected;
-  app::DeformedFrame frame;
+  deform::DeformedFrame frame;
   for (int f = 0; f <= 60; ++f) {
     ASSERT_TRUE(whole.layered->Evaluate(f * dt, frame).ok());
     if (f >= 40) expected.push_back(frame.positions);
@@ -185,11 +185,11 @@ TEST(ElasticPipeline, TenThousandFramesOfARealCaptureStayFiniteAndBounded) {
   ASSERT_FALSE(HasFailure());
   const mocap::Motion& m = l.character->motion;
   ASSERT_EQ(m.num_frames, kFrames);
-  app::DeformedFrame frame;
+  deform::DeformedFrame frame;
   float peak = 0.0f;
   for (int f = 0; f < kFrames; ++f) {
     ASSERT_TRUE(l.layered->Evaluate(f * m.frame_time_s, frame).ok()) << f;
-    const app::ElasticPatchReport r = l.layered->elastic_report().at(0);
+    const deform::ElasticPatchReport r = l.layered->elastic_report().at(0);
     ASSERT_TRUE(std::isfinite(r.displacement)) << "frame " << f;
     ASSERT_LE(r.displacement, r.max_displacement + kPositionTol) << "frame " << f;
     peak = std::max(peak, r.displacement);
@@ -197,7 +197,7 @@ TEST(ElasticPipeline, TenThousandFramesOfARealCaptureStayFiniteAndBounded) {
       for (const glm::vec3& p : frame.positions) ASSERT_TRUE(Finite(p)) << "frame " << f;
     }
   }
-  const app::ElasticPatchReport r = l.layered->elastic_report().at(0);
+  const deform::ElasticPatchReport r = l.layered->elastic_report().at(0);
   EXPECT_EQ(r.counters.non_finite_resets, 0);
   EXPECT_GT(peak, 0.0f);  // it did move
   std::printf("01_01 x 10000 frames: peak |e| %.3f of e_max %.3f, limits %lld (acc %lld, disp %lld)\n",
@@ -229,10 +229,10 @@ TEST(ElasticPipeline, AGlitchyCaptureIsLimitedAndReported) {
                                                });
   ASSERT_FALSE(HasFailure());
   const mocap::Motion& m = l.character->motion;
-  app::DeformedFrame frame;
+  deform::DeformedFrame frame;
   for (int f = 0; f < m.num_frames; ++f) {
     ASSERT_TRUE(l.layered->Evaluate(f * m.frame_time_s, frame).ok());
-    const app::ElasticPatchReport r = l.layered->elastic_report().at(0);
+    const deform::ElasticPatchReport r = l.layered->elastic_report().at(0);
     ASSERT_TRUE(std::isfinite(r.displacement));
     ASSERT_LE(r.displacement, r.max_displacement + kPositionTol) << "frame " << f;
   }

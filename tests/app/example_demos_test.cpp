@@ -24,7 +24,7 @@ namespace {
 using testsupport::Demo;
 
 struct Frames {
-  app::DeformedFrame global, layered;
+  deform::DeformedFrame global, layered;
 };
 
 Frames Evaluate(Demo& d, int frame) {
@@ -148,7 +148,7 @@ TEST(ExampleDemos, ShoulderReproducesItsFiveExamplePoses) {
   ASSERT_EQ(rp.examples.size(), 5u);
   EXPECT_EQ(d->spaces.patches[0].model.num_centres, 6);  // rest + 5
   // Patches without examples, to see each edit land.
-  auto plain = app::FramePipeline::Create(d->character, app::GlobalMethod::kSsd, 1);
+  auto plain = deform::FramePipeline::Create(d->character, deform::GlobalMethod::kSsd, 1);
   ASSERT_TRUE(plain.ok());
   ASSERT_TRUE(plain->SetPatches(d->patches).ok());
   // Each example is a brush stroke at a surface point (u, v): at its pose the
@@ -156,7 +156,7 @@ TEST(ExampleDemos, ShoulderReproducesItsFiveExamplePoses) {
   // nearest it move almost as far), and no vertex moves much further.
   for (const app::RigExample& ex : rp.examples) {
     const Frames f = Evaluate(*d, ex.pose.frame);
-    app::DeformedFrame p;
+    deform::DeformedFrame p;
     ASSERT_TRUE(plain->Evaluate(ex.pose.frame * d->character.motion.frame_time_s, p).ok());
     double moved = 0.0;
     for (std::size_t v = 0; v < p.positions.size(); ++v) {

@@ -18,7 +18,8 @@
 
 #include "app/frame_plan.h"
 #include "app/motion_source.h"
-#include "app/pipeline.h"
+#include "app/character.h"
+#include "deform/pipeline/frame_pipeline.h"
 #include "app/rig_file.h"
 #include "app/rig_setup.h"
 #include "deform/io/gltf_import.h"
@@ -57,7 +58,7 @@ fs::path WriteElbowRig(const fs::path& dir) {
 struct RigRun {
   app::Rig rig;
   std::unique_ptr<app::Character> character;
-  std::optional<app::FramePipeline> pipeline;
+  std::optional<deform::FramePipeline> pipeline;
 };
 
 RigRun LoadRigRun(const fs::path& rig_path) {
@@ -70,7 +71,7 @@ RigRun LoadRigRun(const fs::path& rig_path) {
   auto ch = app::MakeCharacter(std::move(*src));
   EXPECT_TRUE(ch.ok());
   r.character = std::make_unique<app::Character>(std::move(*ch));
-  auto p = app::FramePipeline::Create(*r.character, app::GlobalMethod::kSsd, 1);
+  auto p = deform::FramePipeline::Create(*r.character, deform::GlobalMethod::kSsd, 1);
   EXPECT_TRUE(p.ok());
   r.pipeline.emplace(std::move(*p));
   EXPECT_TRUE(app::ApplyRigLayers(r.rig, *r.character, *r.pipeline).ok());
@@ -100,7 +101,7 @@ TEST(ExportRoundTrip, PatchRigGlbReadsBackWithOurImporter) {
 
   RigRun ref = LoadRigRun(rig);
   ASSERT_EQ(ref.pipeline->num_patches(), 1);
-  auto global_only = app::FramePipeline::Create(*ref.character, app::GlobalMethod::kSsd, 1);
+  auto global_only = deform::FramePipeline::Create(*ref.character, deform::GlobalMethod::kSsd, 1);
   ASSERT_TRUE(global_only.ok());
   auto plan = app::PlanFrames(ref.character->motion, {.frames = "0:60:6"});
   ASSERT_TRUE(plan.ok());
@@ -122,7 +123,7 @@ TEST(ExportRoundTrip, PatchRigGlbReadsBackWithOurImporter) {
 
   auto sampler = deform::GltfMeshSampler::Create(*model);
   ASSERT_TRUE(sampler.ok()) << sampler.error().ToString();
-  app::DeformedFrame frame, plain;
+  deform::DeformedFrame frame, plain;
   const std::size_t nv = ref.character->mesh.bind.positions.size();
   std::vector<glm::vec3> p(nv), n(nv);
   float patch_effect = 0.0f;
@@ -163,7 +164,7 @@ TEST(ExportRoundTrip, BvhBakedGlbShowsOneFramePerKey) {
   ASSERT_TRUE(src.ok());
   auto ch = app::MakeCharacter(std::move(*src), {}, app::BodyKind::kGenerated);  // export's default body
   ASSERT_TRUE(ch.ok());
-  auto pipeline = app::FramePipeline::Create(*ch, app::GlobalMethod::kDqs, 1);
+  auto pipeline = deform::FramePipeline::Create(*ch, deform::GlobalMethod::kDqs, 1);
   ASSERT_TRUE(pipeline.ok());
   auto plan = app::PlanFrames(ch->motion, {.frames = "10:30:5"});
   ASSERT_TRUE(plan.ok());
@@ -178,7 +179,7 @@ TEST(ExportRoundTrip, BvhBakedGlbShowsOneFramePerKey) {
   auto sampler = deform::GltfMeshSampler::Create(*model);
   ASSERT_TRUE(sampler.ok()) << sampler.error().ToString();
   std::vector<glm::vec3> p(frames * nv), n(frames * nv);
-  app::DeformedFrame frame;
+  deform::DeformedFrame frame;
   const double key_step_s = plan->frame_time_s * plan->range.step;
   for (std::size_t k = 0; k < frames; ++k) {
     ASSERT_TRUE(pipeline->Evaluate(plan->frames[k].time_s, frame).ok());
@@ -219,7 +220,7 @@ TEST(ExportRoundTrip, PatchRigObjIsWhatRenderDrew) {
   ASSERT_TRUE(obj.error.empty()) << obj.error;
   RigRun ref = LoadRigRun(rig);
   // Same vertices as the layered pipeline, bit for bit, in the same order.
-  app::DeformedFrame frame;
+  deform::DeformedFrame frame;
   auto plan = app::PlanFrames(ref.character->motion, {.frames = "45:45"});
   ASSERT_TRUE(plan.ok());
   ASSERT_TRUE(ref.pipeline->Evaluate(plan->frames[0].time_s, frame).ok());

@@ -17,7 +17,8 @@
 #include "app/demo_data.h"
 #include "app/frame_plan.h"
 #include "app/motion_source.h"
-#include "app/pipeline.h"
+#include "app/character.h"
+#include "deform/pipeline/frame_pipeline.h"
 #include "render/output/image_io.h"
 #include "render/renderer.h"
 #include "support/data_paths.h"
@@ -78,14 +79,14 @@ TEST(ExportCommand, ObjFramesAreThePipelineFramesAndCamerasAreRenders) {
   base::Result<app::FramePlan> plan = app::PlanFrames(ch.motion, {.frames = "10:40:10"});
   ASSERT_TRUE(plan.ok());
   ASSERT_EQ(plan->frames.size(), 4u);
-  base::Result<app::FramePipeline> pipeline =
-      app::FramePipeline::Create(ch, app::GlobalMethod::kDqs, 1);
+  base::Result<deform::FramePipeline> pipeline =
+      deform::FramePipeline::Create(ch, deform::GlobalMethod::kDqs, 1);
   ASSERT_TRUE(pipeline.ok());
   base::Result<app::CameraPlan> cameras =
       app::CameraPlan::Create(*pipeline, *plan, "follow", 15.0f, {320, 200});
   ASSERT_TRUE(cameras.ok());
 
-  app::DeformedFrame frame;
+  deform::DeformedFrame frame;
   for (const app::OutputFrame& of : plan->frames) {
     char name[64];
     std::snprintf(name, sizeof(name), "mesh_%04d.obj", of.number);
@@ -179,10 +180,10 @@ TEST(ExportCommand, GlbGivesEachFrameAtItsTime) {
   const app::Character ch = Demo();
   base::Result<app::FramePlan> plan = app::PlanFrames(ch.motion, {.frames = "0:20:4"});
   ASSERT_TRUE(plan.ok());
-  base::Result<app::FramePipeline> pipeline =
-      app::FramePipeline::Create(ch, app::GlobalMethod::kSsd, 1);
+  base::Result<deform::FramePipeline> pipeline =
+      deform::FramePipeline::Create(ch, deform::GlobalMethod::kSsd, 1);
   ASSERT_TRUE(pipeline.ok());
-  app::DeformedFrame frame;
+  deform::DeformedFrame frame;
   const double t0 = plan->frames.front().time_s;
   // Positions in file units (cm for the demo): the morph round-off scales with them.
   const float tol = testsupport::kMorphRoundTripTol * 200.0f;

@@ -13,7 +13,8 @@
 #include <gtest/gtest.h>
 
 #include "app/motion_source.h"
-#include "app/pipeline.h"
+#include "app/character.h"
+#include "deform/pipeline/frame_pipeline.h"
 #include "support/body_checks.h"
 #include "support/data_paths.h"
 
@@ -68,9 +69,9 @@ TEST(SwdPipeline, GeneratedBodyHasNoCrackOrSeamOnCmuFrames750And1500) {
   auto c = app::MakeCharacter(std::move(*src), {}, app::BodyKind::kGenerated);
   ASSERT_TRUE(c.ok()) << c.error().ToString();
   EXPECT_EQ(testsupport::BadEdges(c->mesh.bind), 0) << "the generated body is not closed";
-  auto pipeline = app::FramePipeline::Create(*c, app::GlobalMethod::kSwd, 2);
+  auto pipeline = deform::FramePipeline::Create(*c, deform::GlobalMethod::kSwd, 2);
   ASSERT_TRUE(pipeline.ok()) << pipeline.error().ToString();
-  app::DeformedFrame frame;
+  deform::DeformedFrame frame;
   for (const int f : {750, 1500}) {
     ASSERT_TRUE(pipeline->Evaluate(f * c->motion.frame_time_s, frame).ok());
     const float growth = testsupport::MaxEdgeGrowthFraction(c->mesh.bind, frame.positions);

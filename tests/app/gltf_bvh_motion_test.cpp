@@ -19,7 +19,8 @@
 
 #include "app/character_motion.h"
 #include "app/motion_source.h"
-#include "app/pipeline.h"
+#include "app/character.h"
+#include "deform/pipeline/frame_pipeline.h"
 #include "render/output/image_io.h"
 #include "support/data_paths.h"
 #include "support/gltf_writer.h"
@@ -135,9 +136,9 @@ TEST(GltfBvhMotion, VerticesFollowTheRetargetedMotion) {
   const app::Character ch = LoadDrivenCharacter(d);
   ASSERT_EQ(ch.mesh.bind.num_vertices(), 12);
   EXPECT_EQ(ch.motion.num_frames, 2);
-  auto pipeline = app::FramePipeline::Create(ch, app::GlobalMethod::kSsd, 1);
+  auto pipeline = deform::FramePipeline::Create(ch, deform::GlobalMethod::kSsd, 1);
   ASSERT_TRUE(pipeline.ok()) << pipeline.error().ToString();
-  app::DeformedFrame frame;
+  deform::DeformedFrame frame;
 
   // Frame 0 (the BVH's rest pose, standing): the bind mesh.
   ASSERT_TRUE(pipeline->Evaluate(0.0, frame).ok());

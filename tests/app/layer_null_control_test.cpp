@@ -21,7 +21,8 @@
 
 #include "app/frame_render.h"
 #include "app/motion_source.h"
-#include "app/pipeline.h"
+#include "app/character.h"
+#include "deform/pipeline/frame_pipeline.h"
 #include "app/rig_file.h"
 #include "app/rig_patches.h"
 #include "app/rig_setup.h"
@@ -37,8 +38,8 @@ constexpr int kHeight = 180;
 struct Bodies {
   app::Rig rig;
   std::optional<app::Character> character;
-  std::optional<app::FramePipeline> global;
-  std::optional<app::FramePipeline> layered;
+  std::optional<deform::FramePipeline> global;
+  std::optional<deform::FramePipeline> layered;
 };
 
 // samples/data/<demo>.json with `edit` applied to its rig, on the mannequin.
@@ -55,8 +56,8 @@ void LoadBodies(const std::string& demo, Edit edit, Bodies& b) {
   b.character.emplace(std::move(*character));
   auto method = app::ParseGlobalMethod(b.rig.global);
   ASSERT_TRUE(method.ok());
-  auto global = app::FramePipeline::Create(*b.character, *method, 1);
-  auto layered = app::FramePipeline::Create(*b.character, *method, 1);
+  auto global = deform::FramePipeline::Create(*b.character, *method, 1);
+  auto layered = deform::FramePipeline::Create(*b.character, *method, 1);
   ASSERT_TRUE(global.ok() && layered.ok());
   b.global.emplace(std::move(*global));
   b.layered.emplace(std::move(*layered));
@@ -65,8 +66,8 @@ void LoadBodies(const std::string& demo, Edit edit, Bodies& b) {
   ASSERT_GT(b.layered->num_patches(), 0);
 }
 
-render::Image Draw(const app::Character& ch, const app::DeformedFrame& f, const render::Camera& camera,
-                   std::span<const glm::vec3> colors = {}) {
+render::Image Draw(const app::Character& ch, const deform::DeformedFrame& f,
+                   const render::Camera& camera, std::span<const glm::vec3> colors = {}) {
   render::RenderSettings settings;
   settings.width = kWidth;
   settings.height = kHeight;
@@ -94,7 +95,7 @@ void ExpectIdenticalFrames(Bodies& b) {
   const app::Character& ch = *b.character;
   const int frames = ch.motion.num_frames;
   ASSERT_GT(frames, 1);
-  app::DeformedFrame g, l;
+  deform::DeformedFrame g, l;
   for (int frame = 0; frame < frames; frame += 20) {
     const double t = frame * ch.motion.frame_time_s;
     ASSERT_TRUE(b.global->Evaluate(t, g).ok());
@@ -148,7 +149,7 @@ TEST(LayerNullControl, ExamplesWhoseEditsAreAllZeroRenderTheGlobalFrames) {
 
 // Pixels whose colour changes when the vertices `marked` turn red: where their
 // triangles show in `f`, grown by one pixel (the supersampled edges).
-std::vector<bool> MarkedPixels(const app::Character& ch, const app::DeformedFrame& f,
+std::vector<bool> MarkedPixels(const app::Character& ch, const deform::DeformedFrame& f,
                                const render::Camera& camera, const std::vector<bool>& marked) {
   const std::size_t nv = f.positions.size();
   std::vector<glm::vec3> plain(nv, glm::vec3(0.8f)), red(nv, glm::vec3(0.8f));
@@ -191,7 +192,7 @@ TEST(LayerNullControl, ExamplesChangeOnlyThePixelsOfTheirPatchRegion) {
   for (const glm::uvec3& t : ch.mesh.bind.triangles) {
     if (region[t.x] || region[t.y] || region[t.z]) ring[t.x] = ring[t.y] = ring[t.z] = true;
   }
-  app::DeformedFrame g, l;
+  deform::DeformedFrame g, l;
   const double t = 48 * ch.motion.frame_time_s;  // an example pose: the biceps at its largest
   ASSERT_TRUE(b.global->Evaluate(t, g).ok());
   ASSERT_TRUE(b.layered->Evaluate(t, l).ok());

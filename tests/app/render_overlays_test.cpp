@@ -13,7 +13,8 @@
 
 #include "app/frame_render.h"
 #include "app/motion_source.h"
-#include "app/pipeline.h"
+#include "app/character.h"
+#include "deform/pipeline/frame_pipeline.h"
 #include "render/camera.h"
 #include "render/output/image_io.h"
 #include "render/renderer.h"
@@ -43,9 +44,9 @@ TEST(RenderOverlays, WireStaysReadableOnTheWholeBodyAt640x360) {
   ASSERT_TRUE(source.ok());
   auto ch = app::MakeCharacter(std::move(*source));
   ASSERT_TRUE(ch.ok());
-  auto pipeline = app::FramePipeline::Create(*ch, app::GlobalMethod::kSsd, 1);
+  auto pipeline = deform::FramePipeline::Create(*ch, deform::GlobalMethod::kSsd, 1);
   ASSERT_TRUE(pipeline.ok());
-  app::DeformedFrame f;
+  deform::DeformedFrame f;
   ASSERT_TRUE(pipeline->Evaluate(1.0, f).ok());
   const render::Camera camera =
       render::FrameBounds(f.bounds, 35.0f, 640.0f / 360.0f, glm::vec3(-0.4f, -0.2f, -1.0f), 1.6f);

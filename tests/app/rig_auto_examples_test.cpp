@@ -10,7 +10,8 @@
 #include <gtest/gtest.h>
 
 #include "app/motion_source.h"
-#include "app/pipeline.h"
+#include "app/character.h"
+#include "deform/pipeline/frame_pipeline.h"
 #include "app/rig_examples.h"
 #include "app/rig_file.h"
 #include "app/rig_patches.h"
@@ -56,18 +57,18 @@ std::optional<AutoFixture> LoadAutoFixture() {
 // Positions at the bent frame: the patch layer alone, or with the example.
 std::vector<glm::vec3> Bent(const AutoFixture& f, const std::string& examples,
                             std::vector<std::string>* notes = nullptr) {
-  auto pipeline = app::FramePipeline::Create(f.character, app::GlobalMethod::kSsd, 1);
+  auto pipeline = deform::FramePipeline::Create(f.character, deform::GlobalMethod::kSsd, 1);
   EXPECT_TRUE(pipeline.ok());
   EXPECT_TRUE(pipeline->SetPatches(f.patches).ok());
   if (!examples.empty()) {
     auto rig = app::ParseRig(Rig(examples), "r.json");
     EXPECT_TRUE(rig.ok()) << rig.error().ToString();
-    auto spaces = app::BuildRigPoseSpaces(*rig, f.character, f.patches, app::GlobalMethod::kSsd);
+    auto spaces = app::BuildRigPoseSpaces(*rig, f.character, f.patches, deform::GlobalMethod::kSsd);
     EXPECT_TRUE(spaces.ok()) << spaces.error().ToString();
     if (notes) *notes = spaces->notes;
     EXPECT_TRUE(pipeline->SetPoseSpaces(std::move(spaces->patches)).ok());
   }
-  app::DeformedFrame frame;
+  deform::DeformedFrame frame;
   EXPECT_TRUE(pipeline->Evaluate(kBentFrame * f.character.motion.frame_time_s, frame).ok());
   return frame.positions;
 }

@@ -12,7 +12,8 @@
 #include <gtest/gtest.h>
 
 #include "app/motion_source.h"
-#include "app/pipeline.h"
+#include "app/character.h"
+#include "deform/pipeline/frame_pipeline.h"
 #include "app/rig_file.h"
 #include "app/rig_patches.h"
 #include "app/rig_setup.h"
@@ -86,12 +87,12 @@ struct Evaluated {
   std::vector<glm::vec3> with_examples;   // patches + dS
 };
 
-base::Result<app::FramePipeline> MakePipeline(const ElbowFixture& f, const app::Rig* rig) {
-  auto pipeline = app::FramePipeline::Create(f.character, app::GlobalMethod::kSsd, 1);
+base::Result<deform::FramePipeline> MakePipeline(const ElbowFixture& f, const app::Rig* rig) {
+  auto pipeline = deform::FramePipeline::Create(f.character, deform::GlobalMethod::kSsd, 1);
   if (!pipeline.ok()) return pipeline;
   if (base::Status s = pipeline->SetPatches(f.patches); !s.ok()) return s.error();
   if (rig) {
-    auto spaces = app::BuildRigPoseSpaces(*rig, f.character, f.patches, app::GlobalMethod::kSsd);
+    auto spaces = app::BuildRigPoseSpaces(*rig, f.character, f.patches, deform::GlobalMethod::kSsd);
     if (!spaces.ok()) return std::move(spaces).error();
     if (base::Status s = pipeline->SetPoseSpaces(std::move(spaces->patches)); !s.ok()) {
       return s.error();
@@ -248,7 +249,8 @@ TEST(RigExamples, BuildErrorsNameTheFieldPath) {
   for (const Case& c : cases) {
     const auto rig = app::ParseRig(ElbowRig(c.extra), "r.json");
     ASSERT_TRUE(rig.ok()) << rig.error().ToString();
-    const auto spaces = app::BuildRigPoseSpaces(*rig, f->character, f->patches, app::GlobalMethod::kSsd);
+    const auto spaces =
+        app::BuildRigPoseSpaces(*rig, f->character, f->patches, deform::GlobalMethod::kSsd);
     ASSERT_FALSE(spaces.ok()) << c.extra;
     EXPECT_EQ(spaces.error().ToString().rfind(c.message, 0), 0u)
         << spaces.error().ToString() << "\nexpected to start with\n" << c.message;
@@ -278,7 +280,7 @@ TEST(RigExamples, VertexEditsLandAtTheirExamplePoseAndNothingMovesAtRest) {
   ASSERT_TRUE(sculpted.ok()) << sculpted.error().ToString();
   const double tol = 1e-4 * f->patches[0].bound.report.patch_diagonal;
   const double t = frame * f->character.motion.frame_time_s;
-  app::DeformedFrame a, b;
+  deform::DeformedFrame a, b;
   ASSERT_TRUE(plain->Evaluate(t, a).ok());
   ASSERT_TRUE(sculpted->Evaluate(t, b).ok());
   for (int k = 0; k < 2; ++k) {
@@ -336,7 +338,7 @@ TEST(RigExamples, BindFrameMoveTurnsWithTheLimb) {
   auto plain = MakePipeline(*f, nullptr);
   auto sculpted = MakePipeline(*f, &*rig);
   ASSERT_TRUE(plain.ok() && sculpted.ok());
-  app::DeformedFrame a, b;
+  deform::DeformedFrame a, b;
   const double t = frame * ch.motion.frame_time_s;
   ASSERT_TRUE(plain->Evaluate(t, a).ok());
   ASSERT_TRUE(sculpted->Evaluate(t, b).ok());
@@ -381,7 +383,7 @@ TEST(RigExamples, TwoExamplesAreExactAndContinuousBetween) {
   ASSERT_TRUE(plain.ok() && sculpted.ok());
   const double dt = f->character.motion.frame_time_s;
   const auto i = static_cast<std::size_t>(vertex);
-  app::DeformedFrame a, b;
+  deform::DeformedFrame a, b;
   auto offset = [&](double t) {
     EXPECT_TRUE(plain->Evaluate(t, a).ok());
     EXPECT_TRUE(sculpted->Evaluate(t, b).ok());
@@ -501,7 +503,7 @@ TEST(RigExamples, ShoulderThreeBoneRotationsMatchTheSvd) {
 namespace {
 
 // Vertices that moved by more than `frac` x |move| between two frames.
-int CountMoved(const app::DeformedFrame& a, const app::DeformedFrame& b, double threshold) {
+int CountMoved(const deform::DeformedFrame& a, const deform::DeformedFrame& b, double threshold) {
   int n = 0;
   for (std::size_t i = 0; i < a.positions.size(); ++i) {
     if (glm::length(b.positions[i] - a.positions[i]) > threshold) ++n;
@@ -546,7 +548,7 @@ TEST(RigExamples, BrushEditMovesTheNeighbourhoodSmoothly) {
   auto brush = MakePipeline(*f, &*brush_rig);
   ASSERT_TRUE(none.ok() && plain.ok() && brush.ok());
   const double t = frame * f->character.motion.frame_time_s;
-  app::DeformedFrame a, b, c;
+  deform::DeformedFrame a, b, c;
   ASSERT_TRUE(none->Evaluate(t, a).ok());
   ASSERT_TRUE(plain->Evaluate(t, b).ok());
   ASSERT_TRUE(brush->Evaluate(t, c).ok());

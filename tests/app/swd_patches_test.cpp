@@ -14,7 +14,8 @@
 #include <gtest/gtest.h>
 
 #include "app/motion_source.h"
-#include "app/pipeline.h"
+#include "app/character.h"
+#include "deform/pipeline/frame_pipeline.h"
 #include "app/rig_file.h"
 #include "app/rig_patches.h"
 #include "render/output/image_io.h"
@@ -59,11 +60,11 @@ TEST(SwdPatches, LayeredBodyAtTheBindPoseIsTheBindMesh) {
   std::vector<std::vector<int>> regions;
   std::vector<float> sizes;
   for (const deform::PatchSetup& p : patches) regions.push_back(p.region), sizes.push_back(PatchSize(p));
-  auto pipeline = app::FramePipeline::Create(c, app::GlobalMethod::kSwd, 2);
+  auto pipeline = deform::FramePipeline::Create(c, deform::GlobalMethod::kSwd, 2);
   ASSERT_TRUE(pipeline.ok()) << pipeline.error().ToString();
   ASSERT_TRUE(pipeline->SetPatches(patches).ok());
   EXPECT_EQ(pipeline->num_patches(), static_cast<int>(patches.size()));
-  app::DeformedFrame f;
+  deform::DeformedFrame f;
   ASSERT_TRUE(pipeline->Evaluate(0.0, f).ok());
   for (std::size_t k = 0; k < regions.size(); ++k) {
     double worst = 0.0;
@@ -78,13 +79,13 @@ TEST(SwdPatches, LayeredBodyAtTheBindPoseIsTheBindMesh) {
 TEST(SwdPatches, PatchesFollowTheSweepsWhenBentForAnyThreadCount) {
   const app::Character c = BendCharacter();
   const std::vector<deform::PatchSetup> patches = SampleSwdPatches(c);
-  auto global = app::FramePipeline::Create(c, app::GlobalMethod::kSwd, 1);
-  auto one = app::FramePipeline::Create(c, app::GlobalMethod::kSwd, 1);
-  auto two = app::FramePipeline::Create(c, app::GlobalMethod::kSwd, 2);
+  auto global = deform::FramePipeline::Create(c, deform::GlobalMethod::kSwd, 1);
+  auto one = deform::FramePipeline::Create(c, deform::GlobalMethod::kSwd, 1);
+  auto two = deform::FramePipeline::Create(c, deform::GlobalMethod::kSwd, 2);
   ASSERT_TRUE(global.ok() && one.ok() && two.ok());
   ASSERT_TRUE(one->SetPatches(patches).ok());
   ASSERT_TRUE(two->SetPatches(patches).ok());
-  app::DeformedFrame g, a, b;
+  deform::DeformedFrame g, a, b;
   for (double t : {0.5 * c.motion.duration_s(), c.motion.duration_s()}) {
     ASSERT_TRUE(global->Evaluate(t, g).ok());
     ASSERT_TRUE(one->Evaluate(t, a).ok());

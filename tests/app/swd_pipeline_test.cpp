@@ -23,7 +23,8 @@
 #include <gtest/gtest.h>
 
 #include "app/motion_source.h"
-#include "app/pipeline.h"
+#include "app/character.h"
+#include "deform/pipeline/frame_pipeline.h"
 #include "deform/global/skinning_job.h"
 #include "deform/global/swd_rig.h"
 #include "tools/synthetic.h"
@@ -80,7 +81,7 @@ void ExpectClosed(const deform::Mesh& m, const std::string& what) {
 // print only).
 void CheckCharacter(const app::Character& c, const std::string& what, float max_growth) {
   {  // At the bind pose the rig rebuilds the mesh (ALGORITHMS.md 2.3).
-    auto bind = app::BindModelFromJoint(c);
+    auto bind = deform::BindModelFromJoint(c);
     ASSERT_TRUE(bind.ok());
     auto rig = deform::BuildSwdRig(c.skeleton, *bind, c.mesh.bind,
                                    {.vertex_chains = c.mesh.body_chain_coords});
@@ -103,11 +104,11 @@ void CheckCharacter(const app::Character& c, const std::string& what, float max_
   const base::Status w = deform::CheckSkinWeights(
       c.mesh.weights, static_cast<int>(c.mesh.skin_joints.size()), c.mesh.bind.num_vertices());
   EXPECT_TRUE(w.ok()) << what << ": " << w.error().ToString();
-  auto one = app::FramePipeline::Create(c, app::GlobalMethod::kSwd, 1);
+  auto one = deform::FramePipeline::Create(c, deform::GlobalMethod::kSwd, 1);
   ASSERT_TRUE(one.ok()) << what << ": " << one.error().ToString();
-  auto two = app::FramePipeline::Create(c, app::GlobalMethod::kSwd, 2);
+  auto two = deform::FramePipeline::Create(c, deform::GlobalMethod::kSwd, 2);
   ASSERT_TRUE(two.ok());
-  app::DeformedFrame a, b;
+  deform::DeformedFrame a, b;
   const double duration = c.motion.duration_s();
   for (double t : {0.0, 0.5 * duration, duration}) {
     ASSERT_TRUE(one->Evaluate(t, a).ok());

@@ -44,7 +44,7 @@ render::Image RenderElbow(View view) {
   EXPECT_TRUE(cameras.ok());
   if (!cameras.ok()) return render::Image(kWidth, kHeight);
   const app::OutputFrame of = plan->At(kFrame);
-  app::DeformedFrame left, right;
+  deform::DeformedFrame left, right;
   EXPECT_TRUE(demo->global->Evaluate(of.time_s, left).ok());
   EXPECT_TRUE(demo->layered->Evaluate(of.time_s, right).ok());
 

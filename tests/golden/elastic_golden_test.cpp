@@ -36,7 +36,7 @@ render::Image RenderElasticFrame(const ElasticCase& c) {
   testsupport::RigPipeline l = testsupport::LoadSampleRig(c.rig);
   if (::testing::Test::HasFailure()) return {};
   const double dt = l.character->motion.frame_time_s;
-  app::DeformedFrame left, right;
+  deform::DeformedFrame left, right;
   for (int f = 0; f <= c.frame; ++f) {
     EXPECT_TRUE(l.layered->Evaluate(f * dt, right).ok());
   }

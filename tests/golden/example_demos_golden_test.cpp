@@ -35,7 +35,7 @@ render::Image RenderDemo(const DemoCase& c) {
   EXPECT_TRUE(demo->error.empty()) << demo->error;
   if (!demo->error.empty()) return render::Image(kDemoWidth, kDemoHeight);
   const double t = c.frame * demo->character.motion.frame_time_s;
-  app::DeformedFrame left, right;
+  deform::DeformedFrame left, right;
   EXPECT_TRUE(demo->global->Evaluate(t, left).ok());
   EXPECT_TRUE(demo->layered->Evaluate(t, right).ok());
   deform::Bounds box;
@@ -56,7 +56,7 @@ render::Image RenderDemo(const DemoCase& c) {
   // Side by side, the same camera: global only | global + examples.
   render::Image out(kDemoWidth, kDemoHeight);
   for (int side = 0; side < 2; ++side) {
-    const app::DeformedFrame& f = side == 0 ? left : right;
+    const deform::DeformedFrame& f = side == 0 ? left : right;
     const render::SceneMesh mesh{.positions = f.positions, .normals = f.normals,
                                  .triangles = demo->character.mesh.bind.triangles};
     const render::Image half = render::Render(camera, {&mesh, 1}, {}, settings);

@@ -19,7 +19,8 @@
 #include "app/demo_data.h"
 #include "app/frame_render.h"
 #include "app/motion_source.h"
-#include "app/pipeline.h"
+#include "app/character.h"
+#include "deform/pipeline/frame_pipeline.h"
 #include "app/rig_file.h"
 #include "app/rig_patches.h"
 #include "tools/synthetic.h"
@@ -70,16 +71,16 @@ std::vector<deform::PatchSetup> SampleSwdPatches(const app::Character& c) {
 render::Image Render(const app::Character& c, int frame, bool split,
                      std::vector<deform::PatchSetup> patches = {}) {
   const double t = frame * c.motion.frame_time_s;
-  auto swd = app::FramePipeline::Create(c, app::GlobalMethod::kSwd, 1);
+  auto swd = deform::FramePipeline::Create(c, deform::GlobalMethod::kSwd, 1);
   EXPECT_TRUE(swd.ok()) << swd.error().ToString();
   const bool layered = !patches.empty();
   if (layered) {
     EXPECT_TRUE(swd->SetPatches(std::move(patches)).ok());
   }
-  app::DeformedFrame right, left;
+  deform::DeformedFrame right, left;
   EXPECT_TRUE(swd->Evaluate(t, right).ok());
   if (split) {
-    auto ssd = app::FramePipeline::Create(c, app::GlobalMethod::kSsd, 1);
+    auto ssd = deform::FramePipeline::Create(c, deform::GlobalMethod::kSsd, 1);
     EXPECT_TRUE(ssd.ok());
     EXPECT_TRUE(ssd->Evaluate(t, left).ok());
   }

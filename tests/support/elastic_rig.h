@@ -11,9 +11,10 @@
 
 #include <gtest/gtest.h>
 
-#include "app/elastic_layer.h"
+#include "deform/pipeline/elastic_layer.h"
 #include "app/motion_source.h"
-#include "app/pipeline.h"
+#include "app/character.h"
+#include "deform/pipeline/frame_pipeline.h"
 #include "app/rig_file.h"
 #include "app/rig_patches.h"
 #include "app/rig_setup.h"
@@ -24,8 +25,8 @@ namespace testsupport {
 struct RigPipeline {
   app::Rig rig;
   std::unique_ptr<app::Character> character;   // stable address: the pipelines point to it
-  std::optional<app::FramePipeline> layered;   // global + patches (+ elastic)
-  std::optional<app::FramePipeline> global;    // global only
+  std::optional<deform::FramePipeline> layered;  // global + patches (+ elastic)
+  std::optional<deform::FramePipeline> global;   // global only
   std::vector<std::vector<int>> regions;       // per patch, its region's vertex indices
 };
 
@@ -59,8 +60,8 @@ inline RigPipeline LoadRigPipeline(const app::Rig& rig, int threads = 1,
     ADD_FAILURE() << specs.error().ToString();
     return l;
   }
-  auto layered = app::FramePipeline::Create(*l.character, app::GlobalMethod::kSsd, threads);
-  auto global = app::FramePipeline::Create(*l.character, app::GlobalMethod::kSsd, threads);
+  auto layered = deform::FramePipeline::Create(*l.character, deform::GlobalMethod::kSsd, threads);
+  auto global = deform::FramePipeline::Create(*l.character, deform::GlobalMethod::kSsd, threads);
   if (!layered.ok() || !global.ok()) {
     ADD_FAILURE() << "FramePipeline::Create failed";
     return l;

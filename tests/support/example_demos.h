@@ -16,7 +16,8 @@
 #include <glm/glm.hpp>
 
 #include "app/motion_source.h"
-#include "app/pipeline.h"
+#include "app/character.h"
+#include "deform/pipeline/frame_pipeline.h"
 #include "app/rig_examples.h"
 #include "app/rig_file.h"
 #include "app/rig_patches.h"
@@ -29,8 +30,8 @@ struct Demo {
   app::Rig rig;
   app::Character character;
   std::vector<deform::PatchSetup> patches;
-  std::optional<app::FramePipeline> global;   // the rig's global method alone
-  std::optional<app::FramePipeline> layered;  // + patches + example shapes
+  std::optional<deform::FramePipeline> global;   // the rig's global method alone
+  std::optional<deform::FramePipeline> layered;  // + patches + example shapes
   app::RigPoseSpaces spaces;                  // notes: condition numbers
   std::string error;                          // set when loading failed
 };
@@ -57,8 +58,8 @@ inline std::unique_ptr<Demo> LoadDemo(const std::string& name) {
   if (!method.ok()) return fail(method.error());
   auto spaces = app::BuildRigPoseSpaces(demo->rig, demo->character, demo->patches, *method);
   if (!spaces.ok()) return fail(spaces.error());
-  auto global = app::FramePipeline::Create(demo->character, *method, 1);
-  auto layered = app::FramePipeline::Create(demo->character, *method, 1);
+  auto global = deform::FramePipeline::Create(demo->character, *method, 1);
+  auto layered = deform::FramePipeline::Create(demo->character, *method, 1);
   if (!global.ok()) return fail(global.error());
   if (!layered.ok()) return fail(layered.error());
   if (base::Status s = layered->SetPatches(demo->patches); !s.ok()) return fail(s.error());
@@ -70,7 +71,7 @@ inline std::unique_ptr<Demo> LoadDemo(const std::string& name) {
 }
 
 // Position of joint `name` in an evaluated frame.
-inline glm::dvec3 JointAt(const Demo& d, const app::DeformedFrame& f, const std::string& name) {
+inline glm::dvec3 JointAt(const Demo& d, const deform::DeformedFrame& f, const std::string& name) {
   const int j = d.character.skeleton.FindJoint(name);
   return glm::dvec3(f.joint_positions.at(static_cast<std::size_t>(j)));
 }

@@ -1,13 +1,12 @@
-#include "app/elastic_layer.h"
+#include "deform/pipeline/elastic_layer.h"
 
 #include <algorithm>
 #include <cmath>
 #include <string>
 
-#include "app/pipeline.h"
-#include "app/rig_file.h"
+#include "deform/pipeline/character.h"
 
-namespace app {
+namespace deform {
 namespace {
 
 base::Error ElasticError(const Character& c, int patch, const std::string& field,
@@ -29,42 +28,8 @@ glm::quat RotationOf(const glm::mat4& m) {
 
 }  // namespace
 
-base::Result<std::vector<ElasticPatchSpec>> ResolveRigElastic(
-    const Rig& rig, const Character& character, std::span<const deform::PatchSetup> patches) {
-  std::vector<ElasticPatchSpec> specs;
-  for (std::size_t i = 0; i < rig.patches.size() && i < patches.size(); ++i) {
-    const RigPatch& p = rig.patches[i];
-    if (!p.elastic) continue;
-    const std::string field = "patches[" + std::to_string(i) + "].elastic.joint";
-    ElasticPatchSpec spec;
-    spec.patch = static_cast<int>(i);
-    spec.cutoff_hz = p.elastic->cutoff_hz;
-    spec.params = p.elastic->params;
-    spec.params.units_per_metre = p.elastic->units_per_metre > 0.0f
-                                      ? p.elastic->units_per_metre
-                                      : UnitsPerMetre(character.skeleton.info.detected_units,
-                                                      character.skeleton.info.rest_height);
-    const std::string& name = !p.elastic->joint.empty() ? p.elastic->joint
-                              : p.region.kind == RigRegion::Kind::kJoint ? p.region.joint
-                                                                          : std::string();
-    if (name.empty()) {
-      spec.joint = deform::DominantJoint(character.mesh, patches[i]);
-    } else {
-      spec.joint = character.skeleton.FindJoint(name);
-      if (spec.joint < 0) {
-        return base::MakeError(
-            base::ErrorCode::kNotFound, {rig.file, 0, 0, field},
-            "expected a joint of " + character.source + ", found \"" + name + "\"");
-      }
-    }
-    specs.push_back(spec);
-  }
-  return specs;
-}
-
 base::Result<std::unique_ptr<ElasticLayer>> ElasticLayer::Create(
-    const Character& c, std::span<const deform::PatchSetup> patches,
-    std::vector<ElasticPatchSpec> specs) {
+    const Character& c, std::span<const PatchSetup> patches, std::vector<ElasticPatchSpec> specs) {
   auto layer = std::unique_ptr<ElasticLayer>(new ElasticLayer());
   layer->character_ = &c;
   layer->duration_s_ = c.motion.duration_s();
@@ -101,7 +66,7 @@ base::Result<std::unique_ptr<ElasticLayer>> ElasticLayer::Create(
     k.frames = std::move(*kin);
   }
   for (ElasticPatchSpec& spec : specs) {
-    const deform::PatchSetup& ps = patches[static_cast<std::size_t>(spec.patch)];
+    const PatchSetup& ps = patches[static_cast<std::size_t>(spec.patch)];
     Patch p;
     p.spec = spec;
     for (std::size_t k = 0; k < layer->kinematics_.size(); ++k) {
@@ -115,8 +80,10 @@ base::Result<std::unique_ptr<ElasticLayer>> ElasticLayer::Create(
     // motion, from its column of the compact table.
     float max_w = 0.0f;
     for (std::size_t f = 0; f < static_cast<std::size_t>(c.motion.num_frames); ++f) {
-      max_w = std::max(max_w, glm::length(table.frames[f * nd + static_cast<std::size_t>(p.slot)]
-                                              .local_angular_velocity));
+      max_w = std::max(
+          max_w,
+          glm::length(
+              table.frames[f * nd + static_cast<std::size_t>(p.slot)].local_angular_velocity));
     }
     // Rest control points in the driving joint's (rigid) bind frame.
     const glm::mat4& model_from_joint = (*bind)[static_cast<std::size_t>(spec.joint)];
@@ -126,10 +93,12 @@ base::Result<std::unique_ptr<ElasticLayer>> ElasticLayer::Create(
     for (std::size_t k = 0; k < rest.size(); ++k) {
       rest[k] = glm::conjugate(bind_rotation) * (ps.rest_control[k] - origin);
     }
-    auto network = deform::BuildMassSpringNetwork(
-        {.rows = ps.fit.surface.num_u(), .cols = ps.fit.surface.num_v(), .rest_points = rest,
-         .bind_rotation = bind_rotation, .max_angular_speed_rad_s = max_w},
-        spec.params);
+    auto network = BuildMassSpringNetwork({.rows = ps.fit.surface.num_u(),
+                                           .cols = ps.fit.surface.num_v(),
+                                           .rest_points = rest,
+                                           .bind_rotation = bind_rotation,
+                                           .max_angular_speed_rad_s = max_w},
+                                          spec.params);
     if (!network.ok()) {
       base::Error e = std::move(network).error();
       e.loc.file = c.source;
@@ -139,7 +108,8 @@ base::Result<std::unique_ptr<ElasticLayer>> ElasticLayer::Create(
     p.network = std::move(*network);
     p.state.Resize(p.network);
     p.local.assign(rest.size(), glm::vec3(0.0f));
-    layer->piece_s_ = std::min(layer->piece_s_, 0.5 * static_cast<double>(spec.params.max_time_gap_s));
+    layer->piece_s_ =
+        std::min(layer->piece_s_, 0.5 * static_cast<double>(spec.params.max_time_gap_s));
     layer->patches_.push_back(std::move(p));
   }
   return layer;
@@ -149,16 +119,15 @@ base::Status ElasticLayer::RunAll(double time_s) {
   const Character& c = *character_;
   for (Patch& p : patches_) {
     const Kinematics& table = kinematics_[static_cast<std::size_t>(p.kinematics)];
-    const base::JobStatus s =
-        deform::MassSpringStepJob{.network = &p.network,
-                                  .state = &p.state,
-                                  .time_s = time_s,
-                                  .kinematics = table.frames,
-                                  .num_joints = static_cast<int>(table.joints.size()),
-                                  .joint = p.slot,
-                                  .frame_time_s = c.motion.frame_time_s,
-                                  .displacements = p.local}
-            .Run();
+    const base::JobStatus s = MassSpringStepJob{.network = &p.network,
+                                                .state = &p.state,
+                                                .time_s = time_s,
+                                                .kinematics = table.frames,
+                                                .num_joints = static_cast<int>(table.joints.size()),
+                                                .joint = p.slot,
+                                                .frame_time_s = c.motion.frame_time_s,
+                                                .displacements = p.local}
+                                  .Run();
     if (!s) {
       return base::MakeError(base::ErrorCode::kInternal, {c.source, 0, 0, {}},
                              std::string("elastic layer refused to run: ") + s.what);
@@ -212,7 +181,7 @@ std::vector<ElasticPatchReport> ElasticLayer::Report() const {
     r.time_step_s = p.network.time_step_s;
     r.max_displacement = p.network.params.max_displacement;
     r.displacement = p.displacement;
-    const deform::MassSpringCounters& now = p.state.counters();
+    const MassSpringCounters& now = p.state.counters();
     r.counters.steps = now.steps - p.baseline.steps;
     r.counters.displacement_clamps = now.displacement_clamps - p.baseline.displacement_clamps;
     r.counters.acceleration_clamps = now.acceleration_clamps - p.baseline.acceleration_clamps;
@@ -225,4 +194,4 @@ std::vector<ElasticPatchReport> ElasticLayer::Report() const {
   return out;
 }
 
-}  // namespace app
+}  // namespace deform

@@ -1,4 +1,4 @@
-#include "app/pipeline.h"
+#include "deform/pipeline/frame_pipeline.h"
 
 #include <algorithm>
 #include <array>
@@ -6,20 +6,15 @@
 #include <optional>
 #include <string>
 
-#include "app/frame_render.h"
-#include "app/motion_source.h"
 #include "base/parallel.h"
-#include "deform/body/bind_pose.h"
-#include "deform/body/generated_body.h"
 #include "deform/global/dqs_job.h"
 #include "deform/global/skinning_job.h"
 #include "deform/global/swd_job.h"
 #include "deform/global/swd_rig.h"
-#include "mocap/bvh_reader.h"
 #include "mocap/pose.h"
 #include "mocap/sampling.h"
 
-namespace app {
+namespace deform {
 namespace {
 
 inline constexpr int kMaxThreads = 64;
@@ -56,8 +51,7 @@ std::span<const T> Sub(const std::vector<T>& v, int begin, int end, int stride =
 // Sets the fields SkinningJob and DqsJob share to vertices [begin, end) of
 // `mesh` and `out` (normals only when the mesh has them).
 template <typename Job>
-Job WithVertexRange(Job job, const deform::SkinnedMesh& mesh, int begin, int end,
-                    DeformedFrame& out) {
+Job WithVertexRange(Job job, const SkinnedMesh& mesh, int begin, int end, DeformedFrame& out) {
   const int k = mesh.weights.influences;
   job.influences = k;
   job.joint_indices = Sub(mesh.weights.joints, begin, end, k);
@@ -79,7 +73,7 @@ base::Error JobError(const Character& c, const base::JobStatus& s, const char* s
 void GlobalNormals(std::span<const glm::vec3> positions, std::span<const glm::uvec3> triangles,
                    bool has_normals, std::span<glm::vec3> normals) {
   if (!has_normals) {
-    deform::ComputeVertexNormals(positions, triangles, normals);
+    ComputeVertexNormals(positions, triangles, normals);
     return;
   }
   for (glm::vec3& n : normals) {
@@ -99,101 +93,14 @@ void AddLayerNormals(std::span<const glm::vec3> global_geometric,
     if (change == glm::vec3(0.0f)) continue;
     const glm::vec3 n = normals[v] + change;
     const float len = glm::length(n);
-    if (len > 0.0f) normals[v] = n / len;
-    else normals[v] = layered_geometric[v];
+    if (len > 0.0f)
+      normals[v] = n / len;
+    else
+      normals[v] = layered_geometric[v];
   }
 }
 
 }  // namespace
-
-const char* GlobalMethodName(GlobalMethod method) {
-  switch (method) {
-    case GlobalMethod::kSsd: return "ssd";
-    case GlobalMethod::kDqs: return "dqs";
-    case GlobalMethod::kSwd: return "swd";
-  }
-  return "?";
-}
-
-base::Result<GlobalMethod> ParseGlobalMethod(const std::string& name) {
-  if (name == "ssd" || name == "lbs") return GlobalMethod::kSsd;
-  if (name == "dqs") return GlobalMethod::kDqs;
-  if (name == "swd") return GlobalMethod::kSwd;
-  return base::MakeError(base::ErrorCode::kInvalidArgument, {"--global", 0, 0, {}},
-                         "expected ssd, dqs or swd, found '" + name + "'");
-}
-
-base::Result<std::vector<glm::mat4>> BindModelFromJoint(const Character& c) {
-  const auto nj = static_cast<std::size_t>(c.skeleton.num_joints());
-  std::vector<mocap::JointTransform> locals(nj);
-  std::vector<glm::mat4> model(nj);
-  mocap::RestPose(c.skeleton, locals);
-  if (c.bound_at_first_frame && c.motion.num_frames > 0) {
-    (void)mocap::LocalPoseJob{&c.skeleton, c.motion.frame(0), locals}.Run();
-  }
-  const base::JobStatus s =
-      mocap::LocalToModelJob{
-          .parents = c.skeleton.parents, .locals = locals, .model_from_joint = model}
-          .Run();
-  if (!s) return JobError(c, s, "local-to-model");
-  // A skinned mesh's own bind matrices win over the rest pose (glTF).
-  for (std::size_t i = 0; i < c.mesh.skin_joints.size() && i < c.mesh.joint_from_bind.size(); ++i) {
-    const auto j = static_cast<std::size_t>(c.mesh.skin_joints[i]);
-    if (j < nj) model[j] = glm::inverse(c.mesh.joint_from_bind[i]);
-  }
-  return model;
-}
-
-base::Result<BodyKind> ParseBodyKind(const std::string& name) {
-  if (name == "tubes") return BodyKind::kTubes;
-  if (name == "generated") return BodyKind::kGenerated;
-  return base::MakeError(base::ErrorCode::kInvalidArgument, {"--body", 0, 0, {}},
-                         "expected generated, tubes or a glTF/GLB file, found '" + name + "'");
-}
-
-base::Result<Character> MakeCharacter(MotionSource&& source,
-                                      const deform::MannequinOptions& mannequin, BodyKind kind) {
-  Character c;
-  c.source = source.gltf ? source.gltf->skeleton.info.source_file : source.skeleton.info.source_file;
-  c.skeleton = std::move(source.skeleton);
-  c.motion = std::move(source.motion);
-  c.warnings = std::move(source.warnings);
-  if (c.source.empty()) c.source = "<input>";
-  if (source.gltf) {
-    c.mesh = std::move(source.gltf->mesh);
-    c.textures = BuildCharacterTextures(c.mesh);
-    c.closed_surface = deform::IsClosedOutward(c.mesh.bind.positions, c.mesh.bind.triangles);
-    return c;
-  }
-  // A rest pose far lower than the first frame's is not a body pose (limbs
-  // folded or lying flat): build and bind the body at frame 0 instead. Without a
-  // body in either pose BuildMannequin below reports why.
-  base::Result<deform::BindPoseChoice> pose =
-      deform::ChooseBindPose(c.skeleton, c.motion, mannequin.min_branch_extent);
-  c.bound_at_first_frame = pose.ok() && pose->frame == 0;
-  // One welded skin fuses whatever touches in its bind pose: a rest pose much taller
-  // than the first frame (LAFAN's arms raised beside the head) would fuse arms and head,
-  // so the generated body is bound at frame 0 then.
-  if (kind == BodyKind::kGenerated && !c.bound_at_first_frame && c.motion.num_frames > 0) {
-    const float rest = mocap::RestHeight(c.skeleton, c.skeleton.info.up_axis);
-    const float first = mocap::FirstFrameHeight(c.skeleton, c.motion, c.skeleton.info.up_axis);
-    c.bound_at_first_frame = first > 0.0f && rest > 1.15f * first;
-  }
-  base::Result<std::vector<glm::mat4>> model = BindModelFromJoint(c);
-  if (!model.ok()) return std::move(model).error();
-  base::Result<deform::SkinnedMesh> body =
-      kind == BodyKind::kGenerated
-          ? deform::BuildGeneratedBodyCached(c.skeleton, *model, {}, deform::BodyCacheFolder())
-          : deform::BuildMannequin(c.skeleton, *model, mannequin);
-  if (!body.ok()) {
-    base::Error e = std::move(body).error();
-    if (e.loc.file.empty()) e.loc.file = c.source;
-    return e;
-  }
-  c.mesh = std::move(*body);
-  c.closed_surface = deform::IsClosedOutward(c.mesh.bind.positions, c.mesh.bind.triangles);
-  return c;
-}
 
 struct FramePipeline::Impl {
   const Character* character = nullptr;
@@ -202,32 +109,32 @@ struct FramePipeline::Impl {
   std::vector<mocap::JointTransform> locals, scratch;
   std::vector<glm::mat4> model_from_joint;
   std::vector<glm::mat4> palette;
-  std::vector<deform::DualQuat> dq_palette;
+  std::vector<DualQuat> dq_palette;
   // The patch layer (empty: global only).
-  std::vector<deform::PatchSetup> patches;
-  std::vector<std::vector<glm::vec3>> carried;          // per patch, #M x #N
+  std::vector<PatchSetup> patches;
+  std::vector<std::vector<glm::vec3>> carried;  // per patch, #M x #N
   std::vector<std::span<const glm::vec3>> carried_views;
   // Per patch, the control points as the global layer alone carries them (G):
   // the layer adds P(Q) - P(G), so without local displacements it is the identity.
   std::vector<std::vector<glm::vec3>> reference;
   std::vector<std::span<const glm::vec3>> reference_views;
-  deform::PatchLayerScratch patch_scratch;
+  PatchLayerScratch patch_scratch;
   // Normals with patches (#V each): the global positions and the geometric
   // normals of them and of the layered mesh (LayerNormals).
   std::vector<glm::vec3> global_positions, global_geometric, layered_geometric;
-  std::unique_ptr<ElasticLayer> elastic;                // null: no elastic patches
-  std::vector<std::vector<glm::vec3>> displacement;     // per patch, empty or #M x #N (model)
+  std::unique_ptr<ElasticLayer> elastic;             // null: no elastic patches
+  std::vector<std::vector<glm::vec3>> displacement;  // per patch, empty or #M x #N (model)
   std::vector<std::span<const glm::vec3>> displacement_views;
   // Example shapes (empty: none): per patch, and scratch for the largest.
-  std::vector<deform::PatchPoseSpace> pose_spaces;
+  std::vector<PatchPoseSpace> pose_spaces;
   std::vector<float> pose_features;       // max #X
   std::vector<glm::vec3> pose_ds;         // max #M x #N, dS in the local frames
   std::vector<glm::quat> pose_rotations;  // max #M x #N, A
-  std::optional<deform::SwdRig> swd_rig;
+  std::optional<SwdRig> swd_rig;
   std::vector<glm::quat> swd_rotations;  // #threads x #J scratch
   std::vector<glm::vec3> swd_joints;     // #threads x #J scratch
   // SWD only: per patch, its control points bound to the sweeps (#M x #N).
-  std::vector<std::vector<deform::SweepVertexBinding>> swd_control;
+  std::vector<std::vector<SweepVertexBinding>> swd_control;
 };
 
 FramePipeline::FramePipeline(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -241,15 +148,15 @@ int FramePipeline::threads() const { return impl_->threads; }
 
 int FramePipeline::num_patches() const { return static_cast<int>(impl_->patches.size()); }
 
-base::Status FramePipeline::SetPatches(std::vector<deform::PatchSetup> patches) {
+base::Status FramePipeline::SetPatches(std::vector<PatchSetup> patches) {
   Impl& m = *impl_;
-  std::vector<std::vector<deform::SweepVertexBinding>> swd_control;
+  std::vector<std::vector<SweepVertexBinding>> swd_control;
   if (m.method == GlobalMethod::kSwd) {
     // Each control point follows the sweeps of the region vertex nearest it (the part
     // of the body its surface approximates), bound like a vertex (ALGORITHMS.md 2.3).
     const std::span<const glm::vec3> rest = m.character->mesh.bind.positions;
     for (std::size_t p = 0; p < patches.size(); ++p) {
-      const deform::PatchSetup& patch = patches[p];
+      const PatchSetup& patch = patches[p];
       std::vector<int> guides(patch.rest_control.size(), -1);
       for (std::size_t i = 0; i < guides.size(); ++i) {
         float best = std::numeric_limits<float>::max();
@@ -259,8 +166,8 @@ base::Status FramePipeline::SetPatches(std::vector<deform::PatchSetup> patches) 
           if (glm::dot(d, d) < best) best = glm::dot(d, d), guides[i] = v;
         }
       }
-      base::Result<std::vector<deform::SweepVertexBinding>> bound =
-          deform::BindPointsLikeVertices(*m.swd_rig, patch.rest_control, guides);
+      base::Result<std::vector<SweepVertexBinding>> bound =
+          BindPointsLikeVertices(*m.swd_rig, patch.rest_control, guides);
       if (!bound.ok()) {
         base::Error e = std::move(bound).error();
         e.loc.file = m.character->source;
@@ -306,7 +213,7 @@ std::vector<ElasticPatchReport> FramePipeline::elastic_report() const {
   return impl_->elastic ? impl_->elastic->Report() : std::vector<ElasticPatchReport>();
 }
 
-base::Status FramePipeline::SetPoseSpaces(std::vector<deform::PatchPoseSpace> spaces) {
+base::Status FramePipeline::SetPoseSpaces(std::vector<PatchPoseSpace> spaces) {
   Impl& m = *impl_;
   const base::FileLoc loc{m.character->source, 0, 0, {}};
   if (!spaces.empty() && spaces.size() != m.patches.size()) {
@@ -324,8 +231,8 @@ base::Status FramePipeline::SetPoseSpaces(std::vector<deform::PatchPoseSpace> sp
       return base::MakeError(base::ErrorCode::kUnsupported, loc,
                              "example shapes need global ssd or dqs (not available with swd yet)");
     }
-    const deform::RbfModel& model = spaces[p].model;
-    const int dim = deform::PoseFeatureDimension(m.character->skeleton, spaces[p].features);
+    const RbfModel& model = spaces[p].model;
+    const int dim = PoseFeatureDimension(m.character->skeleton, spaces[p].features);
     if (model.dimension != dim || model.num_values != 3 * m.patches[p].num_control()) {
       return base::MakeError(base::ErrorCode::kInvalidArgument, loc,
                              "pose space " + std::to_string(p) +
@@ -343,36 +250,35 @@ base::Status FramePipeline::SetPoseSpaces(std::vector<deform::PatchPoseSpace> sp
 
 // Q = G + A dS(theta) for patch p, in place on its carried control points.
 base::JobStatus FramePipeline::AddExampleShapes(Impl& m, std::size_t p) {
-  const deform::PatchPoseSpace& space = m.pose_spaces[p];
+  const PatchPoseSpace& space = m.pose_spaces[p];
   const std::size_t nc = m.patches[p].rest_control.size();
   const std::span<float> features =
       std::span<float>(m.pose_features).first(static_cast<std::size_t>(space.model.dimension));
   const std::span<glm::vec3> ds = std::span<glm::vec3>(m.pose_ds).first(nc);
   const std::span<glm::quat> rotations = std::span<glm::quat>(m.pose_rotations).first(nc);
-  if (!deform::ComputePoseFeatures(m.character->skeleton, space.features, m.locals, features).ok()) {
+  if (!ComputePoseFeatures(m.character->skeleton, space.features, m.locals, features).ok()) {
     return {base::JobStatus::kSizeMismatch, "pose features"};
   }
   base::JobStatus s =
-      deform::PoseSpaceJob{.model = &space.model, .features = features, .displacement = ds}.Run();
+      PoseSpaceJob{.model = &space.model, .features = features, .displacement = ds}.Run();
   if (!s) return s;
   const bool dqs = m.method == GlobalMethod::kDqs;
-  s = deform::PatchControlRotations(
+  s = PatchControlRotations(
       m.patches[p],
       {.model_from_bind = m.palette,
-       .dq_palette = dqs ? std::span<const deform::DualQuat>(m.dq_palette)
-                         : std::span<const deform::DualQuat>()},
+       .dq_palette = dqs ? std::span<const DualQuat>(m.dq_palette) : std::span<const DualQuat>()},
       rotations, ds);
   if (!s) return s;
-  return deform::PoseSpaceApplyJob{
+  return PoseSpaceApplyJob{
       .global = m.carried[p], .rotations = rotations, .displacement = ds, .control = m.carried[p]}
       .Run();
 }
 
 base::Result<FramePipeline> FramePipeline::Create(const Character& character, GlobalMethod method,
                                                   int threads) {
-  const base::Status weights = deform::CheckSkinWeights(
-      character.mesh.weights, static_cast<int>(character.mesh.skin_joints.size()),
-      character.mesh.bind.num_vertices());
+  const base::Status weights =
+      CheckSkinWeights(character.mesh.weights, static_cast<int>(character.mesh.skin_joints.size()),
+                       character.mesh.bind.num_vertices());
   if (!weights.ok()) return weights.error();
   auto impl = std::make_unique<Impl>();
   impl->character = &character;
@@ -387,9 +293,8 @@ base::Result<FramePipeline> FramePipeline::Create(const Character& character, Gl
   if (method == GlobalMethod::kSwd) {
     base::Result<std::vector<glm::mat4>> bind = BindModelFromJoint(character);
     if (!bind.ok()) return std::move(bind).error();
-    base::Result<deform::SwdRig> rig =
-        deform::BuildSwdRig(character.skeleton, *bind, character.mesh.bind,
-                            {.vertex_chains = character.mesh.body_chain_coords});
+    base::Result<SwdRig> rig = BuildSwdRig(character.skeleton, *bind, character.mesh.bind,
+                                           {.vertex_chains = character.mesh.body_chain_coords});
     if (!rig.ok()) {
       base::Error e = std::move(rig).error();
       if (e.loc.file.empty()) e.loc.file = character.source;
@@ -405,7 +310,7 @@ base::Result<FramePipeline> FramePipeline::Create(const Character& character, Gl
 base::Status FramePipeline::Evaluate(double time_s, DeformedFrame& out) {
   Impl& m = *impl_;
   const Character& c = *m.character;
-  const deform::SkinnedMesh& mesh = c.mesh;
+  const SkinnedMesh& mesh = c.mesh;
   if (c.motion.num_frames > 0) {
     const base::JobStatus s = mocap::SampleLocalsJob{.skeleton = &c.skeleton,
                                                      .motion = &c.motion,
@@ -423,7 +328,7 @@ base::Status FramePipeline::Evaluate(double time_s, DeformedFrame& out) {
                                              .model_from_joint = m.model_from_joint}
                           .Run();
   if (!s) return JobError(c, s, "local-to-model");
-  s = deform::BuildSkinningPalette(m.model_from_joint, mesh, m.palette);
+  s = BuildSkinningPalette(m.model_from_joint, mesh, m.palette);
   if (!s) return JobError(c, s, "palette");
 
   const int nv = mesh.bind.num_vertices();
@@ -431,7 +336,7 @@ base::Status FramePipeline::Evaluate(double time_s, DeformedFrame& out) {
   out.normals.resize(static_cast<std::size_t>(nv));
   const bool has_normals = !mesh.bind.normals.empty();
   if (m.method == GlobalMethod::kDqs) {
-    s = deform::BuildDualQuatPalette(m.palette, m.dq_palette);
+    s = BuildDualQuatPalette(m.palette, m.dq_palette);
     if (!s) return JobError(c, s, "dual quaternion palette");
   }
   std::array<base::JobStatus, kMaxThreads> results{};
@@ -439,22 +344,21 @@ base::Status FramePipeline::Evaluate(double time_s, DeformedFrame& out) {
     base::JobStatus r;
     if (m.method == GlobalMethod::kSwd) {
       const int nj = static_cast<int>(m.model_from_joint.size());
-      r = deform::SwdRigJob{.rig = &*m.swd_rig,
-                            .model_from_joint = m.model_from_joint,
-                            .vertex_begin = begin,
-                            .joint_rotations = Sub(m.swd_rotations, chunk, chunk + 1, nj),
-                            .joint_positions = Sub(m.swd_joints, chunk, chunk + 1, nj),
-                            .keep_volume = false,
-                            .positions = Sub(out.positions, begin, end),
-                            .normals = has_normals ? Sub(out.normals, begin, end)
-                                                   : std::span<glm::vec3>()}
+      r = SwdRigJob{.rig = &*m.swd_rig,
+                    .model_from_joint = m.model_from_joint,
+                    .vertex_begin = begin,
+                    .joint_rotations = Sub(m.swd_rotations, chunk, chunk + 1, nj),
+                    .joint_positions = Sub(m.swd_joints, chunk, chunk + 1, nj),
+                    .keep_volume = false,
+                    .positions = Sub(out.positions, begin, end),
+                    .normals = has_normals ? Sub(out.normals, begin, end) : std::span<glm::vec3>()}
               .Run();
     } else if (m.method == GlobalMethod::kDqs) {
-      deform::DqsJob job;
+      DqsJob job;
       job.palette = m.dq_palette;
       r = WithVertexRange(job, mesh, begin, end, out).Run();
     } else {
-      deform::SkinningJob job;
+      SkinningJob job;
       job.model_from_bind = m.palette;
       r = WithVertexRange(job, mesh, begin, end, out).Run();
     }
@@ -472,17 +376,17 @@ base::Status FramePipeline::Evaluate(double time_s, DeformedFrame& out) {
       const int nj = static_cast<int>(m.model_from_joint.size());
       const std::span<glm::quat> rotations = Sub(m.swd_rotations, 0, 1, nj);
       const std::span<glm::vec3> joints = Sub(m.swd_joints, 0, 1, nj);
-      s = deform::ComputeSwdJointState(*m.swd_rig, m.model_from_joint, rotations, joints);
+      s = ComputeSwdJointState(*m.swd_rig, m.model_from_joint, rotations, joints);
       for (std::size_t p = 0; s && p < m.patches.size(); ++p) {
-        s = deform::SwdJob{.chains = m.swd_rig->chains(),
-                           .joint_rotations = rotations,
-                           .joint_positions = joints,
-                           .bindings = m.swd_control[p],
-                           .rest_normals = {},
-                           .keep_volume = false,
-                           .section_scales = {},
-                           .positions = m.carried[p],
-                           .normals = {}}
+        s = SwdJob{.chains = m.swd_rig->chains(),
+                   .joint_rotations = rotations,
+                   .joint_positions = joints,
+                   .bindings = m.swd_control[p],
+                   .rest_normals = {},
+                   .keep_volume = false,
+                   .section_scales = {},
+                   .positions = m.carried[p],
+                   .normals = {}}
                 .Run();
       }
       if (!s) return JobError(c, s, "patch control points (swd)");
@@ -492,12 +396,12 @@ base::Status FramePipeline::Evaluate(double time_s, DeformedFrame& out) {
     }
     for (std::size_t p = 0; m.method != GlobalMethod::kSwd && p < m.patches.size(); ++p) {
       const bool dqs = m.method == GlobalMethod::kDqs;
-      s = deform::CarryControlPointsJob{
-          .patch = &m.patches[p],
-          .model_from_bind = dqs ? std::span<const glm::mat4>() : std::span<const glm::mat4>(m.palette),
-          .dq_palette = dqs ? std::span<const deform::DualQuat>(m.dq_palette)
-                            : std::span<const deform::DualQuat>(),
-          .control = m.carried[p]}
+      s = CarryControlPointsJob{.patch = &m.patches[p],
+                                .model_from_bind = dqs ? std::span<const glm::mat4>()
+                                                       : std::span<const glm::mat4>(m.palette),
+                                .dq_palette = dqs ? std::span<const DualQuat>(m.dq_palette)
+                                                  : std::span<const DualQuat>(),
+                                .control = m.carried[p]}
               .Run();
       if (!s) return JobError(c, s, "patch control points");
       std::copy(m.carried[p].begin(), m.carried[p].end(), m.reference[p].begin());
@@ -511,13 +415,13 @@ base::Status FramePipeline::Evaluate(double time_s, DeformedFrame& out) {
       // dE: the mass-spring networks advanced to this frame's time (state carried).
       const base::Status advanced = m.elastic->Advance(time_s, m.model_from_joint, m.displacement);
       if (!advanced.ok()) return advanced;
-      for (std::size_t p = 0; p < m.patches.size(); ++p) m.displacement_views[p] = m.displacement[p];
+      for (std::size_t p = 0; p < m.patches.size(); ++p)
+        m.displacement_views[p] = m.displacement[p];
       displacements = m.displacement_views;
     }
     std::copy(out.positions.begin(), out.positions.end(), m.global_positions.begin());
-    const base::Status layered =
-        deform::ApplyPatchLayer(m.patches, m.carried_views, displacements, m.patch_scratch,
-                                out.positions, m.reference_views);
+    const base::Status layered = ApplyPatchLayer(m.patches, m.carried_views, displacements,
+                                                 m.patch_scratch, out.positions, m.reference_views);
     if (!layered.ok()) return layered;
   }
   // Normals (one way for every variant): without bind normals the final
@@ -525,16 +429,16 @@ base::Status FramePipeline::Evaluate(double time_s, DeformedFrame& out) {
   // layer's change of the geometric normals where the layer moved the surface.
   GlobalNormals(out.positions, mesh.bind.triangles, has_normals, out.normals);
   if (!m.patches.empty() && has_normals) {
-    deform::ComputeVertexNormals(m.global_positions, mesh.bind.triangles, m.global_geometric);
-    deform::ComputeVertexNormals(out.positions, mesh.bind.triangles, m.layered_geometric);
+    ComputeVertexNormals(m.global_positions, mesh.bind.triangles, m.global_geometric);
+    ComputeVertexNormals(out.positions, mesh.bind.triangles, m.layered_geometric);
     AddLayerNormals(m.global_geometric, m.layered_geometric, out.normals);
   }
   out.joint_positions.resize(m.model_from_joint.size());
   for (std::size_t j = 0; j < m.model_from_joint.size(); ++j) {
     out.joint_positions[j] = glm::vec3(m.model_from_joint[j][3]);
   }
-  out.bounds = deform::ComputeBounds(out.positions);
+  out.bounds = ComputeBounds(out.positions);
   return base::Status::Ok();
 }
 
-}  // namespace app
+}  // namespace deform

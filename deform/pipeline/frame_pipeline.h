@@ -19,70 +19,24 @@
 
 #include <glm/glm.hpp>
 
-#include "app/elastic_layer.h"
+#include "deform/global/global_skinning.h"
+#include "deform/pipeline/character.h"
+#include "deform/pipeline/elastic_layer.h"
 #include "deform/shapes/example_shapes.h"
-#include "deform/body/mannequin.h"
 #include "deform/mesh.h"
 #include "deform/patch/patch_layer.h"
 #include "base/error.h"
 #include "mocap/motion.h"
 #include "mocap/skeleton.h"
 
-namespace app {
-
-struct MotionSource;
-struct CharacterTextures;  // app/frame_render.h
-
-enum class GlobalMethod { kSsd, kDqs, kSwd };
-const char* GlobalMethodName(GlobalMethod method);
-// "ssd", "dqs", "swd" (also "lbs" for ssd); kInvalidArgument otherwise.
-base::Result<GlobalMethod> ParseGlobalMethod(const std::string& name);
-
-// What gets deformed: a skeleton, its motion, and a skinned mesh bound to it
-// (the glTF's own mesh, or a mannequin generated from a BVH skeleton).
-struct Character {
-  std::string source;                  // file name (or "demo"), for messages and metadata
-  mocap::Skeleton skeleton;
-  mocap::Motion motion;
-  deform::SkinnedMesh mesh;
-  glm::mat4 world_from_model{1.0f};    // glTF: node transform of the skinned mesh is ignored
-                                       // (glTF rule), so identity; kept for other sources
-  bool closed_surface = false;         // the bind mesh is closed and outward (deform::IsClosedOutward)
-  bool bound_at_first_frame = false;   // BVH: the rest pose was not a body pose, so the
-                                       // mannequin was built and bound at frame 0
-  std::vector<base::Warning> warnings;
-  // The renderer's mip pyramids of mesh.materials' textures, built once (null: untextured).
-  std::shared_ptr<const CharacterTextures> textures;
-};
-
-// Builds a Character from a loaded source: glTF keeps its mesh; BVH gets a
-// mannequin, bound at the rest pose unless the rest pose is much lower than the
-// first frame's pose (rest poses that lie flat, e.g. Bandai Namco's), in which
-// case it is bound at frame 0 (deform::ChooseBindPose: heights of the body's
-// joints, without a root that only positions it). With SWD each mannequin tube is
-// bound to the sweep of the chain it was generated on (body_chain_coords).
-// Which body a BVH skeleton gets: the tube mannequin (deform/body/mannequin.h; rig files name
-// its vertices) or the generated body (deform/body/generated_body.h: one smooth closed
-// skin with bone-heat weights, read from the body cache when it was built before).
-enum class BodyKind { kTubes, kGenerated };
-// "tubes" or "generated"; kInvalidArgument (naming --body) otherwise.
-base::Result<BodyKind> ParseBodyKind(const std::string& name);
-
-base::Result<Character> MakeCharacter(MotionSource&& source,
-                                      const deform::MannequinOptions& mannequin = {},
-                                      BodyKind body = BodyKind::kTubes);
-
-// The model-space joint matrices (#J) of the pose the character's mesh was made
-// in: the rest pose, or frame 0 when bound_at_first_frame; a skinned mesh's own
-// bind matrices replace those of its skin joints.
-base::Result<std::vector<glm::mat4>> BindModelFromJoint(const Character& character);
+namespace deform {
 
 // One evaluated frame, in world space.
 struct DeformedFrame {
   std::vector<glm::vec3> positions;        // #V
   std::vector<glm::vec3> normals;          // #V unit normals
   std::vector<glm::vec3> joint_positions;  // #J
-  deform::Bounds bounds;                   // of positions
+  Bounds bounds;                           // of positions
 };
 
 // Evaluates a Character frame by frame. Owns its scratch buffers (reused
@@ -110,14 +64,14 @@ class FramePipeline {
   // Adds the patch layer (ALGORITHMS.md 0, 3.7, 3.8), applied after the global
   // step: control points carried by the same method (SSD, DQS or SWD), bound
   // vertices rebuilt and blended. The layer adds only what the local layer
-  // changes, P(Q) - P(G) (deform::ApplyPatchLayer with a reference grid), and
+  // changes, P(Q) - P(G) (ApplyPatchLayer with a reference grid), and
   // normals are the global ones turned by the layer's change of the geometric
   // normals: patches without examples or elastic layer give the global frame
   // bit for bit, and outside the patch regions' one-rings nothing differs.
   // Patches must be built on this character's bind mesh. With SWD every control
   // point is bound to the sweeps of its nearest region vertex
-  // (deform::BindPointsLikeVertices) and carried by deform::SwdJob.
-  base::Status SetPatches(std::vector<deform::PatchSetup> patches);
+  // (BindPointsLikeVertices) and carried by SwdJob.
+  base::Status SetPatches(std::vector<PatchSetup> patches);
   int num_patches() const;
 
   // Adds example shapes to the patches (ALGORITHMS.md 0 step 2, 4.3, 5): per
@@ -127,8 +81,8 @@ class FramePipeline {
   // SetPatches (inactive entries: no examples); kInvalidArgument otherwise or
   // when a model's size disagrees with its patch; kUnsupported with SWD (its
   // control-point frames A are not defined yet). Empty clears them.
-  base::Status SetPoseSpaces(std::vector<deform::PatchPoseSpace> spaces);
-  // Adds the elastic layer dE (ALGORITHMS.md 6, app/elastic_layer.h) to some of
+  base::Status SetPoseSpaces(std::vector<PatchPoseSpace> spaces);
+  // Adds the elastic layer dE (ALGORITHMS.md 6, elastic_layer.h) to some of
   // the patches set by SetPatches (call it after them): each frame, before the
   // rebuild, the carried control points of patch spec.patch get R_drv e. The
   // state is carried across Evaluate calls; an earlier time than the last one
@@ -145,4 +99,4 @@ class FramePipeline {
   std::unique_ptr<Impl> impl_;
 };
 
-}  // namespace app
+}  // namespace deform

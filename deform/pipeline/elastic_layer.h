@@ -21,41 +21,32 @@
 
 #include <glm/glm.hpp>
 
+#include "base/error.h"
 #include "deform/elastic/mass_spring.h"
 #include "deform/patch/patch_layer.h"
-#include "base/error.h"
 #include "mocap/kinematics.h"
 
-namespace app {
+namespace deform {
 
-struct Character;
-struct Rig;
+struct Character;  // deform/pipeline/character.h
 
 // One elastic patch, resolved on a character.
 struct ElasticPatchSpec {
-  int patch = 0;                    // index of the patch in the pipeline's patch list
-  int joint = 0;                    // driving joint (skeleton index)
-  double cutoff_hz = 10.0;          // low-pass of the joint paths before differencing; 0 = off
-  deform::MassSpringParams params;  // with units_per_metre resolved (> 0)
+  int patch = 0;            // index of the patch in the pipeline's patch list
+  int joint = 0;            // driving joint (skeleton index)
+  double cutoff_hz = 10.0;  // low-pass of the joint paths before differencing; 0 = off
+  MassSpringParams params;  // with units_per_metre resolved (> 0)
 };
-
-// The rig's elastic patches on a character whose patches (one per rig patch,
-// in order) were built by BuildRigPatches. Driving joint: the rig's
-// `elastic.joint`, else the region's joint, else the joint with the largest
-// total skin weight on the patch's control points. Errors (kNotFound) name
-// "patches[i].elastic.joint".
-base::Result<std::vector<ElasticPatchSpec>> ResolveRigElastic(
-    const Rig& rig, const Character& character, std::span<const deform::PatchSetup> patches);
 
 // What one elastic patch did, for reports and tests.
 struct ElasticPatchReport {
-  int patch = 0;                        // pipeline patch index
-  int joint = 0;                        // driving joint
-  double time_step_s = 0.0;             // h after the step rule
-  float max_displacement = 0.0f;        // e_max (model units)
-  float displacement = 0.0f;            // largest |e| of the last output (model units)
-  deform::MassSpringCounters counters;  // limits applied since the last restart from t = 0
-  std::vector<std::string> messages;    // step-rule notes of the network
+  int patch = 0;                      // pipeline patch index
+  int joint = 0;                      // driving joint
+  double time_step_s = 0.0;           // h after the step rule
+  float max_displacement = 0.0f;      // e_max (model units)
+  float displacement = 0.0f;          // largest |e| of the last output (model units)
+  MassSpringCounters counters;        // limits applied since the last restart from t = 0
+  std::vector<std::string> messages;  // step-rule notes of the network
 };
 
 class ElasticLayer {
@@ -66,9 +57,9 @@ class ElasticLayer {
   // Errors: kInvalidArgument for a motion without frames, a patch index out of
   // range, a grid beyond 16 x 16 or parameters the network refuses (with
   // "patches[i].elastic" as the field path).
-  static base::Result<std::unique_ptr<ElasticLayer>> Create(
-      const Character& character, std::span<const deform::PatchSetup> patches,
-      std::vector<ElasticPatchSpec> specs);
+  static base::Result<std::unique_ptr<ElasticLayer>> Create(const Character& character,
+                                                            std::span<const PatchSetup> patches,
+                                                            std::vector<ElasticPatchSpec> specs);
 
   // Advances every network to `time_s` (clamped to the motion) and writes each
   // elastic patch's displacement in model space, R_drv(t) e (#M x #N), into
@@ -83,12 +74,12 @@ class ElasticLayer {
  private:
   struct Patch {
     ElasticPatchSpec spec;
-    deform::MassSpringNetwork network;
-    deform::MassSpringState state;
-    deform::MassSpringCounters baseline;  // counters at the last restart
-    std::vector<glm::vec3> local;         // #M x #N displacement in the joint frame
-    int kinematics = 0;                   // index into kinematics_
-    int slot = 0;                         // column of spec.joint in that table
+    MassSpringNetwork network;
+    MassSpringState state;
+    MassSpringCounters baseline;   // counters at the last restart
+    std::vector<glm::vec3> local;  // #M x #N displacement in the joint frame
+    int kinematics = 0;            // index into kinematics_
+    int slot = 0;                  // column of spec.joint in that table
     float displacement = 0.0f;
   };
   // The driving joints sharing one cutoff, and their kinematics only.
@@ -103,9 +94,9 @@ class ElasticLayer {
   std::vector<Patch> patches_;
   std::vector<Kinematics> kinematics_;
   bool started_ = false;
-  double time_s_ = 0.0;     // time of the last output
+  double time_s_ = 0.0;  // time of the last output
   double duration_s_ = 0.0;
-  double piece_s_ = 0.25;   // longest single advance (below every max_time_gap_s)
+  double piece_s_ = 0.25;  // longest single advance (below every max_time_gap_s)
 };
 
-}  // namespace app
+}  // namespace deform
