@@ -117,10 +117,9 @@ base::Result<RigPoseSpaces> BuildRigPoseSpaces(const Rig& rig, const Character& 
   }
   const mocap::Skeleton& s = ch.skeleton;
   const auto nj = static_cast<std::size_t>(s.num_joints());
-  const std::size_t ns = ch.mesh.skin_joints.size();
   std::vector<mocap::JointTransform> locals(nj);
-  std::vector<glm::mat4> model(nj), palette(ns);
-  std::vector<deform::DualQuat> dq(ns);
+  std::vector<glm::mat4> model(nj);
+  deform::SkinningPalettes palettes;
   for (std::size_t i = 0; i < rig.patches.size(); ++i) {
     const RigPatch& rp = rig.patches[i];
     if (rp.examples.empty()) continue;
@@ -144,15 +143,10 @@ base::Result<RigPoseSpaces> BuildRigPoseSpaces(const Rig& rig, const Character& 
                                                   .model_from_root = ch.world_from_model,
                                                   .model_from_joint = model}
                                .Run();
-      if (js) js = deform::BuildSkinningPalette(model, ch.mesh, palette);
-      if (js && method == deform::GlobalMethod::kDqs)
-        js = deform::BuildDualQuatPalette(palette, dq);
+      if (js) js = palettes.Update(model, ch.mesh, method == deform::GlobalMethod::kDqs);
       if (!js)
         return base::MakeError(base::ErrorCode::kInternal, {rig.file, 0, 0, ex.path}, js.what);
-      const deform::ExamplePose pose{.model_from_bind = palette,
-                                     .dq_palette = method == deform::GlobalMethod::kDqs
-                                                       ? std::span<const deform::DualQuat>(dq)
-                                                       : std::span<const deform::DualQuat>()};
+      const deform::SkinningPose pose = palettes.view();
       base::Result<deform::SculptedExample> sculpted = deform::SculptedExample{};
       if (!ex.auto_kind.empty()) {
         // Computed at load, once (deform/shapes/corrective_example.h).

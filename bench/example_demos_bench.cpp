@@ -95,9 +95,10 @@ void Update(benchmark::State& state, bool rebuild) {
   std::vector<glm::vec3> carried(nc), ds(nc), rebuilt(p.bound.binding.size());
   std::vector<glm::quat> rotations(nc);
   std::vector<float> features(static_cast<std::size_t>(space.model.dimension));
-  (void)deform::CarryControlPointsJob{.patch = &p, .model_from_bind = s.palette, .control = carried}
+  (void)deform::CarryControlPointsJob{
+      .patch = &p, .pose = {.model_from_bind = s.palette}, .control = carried}
       .Run();
-  const deform::ExamplePose pose{.model_from_bind = s.palette};
+  const deform::SkinningPose pose{.model_from_bind = s.palette};
   // How many control points need A at this pose (dS != 0), and how many of
   // those blend three or more bones (Newton's polar iteration).
   (void)deform::ComputePoseFeatures(s.character.skeleton, space.features, s.locals, features);
@@ -124,8 +125,8 @@ void Update(benchmark::State& state, bool rebuild) {
   state.counters["bones"] = static_cast<double>(std::count(bone_used.begin(), bone_used.end(), 1));
   for (auto _ : state) {
     if (rebuild) {
-      (void)deform::CarryControlPointsJob{.patch = &p, .model_from_bind = s.palette,
-                                          .control = carried}
+      (void)deform::CarryControlPointsJob{
+          .patch = &p, .pose = {.model_from_bind = s.palette}, .control = carried}
           .Run();
     }
     (void)deform::ComputePoseFeatures(s.character.skeleton, space.features, s.locals, features);
@@ -167,9 +168,10 @@ void Part(benchmark::State& state, bool rotations_only) {
   std::vector<glm::vec3> carried(nc), ds(nc), control(nc);
   std::vector<glm::quat> rotations(nc);
   std::vector<float> features(static_cast<std::size_t>(space.model.dimension));
-  (void)deform::CarryControlPointsJob{.patch = &p, .model_from_bind = s.palette, .control = carried}
+  (void)deform::CarryControlPointsJob{
+      .patch = &p, .pose = {.model_from_bind = s.palette}, .control = carried}
       .Run();
-  const deform::ExamplePose pose{.model_from_bind = s.palette};
+  const deform::SkinningPose pose{.model_from_bind = s.palette};
   (void)deform::ComputePoseFeatures(s.character.skeleton, space.features, s.locals, features);
   (void)deform::PoseSpaceJob{.model = &space.model, .features = features, .displacement = ds}.Run();
   (void)deform::PatchControlRotations(p, pose, rotations, ds);

@@ -37,7 +37,8 @@ void CarryAndRebuild(benchmark::State& state) {
   const deform::PatchSetup& p = s.patches[static_cast<std::size_t>(state.range(0))];
   std::vector<glm::vec3> control(p.rest_control.size()), rebuilt(p.bound.binding.size());
   for (auto _ : state) {
-    (void)deform::CarryControlPointsJob{.patch = &p, .model_from_bind = s.palette, .control = control}
+    (void)deform::CarryControlPointsJob{
+        .patch = &p, .pose = {.model_from_bind = s.palette}, .control = control}
         .Run();
     (void)deform::PatchRebuildJob{.control = control, .bindings = p.bound.binding.view(),
                                   .positions = rebuilt}
@@ -72,8 +73,8 @@ void Frame(benchmark::State& state, bool layered) {
         .Run();
     if (layered) {
       for (std::size_t k = 0; k < s.patches.size(); ++k) {
-        (void)deform::CarryControlPointsJob{.patch = &s.patches[k], .model_from_bind = s.palette,
-                                            .control = carried[k]}
+        (void)deform::CarryControlPointsJob{
+            .patch = &s.patches[k], .pose = {.model_from_bind = s.palette}, .control = carried[k]}
             .Run();
       }
       (void)deform::ApplyPatchLayer(s.patches, views, {}, scratch, positions);

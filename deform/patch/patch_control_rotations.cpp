@@ -52,7 +52,7 @@ constexpr glm::quat kIdentity(1.0f, 0.0f, 0.0f, 0.0f);
 
 }  // namespace
 
-base::JobStatus PatchControlRotations(const PatchSetup& patch, const ExamplePose& pose,
+base::JobStatus PatchControlRotations(const PatchSetup& patch, const SkinningPose& pose,
                                       std::span<glm::quat> rotations,
                                       std::span<const glm::vec3> displacement) {
   if (!displacement.empty() && displacement.size() != rotations.size()) {
@@ -71,9 +71,9 @@ base::JobStatus PatchControlRotations(const PatchSetup& patch, const ExamplePose
     return st;
   };
   const SkinWeights& w = patch.control_weights;
-  if (!pose.dq_palette.empty()) {
+  if (!pose.dual_quats.empty()) {
     return identity_where_skipped(
-        DqsControlRotations(pose.dq_palette, w.influences, w.joints, w.weights, rotations));
+        DqsControlRotations(pose.dual_quats, w.influences, w.joints, w.weights, rotations));
   }
   const std::size_t num_skin = pose.model_from_bind.size();
   const int k = w.influences;

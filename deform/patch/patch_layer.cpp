@@ -186,8 +186,8 @@ base::Result<PatchSetup> BuildPatchSetup(const SkinnedMesh& mesh, std::span<cons
 base::JobStatus CarryControlPointsJob::Validate() const {
   using S = base::JobStatus;
   if (patch == nullptr) return {S::kMissingInput, "no patch"};
-  if (model_from_bind.empty() == dq_palette.empty()) {
-    return {S::kMissingInput, "exactly one of the SSD and DQS palettes is required"};
+  if (pose.model_from_bind.empty() && pose.dual_quats.empty()) {
+    return {S::kMissingInput, "no SSD or DQS palette"};
   }
   if (control.size() != patch->rest_control.size()) {
     return {S::kSizeMismatch, "control output is not #M x #N"};
@@ -198,18 +198,8 @@ base::JobStatus CarryControlPointsJob::Validate() const {
 base::JobStatus CarryControlPointsJob::Run() const {
   const base::JobStatus s = Validate();
   if (!s) return s;
-  const SkinWeights& w = patch->control_weights;
-  if (!dq_palette.empty()) {
-    return DqsJob{.palette = dq_palette, .influences = w.influences, .joint_indices = w.joints,
-                  .joint_weights = w.weights, .rest_positions = patch->rest_control,
-                  .rest_normals = {}, .positions = control, .normals = {}}
-        .Run();
-  }
-  return SkinningJob{.model_from_bind = model_from_bind, .influences = w.influences,
-                     .joint_indices = w.joints, .joint_weights = w.weights,
-                     .rest_positions = patch->rest_control, .rest_normals = {},
-                     .positions = control, .normals = {}}
-      .Run();
+  return SkinPoints(pose, patch->control_weights, patch->rest_control, {}, 0, patch->num_control(),
+                    control, {});
 }
 
 void PatchLayerScratch::Prepare(std::span<const PatchSetup> patches, int num_vertices) {

@@ -25,7 +25,7 @@
 
 #include <glm/glm.hpp>
 
-#include "deform/global/dqs_job.h"
+#include "deform/global/global_skinning.h"
 #include "deform/mesh.h"
 #include "deform/patch/patch_binding.h"
 #include "deform/patch/patch_fit.h"
@@ -97,13 +97,12 @@ std::vector<float> BorderWeights(const PatchBinding& binding,
                                  std::span<const glm::uvec3> triangles, int num_vertices,
                                  float width);
 
-// Carries one patch's rest control points by SSD (palette set) or DQS
-// (dq_palette set; exactly one of the two), like skin vertices.
+// Carries one patch's rest control points by SSD or DQS (pose.dual_quats set),
+// like skin vertices (SkinPoints).
 struct CarryControlPointsJob {
   // Inputs.
   const PatchSetup* patch = nullptr;
-  std::span<const glm::mat4> model_from_bind{};  // #S SSD palette (BuildSkinningPalette)
-  std::span<const DualQuat> dq_palette{};        // #S DQS palette, or empty
+  SkinningPose pose{};  // #S palettes
   // Outputs.
   std::span<glm::vec3> control{};                // #M x #N carried control points G
 

@@ -7,10 +7,7 @@
 #include <string>
 
 #include "base/parallel.h"
-#include "deform/global/dqs_job.h"
 #include "deform/global/skinning_job.h"
-#include "deform/global/swd_job.h"
-#include "deform/global/swd_rig.h"
 #include "mocap/pose.h"
 #include "mocap/sampling.h"
 
@@ -37,30 +34,20 @@ void ParallelRanges(int n, int threads, Fn&& fn) {
   });
 }
 
-template <typename T>
-std::span<T> Sub(std::vector<T>& v, int begin, int end, int stride = 1) {
-  return std::span<T>(v).subspan(static_cast<std::size_t>(begin * stride),
-                                 static_cast<std::size_t>((end - begin) * stride));
-}
-template <typename T>
-std::span<const T> Sub(const std::vector<T>& v, int begin, int end, int stride = 1) {
-  return std::span<const T>(v).subspan(static_cast<std::size_t>(begin * stride),
-                                       static_cast<std::size_t>((end - begin) * stride));
-}
-
-// Sets the fields SkinningJob and DqsJob share to vertices [begin, end) of
-// `mesh` and `out` (normals only when the mesh has them).
-template <typename Job>
-Job WithVertexRange(Job job, const SkinnedMesh& mesh, int begin, int end, DeformedFrame& out) {
-  const int k = mesh.weights.influences;
-  job.influences = k;
-  job.joint_indices = Sub(mesh.weights.joints, begin, end, k);
-  job.joint_weights = Sub(mesh.weights.weights, begin, end, k);
-  job.rest_positions = Sub(mesh.bind.positions, begin, end);
-  if (!mesh.bind.normals.empty()) job.rest_normals = Sub(mesh.bind.normals, begin, end);
-  job.positions = Sub(out.positions, begin, end);
-  job.normals = Sub(out.normals, begin, end);
-  return job;
+// For each control point of `patch`, the region vertex nearest it in the bind
+// mesh (-1 if the region has none): with SWD a control point follows the sweeps
+// of the body part its surface approximates (ALGORITHMS.md 2.3).
+std::vector<int> NearestRegionVertices(const PatchSetup& patch, const Mesh& bind) {
+  std::vector<int> nearest(patch.rest_control.size(), -1);
+  for (std::size_t i = 0; i < nearest.size(); ++i) {
+    float best = std::numeric_limits<float>::max();
+    for (const int v : patch.region) {
+      if (v < 0 || v >= bind.num_vertices()) continue;
+      const glm::vec3 d = bind.positions[static_cast<std::size_t>(v)] - patch.rest_control[i];
+      if (glm::dot(d, d) < best) best = glm::dot(d, d), nearest[i] = v;
+    }
+  }
+  return nearest;
 }
 
 base::Error JobError(const Character& c, const base::JobStatus& s, const char* stage) {
@@ -104,14 +91,13 @@ void AddLayerNormals(std::span<const glm::vec3> global_geometric,
 
 struct FramePipeline::Impl {
   const Character* character = nullptr;
-  GlobalMethod method = GlobalMethod::kSsd;
   int threads = 1;
   std::vector<mocap::JointTransform> locals, scratch;
   std::vector<glm::mat4> model_from_joint;
-  std::vector<glm::mat4> palette;
-  std::vector<DualQuat> dq_palette;
+  std::optional<GlobalSkinning> global;
   // The patch layer (empty: global only).
   std::vector<PatchSetup> patches;
+  std::vector<SkinBoundPoints> control_points;  // per patch, bound like the skin
   std::vector<std::vector<glm::vec3>> carried;  // per patch, #M x #N
   std::vector<std::span<const glm::vec3>> carried_views;
   // Per patch, the control points as the global layer alone carries them (G):
@@ -130,11 +116,6 @@ struct FramePipeline::Impl {
   std::vector<float> pose_features;       // max #X
   std::vector<glm::vec3> pose_ds;         // max #M x #N, dS in the local frames
   std::vector<glm::quat> pose_rotations;  // max #M x #N, A
-  std::optional<SwdRig> swd_rig;
-  std::vector<glm::quat> swd_rotations;  // #threads x #J scratch
-  std::vector<glm::vec3> swd_joints;     // #threads x #J scratch
-  // SWD only: per patch, its control points bound to the sweeps (#M x #N).
-  std::vector<std::vector<SweepVertexBinding>> swd_control;
 };
 
 FramePipeline::FramePipeline(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -142,7 +123,7 @@ FramePipeline::FramePipeline(FramePipeline&&) noexcept = default;
 FramePipeline& FramePipeline::operator=(FramePipeline&&) noexcept = default;
 FramePipeline::~FramePipeline() = default;
 
-GlobalMethod FramePipeline::method() const { return impl_->method; }
+GlobalMethod FramePipeline::method() const { return impl_->global->method(); }
 const Character& FramePipeline::character() const { return *impl_->character; }
 int FramePipeline::threads() const { return impl_->threads; }
 
@@ -150,35 +131,26 @@ int FramePipeline::num_patches() const { return static_cast<int>(impl_->patches.
 
 base::Status FramePipeline::SetPatches(std::vector<PatchSetup> patches) {
   Impl& m = *impl_;
-  std::vector<std::vector<SweepVertexBinding>> swd_control;
-  if (m.method == GlobalMethod::kSwd) {
-    // Each control point follows the sweeps of the region vertex nearest it (the part
-    // of the body its surface approximates), bound like a vertex (ALGORITHMS.md 2.3).
-    const std::span<const glm::vec3> rest = m.character->mesh.bind.positions;
-    for (std::size_t p = 0; p < patches.size(); ++p) {
-      const PatchSetup& patch = patches[p];
-      std::vector<int> guides(patch.rest_control.size(), -1);
-      for (std::size_t i = 0; i < guides.size(); ++i) {
-        float best = std::numeric_limits<float>::max();
-        for (const int v : patch.region) {
-          if (v < 0 || static_cast<std::size_t>(v) >= rest.size()) continue;
-          const glm::vec3 d = rest[static_cast<std::size_t>(v)] - patch.rest_control[i];
-          if (glm::dot(d, d) < best) best = glm::dot(d, d), guides[i] = v;
-        }
-      }
-      base::Result<std::vector<SweepVertexBinding>> bound =
-          BindPointsLikeVertices(*m.swd_rig, patch.rest_control, guides);
-      if (!bound.ok()) {
-        base::Error e = std::move(bound).error();
-        e.loc.file = m.character->source;
-        e.message = "patch " + std::to_string(p) + ": " + e.message;
-        return e;
-      }
-      swd_control.push_back(std::move(*bound));
+  std::vector<SkinBoundPoints> control_points;
+  for (std::size_t p = 0; p < patches.size(); ++p) {
+    const PatchSetup& patch = patches[p];
+    const std::vector<int> guides = m.global->method() == GlobalMethod::kSwd
+                                        ? NearestRegionVertices(patch, m.character->mesh.bind)
+                                        : std::vector<int>();
+    base::Result<SkinBoundPoints> bound =
+        m.global->BindPoints(patch.rest_control, patch.control_weights, guides);
+    if (!bound.ok()) {
+      base::Error e = std::move(bound).error();
+      e.loc.file = m.character->source;
+      e.message = "patch " + std::to_string(p) + ": " + e.message;
+      return e;
     }
+    control_points.push_back(std::move(*bound));
   }
-  m.swd_control = std::move(swd_control);
+  // The bindings refer to the patches' rest points and weights, whose storage
+  // moves with the vector.
   m.patches = std::move(patches);
+  m.control_points = std::move(control_points);
   m.carried.assign(m.patches.size(), {});
   m.reference.assign(m.patches.size(), {});
   m.carried_views.clear();
@@ -225,7 +197,7 @@ base::Status FramePipeline::SetPoseSpaces(std::vector<PatchPoseSpace> spaces) {
   std::size_t max_x = 0, max_c = 0;
   for (std::size_t p = 0; p < spaces.size(); ++p) {
     if (!spaces[p].active()) continue;
-    if (m.method == GlobalMethod::kSwd) {
+    if (m.global->method() == GlobalMethod::kSwd) {
       // The frames A that carry dS (ALGORITHMS.md 4.3) are defined here for
       // SSD and DQS only; refuse rather than drop the examples silently.
       return base::MakeError(base::ErrorCode::kUnsupported, loc,
@@ -262,12 +234,7 @@ base::JobStatus FramePipeline::AddExampleShapes(Impl& m, std::size_t p) {
   base::JobStatus s =
       PoseSpaceJob{.model = &space.model, .features = features, .displacement = ds}.Run();
   if (!s) return s;
-  const bool dqs = m.method == GlobalMethod::kDqs;
-  s = PatchControlRotations(
-      m.patches[p],
-      {.model_from_bind = m.palette,
-       .dq_palette = dqs ? std::span<const DualQuat>(m.dq_palette) : std::span<const DualQuat>()},
-      rotations, ds);
+  s = PatchControlRotations(m.patches[p], m.global->palettes(), rotations, ds);
   if (!s) return s;
   return PoseSpaceApplyJob{
       .global = m.carried[p], .rotations = rotations, .displacement = ds, .control = m.carried[p]}
@@ -280,30 +247,27 @@ base::Result<FramePipeline> FramePipeline::Create(const Character& character, Gl
       CheckSkinWeights(character.mesh.weights, static_cast<int>(character.mesh.skin_joints.size()),
                        character.mesh.bind.num_vertices());
   if (!weights.ok()) return weights.error();
+  std::vector<glm::mat4> bind;  // SWD builds its sweeps in the bind pose
+  if (method == GlobalMethod::kSwd) {
+    base::Result<std::vector<glm::mat4>> model = BindModelFromJoint(character);
+    if (!model.ok()) return std::move(model).error();
+    bind = std::move(*model);
+  }
+  base::Result<GlobalSkinning> global =
+      GlobalSkinning::Create(method, character.skeleton, bind, character.mesh);
+  if (!global.ok()) {
+    base::Error e = std::move(global).error();
+    if (e.loc.file.empty()) e.loc.file = character.source;
+    return e;
+  }
   auto impl = std::make_unique<Impl>();
   impl->character = &character;
-  impl->method = method;
+  impl->global = std::move(*global);
   impl->threads = base::ResolveThreads(threads);
   const auto nj = static_cast<std::size_t>(character.skeleton.num_joints());
   impl->locals.resize(nj);
   impl->scratch.resize(nj);
   impl->model_from_joint.resize(nj);
-  impl->palette.resize(character.mesh.skin_joints.size());
-  impl->dq_palette.resize(character.mesh.skin_joints.size());
-  if (method == GlobalMethod::kSwd) {
-    base::Result<std::vector<glm::mat4>> bind = BindModelFromJoint(character);
-    if (!bind.ok()) return std::move(bind).error();
-    base::Result<SwdRig> rig = BuildSwdRig(character.skeleton, *bind, character.mesh.bind,
-                                           {.vertex_chains = character.mesh.body_chain_coords});
-    if (!rig.ok()) {
-      base::Error e = std::move(rig).error();
-      if (e.loc.file.empty()) e.loc.file = character.source;
-      return e;
-    }
-    impl->swd_rig = std::move(*rig);
-    impl->swd_rotations.resize(nj * static_cast<std::size_t>(kMaxThreads));
-    impl->swd_joints.resize(nj * static_cast<std::size_t>(kMaxThreads));
-  }
   return FramePipeline(std::move(impl));
 }
 
@@ -328,81 +292,27 @@ base::Status FramePipeline::Evaluate(double time_s, DeformedFrame& out) {
                                              .model_from_joint = m.model_from_joint}
                           .Run();
   if (!s) return JobError(c, s, "local-to-model");
-  s = BuildSkinningPalette(m.model_from_joint, mesh, m.palette);
-  if (!s) return JobError(c, s, "palette");
+  s = m.global->Pose(m.model_from_joint);
+  if (!s) return JobError(c, s, "global pose");
 
   const int nv = mesh.bind.num_vertices();
   out.positions.resize(static_cast<std::size_t>(nv));
   out.normals.resize(static_cast<std::size_t>(nv));
   const bool has_normals = !mesh.bind.normals.empty();
-  if (m.method == GlobalMethod::kDqs) {
-    s = BuildDualQuatPalette(m.palette, m.dq_palette);
-    if (!s) return JobError(c, s, "dual quaternion palette");
-  }
   std::array<base::JobStatus, kMaxThreads> results{};
   ParallelRanges(nv, m.threads, [&](int chunk, int begin, int end) {
-    base::JobStatus r;
-    if (m.method == GlobalMethod::kSwd) {
-      const int nj = static_cast<int>(m.model_from_joint.size());
-      r = SwdRigJob{.rig = &*m.swd_rig,
-                    .model_from_joint = m.model_from_joint,
-                    .vertex_begin = begin,
-                    .joint_rotations = Sub(m.swd_rotations, chunk, chunk + 1, nj),
-                    .joint_positions = Sub(m.swd_joints, chunk, chunk + 1, nj),
-                    .keep_volume = false,
-                    .positions = Sub(out.positions, begin, end),
-                    .normals = has_normals ? Sub(out.normals, begin, end) : std::span<glm::vec3>()}
-              .Run();
-    } else if (m.method == GlobalMethod::kDqs) {
-      DqsJob job;
-      job.palette = m.dq_palette;
-      r = WithVertexRange(job, mesh, begin, end, out).Run();
-    } else {
-      SkinningJob job;
-      job.model_from_bind = m.palette;
-      r = WithVertexRange(job, mesh, begin, end, out).Run();
-    }
-    results[static_cast<std::size_t>(chunk)] = r;
+    results[static_cast<std::size_t>(chunk)] =
+        m.global->SkinVertices(begin, end, out.positions, out.normals);
   });
   for (const base::JobStatus& r : results) {
-    if (!r) return JobError(c, r, GlobalMethodName(m.method));
+    if (!r) return JobError(c, r, GlobalMethodName(m.global->method()));
   }
   if (!m.patches.empty()) {
     // Patch layer: carry the control points like skin vertices, add the
     // example shapes dS (in the frames the control points move with) and the
     // elastic displacements dE, rebuild and blend.
-    if (m.method == GlobalMethod::kSwd) {
-      // The joint state the vertex pass used, once more for the control points.
-      const int nj = static_cast<int>(m.model_from_joint.size());
-      const std::span<glm::quat> rotations = Sub(m.swd_rotations, 0, 1, nj);
-      const std::span<glm::vec3> joints = Sub(m.swd_joints, 0, 1, nj);
-      s = ComputeSwdJointState(*m.swd_rig, m.model_from_joint, rotations, joints);
-      for (std::size_t p = 0; s && p < m.patches.size(); ++p) {
-        s = SwdJob{.chains = m.swd_rig->chains(),
-                   .joint_rotations = rotations,
-                   .joint_positions = joints,
-                   .bindings = m.swd_control[p],
-                   .rest_normals = {},
-                   .keep_volume = false,
-                   .section_scales = {},
-                   .positions = m.carried[p],
-                   .normals = {}}
-                .Run();
-      }
-      if (!s) return JobError(c, s, "patch control points (swd)");
-      for (std::size_t p = 0; p < m.patches.size(); ++p) {
-        std::copy(m.carried[p].begin(), m.carried[p].end(), m.reference[p].begin());
-      }
-    }
-    for (std::size_t p = 0; m.method != GlobalMethod::kSwd && p < m.patches.size(); ++p) {
-      const bool dqs = m.method == GlobalMethod::kDqs;
-      s = CarryControlPointsJob{.patch = &m.patches[p],
-                                .model_from_bind = dqs ? std::span<const glm::mat4>()
-                                                       : std::span<const glm::mat4>(m.palette),
-                                .dq_palette = dqs ? std::span<const DualQuat>(m.dq_palette)
-                                                  : std::span<const DualQuat>(),
-                                .control = m.carried[p]}
-              .Run();
+    for (std::size_t p = 0; p < m.patches.size(); ++p) {
+      s = m.global->CarryPoints(m.control_points[p], m.carried[p]);
       if (!s) return JobError(c, s, "patch control points");
       std::copy(m.carried[p].begin(), m.carried[p].end(), m.reference[p].begin());
       if (p < m.pose_spaces.size() && m.pose_spaces[p].active()) {

@@ -7,8 +7,7 @@
 #include <Eigen/Sparse>
 #include <Eigen/SparseCholesky>
 
-#include "deform/global/dqs_job.h"
-#include "deform/global/skinning_job.h"
+#include "deform/global/global_skinning.h"
 #include "deform/patch/fold_measure.h"
 #include "deform/shapes/direct_manipulation.h"
 #include "deform/shapes/internal/control_grid.h"
@@ -115,11 +114,11 @@ void RegionVolumeGradient(std::span<const glm::dvec3> positions,
 }
 
 base::Result<CorrectedExample> CorrectExample(const PatchSetup& patch, const SkinnedMesh& mesh,
-                                              const ExamplePose& pose, CorrectiveKind kind,
+                                              const SkinningPose& pose, CorrectiveKind kind,
                                               const CorrectiveOptions& options) {
   const std::size_t num_skin = mesh.skin_joints.size();
   if (pose.model_from_bind.size() != num_skin ||
-      (!pose.dq_palette.empty() && pose.dq_palette.size() != num_skin)) {
+      (!pose.dual_quats.empty() && pose.dual_quats.size() != num_skin)) {
     return InvalidArgument("example pose: expected palettes of " + std::to_string(num_skin) +
                            " skin joints, found " + std::to_string(pose.model_from_bind.size()));
   }
@@ -139,34 +138,11 @@ base::Result<CorrectedExample> CorrectExample(const PatchSetup& patch, const Ski
   // G: skinned vertices and carried control points at the pose.
   const auto num_v = static_cast<std::size_t>(mesh.bind.num_vertices());
   std::vector<glm::vec3> skinned(num_v);
-  const SkinWeights& sw = mesh.weights;
-  base::JobStatus s = pose.dq_palette.empty() ? SkinningJob{.model_from_bind = pose.model_from_bind,
-                                                            .influences = sw.influences,
-                                                            .joint_indices = sw.joints,
-                                                            .joint_weights = sw.weights,
-                                                            .rest_positions = mesh.bind.positions,
-                                                            .rest_normals = {},
-                                                            .positions = skinned,
-                                                            .normals = {}}
-                                                    .Run()
-                                              : DqsJob{.palette = pose.dq_palette,
-                                                       .influences = sw.influences,
-                                                       .joint_indices = sw.joints,
-                                                       .joint_weights = sw.weights,
-                                                       .rest_positions = mesh.bind.positions,
-                                                       .rest_normals = {},
-                                                       .positions = skinned,
-                                                       .normals = {}}
-                                                    .Run();
+  base::JobStatus s = SkinPoints(pose, mesh.weights, mesh.bind.positions, {}, 0,
+                                 mesh.bind.num_vertices(), skinned, {});
   if (!s) return InvalidArgument(s.what);
   std::vector<glm::vec3> carried(static_cast<std::size_t>(nc));
-  s = CarryControlPointsJob{.patch = &patch,
-                            .model_from_bind = pose.dq_palette.empty()
-                                                   ? pose.model_from_bind
-                                                   : std::span<const glm::mat4>(),
-                            .dq_palette = pose.dq_palette,
-                            .control = carried}
-          .Run();
+  s = CarryControlPointsJob{.patch = &patch, .pose = pose, .control = carried}.Run();
   if (!s) return InvalidArgument(s.what);
   BSplineSurface base = patch.fit.surface;
   for (int c = 0; c < nc; ++c) {

@@ -99,7 +99,7 @@ void RegionVolumeGradient(std::span<const glm::dvec3> positions,
 // iterations out of range (kInvalidArgument); a volume with no sensitivity
 // (kInvalidArgument: the region's triangles are all fixed or degenerate).
 base::Result<CorrectedExample> CorrectExample(const PatchSetup& patch, const SkinnedMesh& mesh,
-                                              const ExamplePose& pose, CorrectiveKind kind,
+                                              const SkinningPose& pose, CorrectiveKind kind,
                                               const CorrectiveOptions& options = {});
 
 }  // namespace deform

@@ -27,13 +27,13 @@ glm::dmat3 Rotation3(const glm::mat4& m) { return glm::dmat3(glm::mat3(m)); }
 }  // namespace
 
 base::Result<SculptedExample> SculptExample(const PatchSetup& patch, const SkinnedMesh& mesh,
-                                            const ExamplePose& pose,
+                                            const SkinningPose& pose,
                                             std::span<const ExampleEdit> edits,
                                             const ManipulationOptions& options, int iterations) {
   const int nc = patch.num_control();
   const std::size_t num_skin = mesh.skin_joints.size();
   if (pose.model_from_bind.size() != num_skin ||
-      (!pose.dq_palette.empty() && pose.dq_palette.size() != num_skin)) {
+      (!pose.dual_quats.empty() && pose.dual_quats.size() != num_skin)) {
     return base::MakeError(ErrorCode::kInvalidArgument, {},
                            "example pose: expected palettes of " + std::to_string(num_skin) +
                                " skin joints, found " +
@@ -46,13 +46,8 @@ base::Result<SculptedExample> SculptExample(const PatchSetup& patch, const Skinn
 
   // G: the control points carried to the example pose (float, as per frame).
   std::vector<glm::vec3> carried(static_cast<std::size_t>(nc));
-  base::JobStatus s = CarryControlPointsJob{.patch = &patch,
-                                            .model_from_bind = pose.dq_palette.empty()
-                                                                   ? pose.model_from_bind
-                                                                   : std::span<const glm::mat4>(),
-                                            .dq_palette = pose.dq_palette,
-                                            .control = carried}
-                          .Run();
+  base::JobStatus s =
+      CarryControlPointsJob{.patch = &patch, .pose = pose, .control = carried}.Run();
   if (!s) return base::MakeError(ErrorCode::kInvalidArgument, {}, s.what);
   std::vector<glm::quat> rotations(static_cast<std::size_t>(nc));
   s = PatchControlRotations(patch, pose, rotations);

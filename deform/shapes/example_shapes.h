@@ -25,7 +25,7 @@
 
 #include "deform/shapes/brush_edit.h"
 #include "deform/shapes/direct_manipulation.h"
-#include "deform/global/dqs_job.h"
+#include "deform/global/global_skinning.h"
 #include "deform/mesh.h"
 #include "deform/patch/patch_layer.h"
 #include "deform/shapes/pose_space.h"
@@ -49,12 +49,6 @@ struct ExampleEdit {
   // units). 0: the plain minimum-norm edit (4.2).
   double radius = 0.0;
   base::FileLoc loc{};  // where it was defined (rig file field path), for messages
-};
-
-// The example pose's global deformation, as the pipeline builds it.
-struct ExamplePose {
-  std::span<const glm::mat4> model_from_bind{};  // #S SSD palette at the pose (required)
-  std::span<const DualQuat> dq_palette{};        // #S DQS palette, or empty for SSD
 };
 
 // A sculpted example's displacement and how well the solve met the edits.
@@ -85,13 +79,13 @@ inline constexpr float kMinEditableBorderWeight = 0.05f;
 // s(u,v) moved by its move as a heavy row; a vertex's offset d n is then not
 // re-solved for the turning normal); without one, exactly as before.
 base::Result<SculptedExample> SculptExample(const PatchSetup& patch, const SkinnedMesh& mesh,
-                                            const ExamplePose& pose,
+                                            const SkinningPose& pose,
                                             std::span<const ExampleEdit> edits,
                                             const ManipulationOptions& options = {},
                                             int iterations = 4);
 
 // The rotations A_c (#C unit quaternions) the control points of `patch` move
-// with under the global layer: DqsControlRotations when pose.dq_palette is
+// with under the global layer: DqsControlRotations when pose.dual_quats is
 // set; otherwise the SSD polar rotation of sum_b W_c,b R_b (4.3), the same
 // rotation SsdControlRotations gives (to round-off, ~1e-12 before the cast to
 // float) but faster: in closed form for a control point with one or two
@@ -114,7 +108,7 @@ base::Result<SculptedExample> SculptExample(const PatchSetup& patch, const Skinn
 // weighted joint index beyond the palette (rotations then unspecified).
 // Never allocates.
 [[nodiscard]] base::JobStatus PatchControlRotations(const PatchSetup& patch,
-                                                    const ExamplePose& pose,
+                                                    const SkinningPose& pose,
                                                     std::span<glm::quat> rotations,
                                                     std::span<const glm::vec3> displacement = {});
 

@@ -115,8 +115,8 @@ inline LayeredFrame EvaluateLayered(const LayeredBody& b, std::span<const deform
   std::vector<std::span<const glm::vec3>> views;
   for (std::size_t k = 0; k < patches.size(); ++k) {
     carried[k].resize(patches[k].rest_control.size());
-    (void)deform::CarryControlPointsJob{.patch = &patches[k], .model_from_bind = palette,
-                                        .control = carried[k]}
+    (void)deform::CarryControlPointsJob{
+        .patch = &patches[k], .pose = {.model_from_bind = palette}, .control = carried[k]}
         .Run();
     views.emplace_back(carried[k]);
   }
