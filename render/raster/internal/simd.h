@@ -16,6 +16,8 @@
 #include <emmintrin.h>
 #endif
 
+#include <glm/glm.hpp>
+
 namespace render::simd {
 
 // Nearest integer, ties to even (lrint in the default rounding mode), without
@@ -48,6 +50,16 @@ inline __m128i LoadU(const std::uint32_t* p) {
 }
 inline void StoreU(std::uint32_t* p, __m128i v) {
   _mm_storeu_si128(reinterpret_cast<__m128i*>(p), v);
+}
+
+// Lanes (v.x, v.y, v.z, v.w).
+inline __m128 Set(const glm::vec4& v) { return _mm_setr_ps(v.x, v.y, v.z, v.w); }
+
+// Per lane: x * a.x + y * a.y + z * a.z, summed left to right, no fused
+// multiply-add: four points (x, y, z) dotted with one vector a.
+inline __m128 Dot(__m128 x, __m128 y, __m128 z, const glm::vec3& a) {
+  return _mm_add_ps(_mm_add_ps(_mm_mul_ps(x, _mm_set1_ps(a.x)), _mm_mul_ps(y, _mm_set1_ps(a.y))),
+                    _mm_mul_ps(z, _mm_set1_ps(a.z)));
 }
 
 #endif  // __SSE2__
