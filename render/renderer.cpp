@@ -7,12 +7,8 @@
 #include <cstring>
 #include <limits>
 
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#include <xmmintrin.h>
-#endif
-
 #include "base/parallel.h"
+#include "render/raster/internal/simd.h"
 #include "render/raster/shading4.h"
 
 namespace render {
@@ -26,7 +22,7 @@ constexpr float kInf = std::numeric_limits<float>::infinity();
 inline void StreamStore(glm::vec4* dst, const glm::vec4& v) {
 #if defined(__SSE2__)
   if ((reinterpret_cast<std::uintptr_t>(dst) & 15u) == 0) {
-    _mm_stream_ps(reinterpret_cast<float*>(dst), _mm_set_ps(v.w, v.z, v.y, v.x));
+    _mm_stream_ps(reinterpret_cast<float*>(dst), simd::Set(v));
     return;
   }
 #endif
@@ -56,12 +52,10 @@ void WriteDepthRow(const float* inv_w, const std::uint32_t* ids, int n, float* o
   const __m128i empty = _mm_set1_epi32(static_cast<int>(kNoTriangle));
   const bool aligned = (reinterpret_cast<std::uintptr_t>(out) & 15u) == 0;
   for (; i + 4 <= n; i += 4) {
-    const __m128 miss = _mm_castsi128_ps(_mm_cmpeq_epi32(
-        _mm_loadu_si128(reinterpret_cast<const __m128i*>(ids + i)), empty));  // all ones = empty
+    const __m128 miss = _mm_castsi128_ps(_mm_cmpeq_epi32(simd::LoadU(ids + i), empty));
     // Empty samples hold 1/w = 0: divide 1 by 1 there instead, then select inf.
-    const __m128 d = _mm_div_ps(one, _mm_or_ps(_mm_andnot_ps(miss, _mm_loadu_ps(inv_w + i)),
-                                               _mm_and_ps(miss, one)));
-    const __m128 v = _mm_or_ps(_mm_and_ps(miss, inf), _mm_andnot_ps(miss, d));
+    const __m128 d = _mm_div_ps(one, simd::Select(miss, one, _mm_loadu_ps(inv_w + i)));
+    const __m128 v = simd::Select(miss, inf, d);
     if (aligned) {
       _mm_stream_ps(out + i, v);
     } else {
@@ -420,9 +414,7 @@ class Renderer::SampleShader {
     if (t.ground) return Kind::kGround;
     if (t.lambert_plane) {
       const float fx = static_cast<float>(sx - t.ref_x), fy = static_cast<float>(sy - t.ref_y);
-      _mm_store_ps(nd, _mm_add_ps(_mm_add_ps(_mm_load_ps(t.plane_c),
-                                             _mm_mul_ps(_mm_load_ps(t.plane_a), _mm_set1_ps(fx))),
-                                  _mm_mul_ps(_mm_load_ps(t.plane_b), _mm_set1_ps(fy))));
+      _mm_store_ps(nd, PlaneAt(t, fx, fy));
       _mm_store_ps(base, _mm_load_ps(t.lit_base));
       _mm_store_ps(key, _mm_load_ps(t.lit_key));
       return Kind::kColor;
@@ -431,7 +423,7 @@ class Renderer::SampleShader {
     const Kind kind =
         ShadeSample(id, static_cast<float>(sx), static_cast<float>(sy), c, deferred, i);
     if (kind != Kind::kColor) return kind;
-    _mm_store_ps(base, _mm_set_ps(1.0f, c.z, c.y, c.x));
+    _mm_store_ps(base, simd::Set(glm::vec4(c, 1.0f)));
     _mm_store_ps(key, _mm_setzero_ps());
     _mm_store_ps(nd, _mm_setzero_ps());
     return Kind::kColor;
@@ -473,16 +465,21 @@ class Renderer::SampleShader {
     return t.texture->Sample(uv, t.texture->Lod(du_dx, du_dy));
   }
 
+#if defined(__SSE2__)
+  // The entry's (N, D) planes at (fx, fy): c + a * fx + b * fy, in that order.
+  [[gnu::always_inline]] static __m128 PlaneAt(const Entry& t, float fx, float fy) {
+    return _mm_add_ps(
+        _mm_add_ps(_mm_load_ps(t.plane_c), _mm_mul_ps(_mm_load_ps(t.plane_a), _mm_set1_ps(fx))),
+        _mm_mul_ps(_mm_load_ps(t.plane_b), _mm_set1_ps(fy)));
+  }
+#endif
 
   // Lambert from the entry's planes; `alpha` is the w of the result.
   [[gnu::always_inline]] static glm::vec4 LambertPlane(const Entry& t, float fx, float fy,
                                                        float alpha) {
 #if defined(__SSE2__)
-    const __m128 v = _mm_add_ps(_mm_add_ps(_mm_load_ps(t.plane_c),
-                                           _mm_mul_ps(_mm_load_ps(t.plane_a), _mm_set1_ps(fx))),
-                                _mm_mul_ps(_mm_load_ps(t.plane_b), _mm_set1_ps(fy)));
     alignas(16) float nd[4];
-    _mm_store_ps(nd, v);
+    _mm_store_ps(nd, PlaneAt(t, fx, fy));
     const float len2 = nd[0] * nd[0] + nd[1] * nd[1] + nd[2] * nd[2];
     const float n_dot_l = nd[3] > 0.0f && len2 > 0.0f ? nd[3] / std::sqrt(len2) : 0.0f;
     alignas(16) float out[4];
@@ -702,7 +699,7 @@ void Renderer::ShadeTile(int tile, const RenderSettings& settings,
       for (int i = 0; i < n; ++i) {
         const std::uint32_t id = s.ids[row + static_cast<std::size_t>(i)];
         if (id == kNoTriangle) {
-          _mm_store_ps(base[i], _mm_set_ps(bg.w, bg.z, bg.y, bg.x));
+          _mm_store_ps(base[i], simd::Set(bg));
           _mm_store_ps(key[i], _mm_setzero_ps());
           _mm_store_ps(nd[i], _mm_setzero_ps());
         } else {
@@ -716,7 +713,7 @@ void Renderer::ShadeTile(int tile, const RenderSettings& settings,
         }
       }
       auto store_base = [&](int i, const glm::vec3& c) {
-        _mm_store_ps(base[i], _mm_set_ps(1.0f, c.z, c.y, c.x));
+        _mm_store_ps(base[i], simd::Set(glm::vec4(c, 1.0f)));
       };
       if (any_ground) ShadeGroundRow(x0, sy, n, ground, store_base);
       if (any_surface) ShadeSurfaceRow(n, surface, deferred, store_base);

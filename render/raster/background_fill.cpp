@@ -3,10 +3,7 @@
 #include <algorithm>
 #include <limits>
 
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#include <xmmintrin.h>
-#endif
+#include "render/raster/internal/simd.h"
 
 namespace render {
 namespace {
@@ -18,7 +15,7 @@ void StreamRow(glm::vec4* dst, int n, const glm::vec4& v) {
   int i = 0;
 #if defined(__SSE2__)
   if ((reinterpret_cast<std::uintptr_t>(dst) & 15u) == 0) {
-    const __m128 x = _mm_set_ps(v.w, v.z, v.y, v.x);
+    const __m128 x = simd::Set(v);
     for (; i + 4 <= n; i += 4) {  // a cache line per step
       float* p = reinterpret_cast<float*>(dst + i);
       _mm_stream_ps(p, x);

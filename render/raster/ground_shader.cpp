@@ -6,9 +6,7 @@
 #include <cstring>
 #include <limits>
 
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
+#include "render/raster/internal/simd.h"
 
 namespace render {
 namespace {
@@ -144,7 +142,7 @@ void GroundShader::Shade4(int sx, int sy, float* r, float* g, float* b) const {
     const __m128 from_edge = _mm_sub_ps(d, _mm_set1_ps(half_width_));
     // Between lines (from_edge >= soft) the weight is exactly 0.
     const __m128 near = _mm_cmplt_ps(from_edge, _mm_set1_ps(soft_));
-    if (_mm_movemask_ps(near) != 0) {
+    if (simd::Any(near)) {
       const __m128 one = _mm_set1_ps(1.0f);
       line = _mm_sub_ps(one, Clamp01(_mm_mul_ps(from_edge, _mm_set1_ps(inv_soft_))));
       const __m128 dist2 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(ox, ox), _mm_mul_ps(oz, oz)),
@@ -162,11 +160,10 @@ void GroundShader::Shade4(int sx, int sy, float* r, float* g, float* b) const {
     const __m128 uz = _mm_mul_ps(_mm_sub_ps(pz, _mm_set1_ps(s.cz)), _mm_set1_ps(s.inv_rz));
     const __m128 r2 = _mm_add_ps(_mm_mul_ps(ux, ux), _mm_mul_ps(uz, uz));
     const __m128 inside = _mm_cmplt_ps(r2, _mm_set1_ps(kShadowCutR2));
-    if (_mm_movemask_ps(inside) == 0) continue;
+    if (!simd::Any(inside)) continue;
     const __m128 e = ExpNonPositive4(_mm_mul_ps(_mm_set1_ps(-2.0f), _mm_and_ps(inside, r2)));
     const __m128 f = _mm_sub_ps(_mm_set1_ps(1.0f), _mm_mul_ps(_mm_set1_ps(s.strength), e));
-    shadow = _mm_mul_ps(shadow, _mm_or_ps(_mm_and_ps(inside, f),
-                                          _mm_andnot_ps(inside, _mm_set1_ps(1.0f))));
+    shadow = _mm_mul_ps(shadow, simd::Select(inside, f, _mm_set1_ps(1.0f)));
   }
 
   // 1 - visibility of the key light per lane (exactly 0 where lit).

@@ -3,12 +3,10 @@
 #include <algorithm>
 #include <cmath>
 
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
-
 #include "base/check.h"
 #include "base/parallel.h"
+#include "render/raster/internal/simd.h"
+#include "render/raster/internal/tile_draw.h"
 
 namespace render {
 namespace {
@@ -19,17 +17,6 @@ namespace {
 constexpr float kGuardLimitSamples = 131072.0f;
 constexpr int kMaxRasterSize = 16384;
 constexpr int kMaxClipVertices = 10;  // a triangle clipped by 6 planes has at most 9
-// Triangles whose vertices span less than this (fixed point) use the int32 loop.
-constexpr std::int32_t kSmallTriangleExtent = 48 * kSubpixelScale;
-
-// Round to nearest (ties to even), as lrint in the default rounding mode.
-std::int32_t RoundToInt(float x) {
-#if defined(__SSE2__)
-  return _mm_cvtss_si32(_mm_set_ss(x));
-#else
-  return static_cast<std::int32_t>(std::lrint(x));
-#endif
-}
 
 // Floor division for a possibly negative numerator and positive divisor.
 std::int32_t FloorDiv(std::int64_t a, std::int64_t b) {
@@ -70,8 +57,8 @@ bool Rasterizer::Snap(const glm::vec4& clip, SnappedVertex& v) const {
   const float sx = (clip.x * inv_w + 1.0f) * (0.5f * static_cast<float>(width_));
   const float sy = (1.0f - clip.y * inv_w) * (0.5f * static_cast<float>(height_));
   if (!(std::abs(sx) <= kGuardLimitSamples && std::abs(sy) <= kGuardLimitSamples)) return false;
-  v.x = RoundToInt(sx * static_cast<float>(kSubpixelScale));
-  v.y = RoundToInt(sy * static_cast<float>(kSubpixelScale));
+  v.x = simd::RoundToInt(sx * static_cast<float>(kSubpixelScale));
+  v.y = simd::RoundToInt(sy * static_cast<float>(kSubpixelScale));
   v.inv_w = inv_w;
   return true;
 }
@@ -293,207 +280,55 @@ bool Rasterizer::Setup(std::span<const ClipMesh> meshes, const RasterSettings& s
   return true;
 }
 
-void Rasterizer::RasterizeTile(int tile, std::span<float> depth,
-                               std::span<std::uint32_t> ids) const {
+namespace {
+
+// Clears tile `tile`'s buffers and names its rectangle.
+internal::TileTarget StartTile(const Rasterizer& raster, int tile, std::span<float> depth,
+                               std::span<std::uint32_t> ids) {
   PATCHSKIN_CHECK(depth.size() >= kTileBufferSize && ids.size() >= kTileBufferSize);
   std::fill(depth.begin(), depth.begin() + kTileSize * kTileSize, 0.0f);
   std::fill(ids.begin(), ids.begin() + kTileSize * kTileSize, kNoTriangle);
-  const int x0 = (tile % tiles_x_) * kTileSize, y0 = (tile / tiles_x_) * kTileSize;
-  const int x1 = std::min(x0 + kTileSize, width_), y1 = std::min(y0 + kTileSize, height_);
-  const auto t = static_cast<std::size_t>(tile);
-  for (std::uint32_t k = tile_offsets_[t]; k < tile_offsets_[t + 1]; ++k) {
-    const std::uint32_t id = bins_[k];
-    const RasterTriangle& tri = triangle(id);
-    const int bx0 = std::max(x0, tri.min_x), by0 = std::max(y0, tri.min_y);
-    const int bx1 = std::min(x1 - 1, tri.max_x), by1 = std::min(y1 - 1, tri.max_y);
-    std::int64_t row[3], step_x[3], step_y[3];
-    for (int i = 0; i < 3; ++i) {
-      const int a = (i + 1) % 3, b = (i + 2) % 3;
-      const std::int32_t dx = tri.x[b] - tri.x[a], dy = tri.y[b] - tri.y[a];
-      const bool top_left = dy < 0 || (dy == 0 && dx > 0);
-      row[i] = EdgeValue(tri.x[a], tri.y[a], tri.x[b], tri.y[b], bx0, by0) - (top_left ? 0 : 1);
-      step_x[i] = -std::int64_t{dy} * kSubpixelScale;
-      step_y[i] = std::int64_t{dx} * kSubpixelScale;
-    }
-    const std::int64_t area2 = std::int64_t{tri.x[1] - tri.x[0]} * (tri.y[2] - tri.y[0]) -
-                               std::int64_t{tri.y[1] - tri.y[0]} * (tri.x[2] - tri.x[0]);
-    const float inv_area = 1.0f / static_cast<float>(area2);
-    const float z0 = tri.inv_w[0] * inv_area, z1 = tri.inv_w[1] * inv_area,
-                z2 = tri.inv_w[2] * inv_area;
-    const std::int32_t extent_x = std::max({tri.x[0], tri.x[1], tri.x[2]}) - std::min({tri.x[0], tri.x[1], tri.x[2]});
-    const std::int32_t extent_y = std::max({tri.y[0], tri.y[1], tri.y[2]}) - std::min({tri.y[0], tri.y[1], tri.y[2]});
-    if (extent_x < kSmallTriangleExtent && extent_y < kSmallTriangleExtent) {
-      // Small triangle: every edge value inside its bounds fits in 32 bits
-      // (|dx|, |dy| < 2^14 fixed-point units, so |E| < 2^30), so the loop can
-      // run on int32 lanes without branches.
-      std::int32_t row32[3], sx32[3], sy32[3];
-      for (int i = 0; i < 3; ++i) {
-        row32[i] = static_cast<std::int32_t>(row[i]);
-        sx32[i] = static_cast<std::int32_t>(step_x[i]);
-        sy32[i] = static_cast<std::int32_t>(step_y[i]);
-      }
-      const int n = bx1 - bx0 + 1;
-#if defined(__SSE2__)
-      // Four samples per step. The edge values of a row's first four samples
-      // are kept in lanes and stepped down a row with one add each; the group
-      // reaching past the bounds (the last one, when n is not a multiple of
-      // 4) masks off its extra lanes, which may read and rewrite, unchanged,
-      // the next row or the buffer padding.
-      __m128i row0 = _mm_setr_epi32(row32[0], row32[0] + sx32[0], row32[0] + 2 * sx32[0], row32[0] + 3 * sx32[0]);
-      __m128i row1 = _mm_setr_epi32(row32[1], row32[1] + sx32[1], row32[1] + 2 * sx32[1], row32[1] + 3 * sx32[1]);
-      __m128i row2 = _mm_setr_epi32(row32[2], row32[2] + sx32[2], row32[2] + 2 * sx32[2], row32[2] + 3 * sx32[2]);
-      const __m128i down0 = _mm_set1_epi32(sy32[0]), down1 = _mm_set1_epi32(sy32[1]),
-                    down2 = _mm_set1_epi32(sy32[2]);
-      const __m128i step0 = _mm_set1_epi32(4 * sx32[0]), step1 = _mm_set1_epi32(4 * sx32[1]),
-                    step2 = _mm_set1_epi32(4 * sx32[2]);
-      const __m128 zz0 = _mm_set1_ps(z0), zz1 = _mm_set1_ps(z1), zz2 = _mm_set1_ps(z2);
-      const __m128i minus_one = _mm_set1_epi32(-1);
-      const __m128i id4 = _mm_set1_epi32(static_cast<int>(id));
-      const int full = n & ~3;  // samples in whole groups
-      const __m128i tail = _mm_cmplt_epi32(_mm_setr_epi32(0, 1, 2, 3), _mm_set1_epi32(n - full));
-      for (int sy = by0; sy <= by1; ++sy) {
-        float* d = depth.data() + static_cast<std::size_t>(sy - y0) * kTileSize +
-                   static_cast<std::size_t>(bx0 - x0);
-        std::uint32_t* out = ids.data() + (d - depth.data());
-        __m128i e0 = row0, e1 = row1, e2 = row2;
-        // Depth test and store of the group at i for the lanes in `inside`.
-        const auto group = [&](int i, __m128i inside) {
-          const __m128 z = _mm_add_ps(_mm_add_ps(_mm_mul_ps(_mm_cvtepi32_ps(e0), zz0),
-                                                 _mm_mul_ps(_mm_cvtepi32_ps(e1), zz1)),
-                                      _mm_mul_ps(_mm_cvtepi32_ps(e2), zz2));
-          const __m128 old_z = _mm_loadu_ps(d + i);
-          const __m128 pass = _mm_and_ps(_mm_castsi128_ps(inside), _mm_cmpgt_ps(z, old_z));
-          _mm_storeu_ps(d + i, _mm_or_ps(_mm_and_ps(pass, z), _mm_andnot_ps(pass, old_z)));
-          const __m128i old_id = _mm_loadu_si128(reinterpret_cast<const __m128i*>(out + i));
-          const __m128i pass_i = _mm_castps_si128(pass);
-          _mm_storeu_si128(reinterpret_cast<__m128i*>(out + i),
-                           _mm_or_si128(_mm_and_si128(pass_i, id4), _mm_andnot_si128(pass_i, old_id)));
-        };
-        int i = 0;
-        for (; i < full; i += 4) {
-          const __m128i inside =
-              _mm_cmpgt_epi32(_mm_or_si128(_mm_or_si128(e0, e1), e2), minus_one);
-          // No test for an empty group: about half of a small triangle's
-          // bounding box lies outside it, in no predictable pattern, and the
-          // mispredicted branch cost more than the masked depth test and
-          // stores it saved (RasterizeTile ~12 % faster without it, against
-          // SampleShader::Load in alternating perf profiles).
-          group(i, inside);
-          e0 = _mm_add_epi32(e0, step0);
-          e1 = _mm_add_epi32(e1, step1);
-          e2 = _mm_add_epi32(e2, step2);
+  const int x0 = (tile % raster.tiles_x()) * kTileSize, y0 = (tile / raster.tiles_x()) * kTileSize;
+  return {.x0 = x0,
+          .y0 = y0,
+          .x1 = std::min(x0 + kTileSize, raster.width()),
+          .y1 = std::min(y0 + kTileSize, raster.height()),
+          .depth = depth.data(),
+          .ids = ids.data()};
+}
+
+}  // namespace
+
+// The reference: the integer edge walk (exact, top-left rule) and a plain
+// depth test per covered sample. The fast path must match it bit for bit, so
+// the z formula and its float operation order are part of the contract.
+void internal::DrawTriangleReference(const RasterTriangle& tri, std::uint32_t id, TileTarget tile) {
+  const DepthFactors f = MakeDepthFactors(tri);
+  Rasterizer::ForEachSample(
+      tri, tile.x0, tile.y0, tile.x1, tile.y1, [&](int sx, int sy, const std::int64_t(&e)[3]) {
+        const float z = static_cast<float>(e[0]) * f.z[0] + static_cast<float>(e[1]) * f.z[1] +
+                        static_cast<float>(e[2]) * f.z[2];
+        const std::size_t at = static_cast<std::size_t>(sy - tile.y0) * kTileSize +
+                               static_cast<std::size_t>(sx - tile.x0);
+        if (z > tile.depth[at]) {
+          tile.depth[at] = z;
+          tile.ids[at] = id;
         }
-        if (i < n) {
-          const __m128i inside = _mm_and_si128(
-              _mm_cmpgt_epi32(_mm_or_si128(_mm_or_si128(e0, e1), e2), minus_one), tail);
-          if (_mm_movemask_epi8(inside) != 0) group(i, inside);
-        }
-        row0 = _mm_add_epi32(row0, down0);
-        row1 = _mm_add_epi32(row1, down1);
-        row2 = _mm_add_epi32(row2, down2);
-      }
-#else
-      for (int sy = by0; sy <= by1; ++sy) {
-        float* d = depth.data() + static_cast<std::size_t>(sy - y0) * kTileSize +
-                   static_cast<std::size_t>(bx0 - x0);
-        std::uint32_t* out = ids.data() + (d - depth.data());
-        std::int32_t e0 = row32[0], e1 = row32[1], e2 = row32[2];
-        for (int i = 0; i < n; ++i) {
-          const float z = static_cast<float>(e0) * z0 + static_cast<float>(e1) * z1 +
-                          static_cast<float>(e2) * z2;
-          const bool pass = ((e0 | e1 | e2) >= 0) & (z > d[i]);
-          d[i] = pass ? z : d[i];
-          out[i] = pass ? id : out[i];
-          e0 += sx32[0];
-          e1 += sx32[1];
-          e2 += sx32[2];
-        }
-        row32[0] += sy32[0];
-        row32[1] += sy32[1];
-        row32[2] += sy32[2];
-      }
-#endif
-      continue;
-    }
-#if defined(__SSE2__)
-    // Large triangle (the ground's two cover most tiles): the same edge values
-    // in double lanes, exact since every |E| < 2^53, four samples per step;
-    // converting them to float rounds once, as the int64 -> float cast does,
-    // so z and the result are those of the scalar loop below.
-    {
-      const int n = bx1 - bx0 + 1;
-      const __m128d zero = _mm_setzero_pd();
-      const __m128 zz0 = _mm_set1_ps(z0), zz1 = _mm_set1_ps(z1), zz2 = _mm_set1_ps(z2);
-      const __m128i count = _mm_set1_epi32(n), four = _mm_set1_epi32(4);
-      const __m128i id4 = _mm_set1_epi32(static_cast<int>(id));
-      __m128d step4[3];
-      for (int i = 0; i < 3; ++i) step4[i] = _mm_set1_pd(static_cast<double>(4 * step_x[i]));
-      for (int sy = by0; sy <= by1; ++sy) {
-        float* d = depth.data() + static_cast<std::size_t>(sy - y0) * kTileSize +
-                   static_cast<std::size_t>(bx0 - x0);
-        std::uint32_t* out = ids.data() + (d - depth.data());
-        __m128d lo[3], hi[3];  // samples (0, 1) and (2, 3) of the group
-        for (int i = 0; i < 3; ++i) {
-          const auto r = static_cast<double>(row[i]), st = static_cast<double>(step_x[i]);
-          lo[i] = _mm_setr_pd(r, r + st);
-          hi[i] = _mm_setr_pd(r + 2.0 * st, r + 3.0 * st);
-        }
-        __m128i lane = _mm_setr_epi32(0, 1, 2, 3);
-        for (int i = 0; i < n; i += 4) {
-          const __m128d in_lo = _mm_and_pd(_mm_and_pd(_mm_cmpge_pd(lo[0], zero), _mm_cmpge_pd(lo[1], zero)),
-                                           _mm_cmpge_pd(lo[2], zero));
-          const __m128d in_hi = _mm_and_pd(_mm_and_pd(_mm_cmpge_pd(hi[0], zero), _mm_cmpge_pd(hi[1], zero)),
-                                           _mm_cmpge_pd(hi[2], zero));
-          const __m128 inside = _mm_and_ps(
-              _mm_shuffle_ps(_mm_castpd_ps(in_lo), _mm_castpd_ps(in_hi), _MM_SHUFFLE(2, 0, 2, 0)),
-              _mm_castsi128_ps(_mm_cmplt_epi32(lane, count)));
-          __m128 f[3];
-          for (int j = 0; j < 3; ++j) f[j] = _mm_movelh_ps(_mm_cvtpd_ps(lo[j]), _mm_cvtpd_ps(hi[j]));
-          for (int j = 0; j < 3; ++j) {
-            lo[j] = _mm_add_pd(lo[j], step4[j]);
-            hi[j] = _mm_add_pd(hi[j], step4[j]);
-          }
-          lane = _mm_add_epi32(lane, four);
-          if (_mm_movemask_ps(inside) == 0) continue;
-          const __m128 z = _mm_add_ps(_mm_add_ps(_mm_mul_ps(f[0], zz0), _mm_mul_ps(f[1], zz1)),
-                                      _mm_mul_ps(f[2], zz2));
-          const __m128 old_z = _mm_loadu_ps(d + i);
-          const __m128 pass = _mm_and_ps(inside, _mm_cmpgt_ps(z, old_z));
-          _mm_storeu_ps(d + i, _mm_or_ps(_mm_and_ps(pass, z), _mm_andnot_ps(pass, old_z)));
-          const __m128i old_id = _mm_loadu_si128(reinterpret_cast<const __m128i*>(out + i));
-          const __m128i pass_i = _mm_castps_si128(pass);
-          _mm_storeu_si128(reinterpret_cast<__m128i*>(out + i),
-                           _mm_or_si128(_mm_and_si128(pass_i, id4), _mm_andnot_si128(pass_i, old_id)));
-        }
-        row[0] += step_y[0];
-        row[1] += step_y[1];
-        row[2] += step_y[2];
-      }
-      continue;
-    }
-#endif
-    for (int sy = by0; sy <= by1; ++sy) {
-      std::int64_t e0 = row[0], e1 = row[1], e2 = row[2];
-      const std::size_t base = static_cast<std::size_t>(sy - y0) * kTileSize;
-      for (int sx = bx0; sx <= bx1; ++sx) {
-        if ((e0 | e1 | e2) >= 0) {
-          const float z = static_cast<float>(e0) * z0 + static_cast<float>(e1) * z1 +
-                          static_cast<float>(e2) * z2;
-          const std::size_t at = base + static_cast<std::size_t>(sx - x0);
-          if (z > depth[at]) {
-            depth[at] = z;
-            ids[at] = id;
-          }
-        }
-        e0 += step_x[0];
-        e1 += step_x[1];
-        e2 += step_x[2];
-      }
-      row[0] += step_y[0];
-      row[1] += step_y[1];
-      row[2] += step_y[2];
-    }
-  }
+      });
+}
+
+void Rasterizer::RasterizeTile(int tile, std::span<float> depth,
+                               std::span<std::uint32_t> ids) const {
+  const internal::TileTarget target = StartTile(*this, tile, depth, ids);
+  for (const std::uint32_t id : tile_triangles(tile))
+    internal::DrawTriangleFast(triangle(id), id, target);
+}
+
+void Rasterizer::RasterizeTileReference(int tile, std::span<float> depth,
+                                        std::span<std::uint32_t> ids) const {
+  const internal::TileTarget target = StartTile(*this, tile, depth, ids);
+  for (const std::uint32_t id : tile_triangles(tile))
+    internal::DrawTriangleReference(triangle(id), id, target);
 }
 
 }  // namespace render

@@ -18,6 +18,7 @@
 // Determinism: each tile's bin lists its triangles in input order and a tile is
 // rasterized by one thread, so the output is identical for any thread count.
 
+#include <algorithm>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -75,6 +76,38 @@ inline std::int64_t EdgeValue(std::int32_t xa, std::int32_t ya, std::int32_t xb,
   return std::int64_t{xb - xa} * (py - ya) - std::int64_t{yb - ya} * (px - xa);
 }
 
+// Where the edge walk over one triangle starts: its sample bounds cut to a
+// rectangle, and the three edge functions there and per step. Edge i is
+// opposite vertex i (from vertex i+1 to i+2). Every value is exact in int64
+// (fixed-point coordinates < 2^25, see Setup's guard band).
+struct EdgeStart {
+  int bx0, by0, bx1, by1;  // inclusive samples to visit; none if bx0 > bx1 or by0 > by1
+  std::int64_t row[3];     // E_i at (bx0, by0), less 1 where the fill rule does not own edge i
+  std::int64_t step_x[3], step_y[3];  // change of E_i one sample right / one sample down
+};
+
+// Top-left rule: a sample exactly on an edge belongs to the triangle when the
+// edge is a left edge (interior to its right, dy < 0) or a top edge (horizontal,
+// interior below, dy == 0 and dx > 0). Biasing the other edges by -1 makes
+// "E_i >= 0 for all i" the whole coverage test, so triangles sharing an edge
+// cover each sample on it exactly once.
+inline EdgeStart StartEdges(const RasterTriangle& tri, int x0, int y0, int x1, int y1) {
+  EdgeStart s;
+  s.bx0 = std::max(x0, tri.min_x);
+  s.by0 = std::max(y0, tri.min_y);
+  s.bx1 = std::min(x1 - 1, tri.max_x);
+  s.by1 = std::min(y1 - 1, tri.max_y);
+  for (int i = 0; i < 3; ++i) {
+    const int a = (i + 1) % 3, b = (i + 2) % 3;
+    const std::int32_t dx = tri.x[b] - tri.x[a], dy = tri.y[b] - tri.y[a];
+    const bool top_left = dy < 0 || (dy == 0 && dx > 0);
+    s.row[i] = EdgeValue(tri.x[a], tri.y[a], tri.x[b], tri.y[b], s.bx0, s.by0) - (top_left ? 0 : 1);
+    s.step_x[i] = -std::int64_t{dy} * kSubpixelScale;
+    s.step_y[i] = std::int64_t{dx} * kSubpixelScale;
+  }
+  return s;
+}
+
 // Holds the per-frame triangle setup and tile bins; reuse one across frames so
 // its buffers are not reallocated.
 class Rasterizer {
@@ -96,15 +129,29 @@ class Rasterizer {
     const auto t = static_cast<std::size_t>(tile);
     return tile_offsets_[t + 1] - tile_offsets_[t];
   }
+  // Visibility ids of the triangles binned to `tile`, in input order.
+  std::span<const std::uint32_t> tile_triangles(int tile) const {
+    const auto t = static_cast<std::size_t>(tile);
+    return {bins_.data() + tile_offsets_[t], tile_triangle_count(tile)};
+  }
 
   // Rasterizes tile `tile` (row-major over tiles_x() x tiles_y()) into
   // buffers of kTileBufferSize entries (row-major over the tile, row stride
   // kTileSize): `depth` gets the largest 1/w seen (0 = empty) and `ids` the id of
   // the nearest triangle (kNoTriangle = empty). Ties keep the earlier triangle.
+  // Four samples per step with SSE2 (rasterize_tile_fast.cpp); the result is
+  // bit for bit that of RasterizeTileReference.
   void RasterizeTile(int tile, std::span<float> depth, std::span<std::uint32_t> ids) const;
+  // The same output from the scalar reference walk, one sample at a time:
+  // ForEachSample's coverage, z = sum_i float(E_i) * inv_w_i / (doubled area),
+  // summed in that order in float. The definition the fast path is tested
+  // against; several times slower.
+  void RasterizeTileReference(int tile, std::span<float> depth, std::span<std::uint32_t> ids) const;
 
-  // Calls fn(sx, sy) for every sample of `tri` inside [x0,x1)x[y0,y1) that the
-  // fill rule assigns to it (no depth test). Used by coverage tests.
+  // The edge walk: calls fn(sx, sy, e) for every sample of `tri` inside
+  // [x0,x1)x[y0,y1) that the fill rule assigns to it, row by row, left to
+  // right, with e (const std::int64_t[3]) its biased edge values (StartEdges).
+  // No depth test. Integer only, so it is exact for every triangle Setup emits.
   template <class Fn>
   static void ForEachSample(const RasterTriangle& tri, int x0, int y0, int x1, int y1, Fn&& fn);
 
@@ -166,31 +213,14 @@ class Rasterizer {
 
 template <class Fn>
 void Rasterizer::ForEachSample(const RasterTriangle& tri, int x0, int y0, int x1, int y1, Fn&& fn) {
-  const int bx0 = std::max(x0, tri.min_x), by0 = std::max(y0, tri.min_y);
-  const int bx1 = std::min(x1 - 1, tri.max_x), by1 = std::min(y1 - 1, tri.max_y);
-  if (bx0 > bx1 || by0 > by1) return;
-  std::int64_t row[3], step_x[3], step_y[3];
-  for (int i = 0; i < 3; ++i) {
-    const int a = (i + 1) % 3, b = (i + 2) % 3;  // edge opposite vertex i
-    const std::int32_t dx = tri.x[b] - tri.x[a], dy = tri.y[b] - tri.y[a];
-    // Top-left rule: an edge is owned when the interior lies to its right
-    // (left edge, dy < 0) or below a horizontal edge (top edge, dy == 0, dx > 0).
-    const bool top_left = dy < 0 || (dy == 0 && dx > 0);
-    row[i] = EdgeValue(tri.x[a], tri.y[a], tri.x[b], tri.y[b], bx0, by0) - (top_left ? 0 : 1);
-    step_x[i] = -std::int64_t{dy} * kSubpixelScale;
-    step_y[i] = std::int64_t{dx} * kSubpixelScale;
-  }
-  for (int sy = by0; sy <= by1; ++sy) {
-    std::int64_t e0 = row[0], e1 = row[1], e2 = row[2];
-    for (int sx = bx0; sx <= bx1; ++sx) {
-      if ((e0 | e1 | e2) >= 0) fn(sx, sy);
-      e0 += step_x[0];
-      e1 += step_x[1];
-      e2 += step_x[2];
+  EdgeStart s = StartEdges(tri, x0, y0, x1, y1);
+  for (int sy = s.by0; sy <= s.by1; ++sy) {
+    std::int64_t e[3] = {s.row[0], s.row[1], s.row[2]};
+    for (int sx = s.bx0; sx <= s.bx1; ++sx) {
+      if ((e[0] | e[1] | e[2]) >= 0) fn(sx, sy, e);  // all three >= 0: inside
+      for (int i = 0; i < 3; ++i) e[i] += s.step_x[i];
     }
-    row[0] += step_y[0];
-    row[1] += step_y[1];
-    row[2] += step_y[2];
+    for (int i = 0; i < 3; ++i) s.row[i] += s.step_y[i];
   }
 }
 

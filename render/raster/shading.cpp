@@ -3,9 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
+#include "render/raster/internal/simd.h"
 
 namespace render {
 
@@ -95,11 +93,7 @@ namespace {
 // distance is 0.5 either way. Floats of magnitude >= 2^23 are integers.
 float DistanceToInteger(float x) {
   if (!(std::abs(x) < 8388608.0f)) return 0.0f;
-#if defined(__SSE2__)
-  return std::abs(x - static_cast<float>(_mm_cvtss_si32(_mm_set_ss(x))));
-#else
-  return std::abs(x - std::nearbyint(x));
-#endif
+  return std::abs(x - static_cast<float>(simd::RoundToInt(x)));
 }
 
 }  // namespace

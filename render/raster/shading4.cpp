@@ -2,9 +2,7 @@
 
 #include <cmath>
 
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
+#include "render/raster/internal/simd.h"
 
 namespace render {
 
@@ -60,7 +58,7 @@ void ShadeSurface4(const ShadingContext& ctx, const SurfacePoints4& in, float (&
     const Vec4x3 l = Splat(*dirs[i]);
     const __m128 n_dot_l = Dot(n, l);
     const __m128 lit = _mm_cmpgt_ps(n_dot_l, zero);
-    if (_mm_movemask_ps(lit) == 0) continue;
+    if (!simd::Any(lit)) continue;
     Vec4x3 rad = Splat(*radiance[i]);
     if (i == 0) {  // the key light, less its shadowed share
       const __m128 v = _mm_load_ps(in.key_visibility);
@@ -75,7 +73,7 @@ void ShadeSurface4(const ShadingContext& ctx, const SurfacePoints4& in, float (&
         Normalize({_mm_add_ps(l.x, view.x), _mm_add_ps(l.y, view.y), _mm_add_ps(l.z, view.z)});
     const __m128 n_dot_h = Dot(n, half);
     const __m128 shine = _mm_and_ps(lit, _mm_cmpgt_ps(n_dot_h, zero));
-    if (_mm_movemask_ps(shine) == 0) continue;
+    if (!simd::Any(shine)) continue;
     __m128 lobe;
     if (whole) {
       // PowInteger: result = 1, times x for each set bit while x is squared.

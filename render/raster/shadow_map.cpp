@@ -7,10 +7,7 @@
 #include <limits>
 
 #include "base/parallel.h"
-
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
+#include "render/raster/internal/simd.h"
 
 namespace render {
 namespace {
@@ -336,13 +333,11 @@ void ShadowMap::Visibility4(const float (&x)[4], float y, const float (&z)[4], f
 #if defined(__SSE2__)
   // glm::dot's order, (x * a.x + y * a.y) + z * a.z, so each lane is Visibility's value.
   const __m128 px = _mm_loadu_ps(x), pz = _mm_loadu_ps(z), py = _mm_set1_ps(y);
-  const auto dot = [&](const glm::vec3& a) {
-    return _mm_add_ps(_mm_add_ps(_mm_mul_ps(px, _mm_set1_ps(a.x)), _mm_mul_ps(py, _mm_set1_ps(a.y))),
-                      _mm_mul_ps(pz, _mm_set1_ps(a.z)));
-  };
   const __m128 inv = _mm_set1_ps(inv_texel_);
-  const __m128 tx = _mm_mul_ps(_mm_sub_ps(dot(axis_u_), _mm_set1_ps(origin_.x)), inv);
-  const __m128 ty = _mm_mul_ps(_mm_sub_ps(dot(axis_v_), _mm_set1_ps(origin_.y)), inv);
+  const __m128 tx =
+      _mm_mul_ps(_mm_sub_ps(simd::Dot(px, py, pz, axis_u_), _mm_set1_ps(origin_.x)), inv);
+  const __m128 ty =
+      _mm_mul_ps(_mm_sub_ps(simd::Dot(px, py, pz, axis_v_), _mm_set1_ps(origin_.y)), inv);
   const __m128 zero = _mm_setzero_ps(), extent = _mm_set1_ps(static_cast<float>(size_));
   const int inside = _mm_movemask_ps(_mm_and_ps(
       _mm_and_ps(_mm_cmpge_ps(tx, zero), _mm_cmpge_ps(ty, zero)),
@@ -352,7 +347,7 @@ void ShadowMap::Visibility4(const float (&x)[4], float y, const float (&z)[4], f
   alignas(16) float fx[4], fy[4], depth[4];
   _mm_store_ps(fx, tx);
   _mm_store_ps(fy, ty);
-  _mm_store_ps(depth, _mm_add_ps(dot(axis_w_), _mm_set1_ps(bias_)));
+  _mm_store_ps(depth, _mm_add_ps(simd::Dot(px, py, pz, axis_w_), _mm_set1_ps(bias_)));
   for (int k = 0; k < 4; ++k)
     if ((inside >> k) & 1) out[k] = VisibilityAt(fx[k], fy[k], depth[k]);
 #else
@@ -390,12 +385,9 @@ void ShadowMap::SurfaceVisibility4(const float (&p)[3][4], const float (&n)[3][4
 #if defined(__SSE2__)
   // SurfaceVisibility's operations in its order, four lanes at a time.
   const __m128 nx = _mm_loadu_ps(n[0]), ny = _mm_loadu_ps(n[1]), nz = _mm_loadu_ps(n[2]);
-  const auto dot = [](__m128 x, __m128 y, __m128 z, const glm::vec3& a) {
-    return _mm_add_ps(_mm_add_ps(_mm_mul_ps(x, _mm_set1_ps(a.x)), _mm_mul_ps(y, _mm_set1_ps(a.y))),
-                      _mm_mul_ps(z, _mm_set1_ps(a.z)));
-  };
   const __m128 one = _mm_set1_ps(1.0f);
-  const __m128 cos_l = _mm_min_ps(_mm_max_ps(dot(nx, ny, nz, axis_w_), _mm_set1_ps(-1.0f)), one);
+  const __m128 cos_l =
+      _mm_min_ps(_mm_max_ps(simd::Dot(nx, ny, nz, axis_w_), _mm_set1_ps(-1.0f)), one);
   const __m128 sine = _mm_sqrt_ps(_mm_sub_ps(one, _mm_mul_ps(cos_l, cos_l)));
   const __m128 push =
       _mm_mul_ps(_mm_set1_ps(normal_offset_), _mm_add_ps(one, _mm_mul_ps(_mm_set1_ps(2.0f), sine)));
@@ -404,9 +396,11 @@ void ShadowMap::SurfaceVisibility4(const float (&p)[3][4], const float (&n)[3][4
   const __m128 qz = _mm_add_ps(_mm_loadu_ps(p[2]), _mm_mul_ps(nz, push));
   const __m128 inv = _mm_set1_ps(inv_texel_);
   alignas(16) float x[4], y[4], depth[4];
-  _mm_store_ps(x, _mm_mul_ps(_mm_sub_ps(dot(qx, qy, qz, axis_u_), _mm_set1_ps(origin_.x)), inv));
-  _mm_store_ps(y, _mm_mul_ps(_mm_sub_ps(dot(qx, qy, qz, axis_v_), _mm_set1_ps(origin_.y)), inv));
-  _mm_store_ps(depth, _mm_add_ps(dot(qx, qy, qz, axis_w_), _mm_set1_ps(bias_)));
+  _mm_store_ps(x,
+               _mm_mul_ps(_mm_sub_ps(simd::Dot(qx, qy, qz, axis_u_), _mm_set1_ps(origin_.x)), inv));
+  _mm_store_ps(y,
+               _mm_mul_ps(_mm_sub_ps(simd::Dot(qx, qy, qz, axis_v_), _mm_set1_ps(origin_.y)), inv));
+  _mm_store_ps(depth, _mm_add_ps(simd::Dot(qx, qy, qz, axis_w_), _mm_set1_ps(bias_)));
   for (int k = 0; k < 4; ++k)
     if ((lanes >> k) & 1) out[k] = SurfaceVisibilityAt(x[k], y[k], depth[k]);
 #else

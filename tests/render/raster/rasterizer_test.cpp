@@ -4,12 +4,15 @@
 
 #include "render/raster/rasterizer.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
 
+#include "render/raster/internal/tile_draw.h"
 #include "render/renderer.h"
 #include "support/tolerances.h"
 #include "support/sample_space.h"
@@ -29,8 +32,9 @@ std::vector<int> CountFragments(std::span<const ClipMesh> meshes, int width, int
   EXPECT_TRUE(raster.Setup(meshes, settings));
   std::vector<int> counts(static_cast<std::size_t>(width * height), 0);
   raster.ForEachTriangle([&](const render::RasterTriangle& tri) {
-    Rasterizer::ForEachSample(tri, 0, 0, width, height,
-                              [&](int x, int y) { ++counts[static_cast<std::size_t>(y * width + x)]; });
+    Rasterizer::ForEachSample(tri, 0, 0, width, height, [&](int x, int y, const auto&) {
+      ++counts[static_cast<std::size_t>(y * width + x)];
+    });
   });
   return counts;
 }
@@ -399,10 +403,10 @@ TEST(RasterizerTest, FarPlaneClipsOnlyWhenAsked) {
 }
 
 // RasterizeTile's fast paths (four samples per step: int32 lanes for small
-// triangles, exact double lanes for large ones) against the plain per-sample
-// definition: edge values from EdgeValue with the top-left bias, z = sum of
+// triangles, exact double lanes for large ones) and the reference walk against
+// the plain per-sample definition: edge values from EdgeValue with the top-left bias, z = sum of
 // float(E_i) * inv_w_i / area, nearest wins, ties keep the earlier triangle.
-TEST(RasterizerTest, TileFastPathsEqualThePerSampleDefinition) {
+TEST(RasterizerTest, TileWalksEqualThePerSampleDefinition) {
   const int w = 230, h = 170;  // partial tiles at the right and bottom
   std::vector<glm::vec4> clip;
   std::vector<glm::uvec3> tris;
@@ -435,7 +439,7 @@ TEST(RasterizerTest, TileFastPathsEqualThePerSampleDefinition) {
                                std::int64_t{tri.y[1] - tri.y[0]} * (tri.x[2] - tri.x[0]);
     const float inv_area = 1.0f / static_cast<float>(area2);
     large += tri.max_x - tri.min_x > 48 ? 1 : 0;
-    Rasterizer::ForEachSample(tri, 0, 0, w, h, [&](int x, int y) {
+    Rasterizer::ForEachSample(tri, 0, 0, w, h, [&](int x, int y, const auto&) {
       float z = 0.0f;
       for (int i = 0; i < 3; ++i) {
         const int a = (i + 1) % 3, b = (i + 2) % 3;
@@ -457,22 +461,134 @@ TEST(RasterizerTest, TileFastPathsEqualThePerSampleDefinition) {
   ASSERT_GT(large, 10);
   std::vector<float> depth(render::kTileBufferSize);
   std::vector<std::uint32_t> ids(render::kTileBufferSize);
-  int covered = 0;
-  for (int tile = 0; tile < raster.num_tiles(); ++tile) {
-    raster.RasterizeTile(tile, depth, ids);
-    const int x0 = (tile % raster.tiles_x()) * render::kTileSize;
-    const int y0 = (tile / raster.tiles_x()) * render::kTileSize;
-    for (int y = y0; y < std::min(y0 + render::kTileSize, h); ++y) {
-      for (int x = x0; x < std::min(x0 + render::kTileSize, w); ++x) {
-        const auto local = static_cast<std::size_t>((y - y0) * render::kTileSize + (x - x0));
-        const auto at = static_cast<std::size_t>(y * w + x);
-        ASSERT_EQ(ids[local], ref_ids[at]) << x << "," << y;
-        ASSERT_EQ(depth[local], ref_depth[at]) << x << "," << y;
-        covered += ids[local] != render::kNoTriangle ? 1 : 0;
+  for (const bool reference : {false, true}) {  // RasterizeTile, RasterizeTileReference
+    int covered = 0;
+    for (int tile = 0; tile < raster.num_tiles(); ++tile) {
+      if (reference) {
+        raster.RasterizeTileReference(tile, depth, ids);
+      } else {
+        raster.RasterizeTile(tile, depth, ids);
+      }
+      const int x0 = (tile % raster.tiles_x()) * render::kTileSize;
+      const int y0 = (tile / raster.tiles_x()) * render::kTileSize;
+      for (int y = y0; y < std::min(y0 + render::kTileSize, h); ++y) {
+        for (int x = x0; x < std::min(x0 + render::kTileSize, w); ++x) {
+          const auto local = static_cast<std::size_t>((y - y0) * render::kTileSize + (x - x0));
+          const auto at = static_cast<std::size_t>(y * w + x);
+          ASSERT_EQ(ids[local], ref_ids[at]) << x << "," << y << " reference " << reference;
+          ASSERT_EQ(depth[local], ref_depth[at]) << x << "," << y << " reference " << reference;
+          covered += ids[local] != render::kNoTriangle ? 1 : 0;
+        }
+      }
+    }
+    EXPECT_GT(covered, w * h / 2);
+  }
+}
+
+// Triangles of every kind RasterizeTile's fast path treats differently, in
+// clip space with a different w per vertex: tiny to large (both sides of
+// kSmallTriangleExtent), slivers, a grid whose shared edges pass through
+// sample centres (the top-left rule decides), a duplicated patch (depth ties),
+// and triangles crossing tile and raster edges.
+std::vector<glm::vec4> MixedTriangleSoup(int w, int h, std::vector<glm::uvec3>& tris) {
+  std::vector<glm::vec4> clip;
+  std::uint32_t seed = 2024u;
+  auto next = [&seed] {  // deterministic LCG in [0, 1)
+    seed = seed * 1664525u + 1013904223u;
+    return static_cast<float>(seed >> 8) / 16777216.0f;
+  };
+  // A vertex at sample-space (sx, sy) with a random w (the same projected point).
+  auto vertex = [&](float sx, float sy) {
+    const float wv = 0.5f + 2.0f * next();
+    clip.push_back(AtSample(sx, sy, w, h) * wv);
+    return static_cast<unsigned>(clip.size() - 1);
+  };
+  // Grid of 7.5-sample cells from sample centre (2.5, 3.5): its vertical,
+  // horizontal and diagonal edges cross sample centres; twice over its first
+  // rows, so equal depths tie.
+  const int cells_x = static_cast<int>((static_cast<float>(w) - 5.0f) / 7.5f);
+  const int cells_y = static_cast<int>((static_cast<float>(h) - 5.0f) / 7.5f);
+  const auto first = static_cast<unsigned>(clip.size());
+  for (int j = 0; j <= cells_y; ++j)
+    for (int i = 0; i <= cells_x; ++i)
+      vertex(2.5f + 7.5f * static_cast<float>(i), 3.5f + 7.5f * static_cast<float>(j));
+  const auto at = [&](int i, int j) {
+    return first + static_cast<unsigned>(j * (cells_x + 1) + i);
+  };
+  for (int copy = 0; copy < 2; ++copy) {
+    for (int j = 0; j < (copy == 0 ? cells_y : 3); ++j) {
+      for (int i = 0; i < cells_x; ++i) {
+        if ((i + j) % 2 == 0) {  // both diagonals
+          tris.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
+          tris.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
+        } else {
+          tris.push_back({at(i, j), at(i + 1, j), at(i, j + 1)});
+          tris.push_back({at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)});
+        }
       }
     }
   }
-  EXPECT_GT(covered, w * h / 2);
+  // Random triangles over and past the raster: sizes log-uniform from 0.3 to
+  // 300 samples, every 4th a sliver (its third vertex within a sample of the
+  // line through the other two).
+  for (int t = 0; t < 600; ++t) {
+    const float size = 0.3f * std::pow(1000.0f, next());
+    const glm::vec2 c(-20.0f + (static_cast<float>(w) + 40.0f) * next(),
+                      -20.0f + (static_cast<float>(h) + 40.0f) * next());
+    const glm::vec2 a = c + size * glm::vec2(next() - 0.5f, next() - 0.5f);
+    const glm::vec2 b = c + size * glm::vec2(next() - 0.5f, next() - 0.5f);
+    const glm::vec2 q = t % 4 == 0 ? a + next() * (b - a) + glm::vec2(next() - 0.5f, next() - 0.5f)
+                                   : c + size * glm::vec2(next() - 0.5f, next() - 0.5f);
+    tris.push_back({vertex(a.x, a.y), vertex(b.x, b.y), vertex(q.x, q.y)});
+  }
+  return clip;
+}
+
+// The fast path (SSE2 lanes, tail masks) against the scalar reference walk,
+// every tile, every sample, bit for bit; raster sizes leave partial tiles and
+// rows of every length mod 4.
+TEST(RasterizerTest, FastTileWalkEqualsTheReferenceBitForBit) {
+  for (const auto& [w, h] : {std::pair{197, 133}, std::pair{64, 64}, std::pair{131, 67}}) {
+    std::vector<glm::uvec3> tris;
+    const std::vector<glm::vec4> clip = MixedTriangleSoup(w, h, tris);
+    const ClipMesh mesh{.clip_positions = clip, .triangles = tris};
+    Rasterizer raster;
+    ASSERT_TRUE(raster.Setup({&mesh, 1}, {.width = w, .height = h, .threads = 1}));
+    // What the soup exercises: both lane types, tails, samples on owned edges.
+    int small = 0, large = 0, tails = 0, on_edge = 0;
+    raster.ForEachTriangle([&](const render::RasterTriangle& tri) {
+      const std::int32_t extent = std::max(
+          std::max({tri.x[0], tri.x[1], tri.x[2]}) - std::min({tri.x[0], tri.x[1], tri.x[2]}),
+          std::max({tri.y[0], tri.y[1], tri.y[2]}) - std::min({tri.y[0], tri.y[1], tri.y[2]}));
+      ++(extent < render::internal::kSmallTriangleExtent ? small : large);
+      tails += (tri.max_x - tri.min_x + 1) % 4 != 0 ? 1 : 0;
+      Rasterizer::ForEachSample(tri, 0, 0, w, h, [&](int, int, const std::int64_t(&e)[3]) {
+        on_edge += (e[0] == 0 || e[1] == 0 || e[2] == 0) ? 1 : 0;
+      });
+    });
+    EXPECT_GT(small, 200) << w << "x" << h;
+    EXPECT_GT(large, 50) << w << "x" << h;
+    EXPECT_GT(tails, 100) << w << "x" << h;
+    EXPECT_GT(on_edge, 500) << w << "x" << h;
+    std::vector<float> depth(render::kTileBufferSize), ref_depth(render::kTileBufferSize);
+    std::vector<std::uint32_t> ids(render::kTileBufferSize), ref_ids(render::kTileBufferSize);
+    int covered = 0;
+    for (int tile = 0; tile < raster.num_tiles(); ++tile) {
+      raster.RasterizeTile(tile, depth, ids);
+      raster.RasterizeTileReference(tile, ref_depth, ref_ids);
+      for (int k = 0; k < render::kTileSize * render::kTileSize; ++k) {
+        const auto i = static_cast<std::size_t>(k);
+        const int x = (tile % raster.tiles_x()) * render::kTileSize + k % render::kTileSize;
+        const int y = (tile / raster.tiles_x()) * render::kTileSize + k / render::kTileSize;
+        ASSERT_EQ(ids[i], ref_ids[i]) << w << "x" << h << " sample " << x << "," << y;
+        ASSERT_EQ(std::memcmp(&depth[i], &ref_depth[i], sizeof(float)), 0)
+            << w << "x" << h << " sample " << x << "," << y << ": " << depth[i] << " vs "
+            << ref_depth[i];
+        covered += ids[i] != render::kNoTriangle ? 1 : 0;
+      }
+    }
+    EXPECT_GT(covered, w * h / 2) << w << "x" << h;
+  }
 }
 
 TEST(RasterizerTest, OutputIsIdenticalFor1And2And8Threads) {
