@@ -320,8 +320,8 @@ int RunBench(const BenchOptions& o) {
   base::Result<deform::FramePipeline> pipeline =
       deform::FramePipeline::Create(ch, deform::GlobalMethod::kSsd, threads);
   if (!pipeline.ok()) return ReportError(pipeline.error());
-  base::Result<CameraPlan> cameras =
-      CameraPlan::Create(*pipeline, *plan, "follow", 15.0f, {1280, 720});
+  base::Result<render::CameraPlan> cameras =
+      PlanCameras(*pipeline, *plan, "follow", 15.0f, {1280, 720});
   if (!cameras.ok()) return ReportError(cameras.error());
   deform::DeformedFrame frame;
   if (base::Status s = pipeline->Evaluate(0.0, frame); !s.ok()) return ReportError(s.error());
@@ -340,7 +340,7 @@ int RunBench(const BenchOptions& o) {
   const std::string triangles = std::to_string(ch.mesh.bind.num_triangles()) + " triangles";
   for (const glm::ivec2 size : {glm::ivec2(1280, 720), glm::ivec2(1920, 1080)}) {
     const render::RenderSettings s = draw_settings(size.x, size.y, 1, 1);
-    render::Camera camera = cameras->At(plan->frames.front());
+    render::Camera camera = cameras->At(plan->frames.front().camera);
     camera.aspect = static_cast<float>(size.x) / static_cast<float>(size.y);
     rows.push_back({"raster_fps_" + std::to_string(size.x) + "x" + std::to_string(size.y), "frames/s",
                     Clock::kCpu, Rates(budget, Clock::kCpu, 1.0, [&] {
@@ -368,8 +368,9 @@ int RunBench(const BenchOptions& o) {
       const double c0 = Now(Clock::kProcess);
       for (int i = 0; i < n; ++i) {
         const OutputFrame& of = plan->frames[static_cast<std::size_t>(i % e2e_frames)];
-        failed |= !DrawCharacterFrame(ch, posed[static_cast<std::size_t>(i)], nullptr, cameras->At(of), s,
-                                      {}, renderer, right_renderer, scratch, image)
+        failed |= !DrawCharacterFrame(ch, posed[static_cast<std::size_t>(i)], nullptr,
+                                      cameras->At(of.camera), s, {}, renderer, right_renderer,
+                                      scratch, image)
                        .ok();
       }
       return std::max(Now(Clock::kProcess) - c0, 1e-9);
@@ -418,8 +419,8 @@ int RunBench(const BenchOptions& o) {
       if (s.ok()) {
         FrameDrawOptions draw;
         draw.frame_number = of.number;
-        s = DrawCharacterFrame(ch, frame, nullptr, cameras->At(of), e2e_settings, draw, renderer,
-                               right_renderer, scratch, image);
+        s = DrawCharacterFrame(ch, frame, nullptr, cameras->At(of.camera), e2e_settings, draw,
+                               renderer, right_renderer, scratch, image);
       }
       if (s.ok()) {
         char name[32];
@@ -478,8 +479,8 @@ int RunBench(const BenchOptions& o) {
       settings.antialias = aa;
       FrameDrawOptions draw;
       draw.frame_number = of.number;
-      return DrawCharacterFrame(ch, frame, nullptr, cameras->At(of), settings, draw, renderer,
-                                right_renderer, scratch, img);
+      return DrawCharacterFrame(ch, frame, nullptr, cameras->At(of.camera), settings, draw,
+                                renderer, right_renderer, scratch, img);
     };
   };
   std::vector<render::Image> rendered(static_cast<std::size_t>(out_frames));

@@ -210,10 +210,10 @@ int RunExport(const ExportOptions& options) {
   // pre-pass evaluates the pipeline, as render's does before its frame loop,
   // so a pipeline that carries state between frames (the elastic layer) sees
   // the same sequence of evaluations here as there.
-  base::Result<CameraPlan> camera_plan =
-      CameraPlan::Create(*pipeline, *plan, o.camera, o.elevation_deg, *size);
+  base::Result<render::CameraPlan> camera_plan =
+      PlanCameras(*pipeline, *plan, o.camera, o.elevation_deg, *size);
   if (!camera_plan.ok()) return ReportError(camera_plan.error());
-  const CameraPlan* cameras = o.with_camera ? &*camera_plan : nullptr;
+  const render::CameraPlan* cameras = o.with_camera ? &*camera_plan : nullptr;
   std::optional<deform::GltfSequenceWriter> gltf;
   const deform::Mesh& bind = ch.mesh.bind;
   if (glb) {
@@ -224,7 +224,7 @@ int RunExport(const ExportOptions& options) {
     go.generator = "patchskin export (" + std::string(deform::GlobalMethodName(*method)) + ")";
     go.scratch_dir = out_dir.empty() ? "." : out_dir.string();
     if (cameras) {  // the lens is the same at every frame; the scale moves the planes with the scene
-      const render::Camera first = cameras->At(plan->At(0));
+      const render::Camera first = cameras->At(plan->At(0).camera);
       go.camera = deform::GltfCameraLens{.yfov_rad = glm::radians(first.fov_y_deg),
                                          .aspect = first.aspect,
                                          .znear = first.near_plane * o.scale,
@@ -308,7 +308,7 @@ int RunExport(const ExportOptions& options) {
       char file[32];
       std::snprintf(file, sizeof(file), "camera_%04d.json", of.number);
       // Scaling the scene and the camera's lengths together gives the same picture.
-      render::Camera camera = cameras->At(of);
+      render::Camera camera = cameras->At(of.camera);
       camera.eye *= o.scale;
       camera.target *= o.scale;
       camera.near_plane *= o.scale;

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "base/check.h"
+#include "render/camera_plan.h"
 
 namespace app {
 
@@ -123,57 +124,52 @@ OutputFrame FramePlan::At(std::size_t i) const {
   return {start_number + f, f * frame_time_s, f};
 }
 
-base::Result<CameraPlan> CameraPlan::Create(deform::FramePipeline& pipeline, const FramePlan& plan,
-                                            const std::string& mode, float elevation_deg,
-                                            glm::ivec2 size) {
-  CameraSpec spec;
-  spec.mode = mode;
-  spec.elevation_deg = elevation_deg;
-  return Create(pipeline, plan, spec, size);
-}
-
-glm::vec3 CameraPlan::LookPoint(const deform::DeformedFrame& f) const {
-  if (look_joint_ >= 0) return f.joint_positions[static_cast<std::size_t>(look_joint_)];
-  if (look_region_.empty()) return f.bounds.center();
-  glm::dvec3 sum(0.0);
-  for (const int v : look_region_) sum += glm::dvec3(f.positions[static_cast<std::size_t>(v)]);
-  return glm::vec3(sum / static_cast<double>(look_region_.size()));
-}
-
 namespace {
 
-// The direction the camera looks along: from the eye at `azimuth_deg` about +Y
-// (0 = the body's front, +Z) and `elevation_deg` above the horizontal.
-glm::vec3 ViewDirection(const CameraSpec& spec) {
-  const float elevation = glm::radians(spec.elevation_deg);
-  if (!spec.azimuth_deg) {
-    // Seen from the character's front-left, slightly above (characters face +Z).
-    return -glm::normalize(glm::vec3(0.45f, 0.0f, 1.0f) * std::cos(elevation) +
-                           glm::vec3(0.0f, std::sin(elevation), 0.0f));
-  }
-  const float azimuth = glm::radians(*spec.azimuth_deg);
-  return -glm::vec3(std::sin(azimuth) * std::cos(elevation), std::sin(elevation),
-                    std::cos(azimuth) * std::cos(elevation));
-}
-
-// Moves the eye of a framed camera to `spec`'s distance and zoom (the target
-// stays), near and far following it. Without either it is left as framed.
-void ApplyDistance(const CameraSpec& spec, float body_extent, render::Camera& c) {
-  if (spec.distance <= 0.0f && spec.zoom == 1.0f) return;
-  const glm::vec3 offset = c.eye - c.target;
-  const float framed = glm::length(offset);
-  const float distance = (spec.distance > 0.0f ? spec.distance : framed) / spec.zoom;
-  c.eye = c.target + offset * (distance / framed);
-  c.near_plane = std::max(distance * 0.02f, 1e-3f);
-  c.far_plane = distance + 4.0f * body_extent;
+// The body as the cameras see it: a private global-only SSD pipeline of the
+// character (patches and the elastic layer move the surface by a few percent of
+// the body; the caller's pipeline and its state are never touched).
+base::Result<render::BodySampler> SkinnedBodySampler(const deform::FramePipeline& pipeline,
+                                                     const CameraSpec& spec) {
+  base::Result<deform::FramePipeline> tracker = deform::FramePipeline::Create(
+      pipeline.character(), deform::GlobalMethod::kSsd, pipeline.threads());
+  if (!tracker.ok()) return std::move(tracker).error();
+  struct State {
+    deform::FramePipeline pipeline;
+    deform::DeformedFrame frame;
+    int look_joint;
+    std::vector<int> look_region;
+  };
+  auto state =
+      std::make_shared<State>(State{std::move(*tracker), {}, spec.look_joint, spec.look_region});
+  return render::BodySampler([state](double time_s, render::BodySample& out) -> base::Status {
+    State& st = *state;
+    if (base::Status s = st.pipeline.Evaluate(time_s, st.frame); !s.ok()) return s;
+    out.bounds = st.frame.bounds;
+    out.look_bounds = deform::Bounds();
+    for (const int v : st.look_region) {
+      out.look_bounds.Extend(st.frame.positions[static_cast<std::size_t>(v)]);
+    }
+    if (st.look_joint >= 0) {
+      out.look_point = st.frame.joint_positions[static_cast<std::size_t>(st.look_joint)];
+    } else if (!st.look_region.empty()) {
+      glm::dvec3 sum(0.0);
+      for (const int v : st.look_region) {
+        sum += glm::dvec3(st.frame.positions[static_cast<std::size_t>(v)]);
+      }
+      out.look_point = glm::vec3(sum / static_cast<double>(st.look_region.size()));
+    } else {
+      out.look_point = st.frame.bounds.center();
+    }
+    return base::Status::Ok();
+  });
 }
 
 }  // namespace
 
-base::Result<CameraPlan> CameraPlan::Create(deform::FramePipeline& pipeline, const FramePlan& plan,
-                                            const CameraSpec& spec, glm::ivec2 size) {
-  const std::string& mode = spec.mode;
-  const float elevation_deg = spec.elevation_deg;
+base::Result<render::CameraPlan> PlanCameras(const deform::FramePipeline& pipeline,
+                                             const FramePlan& plan, const CameraSpec& spec,
+                                             glm::ivec2 size) {
   if (spec.azimuth_deg && !(std::abs(*spec.azimuth_deg) <= 3600.0f)) {
     return ArgError("--azimuth", "expected finite degrees in -3600..3600");
   }
@@ -192,193 +188,46 @@ base::Result<CameraPlan> CameraPlan::Create(deform::FramePipeline& pipeline, con
       return ArgError("--look-at", "region vertex out of range");
     }
   }
+  const std::string& mode = spec.mode;
   if (mode != "follow" && mode != "fixed" && mode != "turntable") {
     return ArgError("--camera", "expected follow, fixed or turntable, found '" + mode + "'");
   }
   if (plan.count() == 0) return ArgError("--frames", "no frames to frame");
   // At +-90 degrees the view looks straight along the up vector (a degenerate
   // look-at); NaN would reach the rasterizer's float-to-int conversions.
-  if (!(std::abs(elevation_deg) <= kMaxElevationDeg)) {
+  if (!(std::abs(spec.elevation_deg) <= render::kMaxElevationDeg)) {
     std::ostringstream found;
-    found << elevation_deg;
+    found << spec.elevation_deg;
     return ArgError("--elevation", "expected degrees in -89..89, found " + found.str());
   }
-  CameraPlan cp;
-  cp.mode_ = mode;
-  cp.look_joint_ = spec.look_joint;
-  cp.look_region_ = spec.look_region;
-  const bool look = spec.look_joint >= 0 || !spec.look_region.empty();
-  cp.frame_time_s_ = plan.frame_time_s;
-  base::Result<deform::FramePipeline> tracker = deform::FramePipeline::Create(
-      pipeline.character(), deform::GlobalMethod::kSsd, pipeline.threads());
-  if (!tracker.ok()) return std::move(tracker).error();
-  cp.tracker_ = std::make_unique<deform::FramePipeline>(std::move(*tracker));
-  // Framing: output frames spread evenly over the whole motion, both ends
-  // included, the same whatever --frames asks for.
-  deform::DeformedFrame& frame = cp.scratch_;
-  deform::Bounds all_bounds;
-  glm::vec3 largest_extent(0.0f);
-  float ground_y = 1e30f;
-  // Look-at: the followed point of every sample and the region's largest extent.
-  std::vector<glm::vec3> look_points;
-  glm::vec3 region_extent(0.0f);
-  const std::int64_t last = std::max(0, plan.motion_frames - 1);
-  const std::int64_t samples = std::min<std::int64_t>(kFramingSamples, last + 1);
-  for (std::int64_t i = 0; i < samples; ++i) {
-    const std::int64_t f = samples > 1 ? last * i / (samples - 1) : 0;
-    const base::Status s = cp.tracker_->Evaluate(static_cast<double>(f) * plan.frame_time_s, frame);
-    if (!s.ok()) return s.error();
-    all_bounds.Extend(frame.bounds.min);
-    all_bounds.Extend(frame.bounds.max);
-    largest_extent = glm::max(largest_extent, frame.bounds.size());
-    ground_y = std::min(ground_y, frame.bounds.min.y);
-    if (look) {
-      look_points.push_back(cp.LookPoint(frame));
-      deform::Bounds region;
-      for (const int v : spec.look_region) region.Extend(frame.positions[static_cast<std::size_t>(v)]);
-      if (!region.empty()) region_extent = glm::max(region_extent, region.size());
-    }
-  }
-  // The box framed around the followed point: the whole body, or the look-at
-  // neighbourhood (a joint: a third of the body's largest extent; a region:
-  // its own extent and as much again around it).
-  const float body_extent = std::max({largest_extent.x, largest_extent.y, largest_extent.z});
-  const glm::vec3 half_box = !look ? 0.5f * largest_extent
-                             : spec.look_region.empty() ? glm::vec3(body_extent / 6.0f)
-                                                        : region_extent;
-  cp.ground_y_ = ground_y;
-  const float aspect = static_cast<float>(size.x) / static_cast<float>(size.y);
-  const glm::vec3 view_dir = ViewDirection(spec);
-  if (mode == "turntable") {
-    const base::Status s = cp.tracker_->Evaluate(plan.At(0).time_s, frame);
-    if (!s.ok()) return s.error();
-    deform::Bounds box = frame.bounds;
-    if (look) {
-      box = deform::Bounds();
-      box.Extend(cp.LookPoint(frame) - half_box);
-      box.Extend(cp.LookPoint(frame) + half_box);
-    }
-    render::Camera framed = render::FrameBounds(box, kFovYDeg, aspect, view_dir);
-    ApplyDistance(spec, body_extent, framed);
-    cp.turntable_ = render::TurntablePath(box.center(), glm::length(framed.eye - framed.target),
-                                          elevation_deg, static_cast<int>(plan.count()));
-    for (render::Camera& c : cp.turntable_) {
-      c.fov_y_deg = kFovYDeg;
-      c.aspect = aspect;
-      if (look || spec.distance > 0.0f || spec.zoom != 1.0f) {
-        c.near_plane = framed.near_plane;
-        c.far_plane = framed.far_plane;
-      }
-    }
-  } else if (mode == "fixed") {
-    deform::Bounds box = all_bounds;
-    if (look) {
-      box = deform::Bounds();
-      for (const glm::vec3& p : look_points) {
-        box.Extend(p - half_box);
-        box.Extend(p + half_box);
-      }
-    }
-    cp.fixed_ = render::FrameBounds(box, kFovYDeg, aspect, view_dir);
-    if (look) {
-      const float d = glm::length(cp.fixed_.eye - cp.fixed_.target);
-      cp.fixed_.near_plane = std::max(d * 0.02f, 1e-3f);
-      cp.fixed_.far_plane = d + 4.0f * body_extent;
-    }
-    ApplyDistance(spec, body_extent, cp.fixed_);
-  } else {
-    deform::Bounds typical;
-    typical.Extend(-half_box);
-    typical.Extend(half_box);
-    render::Camera framed = render::FrameBounds(typical, kFovYDeg, aspect, view_dir);
-    if (look) {
-      // Close to a part of the body: the rest of it may lie between the eye and
-      // the part's box, so near may not stop at the box.
-      framed.near_plane = std::max(glm::length(framed.eye - framed.target) * 0.02f, 1e-3f);
-      framed.far_plane = glm::length(framed.eye - framed.target) + 4.0f * body_extent;
-    }
-    ApplyDistance(spec, body_extent, framed);
-    render::FollowCamera& follow = cp.follow_;
-    follow.offset = framed.eye - framed.target;
-    follow.fov_y_deg = kFovYDeg;
-    follow.aspect = aspect;
-    follow.near_plane = framed.near_plane;
-    follow.far_plane = framed.far_plane * 4.0f;
-    follow.frame_time_s = static_cast<float>(plan.frame_time_s);
-    cp.centres_.reserve(static_cast<std::size_t>(follow.window_frames) + 1);
-  }
-  return cp;
+  base::Result<render::BodySampler> sampler = SkinnedBodySampler(pipeline, spec);
+  if (!sampler.ok()) return std::move(sampler).error();
+  const render::CameraSettings settings{
+      .mode = mode == "fixed"       ? render::CameraMode::kFixed
+              : mode == "turntable" ? render::CameraMode::kTurntable
+                                    : render::CameraMode::kFollow,
+      .elevation_deg = spec.elevation_deg,
+      .azimuth_deg = spec.azimuth_deg,
+      .distance = spec.distance,
+      .zoom = spec.zoom,
+      .aim = spec.look_joint >= 0        ? render::CameraAim::kJoint
+             : !spec.look_region.empty() ? render::CameraAim::kRegion
+                                         : render::CameraAim::kBody,
+      .size = size};
+  const render::CameraTimes times{.frame_time_s = plan.frame_time_s,
+                                  .motion_frames = std::max(1, plan.motion_frames),
+                                  .turntable_time_s = plan.At(0).time_s,
+                                  .turntable_views = static_cast<int>(plan.count())};
+  return render::CameraPlan::Create(std::move(*sampler), settings, times);
 }
 
-namespace {
-
-// Largest |x| or |y| in normalised device coordinates of the corners of `box`.
-float ProjectedExtent(const deform::Bounds& box, const render::Camera& camera) {
-  const glm::mat4 clip_from_world = camera.ClipFromView() * camera.ViewFromWorld();
-  float worst = 0.0f;
-  for (int k = 0; k < 8; ++k) {
-    const glm::vec3 p((k & 1) ? box.max.x : box.min.x, (k & 2) ? box.max.y : box.min.y,
-                      (k & 4) ? box.max.z : box.min.z);
-    const glm::vec4 c = clip_from_world * glm::vec4(p, 1.0f);
-    if (!(c.w > 0.0f)) return std::numeric_limits<float>::infinity();
-    worst = std::max({worst, std::abs(c.x / c.w), std::abs(c.y / c.w)});
-  }
-  return worst;
-}
-
-}  // namespace
-
-void CameraPlan::KeepInFrame(const deform::Bounds& box, render::Camera& camera) const {
-  if (box.empty() || ProjectedExtent(box, camera) <= kFollowFrameLimit) return;
-  // Slide target and eye together toward the box's centre: the least pull s
-  // in [0, 1] that brings the box inside the limit (bisection; s = 1 centres it).
-  const glm::vec3 offset = camera.eye - camera.target;
-  const glm::vec3 lagging = camera.target;
-  const glm::vec3 centre = box.center();
-  const auto at = [&](float s) {
-    render::Camera c = camera;
-    c.target = lagging + s * (centre - lagging);
-    c.eye = c.target + offset;
-    return c;
-  };
-  float lo = 0.0f, hi = 1.0f;
-  for (int i = 0; i < 20; ++i) {
-    const float mid = 0.5f * (lo + hi);
-    (ProjectedExtent(box, at(mid)) <= kFollowFrameLimit ? hi : lo) = mid;
-  }
-  camera = at(hi);
-}
-
-render::Camera CameraPlan::At(const OutputFrame& frame) const {
-  if (mode_ == "turntable") return turntable_[static_cast<std::size_t>(frame.camera)];
-  if (mode_ == "fixed") return fixed_;
-  // The window of centres frame - window .. frame: keep what is already
-  // evaluated, drop what fell out, evaluate the rest in ascending order.
-  const int f = frame.camera;
-  const int first = std::max(0, f - std::max(follow_.window_frames, 0));
-  const int cached_end = centre_base_ + static_cast<int>(centres_.size());
-  if (first < centre_base_ || first > cached_end) {
-    centres_.clear();
-    boxes_.clear();
-    centre_base_ = first;
-  } else if (first > centre_base_) {
-    centres_.erase(centres_.begin(), centres_.begin() + (first - centre_base_));
-    boxes_.erase(boxes_.begin(), boxes_.begin() + (first - centre_base_));
-    centre_base_ = first;
-  }
-  for (int g = centre_base_ + static_cast<int>(centres_.size()); g <= f; ++g) {
-    // Evaluate() only fails on sizes, which Create() already checked with
-    // the same pipeline.
-    const base::Status s = tracker_->Evaluate(g * frame_time_s_, scratch_);
-    PATCHSKIN_CHECK(s.ok());
-    centres_.push_back(LookPoint(scratch_));
-    boxes_.push_back(scratch_.bounds);
-  }
-  render::Camera camera = follow_.At(centres_, f - centre_base_);
-  // A camera aimed at a joint or a region frames that close up on purpose.
-  const bool whole_body = look_joint_ < 0 && look_region_.empty();
-  if (whole_body) KeepInFrame(boxes_[static_cast<std::size_t>(f - centre_base_)], camera);
-  return camera;
+base::Result<render::CameraPlan> PlanCameras(const deform::FramePipeline& pipeline,
+                                             const FramePlan& plan, const std::string& mode,
+                                             float elevation_deg, glm::ivec2 size) {
+  CameraSpec spec;
+  spec.mode = mode;
+  spec.elevation_deg = elevation_deg;
+  return PlanCameras(pipeline, plan, spec, size);
 }
 
 }  // namespace app

@@ -17,13 +17,9 @@
 #include "mocap/motion.h"
 #include "mocap/skeleton.h"
 #include "render/camera.h"
+#include "render/camera_plan.h"
 
 namespace app {
-
-// Vertical field of view of every render camera, degrees.
-inline constexpr float kFovYDeg = 35.0f;
-// Largest camera elevation (--elevation), degrees either way.
-inline constexpr float kMaxElevationDeg = 89.0f;
 
 // kInvalidArgument naming the command-line option, e.g. "--frames: error: ...".
 base::Error ArgError(const std::string& option, const std::string& message);
@@ -98,7 +94,7 @@ base::Result<FramePlan> PlanFrames(const mocap::Motion& motion, const FramePlanO
 // --elevation, --distance, --zoom, --look-at; a rig's render.camera object).
 struct CameraSpec {
   std::string mode = "follow";       // follow | fixed | turntable
-  float elevation_deg = 15.0f;       // above the horizontal, |e| <= kMaxElevationDeg
+  float elevation_deg = 15.0f;       // above the horizontal, |e| <= render::kMaxElevationDeg
   // The eye's direction about +Y from the body's front (+Z), towards +X (its
   // left side at 90). None: front-left, atan(0.45) = 24.2 degrees.
   std::optional<float> azimuth_deg;
@@ -112,78 +108,17 @@ struct CameraSpec {
   std::vector<int> look_region;
 };
 
-// The camera of every output frame, as `render` uses it: "follow" (a smoothed
-// follow camera framing the body's largest extent), "fixed" (one camera
-// framing the bounds of the whole motion) or "turntable" (an orbit of the
-// first frame of the range).
-//
-// Nothing here depends on the requested frame range beyond the frame being
-// asked for, so a render split into chunks (--frames 0:9, 10:19, ...) gets the
-// same cameras and ground as one whole render:
-// - framing (extent, fixed bounds, ground height) samples at most
-//   kFramingSamples output frames spread evenly over the WHOLE motion
-//   (deterministic, independent of --frames);
-// - the follow camera of frame f reads the bounds centres of frames
-//   max(0, f - window) .. f only (render::FollowCamera), evaluated on demand and
-//   kept in a sliding window, so memory is constant and the first frame needs
-//   at most window + 1 evaluations, however long the capture. The smoothed
-//   target lags a fast body (a running dog); it is pulled toward frame f's
-//   bounds centre just far enough that the corners of frame f's bounding box
-//   project within kFollowFrameLimit of the image centre (normalised device
-//   coordinates), so the body stays in the frame with a margin. Framing puts a
-//   centred body inside that limit, so the pull always succeeds.
-// Bodies are evaluated with a private global-only SSD pipeline of the same
-// character (patches and the elastic layer move the surface by a few
-// percent of the body; the caller's pipeline and its state are never touched).
-class CameraPlan {
- public:
-  // Output frames of the whole motion sampled for framing and ground height.
-  static constexpr int kFramingSamples = 64;
-  // Follow: the body's bounding box stays within this |x|, |y| (NDC, 1 = the
-  // frame's edge) whenever the camera's framing allows it.
-  static constexpr float kFollowFrameLimit = 0.9f;
-
-  // mode: follow | fixed | turntable; elevation in degrees, |e| <= kMaxElevationDeg
-  // (else kInvalidArgument naming --elevation); size in pixels.
-  // `pipeline` only supplies the character and thread count; it must outlive
-  // nothing here (the character must outlive the CameraPlan).
-  // Errors: kInvalidArgument (mode), and the pipeline's errors.
-  static base::Result<CameraPlan> Create(deform::FramePipeline& pipeline, const FramePlan& plan,
-                                         const std::string& mode, float elevation_deg,
-                                         glm::ivec2 size);
-  // The same with every camera setting (CameraSpec); kInvalidArgument naming
-  // --azimuth, --distance, --zoom or --look-at for values out of range.
-  static base::Result<CameraPlan> Create(deform::FramePipeline& pipeline, const FramePlan& plan,
-                                         const CameraSpec& spec, glm::ivec2 size);
-
-  // The camera of `frame` (one of the plan's frames). Follow: evaluates the
-  // frames of its window not seen yet, so ascending frames cost one body
-  // evaluation each. Not thread-safe (a cache is updated).
-  render::Camera At(const OutputFrame& frame) const;
-  // Lowest point of the sampled frames (world Y): where render draws the ground.
-  float ground_y() const { return ground_y_; }
-
- private:
-  // Follow: pulls `camera` (target and eye together) toward the centre of
-  // `box` until the box projects within kFollowFrameLimit (see above).
-  void KeepInFrame(const deform::Bounds& box, render::Camera& camera) const;
-
-  // The point the camera follows in `f`: the look-at joint, the look-at
-  // region's centroid, or the bounds centre.
-  glm::vec3 LookPoint(const deform::DeformedFrame& f) const;
-  std::string mode_;
-  std::vector<render::Camera> turntable_;
-  render::Camera fixed_;
-  render::FollowCamera follow_;
-  double frame_time_s_ = 1.0 / 30.0;           // output frame f is at f * frame_time_s_
-  std::unique_ptr<deform::FramePipeline> tracker_;  // global-only SSD body for bounds
-  mutable std::vector<glm::vec3> centres_;     // follow: bounds centres of frames centre_base_..
-  mutable std::vector<deform::Bounds> boxes_;  // follow: their bounds
-  mutable int centre_base_ = 0;
-  mutable deform::DeformedFrame scratch_;
-  float ground_y_ = 0.0f;
-  int look_joint_ = -1;
-  std::vector<int> look_region_;
-};
+// The cameras of `plan` as `spec` asks (render::CameraPlan), framing the
+// character `pipeline` deforms, seen through a private global-only SSD pipeline
+// of it (the caller's pipeline and its state are never touched). Errors:
+// kInvalidArgument naming --camera, --elevation, --azimuth, --distance, --zoom,
+// --look-at or --frames; the pipeline's errors.
+base::Result<render::CameraPlan> PlanCameras(const deform::FramePipeline& pipeline,
+                                             const FramePlan& plan, const CameraSpec& spec,
+                                             glm::ivec2 size);
+// The same with the default aim, distance and azimuth.
+base::Result<render::CameraPlan> PlanCameras(const deform::FramePipeline& pipeline,
+                                             const FramePlan& plan, const std::string& mode,
+                                             float elevation_deg, glm::ivec2 size);
 
 }  // namespace app

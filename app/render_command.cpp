@@ -456,8 +456,8 @@ int RunRender(const RenderOptions& options) {
     if (rig && options.given.count("--look-at") == 0) e.loc = {rig->file, 0, 0, "render.camera.look_at"};
     return ReportError(e);
   }
-  base::Result<CameraPlan> cameras =
-      CameraPlan::Create(*pipeline, *framing, camera_spec, view_size);
+  base::Result<render::CameraPlan> cameras =
+      PlanCameras(*pipeline, *framing, camera_spec, view_size);
   if (!cameras.ok()) return ReportError(cameras.error());
   const float ground_y = cameras->ground_y();
 
@@ -579,7 +579,7 @@ int RunRender(const RenderOptions& options) {
       if (!s.ok()) return ReportError(s.error());
       continue;
     }
-    const render::Camera camera = cameras->At(of);
+    const render::Camera camera = cameras->At(of.camera);
     // Displacement colours on a scale shared by both bodies (1, 2 or 5 x 10^k
     // above the frame's largest displacement: the frame alone decides it).
     float delta_scale = 0.0f;

@@ -17,7 +17,7 @@ using base::MakeError;
 
 constexpr std::int64_t kMaxSheetPixels = std::int64_t{1} << 26;
 
-base::Error Invalid(const std::string& what) {
+base::Error SheetError(const std::string& what) {
   return MakeError(ErrorCode::kInvalidArgument, FileLoc{}, "contact sheet: " + what);
 }
 
@@ -31,10 +31,10 @@ cv::Mat Wrap(const Image& img) {
 Result<ContactSheetLayout> ComputeContactSheetLayout(int num_frames, int frame_width,
                                                      int frame_height,
                                                      const ContactSheetOptions& o) {
-  if (num_frames <= 0) return Invalid("expected at least one frame");
-  if (frame_width <= 0 || frame_height <= 0) return Invalid("expected a non-empty frame size");
+  if (num_frames <= 0) return SheetError("expected at least one frame");
+  if (frame_width <= 0 || frame_height <= 0) return SheetError("expected a non-empty frame size");
   if (o.columns < 1 || o.thumb_width < 8 || o.padding < 0 || o.label_height < 0) {
-    return Invalid("expected columns >= 1, thumb_width >= 8, padding >= 0, label_height >= 0");
+    return SheetError("expected columns >= 1, thumb_width >= 8, padding >= 0, label_height >= 0");
   }
   ContactSheetLayout l;
   l.columns = std::min(o.columns, num_frames);
@@ -48,8 +48,8 @@ Result<ContactSheetLayout> ComputeContactSheetLayout(int num_frames, int frame_w
   const std::int64_t h = std::int64_t{l.rows} * (l.thumb_height + o.label_height) +
                          std::int64_t{l.rows + 1} * o.padding;
   if (w * h > kMaxSheetPixels) {
-    return Invalid("sheet of " + std::to_string(w) + "x" + std::to_string(h) +
-                   " pixels is too large (use fewer frames or smaller thumbnails)");
+    return SheetError("sheet of " + std::to_string(w) + "x" + std::to_string(h) +
+                      " pixels is too large (use fewer frames or smaller thumbnails)");
   }
   l.width = static_cast<int>(w);
   l.height = static_cast<int>(h);
@@ -75,14 +75,14 @@ Result<std::unique_ptr<ContactSheetBuilder>> ContactSheetBuilder::Create(
 
 Status ContactSheetBuilder::Add(const Image& frame, int frame_number) {
   if (added_ >= num_frames_) {
-    return Invalid("more frames added than the " + std::to_string(num_frames_) + " announced");
+    return SheetError("more frames added than the " + std::to_string(num_frames_) + " announced");
   }
   if (frame.width != frame_width_ || frame.height != frame_height_ ||
       frame.rgba.size() != static_cast<std::size_t>(frame.width) *
                                static_cast<std::size_t>(frame.height)) {
-    return Invalid("expected a " + std::to_string(frame_width_) + "x" +
-                   std::to_string(frame_height_) + " frame, found " +
-                   std::to_string(frame.width) + "x" + std::to_string(frame.height));
+    return SheetError("expected a " + std::to_string(frame_width_) + "x" +
+                      std::to_string(frame_height_) + " frame, found " +
+                      std::to_string(frame.width) + "x" + std::to_string(frame.height));
   }
   const ContactSheetLayout& l = layout_;
   const int col = added_ % l.columns;
@@ -115,12 +115,13 @@ Status ContactSheetBuilder::Add(const Image& frame, int frame_number) {
 
 Result<Image> MakeContactSheet(std::span<const NumberedFrame> frames,
                                const ContactSheetOptions& options) {
-  if (frames.empty() || frames[0].image == nullptr) return Invalid("expected at least one frame");
+  if (frames.empty() || frames[0].image == nullptr)
+    return SheetError("expected at least one frame");
   Result<std::unique_ptr<ContactSheetBuilder>> builder = ContactSheetBuilder::Create(
       static_cast<int>(frames.size()), frames[0].image->width, frames[0].image->height, options);
   if (!builder) return builder.error();
   for (const NumberedFrame& f : frames) {
-    if (f.image == nullptr) return Invalid("null frame");
+    if (f.image == nullptr) return SheetError("null frame");
     if (Status s = (*builder)->Add(*f.image, f.frame_number); !s) return s.error();
   }
   return (*builder)->sheet();

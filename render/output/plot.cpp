@@ -17,7 +17,7 @@ using base::ErrorCode;
 using base::FileLoc;
 using base::MakeError;
 
-base::Error Invalid(const std::string& what) {
+base::Error PlotError(const std::string& what) {
   return MakeError(ErrorCode::kInvalidArgument, FileLoc{}, "plot: " + what);
 }
 
@@ -49,16 +49,16 @@ constexpr int kFont = cv::FONT_HERSHEY_SIMPLEX;
 
 base::Result<Image> DrawTimePlot(const PlotOptions& options) {
   const int W = options.width, H = options.height;
-  if (W < 200 || H < 200 || W > 4096 || H > 4096) return Invalid("size outside [200, 4096]");
+  if (W < 200 || H < 200 || W > 4096 || H > 4096) return PlotError("size outside [200, 4096]");
   const std::vector<double>& t = options.times_s;
-  if (t.size() < 2) return Invalid("fewer than 2 sample times");
+  if (t.size() < 2) return PlotError("fewer than 2 sample times");
   for (std::size_t k = 1; k < t.size(); ++k)
-    if (!(t[k] > t[k - 1])) return Invalid("sample times are not increasing");
-  if (options.panels.empty()) return Invalid("no panel");
+    if (!(t[k] > t[k - 1])) return PlotError("sample times are not increasing");
+  if (options.panels.empty()) return PlotError("no panel");
   for (const PlotPanel& panel : options.panels) {
-    if (panel.curves.empty()) return Invalid("panel '" + panel.title + "' has no curve");
+    if (panel.curves.empty()) return PlotError("panel '" + panel.title + "' has no curve");
     for (const PlotCurve& c : panel.curves)
-      if (c.values.size() != t.size()) return Invalid("curve '" + c.label + "' is not #T long");
+      if (c.values.size() != t.size()) return PlotError("curve '" + c.label + "' is not #T long");
   }
 
   cv::Mat canvas(H, W, CV_8UC3, kWhite);
@@ -67,7 +67,7 @@ base::Result<Image> DrawTimePlot(const PlotOptions& options) {
     const int gap = 30;
     const int num_panels = static_cast<int>(options.panels.size());
     const int panel_h = (H - top - bottom - gap * (num_panels - 1)) / num_panels;
-    if (panel_h < 40) return Invalid("too many panels for the height");
+    if (panel_h < 40) return PlotError("too many panels for the height");
     if (!options.title.empty()) {
       cv::putText(canvas, options.title, {left, 32}, kFont, 0.7, kInk, 1, cv::LINE_AA);
     }

@@ -120,8 +120,8 @@ float WorstFollowExtent(const app::Character& ch) {
       app::PlanFrames(ch.motion, {.frames = "", .list_frames = false});
   EXPECT_TRUE(plan.ok());
   if (!p.ok() || !plan.ok()) return INFINITY;
-  base::Result<app::CameraPlan> cameras =
-      app::CameraPlan::Create(*p, *plan, "follow", 15.0f, {1280, 720});
+  base::Result<render::CameraPlan> cameras =
+      app::PlanCameras(*p, *plan, "follow", 15.0f, {1280, 720});
   EXPECT_TRUE(cameras.ok());
   if (!cameras.ok()) return INFINITY;
   deform::DeformedFrame frame;
@@ -129,7 +129,7 @@ float WorstFollowExtent(const app::Character& ch) {
   for (std::size_t i = 0; i < plan->count(); ++i) {
     const app::OutputFrame of = plan->At(i);
     EXPECT_TRUE(p->Evaluate(of.time_s, frame).ok());
-    const render::Camera camera = cameras->At(of);
+    const render::Camera camera = cameras->At(of.camera);
     const glm::mat4 clip_from_world = camera.ClipFromView() * camera.ViewFromWorld();
     for (std::size_t v = 0; v < frame.positions.size(); v += 4) {
       const glm::vec4 c = clip_from_world * glm::vec4(frame.positions[v], 1.0f);

@@ -82,8 +82,8 @@ TEST(ExportCommand, ObjFramesAreThePipelineFramesAndCamerasAreRenders) {
   base::Result<deform::FramePipeline> pipeline =
       deform::FramePipeline::Create(ch, deform::GlobalMethod::kDqs, 1);
   ASSERT_TRUE(pipeline.ok());
-  base::Result<app::CameraPlan> cameras =
-      app::CameraPlan::Create(*pipeline, *plan, "follow", 15.0f, {320, 200});
+  base::Result<render::CameraPlan> cameras =
+      app::PlanCameras(*pipeline, *plan, "follow", 15.0f, {320, 200});
   ASSERT_TRUE(cameras.ok());
 
   deform::DeformedFrame frame;
@@ -102,11 +102,11 @@ TEST(ExportCommand, ObjFramesAreThePipelineFramesAndCamerasAreRenders) {
 
     std::snprintf(name, sizeof(name), "camera_%04d.json", of.number);
     const nlohmann::json j = nlohmann::json::parse(testsupport::SlurpFile(dir / name));
-    const render::Camera cam = cameras->At(of);
+    const render::Camera cam = cameras->At(of.camera);
     EXPECT_EQ(j["frame"].get<int>(), of.number);
     EXPECT_EQ(j["width"].get<int>(), 320);
     EXPECT_EQ(j["height"].get<int>(), 200);
-    EXPECT_EQ(j["fov_y_deg"].get<float>(), app::kFovYDeg);
+    EXPECT_EQ(j["fov_y_deg"].get<float>(), render::kFovYDeg);
     EXPECT_EQ(j["aspect"].get<float>(), 320.0f / 200.0f);
     EXPECT_EQ(j["near"].get<float>(), cam.near_plane);
     EXPECT_EQ(j["far"].get<float>(), cam.far_plane);

@@ -40,7 +40,7 @@ render::Image RenderElbow(View view) {
   spec.azimuth_deg = demo->rig.render.azimuth_deg;
   spec.zoom = demo->rig.render.zoom;
   EXPECT_TRUE(app::ResolveLookAt(demo->rig.render.look_at, &demo->rig, ch, spec).ok());
-  auto cameras = app::CameraPlan::Create(*demo->global, *plan, spec, {kWidth / 2, kHeight});
+  auto cameras = app::PlanCameras(*demo->global, *plan, spec, {kWidth / 2, kHeight});
   EXPECT_TRUE(cameras.ok());
   if (!cameras.ok()) return render::Image(kWidth, kHeight);
   const app::OutputFrame of = plan->At(kFrame);
@@ -76,8 +76,8 @@ render::Image RenderElbow(View view) {
   }
   render::Renderer a, b;
   render::Image image, scratch;
-  EXPECT_TRUE(app::DrawCharacterFrame(ch, left, &right, cameras->At(of), settings, draw, a, b,
-                                      scratch, image)
+  EXPECT_TRUE(app::DrawCharacterFrame(ch, left, &right, cameras->At(of.camera), settings, draw, a,
+                                      b, scratch, image)
                   .ok());
   return image;
 }
