@@ -173,24 +173,21 @@ double PeakResidentMb() {
   return static_cast<double>(kb) * 1024.0 / 1e6;
 }
 
-}  // namespace
-
-int RunRender(const RenderOptions& options) {
-  const auto started = std::chrono::steady_clock::now();
-  double first_frame_s = -1.0;  // --stats: when the first frame went to the writer
-  // --- A rig file (docs/rig-file.md) sets the inputs and render settings ---
-  RenderOptions o = options;
+// A rig file (docs/rig-file.md), or the rig --layer auto makes, when the
+// input is one: its settings fill in what the command line left out (an option
+// given wins). No rig: nothing changes.
+base::Result<std::optional<Rig>> TakeRenderRig(RenderOptions& o) {
   std::optional<Rig> rig;
   if (!o.layer.empty()) {
     // --layer auto: the rig `patchskin rig auto` would write, used as if read.
     base::Result<Rig> made = AutoRigForCommand(o.layer, o.input, o.motion, o.body, o.up, o.quiet);
-    if (!made.ok()) return ReportError(made.error());
+    if (!made.ok()) return std::move(made).error();
     rig = std::move(*made);
     o.given.erase("--body");  // the rig names the body now
     o.body = "generated";
   } else if (std::filesystem::path(o.input).extension() == ".json") {
     base::Result<Rig> loaded = LoadRig(o.input);
-    if (!loaded.ok()) return ReportError(loaded.error());
+    if (!loaded.ok()) return std::move(loaded).error();
     rig = std::move(*loaded);
   }
   if (rig) {
@@ -208,100 +205,131 @@ int RunRender(const RenderOptions& options) {
     }
     if (!given("--out") || o.out.empty()) o.out = rig->render.output;
   }
+  return rig;
+}
 
-  // --- Arguments -------------------------------------------------------------
-  const base::Result<glm::ivec2> size = ParseSize(o.size);
-  if (!size.ok()) return ReportError(size.error());
+// The --overlay items asked for.
+struct Overlays {
+  bool skeleton = false, wire = false, patches = false, delta = false;
+};
+
+// The render options' ranges and names (kInvalidArgument naming the option);
+// the overlays they ask for.
+base::Result<Overlays> CheckRenderOptions(const RenderOptions& o, glm::ivec2 size) {
   if (o.supersample != 1 && o.supersample != 2 && o.supersample != 4) {
-    return ReportError(
-        ArgError("--supersample", "expected 1, 2 or 4, found " + std::to_string(o.supersample)));
+    return ArgError("--supersample", "expected 1, 2 or 4, found " + std::to_string(o.supersample));
   }
-  if (std::int64_t{size->x} * size->y * o.supersample * o.supersample > kMaxFrameSamples) {
-    return ReportError(
-        ArgError("--size", "expected at most " + std::to_string(kMaxFrameSamples) +
-                               " samples per frame (width x height x supersample^2), found " +
-                               o.size + " at supersample " + std::to_string(o.supersample)));
+  if (std::int64_t{size.x} * size.y * o.supersample * o.supersample > kMaxFrameSamples) {
+    return ArgError("--size", "expected at most " + std::to_string(kMaxFrameSamples) +
+                                  " samples per frame (width x height x supersample^2), found " +
+                                  o.size + " at supersample " + std::to_string(o.supersample));
   }
   if (o.aa != "ssaa" && o.aa != "msaa") {
-    return ReportError(ArgError("--aa", "expected ssaa or msaa, found '" + o.aa + "'"));
+    return ArgError("--aa", "expected ssaa or msaa, found '" + o.aa + "'");
   }
   if (o.shadows != "on" && o.shadows != "off") {
-    return ReportError(ArgError("--shadows", "expected on or off, found '" + o.shadows + "'"));
+    return ArgError("--shadows", "expected on or off, found '" + o.shadows + "'");
   }
   if (o.textures != "on" && o.textures != "off") {
-    return ReportError(ArgError("--textures", "expected on or off, found '" + o.textures + "'"));
+    return ArgError("--textures", "expected on or off, found '" + o.textures + "'");
   }
   if (o.resolve != "box" && o.resolve != "tent") {
-    return ReportError(ArgError("--resolve", "expected box or tent, found '" + o.resolve + "'"));
+    return ArgError("--resolve", "expected box or tent, found '" + o.resolve + "'");
   }
   if (o.resolve == "tent" && o.supersample > 1 &&
-      std::int64_t{size->x} * size->y * o.supersample * o.supersample > kMaxTentSamples) {
-    return ReportError(
-        ArgError("--resolve", "a tent resolve keeps every sample: expected at most " +
-                                  std::to_string(kMaxTentSamples) + " samples per frame, found " +
-                                  o.size + " at supersample " + std::to_string(o.supersample)));
+      std::int64_t{size.x} * size.y * o.supersample * o.supersample > kMaxTentSamples) {
+    return ArgError("--resolve", "a tent resolve keeps every sample: expected at most " +
+                                     std::to_string(kMaxTentSamples) +
+                                     " samples per frame, found " + o.size + " at supersample " +
+                                     std::to_string(o.supersample));
   }
   if (o.png_compression < 0 || o.png_compression > 9) {
-    return ReportError(ArgError("--png-compression", "expected 0..9"));
+    return ArgError("--png-compression", "expected 0..9");
   }
   if (o.camera != "follow" && o.camera != "fixed" && o.camera != "turntable") {
-    return ReportError(
-        ArgError("--camera", "expected follow, fixed or turntable, found '" + o.camera + "'"));
+    return ArgError("--camera", "expected follow, fixed or turntable, found '" + o.camera + "'");
   }
   if (o.turntable_frames < 1 || o.turntable_frames > 100000) {
-    return ReportError(ArgError("--turntable-frames", "expected 1..100000"));
+    return ArgError("--turntable-frames", "expected 1..100000");
   }
-  if (const auto bad = CheckThreads(o.threads)) return ReportError(*bad);
-  if (const auto bad = CheckFps(o.fps)) return ReportError(*bad);
-  bool overlay_skeleton = false, overlay_wire = false, overlay_patches = false, overlay_delta = false;
+  if (const auto bad = CheckThreads(o.threads)) return *bad;
+  if (const auto bad = CheckFps(o.fps)) return *bad;
+  Overlays overlays;
   for (const std::string& item : SplitList(o.overlay)) {
-    if (item == "skeleton") overlay_skeleton = true;
-    else if (item == "wire" || item == "wireframe") overlay_wire = true;
-    else if (item == "patches") overlay_patches = true;
-    else if (item == "delta") overlay_delta = true;
+    if (item == "skeleton")
+      overlays.skeleton = true;
+    else if (item == "wire" || item == "wireframe")
+      overlays.wire = true;
+    else if (item == "patches")
+      overlays.patches = true;
+    else if (item == "delta")
+      overlays.delta = true;
     else {
-      return ReportError(
-          ArgError("--overlay", "expected skeleton, wire, patches or delta, found '" + item + "'"));
+      return ArgError("--overlay",
+                      "expected skeleton, wire, patches or delta, found '" + item + "'");
     }
   }
   if (o.label != "none" && o.label != "frame" && o.label != "timecode") {
-    return ReportError(
-        ArgError("--label", "expected none, frame or timecode, found '" + o.label + "'"));
+    return ArgError("--label", "expected none, frame or timecode, found '" + o.label + "'");
   }
   if (o.background != "gradient" && o.background != "transparent") {
-    return ReportError(
-        ArgError("--background", "expected gradient or transparent, found '" + o.background + "'"));
+    return ArgError("--background",
+                    "expected gradient or transparent, found '" + o.background + "'");
   }
+  return overlays;
+}
+
+// The body to render: a rig file names its body ("character"); a glTF body
+// is the character and the BVH input its --motion (o.input and o.motion are
+// set so). Errors name --body.
+base::Result<BodyKind> ResolveRenderBody(RenderOptions& o, const Rig* rig) {
+  BodyKind body_kind = BodyKind::kGenerated;
+  const std::string body_ext = std::filesystem::path(o.body).extension().string();
+  if (body_ext == ".glb" || body_ext == ".gltf") {
+    if (rig || !o.motion.empty()) {
+      return ArgError(
+          "--body",
+          "a glTF/GLB body takes a BVH INPUT as its motion; not with a rig file or --motion");
+    }
+    o.motion = o.input.empty() ? std::string() : o.input;
+    if (o.motion.empty())
+      return ArgError("--body", "a glTF/GLB body needs a BVH INPUT to drive it");
+    o.input = o.body;
+  } else {
+    const base::Result<BodyKind> kind = ParseBodyKind(o.body);
+    if (!kind.ok()) return kind.error();
+    body_kind = rig ? RigBodyKind(*rig) : *kind;
+    if (rig && o.given.count("--body") > 0 && *kind != body_kind) {
+      return ArgError("--body",
+                      "the rig file names its body (\"character\"); expected " +
+                          std::string(body_kind == BodyKind::kTubes ? "tubes" : "generated") +
+                          " or no --body with this rig");
+    }
+  }
+  return body_kind;
+}
+
+}  // namespace
+
+int RunRender(const RenderOptions& options) {
+  const auto started = std::chrono::steady_clock::now();
+  double first_frame_s = -1.0;  // --stats: when the first frame went to the writer
+  RenderOptions o = options;
+  base::Result<std::optional<Rig>> loaded_rig = TakeRenderRig(o);
+  if (!loaded_rig.ok()) return ReportError(loaded_rig.error());
+  const std::optional<Rig>& rig = *loaded_rig;
+  const base::Result<glm::ivec2> size = ParseSize(o.size);
+  if (!size.ok()) return ReportError(size.error());
+  base::Result<Overlays> overlays = CheckRenderOptions(o, *size);
+  if (!overlays.ok()) return ReportError(overlays.error());
+  const auto [overlay_skeleton, overlay_wire, overlay_patches, overlay_delta] = *overlays;
   const base::Result<deform::GlobalMethod> method = ParseGlobalMethod(o.global);
   if (!method.ok()) return ReportError(method.error());
   base::Result<TwoBodies> two = ChooseTwoBodies(o, rig ? &*rig : nullptr, *method);
   if (!two.ok()) return ReportError(two.error());
 
-  // --- Body: a rig file names its body ("character"); a glTF body is the
-  // character and the BVH input its --motion.
-  BodyKind body_kind = BodyKind::kGenerated;
-  const std::string body_ext = std::filesystem::path(o.body).extension().string();
-  if (body_ext == ".glb" || body_ext == ".gltf") {
-    if (rig || !o.motion.empty()) {
-      return ReportError(ArgError(
-          "--body",
-          "a glTF/GLB body takes a BVH INPUT as its motion; not with a rig file or --motion"));
-    }
-    o.motion = o.input.empty() ? std::string() : o.input;
-    if (o.motion.empty())
-      return ReportError(ArgError("--body", "a glTF/GLB body needs a BVH INPUT to drive it"));
-    o.input = o.body;
-  } else {
-    const base::Result<BodyKind> kind = ParseBodyKind(o.body);
-    if (!kind.ok()) return ReportError(kind.error());
-    body_kind = rig ? RigBodyKind(*rig) : *kind;
-    if (rig && o.given.count("--body") > 0 && *kind != body_kind) {
-      return ReportError(ArgError(
-          "--body", "the rig file names its body (\"character\"); expected " +
-                        std::string(body_kind == BodyKind::kTubes ? "tubes" : "generated") +
-                        " or no --body with this rig"));
-    }
-  }
+  const base::Result<BodyKind> body_kind = ResolveRenderBody(o, rig ? &*rig : nullptr);
+  if (!body_kind.ok()) return ReportError(body_kind.error());
 
   // --- Input -----------------------------------------------------------------
   const bool demo = o.input.empty();
@@ -311,7 +339,7 @@ int RunRender(const RenderOptions& options) {
   const base::Result<std::optional<mocap::UpAxis>> up = ParseUpAxis(o.up);
   if (!up.ok()) return ReportError(up.error());
   base::Result<Character> character =
-      LoadCommandCharacter(o.input, o.motion, o.quiet, *up, o.joint_map, nullptr, body_kind);
+      LoadCommandCharacter(o.input, o.motion, o.quiet, *up, o.joint_map, nullptr, *body_kind);
   if (!character.ok()) return ReportError(character.error());
   const Character& ch = *character;
 
