@@ -28,6 +28,7 @@
 #include "deform/pipeline/frame_pipeline.h"
 #include "app/rig_file.h"
 #include "app/rig_patches.h"
+#include "app/rig_setup.h"
 #include "mocap/kinematics.h"
 #include "render/camera.h"
 #include "render/image.h"
@@ -191,7 +192,8 @@ void BM_BellyFrameShare(benchmark::State& state) {
     const double t = f * dt;
     const double t0 = ThreadCpuSeconds();
     if (!pipeline->Evaluate(t, frame).ok()) std::abort();
-    const app::FrameDrawOptions options{.frame_number = f};
+    app::FrameDrawOptions options;
+    options.frame_number = f;
     if (!app::DrawCharacterFrame(*c, frame, nullptr, camera, settings, options, renderer, unused,
                                  scratch, image)
              .ok()) {
