@@ -4,15 +4,16 @@
 #include <string>
 
 #include "app/auto_rig.h"
-#include "app/bench_frame.h"
-#include "app/demo_data.h"
-#include "app/motion_source.h"
+#include "app/bench_scenes.h"
 #include "app/character.h"
 #include "deform/pipeline/frame_pipeline.h"
 #include "app/rig_setup.h"
 
 namespace app::bench {
 namespace {
+
+using ::bench::Clock;
+using ::bench::Now;
 
 bool ReportAutoLayer(const base::Error& e, bool* failed) {
   std::fprintf(stderr, "bench: auto layer: %s\n", e.ToString().c_str());
@@ -23,9 +24,7 @@ bool ReportAutoLayer(const base::Error& e, bool* failed) {
 }  // namespace
 
 void AddAutoLayerRows(const Budget& b, int frames, std::vector<Row>& rows, bool* failed) {
-  base::Result<MotionSource> src = LoadBvhText(DemoBvhText(), "demo_walk.bvh", {.y_up = true});
-  if (!src.ok()) return void(ReportAutoLayer(src.error(), failed));
-  base::Result<Character> character = MakeCharacter(std::move(*src), {}, BodyKind::kGenerated);
+  base::Result<Character> character = LoadDemoCharacter(BodyKind::kGenerated);
   if (!character.ok()) return void(ReportAutoLayer(character.error(), failed));
   const Character& ch = *character;
   base::Result<deform::FramePipeline> global =

@@ -12,9 +12,12 @@
 
 #include <vector>
 
-#include "app/bench_timing.h"
+#include "bench/harness/timing.h"
 
 namespace app::bench {
+
+using ::bench::Budget;
+using ::bench::Row;
 
 // Appends the two rows; sets *failed when a step refuses to run (error printed).
 void AddAutoLayerRows(const Budget& b, int frames, std::vector<Row>& rows, bool* failed);

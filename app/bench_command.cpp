@@ -29,12 +29,11 @@
 #include "app/bench_auto_layer.h"
 #include "app/bench_elastic_share.h"
 #include "app/bench_long_capture.h"
+#include "app/bench_scenes.h"
 #include "app/bench_table1.h"
-#include "app/bench_timing.h"
-#include "app/demo_data.h"
+#include "bench/harness/timing.h"
 #include "app/frame_plan.h"
 #include "app/frame_render.h"
-#include "app/motion_source.h"
 #include "app/character.h"
 #include "deform/pipeline/frame_pipeline.h"
 #include "app/exit_code.h"
@@ -61,12 +60,12 @@
 namespace app {
 namespace {
 
-using bench::Budget;
-using bench::Clock;
-using bench::ClockName;
-using bench::Now;
-using bench::Rates;
-using bench::Row;
+using ::bench::Budget;
+using ::bench::Clock;
+using ::bench::ClockName;
+using ::bench::Now;
+using ::bench::Rates;
+using ::bench::Row;
 using bench::Table1Row;
 
 // ------------------------------------------------------------ workloads ---
@@ -197,7 +196,7 @@ void PrintRow(const Row& r) {
   std::printf("%-30s %12.4g %12.4g %12.4g  %-10s %-4s", r.key.c_str(), r.Median(), r.Min(), r.Max(),
               r.unit.c_str(), ClockName(r.clock));
   if (r.reference > 0.0) {
-    std::printf(" %10.4g %8.1fx", r.reference, r.Median() / r.reference);
+    std::printf(" %10.4g %8.1fx", r.reference, r.Ratio());
   } else {
     std::printf(" %10s %9s", "-", "-");
   }
@@ -210,7 +209,7 @@ nlohmann::json RowJson(const Row& r) {
                       {"runs", r.runs},       {"note", r.note}};
   if (r.reference > 0.0) {
     j[r.reference_name] = r.reference;
-    j["ratio"] = r.Median() / r.reference;
+    j["ratio"] = r.Ratio();
   }
   return j;
 }
@@ -308,9 +307,7 @@ int RunBench(const BenchOptions& o) {
                   "", "two halves on two threads"});
 
   // The demo body (the walk on the generated mannequin).
-  base::Result<MotionSource> src = LoadBvhText(DemoBvhText(), "demo_walk.bvh", {.y_up = true});
-  if (!src.ok()) return ReportError(src.error());
-  base::Result<Character> character = MakeCharacter(std::move(*src));
+  base::Result<Character> character = bench::LoadDemoCharacter();
   if (!character.ok()) return ReportError(character.error());
   const Character& ch = *character;
   const int e2e_frames = o.quick ? 4 : 24;

@@ -11,9 +11,12 @@
 
 #include <vector>
 
-#include "app/bench_timing.h"
+#include "bench/harness/timing.h"
 
 namespace app::bench {
+
+using ::bench::Budget;
+using ::bench::Row;
 
 // Appends the row; sets *failed when a step refuses to run (its error printed).
 void AddElasticShareRow(const Budget& b, int frames, std::vector<Row>& rows, bool* failed);

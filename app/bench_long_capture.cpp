@@ -18,6 +18,9 @@ extern char** environ;
 namespace app::bench {
 namespace {
 
+using ::bench::Clock;
+using ::bench::Now;
+
 namespace fs = std::filesystem;
 
 // Writes the walk cut to exactly `frames` frames; returns its channel count, 0 on failure.

@@ -18,9 +18,11 @@
 #include <string>
 #include <vector>
 
-#include "app/bench_timing.h"
+#include "bench/harness/timing.h"
 
 namespace app::bench {
+
+using ::bench::Row;
 
 // Appends the rows above to `rows`; sets *failed when a capture cannot be
 // written or a child render does not exit with 0 (its stderr is printed).

@@ -18,6 +18,9 @@
 namespace app::bench {
 namespace {
 
+using ::bench::Clock;
+using ::bench::Rates;
+
 // Part of a cylinder about z (200 degrees, radius 4, height 20): the region.
 deform::Mesh Tube(int around, int along) {
   deform::Mesh m;

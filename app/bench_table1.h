@@ -7,10 +7,13 @@
 // cylinder, radius 4, height 20) with the paper's vertex counts, fitted and
 // bound as the rig's patches are (deform/patch/patch_fit.h, deform/patch/patch_binding.h).
 
-#include "app/bench_timing.h"
+#include "bench/harness/timing.h"
 #include "base/error.h"
 
 namespace app::bench {
+
+using ::bench::Budget;
+using ::bench::Row;
 
 // The paper's Table 1 (Core 2, 2.4 GHz); 0 where our sources do not give it.
 struct PatchCase {

@@ -23,11 +23,9 @@
 #include <string>
 #include <vector>
 
-#include "app/motion_source.h"
+#include "app/bench_scenes.h"
 #include "app/character.h"
 #include "app/rig_examples.h"
-#include "app/rig_file.h"
-#include "app/rig_patches.h"
 #include "deform/shapes/example_shapes.h"
 #include "deform/global/skinning_job.h"
 #include "mocap/pose.h"
@@ -47,17 +45,11 @@ struct DemoScene {
 // Loads samples/data/<name>.json and poses it at `frame` of its motion.
 std::unique_ptr<DemoScene> LoadScene(const std::string& name, int frame) {
   auto s = std::make_unique<DemoScene>();
-  auto rig = app::LoadRig(std::string(PATCHSKIN_SAMPLES_DIR) + "/" + name + ".json");
-  if (!rig.ok()) return s->error = rig.error().ToString(), std::move(s);
-  s->rig = std::move(*rig);
-  auto source = app::LoadMotionSource(s->rig.motion, {.y_up = true});
-  if (!source.ok()) return s->error = source.error().ToString(), std::move(s);
-  auto character = app::MakeCharacter(std::move(*source));
-  if (!character.ok()) return s->error = character.error().ToString(), std::move(s);
-  s->character = std::move(*character);
-  auto patches = app::BuildRigPatches(s->rig, s->character);
-  if (!patches.ok()) return s->error = patches.error().ToString(), std::move(s);
-  s->patches = std::move(*patches);
+  auto scene = app::bench::LoadSampleRig(std::string(PATCHSKIN_SAMPLES_DIR) + "/" + name + ".json");
+  if (!scene.ok()) return s->error = scene.error().ToString(), std::move(s);
+  s->rig = std::move(scene->rig);
+  s->character = std::move(scene->character);
+  s->patches = std::move(scene->layers.patches);
   auto spaces =
       app::BuildRigPoseSpaces(s->rig, s->character, s->patches, deform::GlobalMethod::kSsd);
   if (!spaces.ok()) return s->error = spaces.error().ToString(), std::move(s);

@@ -1,6 +1,6 @@
 // The reference for raster_bench's BM_RenderBody: the same scene drawn by
 // Mesa's llvmpipe (Debian's software OpenGL) through OSMesa, timed side by
-// side on the same machine. Same body mesh and camera (bench/body_scene.h),
+// side on the same machine. Same body mesh and camera (bench/harness/body_scene.h),
 // Lambert with the same key light, ambient and albedo evaluated per fragment
 // (a GLSL shader: normalize the interpolated vertex normal, like our smooth
 // shading), depth test on, back faces culled (counter-clockwise = front), and
@@ -39,7 +39,7 @@
 #include <glm/glm.hpp>
 #include <glm/gtc/type_ptr.hpp>
 
-#include "bench/body_scene.h"
+#include "bench/harness/body_scene.h"
 #include "render/camera.h"
 #include "render/renderer.h"
 #include "render/raster/shading.h"

@@ -7,41 +7,22 @@
 // frame after frame, so the difference is the elastic layer's cost per frame.
 // BM_BellyFrameShare: that cost as a share of a whole rendered frame.
 
-#include <algorithm>
-#include <cmath>
-#include <cstdio>
 #include <cstdlib>
-#include <ctime>
 #include <optional>
-#include <span>
 #include <string>
 #include <utility>
-#include <vector>
 
 #include <benchmark/benchmark.h>
 
-#include "app/demo_data.h"
-#include "app/motion_source.h"
-#include "deform/pipeline/elastic_layer.h"
-#include "app/frame_render.h"
+#include "app/bench_scenes.h"
 #include "app/character.h"
 #include "deform/pipeline/frame_pipeline.h"
-#include "app/rig_file.h"
-#include "app/rig_patches.h"
-#include "mocap/kinematics.h"
-#include "render/camera.h"
-#include "render/image.h"
-#include "render/renderer.h"
 
 namespace {
 
 const app::Character& DemoCharacter() {
   static const app::Character character = [] {
-    app::MotionSourceOptions load;
-    load.y_up = true;
-    auto src = app::LoadBvhText(app::DemoBvhText(), "demo_walk.bvh", load);
-    if (!src.ok()) std::abort();
-    auto c = app::MakeCharacter(std::move(*src));
+    auto c = app::bench::LoadDemoCharacter();
     if (!c.ok()) std::abort();
     return std::move(*c);
   }();
@@ -89,38 +70,23 @@ BENCHMARK_CAPTURE(BM_Evaluate, swd, deform::GlobalMethod::kSwd)
 
 // The belly_jump sample rig on the mannequin: its character, patches and
 // resolved elastic specs. Skips the benchmark if the rig is missing.
-struct BellyScene {
-  app::Rig rig;
-  app::Character character;
-  std::vector<deform::PatchSetup> patches;
-  std::vector<deform::ElasticPatchSpec> specs;
-};
-
-std::optional<BellyScene> LoadBelly(benchmark::State& state) {
-  auto rig = app::LoadRig(std::string(PATCHSKIN_SAMPLES_DIR) + "/belly_jump.json");
-  if (!rig.ok()) {
-    state.SkipWithError(rig.error().ToString().c_str());
+std::optional<app::bench::SampleRigScene> LoadBelly(benchmark::State& state) {
+  auto scene = app::bench::LoadSampleRig(std::string(PATCHSKIN_SAMPLES_DIR) + "/belly_jump.json");
+  if (!scene.ok()) {
+    state.SkipWithError(scene.error().ToString().c_str());
     return std::nullopt;
   }
-  auto src = app::LoadMotionSource(rig->motion, {.y_up = true});
-  if (!src.ok()) std::abort();
-  auto c = app::MakeCharacter(std::move(*src));
-  if (!c.ok()) std::abort();
-  auto patches = app::BuildRigPatches(*rig, *c);
-  if (!patches.ok()) std::abort();
-  auto specs = app::ResolveRigElastic(*rig, *c, *patches);
-  if (!specs.ok()) std::abort();
-  return BellyScene{std::move(*rig), std::move(*c), std::move(*patches), std::move(*specs)};
+  return std::move(*scene);
 }
 
 void BM_EvaluateBelly(benchmark::State& state, bool elastic) {
-  std::optional<BellyScene> scene = LoadBelly(state);
+  std::optional<app::bench::SampleRigScene> scene = LoadBelly(state);
   if (!scene) return;
   const app::Character* c = &scene->character;
   auto pipeline = deform::FramePipeline::Create(*c, deform::GlobalMethod::kSsd, 1);
   if (!pipeline.ok()) std::abort();
-  if (!pipeline->SetPatches(std::move(scene->patches)).ok()) std::abort();
-  if (elastic && !pipeline->SetElastic(std::move(scene->specs)).ok()) std::abort();
+  if (!pipeline->SetPatches(std::move(scene->layers.patches)).ok()) std::abort();
+  if (elastic && !pipeline->SetElastic(std::move(scene->layers.elastic)).ok()) std::abort();
   deform::DeformedFrame frame;
   const double dt = c->motion.frame_time_s;
   int f = 0;
@@ -138,73 +104,34 @@ void BM_EvaluateBelly(benchmark::State& state, bool elastic) {
 BENCHMARK_CAPTURE(BM_EvaluateBelly, patch_only, false)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(BM_EvaluateBelly, patch_elastic, true)->Unit(benchmark::kMicrosecond);
 
-double ThreadCpuSeconds() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
-
 // The elastic layer's cost per output frame as a share of the whole frame: the
 // belly_jump rig at 30 fps, each iteration one frame of (a) the layered
-// pipeline with the elastic patch (Evaluate) and (b) its render at 1280 x 720,
-// supersample 2, one thread (DrawCharacterFrame, as `patchskin render` draws;
-// PNG encoding not included), while a separate ElasticLayer advances a copy of
-// the same network to the same time (c). Counters (thread CPU time per frame):
-// elastic_us = (c), frame_us = (a) + (b), elastic_share = (c) / ((a) + (b)).
+// pipeline with the elastic patch (Evaluate) and its render at 1280 x 720,
+// supersample 2, one thread (as `patchskin render` draws; PNG encoding not
+// included), while a separate ElasticLayer advances a copy of the same network
+// to the same time (b): app::bench::ElasticShareProbe, which `patchskin bench`'s
+// row elastic_share_two_patches also uses. Counters (thread CPU time per
+// frame): elastic_us = (b), frame_us = (a), elastic_share = (b) / (a).
 void BM_BellyFrameShare(benchmark::State& state) {
-  std::optional<BellyScene> scene = LoadBelly(state);
+  std::optional<app::bench::SampleRigScene> scene = LoadBelly(state);
   if (!scene) return;
-  const app::Rig* rig = &scene->rig;
   const app::Character* c = &scene->character;
   auto pipeline = deform::FramePipeline::Create(*c, deform::GlobalMethod::kSsd, 1);
   if (!pipeline.ok()) std::abort();
-  auto layer = deform::ElasticLayer::Create(*c, scene->patches, scene->specs);
-  if (!layer.ok()) std::abort();
-  if (!pipeline->SetPatches(std::move(scene->patches)).ok()) std::abort();
-  if (!pipeline->SetElastic(std::move(scene->specs)).ok()) std::abort();
-  // Joint matrices of every frame for the separate layer's driving rotation.
-  const mocap::Skeleton& skel = c->skeleton;
-  const std::size_t nj = static_cast<std::size_t>(skel.num_joints());
-  std::vector<mocap::JointTransform> locals(nj);
-  std::vector<glm::mat4> model(static_cast<std::size_t>(c->motion.num_frames) * nj);
-  if (!mocap::ModelMatricesJob{.skeleton = &skel, .motion = &c->motion, .locals = locals,
-                               .model_from_joint = model}
-           .Run()) {
-    std::abort();
-  }
-  deform::DeformedFrame frame;
-  if (!pipeline->Evaluate(0.0, frame).ok()) std::abort();
-  render::RenderSettings settings;  // 1280 x 720
-  settings.supersample = 2;
-  settings.threads = 1;
-  const render::Camera camera =
-      render::FrameBounds(frame.bounds, 35.0f, 1280.0f / 720.0f, glm::vec3(0.0f, 0.0f, -1.0f));
-  render::Renderer renderer, unused;
-  render::Image image, scratch;
-  std::vector<std::vector<glm::vec3>> displacements(static_cast<std::size_t>(rig->patches.size()));
+  if (!pipeline->SetPatches(scene->layers.patches).ok()) std::abort();
+  if (!pipeline->SetElastic(scene->layers.elastic).ok()) std::abort();
+  auto probe = app::bench::ElasticShareProbe::Create(*c, *pipeline, scene->layers, "belly",
+                                                     /*png=*/false);
+  if (!probe.ok()) std::abort();
   const double dt = 1.0 / 30.0;
   const int frames = static_cast<int>(c->motion.duration_s() / dt);
-  const double clip_dt = c->motion.frame_time_s;
   double elastic_s = 0.0, frame_s = 0.0;
   int f = 0;
   for (auto _ : state) {
-    const double t = f * dt;
-    const double t0 = ThreadCpuSeconds();
-    if (!pipeline->Evaluate(t, frame).ok()) std::abort();
-    const app::FrameDrawOptions options{.frame_number = f};
-    if (!app::DrawCharacterFrame(*c, frame, nullptr, camera, settings, options, renderer, unused,
-                                 scratch, image)
-             .ok()) {
-      std::abort();
-    }
-    const double t1 = ThreadCpuSeconds();
-    const std::size_t clip_frame = static_cast<std::size_t>(std::lround(t / clip_dt));
-    const std::span<const glm::mat4> joints(&model[std::min(clip_frame, model.size() / nj - 1) * nj], nj);
-    if (!(*layer)->Advance(t, joints, displacements).ok()) std::abort();
-    const double t2 = ThreadCpuSeconds();
-    frame_s += t1 - t0;
-    elastic_s += t2 - t1;
-    benchmark::DoNotOptimize(image);
+    auto split = (*probe)->Frame(f);
+    if (!split.ok()) std::abort();
+    frame_s += split->frame_s;
+    elastic_s += split->elastic_s;
     f = f + 1 < frames ? f + 1 : 0;  // a restart re-simulates from t = 0
   }
   const double n = static_cast<double>(state.iterations());

@@ -18,7 +18,7 @@
 #include <benchmark/benchmark.h>
 #include <glm/glm.hpp>
 
-#include "bench/body_scene.h"
+#include "bench/harness/body_scene.h"
 #include "deform/io/gltf_import.h"
 #include "render/renderer.h"
 

@@ -1,7 +1,17 @@
 #pragma once
-// Timing helpers of `patchskin bench` (app/bench_command.h): repeated runs of
-// an operation on the thread's CPU clock or the wall clock, and one reported
-// figure with its runs, median, min, max and reference.
+// The timing half of the bench harness (library patchskin_bench_harness),
+// shared by `patchskin bench` (app/bench_command.h) and the Google Benchmark
+// programs of bench/: the clocks, repeated runs of an operation, and one
+// reported figure with its runs, median, min, max and reference (the ratio is
+// median / reference). Header only, no dependency beyond the C++ library and
+// POSIX clock_gettime; never Google Benchmark, so the shipped binary links it.
+// Google Benchmark programs keep Google Benchmark's own timing and use these
+// only for figures they compute beside it (a thread's CPU time inside one
+// iteration, a median of their own repetitions).
+//
+// The other half, the scenes built from the app's character (the demo walk,
+// the sample rigs, the 1280x720 bench frame), is app/bench_scenes.h: it needs
+// patchskin_app, which links this library, so it lives in that library.
 
 #include <time.h>
 
@@ -11,7 +21,7 @@
 #include <string>
 #include <vector>
 
-namespace app::bench {
+namespace bench {
 
 // The calling thread's CPU time | elapsed time | CPU time of every thread of
 // the process (work done, whatever the machine's load).
@@ -38,7 +48,8 @@ struct Budget {
 // `items` / (seconds per call of `op`), once per repetition. The number of
 // calls per repetition is calibrated first so that reading the clock (a system
 // call for CPU time) stays out of sub-microsecond operations.
-inline std::vector<double> Rates(const Budget& b, Clock clock, double items, const std::function<void()>& op) {
+inline std::vector<double> Rates(const Budget& b, Clock clock, double items,
+                                 const std::function<void()>& op) {
   std::int64_t batch = 1;
   double dt = 0.0;
   for (;;) {
@@ -75,8 +86,10 @@ struct Row {
     const std::size_t n = v.size();
     return n == 0 ? 0.0 : n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
   }
+  // Median / reference; 0 when there is no reference.
+  double Ratio() const { return reference > 0.0 ? Median() / reference : 0.0; }
   double Min() const { return runs.empty() ? 0.0 : *std::min_element(runs.begin(), runs.end()); }
   double Max() const { return runs.empty() ? 0.0 : *std::max_element(runs.begin(), runs.end()); }
 };
 
-}  // namespace app::bench
+}  // namespace bench

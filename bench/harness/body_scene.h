@@ -2,7 +2,8 @@
 // The body scene of the render benchmarks: a ~50k-triangle body-like mesh
 // (eleven subdivided ellipsoids) and the camera that frames it at about a
 // third of the screen. Shared by raster_bench (our renderer) and
-// llvmpipe_bench (Mesa's software OpenGL) so both draw the same scene.
+// llvmpipe_bench (Mesa's software OpenGL) so both draw the same scene. Part of
+// the bench harness (bench/harness/timing.h has its contract); render only.
 
 #include <cmath>
 #include <cstdint>
