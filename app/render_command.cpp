@@ -309,6 +309,60 @@ base::Result<BodyKind> ResolveRenderBody(RenderOptions& o, const Rig* rig) {
   return body_kind;
 }
 
+// The renderer's settings the options ask for (ground_y is the caller's).
+render::RenderSettings MakeRenderSettings(const RenderOptions& o, glm::ivec2 size,
+                                          const std::string& pattern) {
+  render::RenderSettings settings;
+  settings.width = size.x;
+  settings.height = size.y;
+  settings.supersample = o.supersample;
+  settings.resolve =
+      o.resolve == "tent" ? render::ResolveFilter::kTent : render::ResolveFilter::kBox;
+  settings.antialias =
+      o.aa == "ssaa" ? render::AntiAlias::kSupersample : render::AntiAlias::kMultisample;
+  settings.shadows = o.shadows == "on";
+  settings.threads = o.threads;
+  settings.ground_at_scene_min = false;
+  settings.background.transparent = o.background == "transparent";
+  // Only EXR frames store depth (their Z channel); the renderer still keeps it
+  // internally while it draws depth-tested overlays.
+  const base::Result<render::ImageFormat> format = render::ImageFormatFromPath(pattern);
+  settings.write_depth = format.ok() && *format == render::ImageFormat::kExr;
+  return settings;
+}
+
+// The pipelines of a render: one body (the rig's layers on it when it has
+// patches), or the two bodies of a comparison, each with the layers when its
+// side asks for them; the layers' notes go to stderr unless --quiet.
+struct RenderBodies {
+  std::optional<deform::FramePipeline> left;   // the only body, or the left one
+  std::optional<deform::FramePipeline> right;  // the right body of a comparison
+};
+
+base::Result<RenderBodies> MakeRenderBodies(const RenderOptions& o, const Rig* rig,
+                                            const Character& ch, const TwoBodies& two,
+                                            deform::GlobalMethod method) {
+  const bool has_layers = rig && !rig->patches.empty();
+  const BodySpec sides[2] = {two.view != View::kOne ? two.sides[0] : BodySpec{method, has_layers},
+                             two.sides[1]};
+  RenderBodies bodies;
+  for (int side = 0; side < (two.view != View::kOne ? 2 : 1); ++side) {
+    base::Result<deform::FramePipeline> p =
+        deform::FramePipeline::Create(ch, sides[side].method, o.threads);
+    if (!p.ok()) return std::move(p).error();
+    if (sides[side].patches) {
+      // The layers (patches, example shapes, elastic), set up as `export` sets them up.
+      std::vector<std::string> notes;
+      if (base::Status s = ApplyRigLayers(*rig, ch, *p, &notes); !s.ok()) return s.error();
+      if (!o.quiet) {
+        for (const std::string& note : notes) std::fprintf(stderr, "%s\n", note.c_str());
+      }
+    }
+    (side == 0 ? bodies.left : bodies.right).emplace(std::move(*p));
+  }
+  return bodies;
+}
+
 }  // namespace
 
 int RunRender(const RenderOptions& options) {
@@ -395,35 +449,11 @@ int RunRender(const RenderOptions& options) {
     if (!planned.ok()) return ReportError(planned.error());
   }
 
-  // --- Pipelines ---------------------------------------------------------------
-  // One body (the rig's layers on it when it has patches), or the two bodies
-  // of a comparison, each with the layers when its side asks for them.
-  const bool has_layers = rig && !rig->patches.empty();
-  const BodySpec main_body = two->view != View::kOne ? two->sides[0]
-                                                     : BodySpec{*method, has_layers};
-  base::Result<deform::FramePipeline> pipeline =
-      deform::FramePipeline::Create(ch, main_body.method, o.threads);
-  if (!pipeline.ok()) return ReportError(pipeline.error());
-  std::optional<deform::FramePipeline> right_pipeline;
-  if (two->view != View::kOne) {
-    base::Result<deform::FramePipeline> p =
-        deform::FramePipeline::Create(ch, two->sides[1].method, o.threads);
-    if (!p.ok()) return ReportError(p.error());
-    right_pipeline.emplace(std::move(*p));
-  }
-  const std::pair<deform::FramePipeline*, bool> bodies[] = {
-      {&*pipeline, main_body.patches},
-      {right_pipeline ? &*right_pipeline : nullptr, right_pipeline && two->sides[1].patches}};
-  for (const auto& [body, layered] : bodies) {
-    if (body == nullptr || !layered) continue;
-    // The layers (patches, example shapes, elastic), set up as `export` sets them up.
-    std::vector<std::string> notes;
-    if (base::Status s = ApplyRigLayers(*rig, ch, *body, &notes); !s.ok())
-      return ReportError(s.error());
-    if (!o.quiet) {
-      for (const std::string& note : notes) std::fprintf(stderr, "%s\n", note.c_str());
-    }
-  }
+  // --- Pipelines: one body, or the two of a comparison ---------------------------
+  base::Result<RenderBodies> bodies = MakeRenderBodies(o, rig ? &*rig : nullptr, ch, *two, *method);
+  if (!bodies.ok()) return ReportError(bodies.error());
+  std::optional<deform::FramePipeline> pipeline = std::move(bodies->left);
+  std::optional<deform::FramePipeline>& right_pipeline = bodies->right;
   const bool side_by_side = two->view == View::kCompare;
 
   // --- Overlays of the patch layer ----------------------------------------------
@@ -498,24 +528,8 @@ int RunRender(const RenderOptions& options) {
   }
   const std::filesystem::path out_dir =
       std::filesystem::path(*render::ExpandFramePattern(pattern, 0)).parent_path();
-  render::RenderSettings settings;
-  settings.width = size->x;
-  settings.height = size->y;
-  settings.supersample = o.supersample;
-  settings.resolve = o.resolve == "tent" ? render::ResolveFilter::kTent : render::ResolveFilter::kBox;
-  settings.antialias =
-      o.aa == "ssaa" ? render::AntiAlias::kSupersample : render::AntiAlias::kMultisample;
-  settings.shadows = o.shadows == "on";
-  settings.threads = o.threads;
-  settings.ground_at_scene_min = false;
+  render::RenderSettings settings = MakeRenderSettings(o, *size, pattern);
   settings.ground_y = ground_y;
-  settings.background.transparent = o.background == "transparent";
-  // Only EXR frames store depth (their Z channel); the renderer still keeps it
-  // internally while it draws depth-tested overlays.
-  {
-    const base::Result<render::ImageFormat> format = render::ImageFormatFromPath(pattern);
-    settings.write_depth = format.ok() && *format == render::ImageFormat::kExr;
-  }
   render::Renderer renderer;
   render::Renderer right_renderer;
   render::AsyncImageWriter writer({.num_workers = 2, .max_in_flight = 4});
