@@ -363,6 +363,41 @@ base::Result<RenderBodies> MakeRenderBodies(const RenderOptions& o, const Rig* r
   return bodies;
 }
 
+// The frame file pattern (--out, else default_folder/frame_####.png),
+// checked, with every output the render will write registered in `guard`
+// (frames, contact sheet, preview video). Errors name --out or --background,
+// or are the guard's (an existing output without --overwrite or --resume).
+base::Result<std::string> PlanRenderOutputs(const RenderOptions& o,
+                                            const std::string& default_folder,
+                                            const FramePlan& plan, OutputGuard& guard) {
+  const std::string pattern = o.out.empty() ? default_folder + "/frame_####.png" : o.out;
+  if (!render::HasFramePlaceholder(pattern)) {
+    return ArgError(
+        "--out", "the pattern '" + pattern + "' needs one frame placeholder such as #### or %04d");
+  }
+  if (o.background == "transparent") {
+    const base::Result<render::ImageFormat> format = render::ImageFormatFromPath(pattern);
+    if (format.ok() && *format == render::ImageFormat::kJpeg) {
+      return ArgError("--background",
+                      "transparent needs frames with alpha (PNG, EXR or TIFF), found the JPEG "
+                      "pattern '" +
+                          pattern + "'");
+    }
+  }
+  const auto frame_path = [&pattern, &plan](std::size_t i) {
+    return render::ExpandFramePattern(pattern, plan.At(i).number);
+  };
+  const base::Result<std::string> first_path = frame_path(0);
+  if (!first_path.ok()) return first_path.error();
+  const std::filesystem::path dir = std::filesystem::path(*first_path).parent_path();
+  std::vector<std::string> others;
+  if (!o.no_sheet) others.push_back((dir / "contact_sheet.png").string());
+  if (!o.no_video) others.push_back((dir / "preview.mp4").string());
+  const base::Status planned = guard.Plan(plan.count(), frame_path, others);
+  if (!planned.ok()) return planned.error();
+  return pattern;
+}
+
 }  // namespace
 
 int RunRender(const RenderOptions& options) {
@@ -418,36 +453,12 @@ int RunRender(const RenderOptions& options) {
   // every frame of an hour-long capture holds no per-frame list (issue 8).
   const std::size_t num_frames = plan->count();
 
-  std::string pattern = o.out;
-  if (pattern.empty()) pattern = "out/" + name + (turntable ? "_turntable" : "") + "/frame_####.png";
-  if (!render::HasFramePlaceholder(pattern)) {
-    return ReportError(ArgError(
-        "--out", "the pattern '" + pattern + "' needs one frame placeholder such as #### or %04d"));
-  }
-  if (o.background == "transparent") {
-    const base::Result<render::ImageFormat> format = render::ImageFormatFromPath(pattern);
-    if (format.ok() && *format == render::ImageFormat::kJpeg) {
-      return ReportError(ArgError("--background",
-                                  "transparent needs frames with alpha (PNG, EXR or TIFF), "
-                                  "found the JPEG pattern '" +
-                                      pattern + "'"));
-    }
-  }
   // Existing outputs are refused (or, with --resume, skipped) before anything renders.
   OutputGuard guard({.overwrite = o.overwrite, .resume = o.resume});
-  {
-    const auto frame_path = [&pattern, &plan](std::size_t i) {
-      return render::ExpandFramePattern(pattern, plan->At(i).number);
-    };
-    const base::Result<std::string> first_path = frame_path(0);
-    if (!first_path.ok()) return ReportError(first_path.error());
-    const std::filesystem::path dir = std::filesystem::path(*first_path).parent_path();
-    std::vector<std::string> others;
-    if (!o.no_sheet) others.push_back((dir / "contact_sheet.png").string());
-    if (!o.no_video) others.push_back((dir / "preview.mp4").string());
-    const base::Status planned = guard.Plan(num_frames, frame_path, others);
-    if (!planned.ok()) return ReportError(planned.error());
-  }
+  const base::Result<std::string> out_pattern =
+      PlanRenderOutputs(o, "out/" + name + (turntable ? "_turntable" : ""), *plan, guard);
+  if (!out_pattern.ok()) return ReportError(out_pattern.error());
+  const std::string& pattern = *out_pattern;
 
   // --- Pipelines: one body, or the two of a comparison ---------------------------
   base::Result<RenderBodies> bodies = MakeRenderBodies(o, rig ? &*rig : nullptr, ch, *two, *method);
