@@ -6,6 +6,7 @@
 #include <functional>
 #include <vector>
 
+#include "app/exit_code.h"
 #include "app/motion_source.h"
 #include "deform/elastic/mass_spring.h"
 #include "mocap/kinematics.h"
@@ -14,15 +15,6 @@
 #include "render/output/plot.h"
 
 namespace app {
-namespace {
-
-int Fail(const base::Error& e, int code) {
-  std::fprintf(stderr, "%s\n", e.ToString().c_str());
-  return code;
-}
-
-}  // namespace
-
 int RunElastic(const ElasticOptions& o) {
   mocap::Skeleton skel;
   mocap::Motion motion;
@@ -33,14 +25,14 @@ int RunElastic(const ElasticOptions& o) {
     synthetic::JumpOptions jump;
     jump.frame_time_s = 1.0 / 60.0;
     auto m = synthetic::MakeJumpMotion(skel, jump);
-    if (!m.ok()) return Fail(m.error(), 3);
+    if (!m.ok()) return ReportInternal(m.error());
     motion = std::move(m).value();
     if (upm <= 0.0f) upm = 100.0f;
   } else {
     MotionSourceOptions mo;
     mo.scale = o.scale;
     auto loaded = LoadMotionSource(o.file, mo);
-    if (!loaded.ok()) return Fail(loaded.error(), 2);
+    if (!loaded.ok()) return ReportError(loaded.error());
     skel = std::move(loaded->skeleton);
     motion = std::move(loaded->motion);
     if (upm <= 0.0f) upm = 1.0f;
@@ -50,15 +42,15 @@ int RunElastic(const ElasticOptions& o) {
   loc.file = o.file.empty() ? "elastic" : o.file;
   const int joint = skel.FindJoint(o.joint);
   if (joint < 0) {
-    return Fail(
-        base::MakeError(base::ErrorCode::kNotFound, loc, "no joint named '" + o.joint + "'"), 2);
+    return ReportError(
+        base::MakeError(base::ErrorCode::kNotFound, loc, "no joint named '" + o.joint + "'"));
   }
   if (motion.num_frames < 2) {
-    return Fail(
-        base::MakeError(base::ErrorCode::kInvalidArgument, loc, "expected at least 2 frames"), 2);
+    return ReportError(
+        base::MakeError(base::ErrorCode::kInvalidArgument, loc, "expected at least 2 frames"));
   }
   auto kin = mocap::ComputeKinematics(skel, motion, o.cutoff_hz);
-  if (!kin.ok()) return Fail(kin.error(), 2);
+  if (!kin.ok()) return ReportError(kin.error());
   const std::size_t nj = static_cast<std::size_t>(skel.num_joints());
   float max_w = 0.0f;
   for (std::size_t f = 0; f < static_cast<std::size_t>(motion.num_frames); ++f) {
@@ -86,7 +78,7 @@ int RunElastic(const ElasticOptions& o) {
       {.rows = n, .cols = n, .rest_points = pts, .bind_rotation = bind,
        .max_angular_speed_rad_s = max_w},
       params);
-  if (!net.ok()) return Fail(net.error(), 2);
+  if (!net.ok()) return ReportError(net.error());
   for (const std::string& m : net->messages) std::printf("note: %s\n", m.c_str());
 
   deform::MassSpringState state;
@@ -108,7 +100,7 @@ int RunElastic(const ElasticOptions& o) {
         .num_joints = skel.num_joints(), .joint = joint, .frame_time_s = motion.frame_time_s,
         .displacements = disp};
     if (const base::JobStatus s = job.Run(); !s) {
-      return Fail(base::MakeError(base::ErrorCode::kInternal, loc, s.what), 3);
+      return ReportError(base::MakeError(base::ErrorCode::kInternal, loc, s.what));
     }
     const glm::vec3 a = (*kin)[static_cast<std::size_t>(f) * nj + static_cast<std::size_t>(joint)]
                             .local_linear_acceleration;
@@ -121,13 +113,13 @@ int RunElastic(const ElasticOptions& o) {
   plot.panels = {{"driving acceleration", "m/s^2", {accel}},
                  {"patch centre displacement", "cm", {magnitude, normal}}};
   auto image = render::DrawTimePlot(plot);
-  if (!image.ok()) return Fail(image.error(), 3);
+  if (!image.ok()) return ReportInternal(image.error());
   const std::filesystem::path out(o.out);
   if (out.has_parent_path()) {
     std::error_code ec;
     std::filesystem::create_directories(out.parent_path(), ec);
   }
-  if (const base::Status s = render::WriteImage(*image, o.out); !s) return Fail(s.error(), 2);
+  if (const base::Status s = render::WriteImage(*image, o.out); !s) return ReportError(s.error());
   const deform::MassSpringCounters& c = state.counters();
   std::printf("%d frames, h = %.6g s, %lld steps, peak |e| %.3f cm (e_max %.3f cm)\n",
               motion.num_frames, net->time_step_s, static_cast<long long>(c.steps), peak,

@@ -14,4 +14,11 @@ inline int ReportError(const base::Error& e) {
   return e.code == base::ErrorCode::kInternal ? 3 : 2;
 }
 
+// `e` reported as an internal error (exit 3): a step that fails only through a
+// fault of our own, whatever code the library gave it.
+inline int ReportInternal(base::Error e) {
+  e.code = base::ErrorCode::kInternal;
+  return ReportError(e);
+}
+
 }  // namespace app

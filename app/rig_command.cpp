@@ -16,10 +16,7 @@ int RunRigAuto(const RigCommandOptions& o) {
   const std::string folder =
       o.out.empty() ? std::string(".") : std::filesystem::path(o.out).parent_path().string();
   base::Result<std::string> text = WriteRigJson(made->rig, folder);
-  if (!text.ok()) {
-    std::fprintf(stderr, "%s\n", text.error().ToString().c_str());
-    return 3;
-  }
+  if (!text.ok()) return ReportInternal(text.error());
   if (!o.quiet) {
     for (const std::string& note : made->notes) {
       std::fprintf(stderr, "%s: note: %s\n", o.capture.c_str(), note.c_str());
