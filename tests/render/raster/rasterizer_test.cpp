@@ -548,7 +548,9 @@ std::vector<glm::vec4> MixedTriangleSoup(int w, int h, std::vector<glm::uvec3>& 
 // every tile, every sample, bit for bit; raster sizes leave partial tiles and
 // rows of every length mod 4.
 TEST(RasterizerTest, FastTileWalkEqualsTheReferenceBitForBit) {
-  for (const auto& [w, h] : {std::pair{197, 133}, std::pair{64, 64}, std::pair{131, 67}}) {
+  for (const glm::ivec2 size : {glm::ivec2(197, 133), glm::ivec2(64, 64), glm::ivec2(131, 67)}) {
+    // Plain names, not a structured binding: clang 15 cannot capture those in a lambda.
+    const int w = size.x, h = size.y;
     std::vector<glm::uvec3> tris;
     const std::vector<glm::vec4> clip = MixedTriangleSoup(w, h, tris);
     const ClipMesh mesh{.clip_positions = clip, .triangles = tris};
