@@ -94,7 +94,7 @@ base::Result<CameraPlan> CameraPlan::Create(BodySampler sampler, const CameraSet
   // Framing: frames spread evenly over the whole motion, both ends included,
   // the same whatever frames are asked for later.
   BodySample sample;
-  deform::Bounds all_bounds, look_box;
+  deform::Bounds all_bounds;
   glm::vec3 largest_extent(0.0f), region_extent(0.0f);
   float ground_y = std::numeric_limits<float>::max();
   const std::int64_t last = times.motion_frames - 1;
