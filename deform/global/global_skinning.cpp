@@ -105,18 +105,10 @@ base::JobStatus GlobalSkinning::SkinVertices(int begin, int end, std::span<glm::
   if (begin < 0 || end < begin || end > bind.num_vertices()) {
     return {base::JobStatus::kOutOfRange, "vertex range past the mesh"};
   }
-  return SwdJob{
-      .chains = swd_->chains(),
-      .joint_rotations = swd_rotations_,
-      .joint_positions = swd_positions_,
-      .bindings = Range(swd_->bindings(), begin, end),
-      .rest_normals =
-          Range(normals.empty() ? std::span<const glm::vec3>() : swd_->rest_normals(), begin, end),
-      .keep_volume = false,
-      .section_scales = {},
-      .positions = Range(positions, begin, end),
-      .normals = Range(normals, begin, end)}
-      .Run();
+  return Sweep(
+      Range(swd_->bindings(), begin, end),
+      Range(normals.empty() ? std::span<const glm::vec3>() : swd_->rest_normals(), begin, end),
+      Range(positions, begin, end), Range(normals, begin, end));
 }
 
 base::Result<SkinBoundPoints> GlobalSkinning::BindPoints(std::span<const glm::vec3> rest,
@@ -141,15 +133,22 @@ base::JobStatus GlobalSkinning::CarryPoints(const SkinBoundPoints& points,
     return SkinPoints(palettes_.view(), *points.weights, points.rest, {}, 0,
                       static_cast<int>(points.rest.size()), out, {});
   }
+  return Sweep(points.sweeps, {}, out, {});
+}
+
+base::JobStatus GlobalSkinning::Sweep(std::span<const SweepVertexBinding> bindings,
+                                      std::span<const glm::vec3> rest_normals,
+                                      std::span<glm::vec3> positions,
+                                      std::span<glm::vec3> normals) const {
   return SwdJob{.chains = swd_->chains(),
                 .joint_rotations = swd_rotations_,
                 .joint_positions = swd_positions_,
-                .bindings = points.sweeps,
-                .rest_normals = {},
+                .bindings = bindings,
+                .rest_normals = rest_normals,
                 .keep_volume = false,
                 .section_scales = {},
-                .positions = out,
-                .normals = {}}
+                .positions = positions,
+                .normals = normals}
       .Run();
 }
 

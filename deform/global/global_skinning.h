@@ -104,6 +104,11 @@ class GlobalSkinning {
 
  private:
   GlobalSkinning(GlobalMethod method, const SkinnedMesh& mesh) : method_(method), mesh_(&mesh) {}
+  // SWD at the posed joint state, for bound points (vertices or others).
+  [[nodiscard]] base::JobStatus Sweep(std::span<const SweepVertexBinding> bindings,
+                                      std::span<const glm::vec3> rest_normals,
+                                      std::span<glm::vec3> positions,
+                                      std::span<glm::vec3> normals) const;
 
   GlobalMethod method_;
   const SkinnedMesh* mesh_;
