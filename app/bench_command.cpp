@@ -318,7 +318,7 @@ int RunBench(const BenchOptions& o) {
       deform::FramePipeline::Create(ch, deform::GlobalMethod::kSsd, threads);
   if (!pipeline.ok()) return ReportError(pipeline.error());
   base::Result<render::CameraPlan> cameras =
-      PlanCameras(*pipeline, *plan, "follow", 15.0f, {1280, 720});
+      PlanCameras(pipeline->character(), *plan, "follow", 15.0f, {1280, 720});
   if (!cameras.ok()) return ReportError(cameras.error());
   deform::DeformedFrame frame;
   if (base::Status s = pipeline->Evaluate(0.0, frame); !s.ok()) return ReportError(s.error());

@@ -211,7 +211,7 @@ int RunExport(const ExportOptions& options) {
   // so a pipeline that carries state between frames (the elastic layer) sees
   // the same sequence of evaluations here as there.
   base::Result<render::CameraPlan> camera_plan =
-      PlanCameras(*pipeline, *plan, o.camera, o.elevation_deg, *size);
+      PlanCameras(pipeline->character(), *plan, o.camera, o.elevation_deg, *size);
   if (!camera_plan.ok()) return ReportError(camera_plan.error());
   const render::CameraPlan* cameras = o.with_camera ? &*camera_plan : nullptr;
   std::optional<deform::GltfSequenceWriter> gltf;

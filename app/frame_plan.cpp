@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "base/check.h"
+#include "deform/pipeline/body_tracker.h"
 #include "render/camera_plan.h"
 
 namespace app {
@@ -126,40 +127,32 @@ OutputFrame FramePlan::At(std::size_t i) const {
 
 namespace {
 
-// The body as the cameras see it: a private global-only SSD pipeline of the
-// character (patches and the elastic layer move the surface by a few percent of
-// the body; the caller's pipeline and its state are never touched).
-base::Result<render::BodySampler> SkinnedBodySampler(const deform::FramePipeline& pipeline,
+// The body as the cameras see it, from its joints and a sparse hull of its
+// skin (deform/pipeline/body_tracker.h): no body is deformed to frame it.
+base::Result<render::BodySampler> TrackedBodySampler(const deform::Character& character,
                                                      const CameraSpec& spec) {
-  base::Result<deform::FramePipeline> tracker = deform::FramePipeline::Create(
-      pipeline.character(), deform::GlobalMethod::kSsd, pipeline.threads());
+  base::Result<deform::BodyTracker> tracker =
+      deform::BodyTracker::Create(character, spec.look_region);
   if (!tracker.ok()) return std::move(tracker).error();
   struct State {
-    deform::FramePipeline pipeline;
-    deform::DeformedFrame frame;
+    deform::BodyTracker tracker;
+    deform::TrackedBody body;
     int look_joint;
-    std::vector<int> look_region;
   };
-  auto state =
-      std::make_shared<State>(State{std::move(*tracker), {}, spec.look_joint, spec.look_region});
+  auto state = std::make_shared<State>(State{std::move(*tracker), {}, spec.look_joint});
   return render::BodySampler([state](double time_s, render::BodySample& out) -> base::Status {
     State& st = *state;
-    if (base::Status s = st.pipeline.Evaluate(time_s, st.frame); !s.ok()) return s;
-    out.bounds = st.frame.bounds;
-    out.look_bounds = deform::Bounds();
-    for (const int v : st.look_region) {
-      out.look_bounds.Extend(st.frame.positions[static_cast<std::size_t>(v)]);
-    }
+    if (base::Status s = st.tracker.Sample(time_s, st.body); !s.ok()) return s;
+    out.bounds = st.body.hull_bounds;
+    out.look_bounds = deform::ComputeBounds(st.body.tracked);
     if (st.look_joint >= 0) {
-      out.look_point = st.frame.joint_positions[static_cast<std::size_t>(st.look_joint)];
-    } else if (!st.look_region.empty()) {
+      out.look_point = st.body.joint_positions[static_cast<std::size_t>(st.look_joint)];
+    } else if (!st.body.tracked.empty()) {
       glm::dvec3 sum(0.0);
-      for (const int v : st.look_region) {
-        sum += glm::dvec3(st.frame.positions[static_cast<std::size_t>(v)]);
-      }
-      out.look_point = glm::vec3(sum / static_cast<double>(st.look_region.size()));
+      for (const glm::vec3& p : st.body.tracked) sum += glm::dvec3(p);
+      out.look_point = glm::vec3(sum / static_cast<double>(st.body.tracked.size()));
     } else {
-      out.look_point = st.frame.bounds.center();
+      out.look_point = out.bounds.center();
     }
     return base::Status::Ok();
   });
@@ -167,7 +160,7 @@ base::Result<render::BodySampler> SkinnedBodySampler(const deform::FramePipeline
 
 }  // namespace
 
-base::Result<render::CameraPlan> PlanCameras(const deform::FramePipeline& pipeline,
+base::Result<render::CameraPlan> PlanCameras(const deform::Character& character,
                                              const FramePlan& plan, const CameraSpec& spec,
                                              glm::ivec2 size) {
   if (spec.azimuth_deg && !(std::abs(*spec.azimuth_deg) <= 3600.0f)) {
@@ -179,7 +172,6 @@ base::Result<render::CameraPlan> PlanCameras(const deform::FramePipeline& pipeli
   if (!(spec.zoom > 0.0f) || !(spec.zoom <= 1000.0f)) {
     return ArgError("--zoom", "expected a factor in (0, 1000]");
   }
-  const deform::Character& character = pipeline.character();
   if (spec.look_joint >= character.skeleton.num_joints()) {
     return ArgError("--look-at", "joint index out of range");
   }
@@ -200,7 +192,7 @@ base::Result<render::CameraPlan> PlanCameras(const deform::FramePipeline& pipeli
     found << spec.elevation_deg;
     return ArgError("--elevation", "expected degrees in -89..89, found " + found.str());
   }
-  base::Result<render::BodySampler> sampler = SkinnedBodySampler(pipeline, spec);
+  base::Result<render::BodySampler> sampler = TrackedBodySampler(character, spec);
   if (!sampler.ok()) return std::move(sampler).error();
   const render::CameraSettings settings{
       .mode = mode == "fixed"       ? render::CameraMode::kFixed
@@ -221,13 +213,13 @@ base::Result<render::CameraPlan> PlanCameras(const deform::FramePipeline& pipeli
   return render::CameraPlan::Create(std::move(*sampler), settings, times);
 }
 
-base::Result<render::CameraPlan> PlanCameras(const deform::FramePipeline& pipeline,
+base::Result<render::CameraPlan> PlanCameras(const deform::Character& character,
                                              const FramePlan& plan, const std::string& mode,
                                              float elevation_deg, glm::ivec2 size) {
   CameraSpec spec;
   spec.mode = mode;
   spec.elevation_deg = elevation_deg;
-  return PlanCameras(pipeline, plan, spec, size);
+  return PlanCameras(character, plan, spec, size);
 }
 
 }  // namespace app

@@ -12,7 +12,7 @@
 #include <glm/glm.hpp>
 
 #include "app/character.h"
-#include "deform/pipeline/frame_pipeline.h"
+#include "deform/pipeline/character.h"
 #include "base/error.h"
 #include "mocap/motion.h"
 #include "mocap/skeleton.h"
@@ -109,15 +109,15 @@ struct CameraSpec {
 };
 
 // The cameras of `plan` as `spec` asks (render::CameraPlan), framing the
-// character `pipeline` deforms, seen through a private global-only SSD pipeline
-// of it (the caller's pipeline and its state are never touched). Errors:
-// kInvalidArgument naming --camera, --elevation, --azimuth, --distance, --zoom,
-// --look-at or --frames; the pipeline's errors.
-base::Result<render::CameraPlan> PlanCameras(const deform::FramePipeline& pipeline,
+// character as its joints and skin hull place it (deform::BodyTracker; no body
+// is deformed). The character must outlive the plan. Errors: kInvalidArgument
+// naming --camera, --elevation, --azimuth, --distance, --zoom, --look-at or
+// --frames; the tracker's errors.
+base::Result<render::CameraPlan> PlanCameras(const deform::Character& character,
                                              const FramePlan& plan, const CameraSpec& spec,
                                              glm::ivec2 size);
 // The same with the default aim, distance and azimuth.
-base::Result<render::CameraPlan> PlanCameras(const deform::FramePipeline& pipeline,
+base::Result<render::CameraPlan> PlanCameras(const deform::Character& character,
                                              const FramePlan& plan, const std::string& mode,
                                              float elevation_deg, glm::ivec2 size);
 

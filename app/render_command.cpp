@@ -525,8 +525,7 @@ int RunRender(const RenderOptions& options) {
     if (rig && options.given.count("--look-at") == 0) e.loc = {rig->file, 0, 0, "render.camera.look_at"};
     return ReportError(e);
   }
-  base::Result<render::CameraPlan> cameras =
-      PlanCameras(*pipeline, *framing, camera_spec, view_size);
+  base::Result<render::CameraPlan> cameras = PlanCameras(ch, *framing, camera_spec, view_size);
   if (!cameras.ok()) return ReportError(cameras.error());
   const float ground_y = cameras->ground_y();
 

@@ -3,6 +3,7 @@
 #include <string>
 
 #include "mocap/pose.h"
+#include "mocap/sampling.h"
 
 namespace deform {
 
@@ -28,6 +29,36 @@ base::Result<std::vector<glm::mat4>> BindModelFromJoint(const Character& c) {
     if (j < nj) model[j] = glm::inverse(c.mesh.joint_from_bind[i]);
   }
   return model;
+}
+
+base::Error StageError(const Character& c, const base::JobStatus& s, const char* stage) {
+  return base::MakeError(base::ErrorCode::kInternal, {c.source, 0, 0, {}},
+                         std::string(stage) + " refused to run: " + s.what);
+}
+
+base::Status CharacterPose::Sample(const Character& c, double time_s) {
+  const auto nj = static_cast<std::size_t>(c.skeleton.num_joints());
+  locals.resize(nj);
+  scratch_.resize(nj);
+  model_from_joint.resize(nj);
+  if (c.motion.num_frames > 0) {
+    const base::JobStatus s = mocap::SampleLocalsJob{.skeleton = &c.skeleton,
+                                                     .motion = &c.motion,
+                                                     .time_s = time_s,
+                                                     .scratch = scratch_,
+                                                     .locals = locals}
+                                  .Run();
+    if (!s) return StageError(c, s, "sampling");
+  } else {
+    mocap::RestPose(c.skeleton, locals);
+  }
+  const base::JobStatus s = mocap::LocalToModelJob{.parents = c.skeleton.parents,
+                                                   .locals = locals,
+                                                   .model_from_root = c.world_from_model,
+                                                   .model_from_joint = model_from_joint}
+                                .Run();
+  if (!s) return StageError(c, s, "local-to-model");
+  return base::Status::Ok();
 }
 
 }  // namespace deform

@@ -50,11 +50,6 @@ std::vector<int> NearestRegionVertices(const PatchSetup& patch, const Mesh& bind
   return nearest;
 }
 
-base::Error JobError(const Character& c, const base::JobStatus& s, const char* stage) {
-  return base::MakeError(base::ErrorCode::kInternal, {c.source, 0, 0, {}},
-                         std::string(stage) + " refused to run: " + s.what);
-}
-
 // Unit normals of the global result, as every variant gets them: the skinned
 // normals normalized (or, without bind normals, the mesh's geometric normals).
 void GlobalNormals(std::span<const glm::vec3> positions, std::span<const glm::uvec3> triangles,
@@ -92,8 +87,7 @@ void AddLayerNormals(std::span<const glm::vec3> global_geometric,
 struct FramePipeline::Impl {
   const Character* character = nullptr;
   int threads = 1;
-  std::vector<mocap::JointTransform> locals, scratch;
-  std::vector<glm::mat4> model_from_joint;
+  CharacterPose pose;
   std::optional<GlobalSkinning> global;
   // The patch layer (empty: global only).
   std::vector<PatchSetup> patches;
@@ -228,7 +222,7 @@ base::JobStatus FramePipeline::AddExampleShapes(Impl& m, std::size_t p) {
       std::span<float>(m.pose_features).first(static_cast<std::size_t>(space.model.dimension));
   const std::span<glm::vec3> ds = std::span<glm::vec3>(m.pose_ds).first(nc);
   const std::span<glm::quat> rotations = std::span<glm::quat>(m.pose_rotations).first(nc);
-  if (!ComputePoseFeatures(m.character->skeleton, space.features, m.locals, features).ok()) {
+  if (!ComputePoseFeatures(m.character->skeleton, space.features, m.pose.locals, features).ok()) {
     return {base::JobStatus::kSizeMismatch, "pose features"};
   }
   base::JobStatus s =
@@ -264,10 +258,6 @@ base::Result<FramePipeline> FramePipeline::Create(const Character& character, Gl
   impl->character = &character;
   impl->global = std::move(*global);
   impl->threads = base::ResolveThreads(threads);
-  const auto nj = static_cast<std::size_t>(character.skeleton.num_joints());
-  impl->locals.resize(nj);
-  impl->scratch.resize(nj);
-  impl->model_from_joint.resize(nj);
   return FramePipeline(std::move(impl));
 }
 
@@ -275,25 +265,9 @@ base::Status FramePipeline::Evaluate(double time_s, DeformedFrame& out) {
   Impl& m = *impl_;
   const Character& c = *m.character;
   const SkinnedMesh& mesh = c.mesh;
-  if (c.motion.num_frames > 0) {
-    const base::JobStatus s = mocap::SampleLocalsJob{.skeleton = &c.skeleton,
-                                                     .motion = &c.motion,
-                                                     .time_s = time_s,
-                                                     .scratch = m.scratch,
-                                                     .locals = m.locals}
-                                  .Run();
-    if (!s) return JobError(c, s, "sampling");
-  } else {
-    mocap::RestPose(c.skeleton, m.locals);
-  }
-  base::JobStatus s = mocap::LocalToModelJob{.parents = c.skeleton.parents,
-                                             .locals = m.locals,
-                                             .model_from_root = c.world_from_model,
-                                             .model_from_joint = m.model_from_joint}
-                          .Run();
-  if (!s) return JobError(c, s, "local-to-model");
-  s = m.global->Pose(m.model_from_joint);
-  if (!s) return JobError(c, s, "global pose");
+  if (base::Status sampled = m.pose.Sample(c, time_s); !sampled.ok()) return sampled;
+  base::JobStatus s = m.global->Pose(m.pose.model_from_joint);
+  if (!s) return StageError(c, s, "global pose");
 
   const int nv = mesh.bind.num_vertices();
   out.positions.resize(static_cast<std::size_t>(nv));
@@ -305,7 +279,7 @@ base::Status FramePipeline::Evaluate(double time_s, DeformedFrame& out) {
         m.global->SkinVertices(begin, end, out.positions, out.normals);
   });
   for (const base::JobStatus& r : results) {
-    if (!r) return JobError(c, r, GlobalMethodName(m.global->method()));
+    if (!r) return StageError(c, r, GlobalMethodName(m.global->method()));
   }
   if (!m.patches.empty()) {
     // Patch layer: carry the control points like skin vertices, add the
@@ -313,17 +287,18 @@ base::Status FramePipeline::Evaluate(double time_s, DeformedFrame& out) {
     // elastic displacements dE, rebuild and blend.
     for (std::size_t p = 0; p < m.patches.size(); ++p) {
       s = m.global->CarryPoints(m.control_points[p], m.carried[p]);
-      if (!s) return JobError(c, s, "patch control points");
+      if (!s) return StageError(c, s, "patch control points");
       std::copy(m.carried[p].begin(), m.carried[p].end(), m.reference[p].begin());
       if (p < m.pose_spaces.size() && m.pose_spaces[p].active()) {
         s = AddExampleShapes(m, p);
-        if (!s) return JobError(c, s, "pose space");
+        if (!s) return StageError(c, s, "pose space");
       }
     }
     std::span<const std::span<const glm::vec3>> displacements;
     if (m.elastic) {
       // dE: the mass-spring networks advanced to this frame's time (state carried).
-      const base::Status advanced = m.elastic->Advance(time_s, m.model_from_joint, m.displacement);
+      const base::Status advanced =
+          m.elastic->Advance(time_s, m.pose.model_from_joint, m.displacement);
       if (!advanced.ok()) return advanced;
       for (std::size_t p = 0; p < m.patches.size(); ++p)
         m.displacement_views[p] = m.displacement[p];
@@ -343,9 +318,9 @@ base::Status FramePipeline::Evaluate(double time_s, DeformedFrame& out) {
     ComputeVertexNormals(out.positions, mesh.bind.triangles, m.layered_geometric);
     AddLayerNormals(m.global_geometric, m.layered_geometric, out.normals);
   }
-  out.joint_positions.resize(m.model_from_joint.size());
-  for (std::size_t j = 0; j < m.model_from_joint.size(); ++j) {
-    out.joint_positions[j] = glm::vec3(m.model_from_joint[j][3]);
+  out.joint_positions.resize(m.pose.model_from_joint.size());
+  for (std::size_t j = 0; j < m.pose.model_from_joint.size(); ++j) {
+    out.joint_positions[j] = glm::vec3(m.pose.model_from_joint[j][3]);
   }
   out.bounds = ComputeBounds(out.positions);
   return base::Status::Ok();

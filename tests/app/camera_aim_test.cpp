@@ -57,7 +57,7 @@ TEST(CameraAim, AzimuthElevationAndDistancePlaceTheEye) {
     spec.elevation_deg = 20.0f;
     spec.distance = 80.0f;
     spec.look_joint = joint;
-    auto cameras = app::PlanCameras(*s.pipeline, s.plan, spec, {640, 360});
+    auto cameras = app::PlanCameras(s.pipeline->character(), s.plan, spec, {640, 360});
     ASSERT_TRUE(cameras.ok()) << cameras.error().ToString();
     const render::Camera c = cameras->At(s.plan.At(0).camera);
     const glm::vec3 offset = c.eye - c.target;
@@ -67,7 +67,7 @@ TEST(CameraAim, AzimuthElevationAndDistancePlaceTheEye) {
     EXPECT_GT(glm::dot(glm::normalize(offset), expected), 0.99999f) << azimuth;
     // Zoom 2 halves the distance, the direction stays.
     spec.zoom = 2.0f;
-    auto zoomed = app::PlanCameras(*s.pipeline, s.plan, spec, {640, 360});
+    auto zoomed = app::PlanCameras(s.pipeline->character(), s.plan, spec, {640, 360});
     ASSERT_TRUE(zoomed.ok());
     const render::Camera z = zoomed->At(s.plan.At(0).camera);
     EXPECT_NEAR(glm::length(z.eye - z.target), 40.0f, 1e-3f);
@@ -101,7 +101,7 @@ TEST(CameraAim, LookAtFollowsTheJointAndTheRegionWithTheFollowSmoothing) {
     spec.azimuth_deg = 90.0f;
     if (kind == 0) spec.look_joint = joint;
     else spec.look_region = region;
-    auto cameras = app::PlanCameras(*s.pipeline, s.plan, spec, {640, 360});
+    auto cameras = app::PlanCameras(s.pipeline->character(), s.plan, spec, {640, 360});
     ASSERT_TRUE(cameras.ok());
     render::FollowCamera follow;
     follow.frame_time_s = static_cast<float>(s.plan.frame_time_s);
@@ -117,7 +117,7 @@ TEST(CameraAim, LookAtFollowsTheJointAndTheRegionWithTheFollowSmoothing) {
 TEST(CameraAim, RefusesValuesOutOfRange) {
   Scene s;
   const auto refused = [&](app::CameraSpec spec, const std::string& option) {
-    auto c = app::PlanCameras(*s.pipeline, s.plan, spec, {640, 360});
+    auto c = app::PlanCameras(s.pipeline->character(), s.plan, spec, {640, 360});
     ASSERT_FALSE(c.ok()) << option;
     EXPECT_NE(c.error().ToString().find(option), std::string::npos) << c.error().ToString();
   };

@@ -17,6 +17,7 @@
 #include "app/character_motion.h"
 #include "app/frame_plan.h"
 #include "app/character.h"
+#include "deform/pipeline/body_tracker.h"
 #include "deform/pipeline/frame_pipeline.h"
 #include "mocap/bvh_reader.h"
 #include "support/data_paths.h"
@@ -109,32 +110,50 @@ TEST(CapturePose, InspectSaysWhichUpAxisAndWhy) {
   EXPECT_EQ(r.FirstErrLine(), "--up: error: expected y or z, found 'x'");
 }
 
-// The follow camera at 1280x720 keeps the body in the picture: the largest
-// |x| or |y| in normalised device coordinates over a quarter of the body's
-// vertices, at every output frame (infinity when a vertex is behind the eye).
-float WorstFollowExtent(const app::Character& ch) {
+// What the follow camera at 1280x720 sees of a capture, over every output frame:
+// the largest |x| or |y| in normalised device coordinates over a quarter of
+// the body's vertices (infinity when a vertex is behind the eye), and how far
+// the bounds the cameras track (deform::BodyTracker) fall short of the SSD
+// body's, as a fraction of its largest extent.
+struct FollowCheck {
+  float extent = INFINITY;
+  float hull_gap = INFINITY;
+};
+
+FollowCheck CheckFollowCamera(const app::Character& ch) {
   base::Result<deform::FramePipeline> p =
       deform::FramePipeline::Create(ch, deform::GlobalMethod::kSsd, 1);
   EXPECT_TRUE(p.ok());
   base::Result<app::FramePlan> plan =
       app::PlanFrames(ch.motion, {.frames = "", .list_frames = false});
   EXPECT_TRUE(plan.ok());
-  if (!p.ok() || !plan.ok()) return INFINITY;
+  base::Result<deform::BodyTracker> tracker = deform::BodyTracker::Create(ch, {});
+  EXPECT_TRUE(tracker.ok());
+  if (!p.ok() || !plan.ok() || !tracker.ok()) return {};
   base::Result<render::CameraPlan> cameras =
-      app::PlanCameras(*p, *plan, "follow", 15.0f, {1280, 720});
+      app::PlanCameras(ch, *plan, "follow", 15.0f, {1280, 720});
   EXPECT_TRUE(cameras.ok());
-  if (!cameras.ok()) return INFINITY;
+  if (!cameras.ok()) return {};
   deform::DeformedFrame frame;
-  float worst = 0.0f;
+  deform::TrackedBody tracked;
+  FollowCheck worst{0.0f, 0.0f};
   for (std::size_t i = 0; i < plan->count(); ++i) {
     const app::OutputFrame of = plan->At(i);
     EXPECT_TRUE(p->Evaluate(of.time_s, frame).ok());
+    EXPECT_TRUE(tracker->Sample(of.time_s, tracked).ok());
+    const glm::vec3 size = frame.bounds.size();
+    const float body = std::max({size.x, size.y, size.z});
+    for (int a = 0; a < 3; ++a) {
+      worst.hull_gap =
+          std::max({worst.hull_gap, (tracked.hull_bounds.min[a] - frame.bounds.min[a]) / body,
+                    (frame.bounds.max[a] - tracked.hull_bounds.max[a]) / body});
+    }
     const render::Camera camera = cameras->At(of.camera);
     const glm::mat4 clip_from_world = camera.ClipFromView() * camera.ViewFromWorld();
     for (std::size_t v = 0; v < frame.positions.size(); v += 4) {
       const glm::vec4 c = clip_from_world * glm::vec4(frame.positions[v], 1.0f);
-      if (!(c.w > 0.0f)) return INFINITY;
-      worst = std::max({worst, std::abs(c.x / c.w), std::abs(c.y / c.w)});
+      if (!(c.w > 0.0f)) return {};
+      worst.extent = std::max({worst.extent, std::abs(c.x / c.w), std::abs(c.y / c.w)});
     }
   }
   return worst;
@@ -142,6 +161,8 @@ float WorstFollowExtent(const app::Character& ch) {
 
 // Inside the frame with a margin of 5% of its width and height on every side.
 constexpr float kMaxFollowExtent = 0.9f;
+// The tracked bounds are the body's to within 1.5% of its size on every side.
+constexpr float kMaxHullGap = 0.015f;
 
 TEST(CapturePose, FollowCameraKeepsGeneratedBodiesInFrame) {
   const struct {
@@ -160,7 +181,9 @@ TEST(CapturePose, FollowCameraKeepsGeneratedBodiesInFrame) {
     base::Result<app::Character> ch = app::LoadCommandCharacter(bvh.string(), "", true);
     ASSERT_TRUE(ch.ok()) << ch.error().ToString();
     EXPECT_EQ(ch->skeleton.info.up_axis_source, mocap::UpAxisSource::kAnimatedPoses);
-    EXPECT_LE(WorstFollowExtent(*ch), kMaxFollowExtent);
+    const FollowCheck check = CheckFollowCamera(*ch);
+    EXPECT_LE(check.extent, kMaxFollowExtent);
+    EXPECT_LE(check.hull_gap, kMaxHullGap);
   }
 }
 
@@ -173,9 +196,11 @@ TEST(CapturePose, FollowCameraKeepsEveryRealCaptureInFrame) {
     SCOPED_TRACE(e.path().string());
     base::Result<app::Character> ch = app::LoadCommandCharacter(e.path().string(), "", true);
     ASSERT_TRUE(ch.ok()) << ch.error().ToString();
-    const float worst = WorstFollowExtent(*ch);
-    EXPECT_LE(worst, kMaxFollowExtent);
-    std::printf("%-60s %.3f\n", e.path().filename().string().c_str(), worst);
+    const FollowCheck check = CheckFollowCamera(*ch);
+    EXPECT_LE(check.extent, kMaxFollowExtent);
+    EXPECT_LE(check.hull_gap, kMaxHullGap);
+    std::printf("%-60s extent %.3f, hull gap %.4f\n", e.path().filename().string().c_str(),
+                check.extent, check.hull_gap);
     ++checked;
   }
   EXPECT_GT(checked, 0);

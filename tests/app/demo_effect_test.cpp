@@ -97,7 +97,7 @@ EffectMeasure Measure(const std::string& demo) {
   const base::Status look = app::ResolveLookAt(rig->render.look_at, &*rig, *ch, spec);
   EXPECT_TRUE(look.ok()) << look.error().ToString();
   const glm::ivec2 size = rig->render.size;
-  auto cameras = app::PlanCameras(*global, *plan, spec, {size.x / 2, size.y});
+  auto cameras = app::PlanCameras(global->character(), *plan, spec, {size.x / 2, size.y});
   EXPECT_TRUE(cameras.ok());
   if (!cameras.ok()) return m;
   const render::Camera camera = cameras->At(of.camera);

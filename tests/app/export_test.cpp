@@ -83,7 +83,7 @@ TEST(ExportCommand, ObjFramesAreThePipelineFramesAndCamerasAreRenders) {
       deform::FramePipeline::Create(ch, deform::GlobalMethod::kDqs, 1);
   ASSERT_TRUE(pipeline.ok());
   base::Result<render::CameraPlan> cameras =
-      app::PlanCameras(*pipeline, *plan, "follow", 15.0f, {320, 200});
+      app::PlanCameras(pipeline->character(), *plan, "follow", 15.0f, {320, 200});
   ASSERT_TRUE(cameras.ok());
 
   deform::DeformedFrame frame;

@@ -40,7 +40,7 @@ render::Image RenderElbow(View view) {
   spec.azimuth_deg = demo->rig.render.azimuth_deg;
   spec.zoom = demo->rig.render.zoom;
   EXPECT_TRUE(app::ResolveLookAt(demo->rig.render.look_at, &demo->rig, ch, spec).ok());
-  auto cameras = app::PlanCameras(*demo->global, *plan, spec, {kWidth / 2, kHeight});
+  auto cameras = app::PlanCameras(demo->global->character(), *plan, spec, {kWidth / 2, kHeight});
   EXPECT_TRUE(cameras.ok());
   if (!cameras.ok()) return render::Image(kWidth, kHeight);
   const app::OutputFrame of = plan->At(kFrame);

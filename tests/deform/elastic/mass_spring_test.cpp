@@ -21,6 +21,7 @@
 #include "tools/synthetic.h"
 #include "support/data_paths.h"
 #include "support/tolerances.h"
+#include "support/same_bits.h"
 
 namespace {
 
@@ -573,9 +574,7 @@ std::vector<glm::vec3> RunAll(const MassSpringNetwork& net, const DriveFn& drive
   return all;
 }
 
-bool SameBits(const std::vector<glm::vec3>& a, const std::vector<glm::vec3>& b) {
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(glm::vec3)) == 0;
-}
+using testsupport::SameBits;
 
 // A sample with a NaN or Inf in any of its 13 floats, or a zero rotation, is
 // the bind frame at rest (the same bits as a source that gives it), counted

@@ -19,6 +19,7 @@
 #include "support/random_blends.h"
 #include "support/rotations.h"
 #include "support/tolerances.h"
+#include "support/same_bits.h"
 
 namespace {
 
@@ -77,9 +78,7 @@ glm::dmat3 Blend(const deform::PatchSetup& p, std::span<const glm::mat4> palette
   return blend;
 }
 
-bool SameBits(std::span<const glm::quat> a, std::span<const glm::quat> b) {
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size_bytes()) == 0;
-}
+using testsupport::SameBits;
 
 // Every 3+-bone rotation the bits of the Newton iteration on its blend (where
 // that accepts the blend), and every rotation within kRotationTol of the SVD
@@ -96,7 +95,7 @@ void ExpectTheDefinition(const deform::PatchSetup& p, std::span<const glm::mat4>
     glm::dmat3 r;
     if (deform::PolarRotationNewton(blend, r)) {
       const glm::quat newton = glm::normalize(glm::quat(glm::quat_cast(r)));
-      EXPECT_TRUE(SameBits(std::span(&fast[c], 1), std::span(&newton, 1))) << c;
+      EXPECT_TRUE(SameBits<glm::quat>(std::span(&fast[c], 1), std::span(&newton, 1))) << c;
     }
   }
 }
@@ -234,7 +233,8 @@ TEST(PatchControlRotations, FindsTheMovingControlPointsForAnyCount) {
     for (std::size_t c = 0; c < ds.size(); ++c) {
       const bool still = ds[c].x == 0.0f && ds[c].y == 0.0f && ds[c].z == 0.0f;
       const glm::quat expected = still ? glm::quat(1.0f, 0.0f, 0.0f, 0.0f) : all[c];
-      EXPECT_TRUE(SameBits(std::span(&masked[c], 1), std::span(&expected, 1))) << count << " " << c;
+      EXPECT_TRUE(SameBits<glm::quat>(std::span(&masked[c], 1), std::span(&expected, 1)))
+          << count << " " << c;
     }
   }
 }

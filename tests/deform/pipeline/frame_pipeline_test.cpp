@@ -17,6 +17,7 @@
 #include "mocap/pose.h"
 #include "mocap/sampling.h"
 #include "tools/synthetic.h"
+#include "support/same_bits.h"
 
 namespace {
 
@@ -54,9 +55,7 @@ std::vector<glm::mat4> PoseAt(const deform::Character& c, double t) {
   return model;
 }
 
-bool SameBits(const std::vector<glm::vec3>& a, const std::vector<glm::vec3>& b) {
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(a[0])) == 0;
-}
+using testsupport::SameBits;
 
 deform::GlobalSkinning Posed(GlobalMethod method, const std::vector<glm::mat4>& pose) {
   const deform::Character& c = BendingBody();
