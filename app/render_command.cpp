@@ -398,193 +398,188 @@ base::Result<std::string> PlanRenderOutputs(const RenderOptions& o,
   return pattern;
 }
 
-}  // namespace
-
-int RunRender(const RenderOptions& options) {
-  const auto started = std::chrono::steady_clock::now();
-  double first_frame_s = -1.0;  // --stats: when the first frame went to the writer
-  RenderOptions o = options;
-  base::Result<std::optional<Rig>> loaded_rig = TakeRenderRig(o);
-  if (!loaded_rig.ok()) return ReportError(loaded_rig.error());
-  const std::optional<Rig>& rig = *loaded_rig;
-  const base::Result<glm::ivec2> size = ParseSize(o.size);
-  if (!size.ok()) return ReportError(size.error());
-  base::Result<Overlays> overlays = CheckRenderOptions(o, *size);
-  if (!overlays.ok()) return ReportError(overlays.error());
-  const auto [overlay_skeleton, overlay_wire, overlay_patches, overlay_delta] = *overlays;
-  const base::Result<deform::GlobalMethod> method = ParseGlobalMethod(o.global);
-  if (!method.ok()) return ReportError(method.error());
-  base::Result<TwoBodies> two = ChooseTwoBodies(o, rig ? &*rig : nullptr, *method);
-  if (!two.ok()) return ReportError(two.error());
-
-  const base::Result<BodyKind> body_kind = ResolveRenderBody(o, rig ? &*rig : nullptr);
-  if (!body_kind.ok()) return ReportError(body_kind.error());
-
-  // --- Input -----------------------------------------------------------------
-  const bool demo = o.input.empty();
-  const std::string name = demo  ? "demo"
-                           : rig ? std::filesystem::path(rig->file).stem().string()
-                                 : std::filesystem::path(o.input).stem().string();
-  const base::Result<std::optional<mocap::UpAxis>> up = ParseUpAxis(o.up);
-  if (!up.ok()) return ReportError(up.error());
-  base::Result<Character> character =
-      LoadCommandCharacter(o.input, o.motion, o.quiet, *up, o.joint_map, nullptr, *body_kind);
-  if (!character.ok()) return ReportError(character.error());
-  const Character& ch = *character;
-
-  const bool turntable = o.camera == "turntable";
+// The output frames (app/frame_plan.h). When the range came from the rig file
+// (`typed`, the options as typed, gave none), errors name it and its field, not --frames.
+base::Result<FramePlan> PlanRenderFrames(const RenderOptions& typed, const RenderOptions& o,
+                                         const Rig* rig, const Character& ch) {
   base::Result<FramePlan> plan = PlanFrames(ch.motion, {.frames = o.frames,
                                                         .fps = o.fps,
-                                                        .turntable = turntable,
+                                                        .turntable = o.camera == "turntable",
                                                         .turntable_frames = o.turntable_frames,
                                                         .start_number = o.start_number,
                                                         .list_frames = false});
-  if (!plan.ok()) {
-    if (rig && options.frames.empty() && !rig->render.frames.empty()) {
-      // The range came from the rig file: name it and its field, not --frames.
-      base::Error e = plan.error();
-      e.loc = {rig->file, 0, 0, "render.frames"};
-      return ReportError(e);
+  if (!plan.ok() && rig && typed.frames.empty() && !rig->render.frames.empty()) {
+    base::Error e = plan.error();
+    e.loc = {rig->file, 0, 0, "render.frames"};
+    return e;
+  }
+  return plan;
+}
+
+// The colours of the patch layer's overlays: patches tints every region (both
+// bodies); delta colours each body with patches by its displacement from the
+// same method alone, evaluated by a global-only pipeline per such body.
+class RenderOverlayColors {
+ public:
+  // Errors: an overlay without a rig with patches (naming --overlay), those of
+  // BuildRigPatches and of the global-only pipelines.
+  static base::Result<RenderOverlayColors> Create(const Overlays& overlays, const Rig* rig,
+                                                  const Character& ch, const RenderBodies& bodies,
+                                                  int threads) {
+    if ((overlays.patches || overlays.delta) && (!rig || rig->patches.empty())) {
+      return ArgError("--overlay", std::string(overlays.delta ? "delta" : "patches") +
+                                       " needs a rig file with patches as the input");
     }
-    return ReportError(plan.error());
+    RenderOverlayColors out;
+    out.delta_on_ = overlays.delta;
+    if (overlays.patches) {
+      base::Result<std::vector<deform::PatchSetup>> patches = BuildRigPatches(*rig, ch);
+      if (!patches.ok()) return patches.error();
+      out.tint_ = PatchTint(*patches, ch.mesh.bind.num_vertices(), ch.mesh.bind.colors);
+    }
+    for (int side = 0; side < 2 && overlays.delta; ++side) {
+      const deform::FramePipeline* body = side == 0      ? &*bodies.left
+                                          : bodies.right ? &*bodies.right
+                                                         : nullptr;
+      if (body == nullptr || body->num_patches() == 0) continue;
+      base::Result<deform::FramePipeline> base =
+          deform::FramePipeline::Create(ch, body->method(), threads);
+      if (!base.ok()) return base.error();
+      out.delta_[side].base.emplace(std::move(*base));
+    }
+    return out;
   }
-  const double frame_time = plan->frame_time_s;
-  // The output frames are computed one at a time (plan->At): a render of
-  // every frame of an hour-long capture holds no per-frame list (issue 8).
-  const std::size_t num_frames = plan->count();
 
-  // Existing outputs are refused (or, with --resume, skipped) before anything renders.
-  OutputGuard guard({.overwrite = o.overwrite, .resume = o.resume});
-  const base::Result<std::string> out_pattern =
-      PlanRenderOutputs(o, "out/" + name + (turntable ? "_turntable" : ""), *plan, guard);
-  if (!out_pattern.ok()) return ReportError(out_pattern.error());
-  const std::string& pattern = *out_pattern;
-
-  // --- Pipelines: one body, or the two of a comparison ---------------------------
-  base::Result<RenderBodies> bodies = MakeRenderBodies(o, rig ? &*rig : nullptr, ch, *two, *method);
-  if (!bodies.ok()) return ReportError(bodies.error());
-  std::optional<deform::FramePipeline> pipeline = std::move(bodies->left);
-  std::optional<deform::FramePipeline>& right_pipeline = bodies->right;
-  const bool side_by_side = two->view == View::kCompare;
-
-  // --- Overlays of the patch layer ----------------------------------------------
-  // patches: every region tinted (both bodies); delta: each body with the
-  // layer coloured by its displacement from the same method alone, evaluated
-  // by a global-only pipeline per such body.
-  if ((overlay_patches || overlay_delta) && (!rig || rig->patches.empty())) {
-    return ReportError(ArgError("--overlay", std::string(overlay_delta ? "delta" : "patches") +
-                                                 " needs a rig file with patches as the input"));
+  // With the delta overlay, evaluates the global-only bodies at `time_s` and
+  // colours the layered ones (`right` unused without one) on a scale shared
+  // by both: 1, 2 or 5 x 10^k above the frame's largest displacement (the
+  // frame alone decides it). Returns the colour bar's scale, 0 without it.
+  base::Result<float> Paint(double time_s, const deform::DeformedFrame& left,
+                            const deform::DeformedFrame& right) {
+    if (!delta_on_) return 0.0f;
+    float scale = 0.0f;
+    for (int b = 0; b < 2; ++b) {
+      if (!delta_[b].base) continue;
+      const base::Status s = delta_[b].base->Evaluate(time_s, delta_[b].base_frame);
+      if (!s.ok()) return s.error();
+      const deform::DeformedFrame& layered = b == 0 ? left : right;
+      for (std::size_t v = 0; v < layered.positions.size(); ++v) {
+        scale =
+            std::max(scale, glm::length(layered.positions[v] - delta_[b].base_frame.positions[v]));
+      }
+    }
+    scale = NiceScale(scale);
+    for (int b = 0; b < 2; ++b) {
+      if (!delta_[b].base) continue;
+      DisplacementColors(delta_[b].base_frame.positions, (b == 0 ? left : right).positions, scale,
+                         delta_[b].colors);
+    }
+    return scale;
   }
-  std::vector<glm::vec3> tint;
-  if (overlay_patches) {
-    base::Result<std::vector<deform::PatchSetup>> patches = BuildRigPatches(*rig, ch);
-    if (!patches.ok()) return ReportError(patches.error());
-    tint = PatchTint(*patches, ch.mesh.bind.num_vertices(), ch.mesh.bind.colors);
+
+  // The albedo of body `side` (0 left or only, 1 right): #V, or empty for the mesh's own.
+  std::span<const glm::vec3> colors(int side) const {
+    return delta_[side].base ? std::span<const glm::vec3>(delta_[side].colors)
+                             : std::span<const glm::vec3>(tint_);
   }
+
+ private:
   struct DeltaBody {
     std::optional<deform::FramePipeline> base;  // the same method without the layer
     deform::DeformedFrame base_frame;
     std::vector<glm::vec3> colors;
   };
-  DeltaBody delta[2];
-  for (int side = 0; side < 2 && overlay_delta; ++side) {
-    const deform::FramePipeline* body = side == 0        ? &*pipeline
-                                        : right_pipeline ? &*right_pipeline
-                                                         : nullptr;
-    if (body == nullptr || body->num_patches() == 0) continue;
-    base::Result<deform::FramePipeline> base =
-        deform::FramePipeline::Create(ch, body->method(), o.threads);
-    if (!base.ok()) return ReportError(base.error());
-    delta[side].base.emplace(std::move(*base));
-  }
+  bool delta_on_ = false;
+  std::vector<glm::vec3> tint_;  // empty without the patches overlay
+  DeltaBody delta_[2];
+};
 
-  // --- Framing (app/frame_plan.h) ------------------------------------------------
-  deform::DeformedFrame frame, right_frame;
+// The camera of every output frame, framed on the --framing range when given
+// (so the chunks of one render frame the body alike).
+base::Result<render::CameraPlan> PlanRenderCameras(const RenderOptions& o, const Rig* rig,
+                                                   const Character& ch, const FramePlan& plan,
+                                                   glm::ivec2 size, bool side_by_side) {
   base::Result<FramePlan> framing = plan;
-  if (!o.framing.empty() && !turntable) {
+  if (!o.framing.empty() && o.camera != "turntable") {
     framing = PlanFrames(ch.motion, {.frames = o.framing, .fps = o.fps,
                                      .start_number = o.start_number, .list_frames = false});
-    if (!framing.ok()) return ReportError(ArgError("--framing", framing.error().message));
-    if (plan->range.first < framing->range.first || plan->range.last > framing->range.last) {
-      return ReportError(ArgError("--framing", "expected a range holding every output frame (" +
-                                                   std::to_string(plan->range.first) + ".." +
-                                                   std::to_string(plan->range.last) + "), found '" +
-                                                   o.framing + "'"));
+    if (!framing.ok()) return ArgError("--framing", framing.error().message);
+    if (plan.range.first < framing->range.first || plan.range.last > framing->range.last) {
+      return ArgError("--framing", "expected a range holding every output frame (" +
+                                       std::to_string(plan.range.first) + ".." +
+                                       std::to_string(plan.range.last) + "), found '" + o.framing +
+                                       "'");
     }
   }
-  // Side by side, every body is framed in its own half of the frame.
-  const glm::ivec2 view_size = side_by_side ? glm::ivec2(size->x / 2, size->y) : *size;
   CameraSpec camera_spec;
   camera_spec.mode = o.camera;
   camera_spec.elevation_deg = o.elevation_deg;
   camera_spec.azimuth_deg = o.azimuth_deg;
   camera_spec.distance = o.distance;
   camera_spec.zoom = o.zoom;
-  if (base::Status s = ResolveLookAt(o.look_at, rig ? &*rig : nullptr, ch, camera_spec); !s.ok()) {
+  if (base::Status s = ResolveLookAt(o.look_at, rig, ch, camera_spec); !s.ok()) {
     base::Error e = s.error();
-    if (rig && options.given.count("--look-at") == 0) e.loc = {rig->file, 0, 0, "render.camera.look_at"};
-    return ReportError(e);
+    if (rig && o.given.count("--look-at") == 0) e.loc = {rig->file, 0, 0, "render.camera.look_at"};
+    return e;
   }
-  base::Result<render::CameraPlan> cameras = PlanCameras(ch, *framing, camera_spec, view_size);
-  if (!cameras.ok()) return ReportError(cameras.error());
-  const float ground_y = cameras->ground_y();
+  // Side by side, every body is framed in its own half of the frame.
+  const glm::ivec2 view_size = side_by_side ? glm::ivec2(size.x / 2, size.y) : size;
+  return PlanCameras(ch, *framing, camera_spec, view_size);
+}
 
-  // --- Outputs -------------------------------------------------------------------
-  {
-    const base::Result<std::string> first = render::ExpandFramePattern(pattern, plan->At(0).number);
-    if (!first.ok()) return ReportError(first.error());
-    const base::Status writable = PrepareOutputFolder(std::filesystem::path(*first).parent_path());
-    if (!writable.ok()) return ReportError(writable.error());
-  }
-  const std::filesystem::path out_dir =
-      std::filesystem::path(*render::ExpandFramePattern(pattern, 0)).parent_path();
-  render::RenderSettings settings = MakeRenderSettings(o, *size, pattern);
-  settings.ground_y = ground_y;
-  render::Renderer renderer;
-  render::Renderer right_renderer;
-  render::AsyncImageWriter writer({.num_workers = 2, .max_in_flight = 4});
+// Where a render's frames go: their files through the image writer, and the
+// contact sheet and the preview video, fed in order on the side queue.
+struct RenderOutputs {
+  std::string pattern;            // the frame files' (PlanRenderOutputs)
+  std::filesystem::path out_dir;  // the sheet's and the video's folder
+  std::size_t num_frames = 0;
+  render::RenderSettings settings;
+  render::Renderer renderer, right_renderer;
+  render::AsyncImageWriter writer{{.num_workers = 2, .max_in_flight = 4}};
   render::WriteOptions write_options;
-  write_options.png_compression = o.png_compression;
-  write_options.source_file = demo ? "demo_walk.bvh (built in)" : rig ? rig->file : o.input;
+  int sheet_count = 0, next_sheet = 0;  // the sheet's thumbnails, and those added so far
+  std::unique_ptr<render::ContactSheetBuilder> sheet;  // null with --no-sheet
+  std::unique_ptr<render::VideoWriter> video;          // null with --no-video or when it failed
+  std::optional<render::ImageFormat> frame_format;     // the frame files' (none: unknown)
+  render::Image image, right_image;  // the frame drawn, and DrawCharacterFrame's scratch
+  // The sheet and the H.264 preview take frames in order on their own thread,
+  // so encoding the video overlaps rendering the next frame (each task holds
+  // its own copy of the frame; at most two are pending). Last, so it stops
+  // before the members its tasks use go.
+  render::SerialTaskQueue side{{.max_queued = 2}};
 
-  const int sheet_count = std::min<int>(kMaxSheetFrames, static_cast<int>(num_frames));
-  std::unique_ptr<render::ContactSheetBuilder> sheet;
-  if (!o.no_sheet) {
-    auto b = render::ContactSheetBuilder::Create(
-        sheet_count, size->x, size->y, {.columns = render::ContactSheetColumns(sheet_count)});
-    if (!b.ok()) return ReportError(b.error());
-    sheet = std::move(*b);
-  }
-  std::unique_ptr<render::VideoWriter> video;
-  if (!o.no_video) {
-    const double video_fps = turntable ? 24.0 : 1.0 / (frame_time * plan->range.step);
-    auto v = render::VideoWriter::Open((out_dir / "preview.mp4").string(), size->x & ~1,
-                                       size->y & ~1, {.fps = video_fps});
-    // The video is a preview: a render never fails over it (a warning, no video).
-    if (v.ok()) {
-      video = std::move(*v);
-    } else {
-      const base::Warning w{v.error().loc, v.error().message + "; no preview video"};
-      std::fprintf(stderr, "%s\n", w.ToString().c_str());
-    }
+  // Output frame i (file number `number`) to the sheet and the video, on the side queue.
+  base::Status Feed(std::size_t i, int number, std::shared_ptr<const render::Image> img,
+                    bool read_back) {
+    if (!sheet && !video) return base::Status::Ok();
+    return side.Submit([this, i, number, img = std::move(img), read_back] {
+      return FeedSheetAndVideo(i, number, *img, read_back);
+    });
   }
 
-  // --- The frame loop -------------------------------------------------------------
-  Progress progress(demo ? "render demo" : "render " + name, static_cast<int>(num_frames), o.quiet);
-  render::Image image, right_image;
-  int next_sheet = 0;
+  // A frame --resume skips: its finished file on disk feeds the sheet and the video.
+  base::Status FeedFinishedFrame(std::size_t i, int number) {
+    if (!sheet && !video) return base::Status::Ok();
+    const base::Result<std::string> done_path = render::ExpandFramePattern(pattern, number);
+    if (!done_path.ok()) return done_path.error();
+    base::Result<render::Image> done = render::ReadImage(*done_path);
+    if (!done.ok()) return done.error();
+    return Feed(i, number, std::make_shared<const render::Image>(std::move(*done)),
+                /*read_back=*/true);
+  }
+
+ private:
   // The sheet gets every frame as its file will read back (render/output/stored_image.h),
   // so a --resume that rebuilds it from finished frames on disk gives the same
   // bytes; formats whose round trip is not modelled (JPEG) use the frame as is.
-  const base::Result<render::ImageFormat> frame_format = render::ImageFormatFromPath(pattern);
-  auto feed_sheet_and_video = [&](std::size_t i, int number, const render::Image& img,
-                                  bool read_back) {
+  base::Status FeedSheetAndVideo(std::size_t i, int number, const render::Image& img,
+                                 bool read_back) {
     if (sheet && next_sheet < sheet_count &&
         static_cast<std::int64_t>(i) ==
             render::ContactSheetPick(next_sheet, sheet_count, static_cast<std::int64_t>(num_frames))) {
       const render::Image* thumb_source = &img;
       base::Result<render::Image> stored = render::Image();
-      if (!read_back && frame_format.ok()) {
+      if (!read_back && frame_format) {
         stored = render::AsStored(img, *frame_format, write_options);
         if (stored.ok()) thumb_source = &*stored;
       }
@@ -593,127 +588,165 @@ int RunRender(const RenderOptions& options) {
     }
     if (video) return video->AddFrame(img);
     return base::Status::Ok();
-  };
-  // The sheet and the H.264 preview take frames in order on their own thread,
-  // so encoding the video overlaps rendering the next frame (each task holds
-  // its own copy of the frame; at most two are pending).
-  render::SerialTaskQueue side({.max_queued = 2});
-  auto feed_async = [&](std::size_t i, int number, std::shared_ptr<const render::Image> img,
-                        bool read_back) {
-    if (!sheet && !video) return base::Status::Ok();
-    return side.Submit([&feed_sheet_and_video, i, number, img = std::move(img), read_back] {
-      return feed_sheet_and_video(i, number, *img, read_back);
-    });
-  };
-  int frames_done = guard.num_skipped();
-  int last_done_number = -1;
-  for (std::size_t i = 0; i < num_frames; ++i) {
+  }
+};
+
+// Opens `out` for the frames of `pattern` before anything renders: their
+// folder (created, and refused when it cannot be written), the sheet and the video.
+base::Status OpenRenderOutputs(const RenderOptions& o, const Rig* rig, glm::ivec2 size,
+                               const FramePlan& plan, const std::string& pattern, float ground_y,
+                               RenderOutputs& out) {
+  out.pattern = pattern;
+  {
+    const base::Result<std::string> first = render::ExpandFramePattern(pattern, plan.At(0).number);
+    if (!first.ok()) return first.error();
+    const base::Status writable = PrepareOutputFolder(std::filesystem::path(*first).parent_path());
+    if (!writable.ok()) return writable;
+  }
+  out.out_dir = std::filesystem::path(*render::ExpandFramePattern(pattern, 0)).parent_path();
+  out.num_frames = plan.count();
+  out.settings = MakeRenderSettings(o, size, pattern);
+  out.settings.ground_y = ground_y;
+  out.write_options.png_compression = o.png_compression;
+  out.write_options.source_file = o.input.empty() ? "demo_walk.bvh (built in)"
+                                  : rig           ? rig->file
+                                                  : o.input;
+  out.sheet_count = std::min<int>(kMaxSheetFrames, static_cast<int>(out.num_frames));
+  if (!o.no_sheet) {
+    auto b = render::ContactSheetBuilder::Create(
+        out.sheet_count, size.x, size.y, {.columns = render::ContactSheetColumns(out.sheet_count)});
+    if (!b.ok()) return b.error();
+    out.sheet = std::move(*b);
+  }
+  if (!o.no_video) {
+    const double video_fps =
+        o.camera == "turntable" ? 24.0 : 1.0 / (plan.frame_time_s * plan.range.step);
+    auto v = render::VideoWriter::Open((out.out_dir / "preview.mp4").string(), size.x & ~1,
+                                       size.y & ~1, {.fps = video_fps});
+    // The video is a preview: a render never fails over it (a warning, no video).
+    if (v.ok()) {
+      out.video = std::move(*v);
+    } else {
+      const base::Warning w{v.error().loc, v.error().message + "; no preview video"};
+      std::fprintf(stderr, "%s\n", w.ToString().c_str());
+    }
+  }
+  const base::Result<render::ImageFormat> frame_format = render::ImageFormatFromPath(pattern);
+  if (frame_format.ok()) out.frame_format = *frame_format;
+  return base::Status::Ok();
+}
+
+// What every frame of a render reads, set up before the first one.
+struct RenderScene {
+  const RenderOptions& o;
+  const Rig* rig;  // null without a rig file
+  const Character& ch;
+  const FramePlan& plan;
+  const TwoBodies& two;
+  const Overlays& overlays;
+  RenderBodies& bodies;
+  RenderOverlayColors& colors;
+  const render::CameraPlan& cameras;
+  deform::DeformedFrame frame{}, right_frame{};  // the bodies at the current frame
+};
+
+// How far the frame loop got, for the progress bar, --stats and an interruption's message.
+struct RenderTally {
+  Progress progress;
+  std::chrono::steady_clock::time_point started;  // when the command started
+  int frames_done = 0;                            // --resume's skipped frames count as done
+  int last_done_number = -1;                      // the file number of the last frame rendered
+  double first_frame_s = -1.0;  // --stats: when the first frame went to the writer
+};
+
+// How output frame `of` is drawn: the overlays, its label and the bodies' colours.
+FrameDrawOptions RenderFrameDraw(const RenderScene& scene, const OutputFrame& of,
+                                 float color_bar_scale) {
+  const bool turntable = scene.o.camera == "turntable";
+  // A turntable's frames all show one motion frame: the label names it and the view.
+  const int label_number = turntable ? scene.o.start_number + scene.plan.range.first : of.number;
+  std::string frame_text = FrameLabel(scene.o.label, label_number, scene.plan.frame_time_s);
+  if (turntable && !frame_text.empty()) frame_text += "  view " + std::to_string(of.camera);
+  const bool two = scene.bodies.right.has_value();
+  return {.skeleton = scene.overlays.skeleton,
+          .wireframe = scene.overlays.wire,
+          .frame_number = label_number,
+          .frame_text = frame_text,
+          .left_label = two ? scene.two.sides[0].Label() : "",
+          .right_label = two ? scene.two.sides[1].Label() : "",
+          .side_by_side = scene.two.view == View::kCompare,
+          .left_colors = scene.colors.colors(0),
+          .right_colors = scene.colors.colors(1),
+          .color_bar_scale = color_bar_scale,
+          .textures = scene.o.textures == "on"};
+}
+
+// Output frame i: the bodies evaluated, then drawn and handed to the writer
+// and the side queue, or, when --resume skips it, its file fed to the side queue.
+base::Status RenderOutputFrame(std::size_t i, RenderScene& scene, const OutputGuard& guard,
+                               RenderOutputs& out, RenderTally& tally) {
+  const OutputFrame of = scene.plan.At(i);
+  // Skipped frames are still evaluated: a pipeline that carries state from
+  // frame to frame (the elastic layer) must see every frame to give a
+  // resumed range the same result.
+  base::Status s = scene.bodies.left->Evaluate(of.time_s, scene.frame);
+  if (!s.ok()) return s;
+  if (scene.bodies.right) {
+    s = scene.bodies.right->Evaluate(of.time_s, scene.right_frame);
+    if (!s.ok()) return s;
+  }
+  if (guard.skip(i)) return out.FeedFinishedFrame(i, of.number);
+  const render::Camera camera = scene.cameras.At(of.camera);
+  const base::Result<float> bar_scale =
+      scene.colors.Paint(of.time_s, scene.frame, scene.right_frame);
+  if (!bar_scale.ok()) return bar_scale.error();
+  s = DrawCharacterFrame(scene.ch, scene.frame, scene.bodies.right ? &scene.right_frame : nullptr,
+                         camera, out.settings, RenderFrameDraw(scene, of, *bar_scale), out.renderer,
+                         out.right_renderer, out.right_image, out.image);
+  if (!s.ok()) return s;
+  s = out.Feed(i, of.number, std::make_shared<const render::Image>(out.image),
+               /*read_back=*/false);
+  if (!s.ok()) return s;
+  const base::Result<std::string> path = render::ExpandFramePattern(out.pattern, of.number);
+  if (!path.ok()) return path.error();
+  out.write_options.frame = of.number;
+  // The frame moves to the writer; the next one renders into the buffers
+  // of one already written (when there is one), so no frame-sized buffer is
+  // copied, allocated or first touched per frame.
+  s = out.writer.Submit(std::move(out.image), *path, out.write_options);
+  if (!s.ok()) return s;
+  out.image = out.writer.TakeSpareImage();
+  ++tally.frames_done;
+  if (tally.first_frame_s < 0.0) {
+    tally.first_frame_s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - tally.started).count();
+  }
+  tally.last_done_number = of.number;
+  tally.progress.Step(of.number);
+  return base::Status::Ok();
+}
+
+// Every output frame in order, until SIGINT or SIGTERM arrives (app/output_guard.h).
+base::Status RenderFrames(RenderScene& scene, const OutputGuard& guard, RenderOutputs& out,
+                          RenderTally& tally) {
+  for (std::size_t i = 0; i < out.num_frames; ++i) {
     if (guard.interrupted()) break;
-    const OutputFrame of = plan->At(i);
-    // Skipped frames are still evaluated: a pipeline that carries state from
-    // frame to frame (the elastic layer) must see every frame to give a
-    // resumed range the same result.
-    base::Status s = pipeline->Evaluate(of.time_s, frame);
-    if (!s.ok()) return ReportError(s.error());
-    if (right_pipeline) {
-      s = right_pipeline->Evaluate(of.time_s, right_frame);
-      if (!s.ok()) return ReportError(s.error());
-    }
-    if (guard.skip(i)) {
-      // Resumed: the finished frame on disk feeds the sheet and the video.
-      if (!sheet && !video) continue;
-      const base::Result<std::string> done_path = render::ExpandFramePattern(pattern, of.number);
-      if (!done_path.ok()) return ReportError(done_path.error());
-      base::Result<render::Image> done = render::ReadImage(*done_path);
-      if (!done.ok()) return ReportError(done.error());
-      s = feed_async(i, of.number, std::make_shared<const render::Image>(std::move(*done)),
-                     /*read_back=*/true);
-      if (!s.ok()) return ReportError(s.error());
-      continue;
-    }
-    const render::Camera camera = cameras->At(of.camera);
-    // Displacement colours on a scale shared by both bodies (1, 2 or 5 x 10^k
-    // above the frame's largest displacement: the frame alone decides it).
-    float delta_scale = 0.0f;
-    for (int b = 0; b < 2; ++b) {
-      if (!delta[b].base) continue;
-      s = delta[b].base->Evaluate(of.time_s, delta[b].base_frame);
-      if (!s.ok()) return ReportError(s.error());
-      const deform::DeformedFrame& layered = b == 0 ? frame : right_frame;
-      for (std::size_t v = 0; v < layered.positions.size(); ++v) {
-        delta_scale = std::max(delta_scale,
-                               glm::length(layered.positions[v] - delta[b].base_frame.positions[v]));
-      }
-    }
-    if (overlay_delta) delta_scale = NiceScale(delta_scale);
-    for (int b = 0; b < 2; ++b) {
-      if (!delta[b].base) continue;
-      DisplacementColors(delta[b].base_frame.positions,
-                         (b == 0 ? frame : right_frame).positions, delta_scale, delta[b].colors);
-    }
-    const auto colors = [&](int b) {
-      return delta[b].base ? std::span<const glm::vec3>(delta[b].colors)
-                              : std::span<const glm::vec3>(tint);
-    };
-    // A turntable's frames all show one motion frame: the label names it and the view.
-    const int label_number = turntable ? o.start_number + plan->range.first : of.number;
-    std::string frame_text = FrameLabel(o.label, label_number, frame_time);
-    if (turntable && !frame_text.empty()) frame_text += "  view " + std::to_string(of.camera);
-    const FrameDrawOptions draw{.skeleton = overlay_skeleton,
-                                .wireframe = overlay_wire,
-                                .frame_number = label_number,
-                                .frame_text = frame_text,
-                                .left_label = right_pipeline ? two->sides[0].Label() : "",
-                                .right_label = right_pipeline ? two->sides[1].Label() : "",
-                                .side_by_side = side_by_side,
-                                .left_colors = colors(0),
-                                .right_colors = colors(1),
-                                .color_bar_scale = overlay_delta ? delta_scale : 0.0f,
-                                .textures = o.textures == "on"};
-    s = DrawCharacterFrame(ch, frame, right_pipeline ? &right_frame : nullptr, camera, settings,
-                           draw, renderer, right_renderer, right_image, image);
-    if (!s.ok()) return ReportError(s.error());
-    s = feed_async(i, of.number, std::make_shared<const render::Image>(image), /*read_back=*/false);
-    if (!s.ok()) return ReportError(s.error());
-    const base::Result<std::string> path = render::ExpandFramePattern(pattern, of.number);
-    if (!path.ok()) return ReportError(path.error());
-    write_options.frame = of.number;
-    // The frame moves to the writer; the next one renders into the buffers
-    // of one already written (when there is one), so no frame-sized buffer is
-    // copied, allocated or first touched per frame.
-    s = writer.Submit(std::move(image), *path, write_options);
-    if (!s.ok()) return ReportError(s.error());
-    image = writer.TakeSpareImage();
-    ++frames_done;
-    if (first_frame_s < 0.0) {
-      first_frame_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-    }
-    last_done_number = of.number;
-    progress.Step(of.number);
+    if (base::Status s = RenderOutputFrame(i, scene, guard, out, tally); !s.ok()) return s;
   }
-  // Every frame handed to the writer is finished (so none is left half-written).
-  base::Status s = writer.Finish();
-  if (!s.ok()) return ReportError(s.error());
-  s = side.Finish();
-  if (!s.ok()) return ReportError(s.error());
-  progress.Finish();
-  if (guard.interrupted()) {
-    // The sheet and the video would be partial: the video writer's destructor
-    // removes its temporary file; --resume rebuilds both.
-    std::fprintf(stderr, "%s: %s\n", pattern.c_str(),
-                 guard.StopMessage(last_done_number, frames_done, static_cast<int>(num_frames))
-                     .c_str());
-    return guard.exit_code();
-  }
-  // The elastic layer says when it had to limit anything (ALGORITHMS.md 6).
-  for (const deform::FramePipeline* p : {&*pipeline, right_pipeline ? &*right_pipeline : nullptr}) {
+  return base::Status::Ok();
+}
+
+// The elastic layer says when it had to limit anything (ALGORITHMS.md 6).
+void WarnRenderElasticLimits(const RenderBodies& bodies, const Rig* rig,
+                             const std::string& source_file) {
+  for (const deform::FramePipeline* p : {&*bodies.left, bodies.right ? &*bodies.right : nullptr}) {
     if (p == nullptr) continue;
     for (const deform::ElasticPatchReport& r : p->elastic_report()) {
       if (r.counters.any_limit() == 0) continue;
       std::fprintf(stderr,
                    "%s: warning: elastic patch \"%s\" was limited: %lld acceleration clamps, "
                    "%lld displacement clamps, %lld non-finite inputs, %lld non-finite resets\n",
-                   write_options.source_file.c_str(),
+                   source_file.c_str(),
                    rig ? rig->patches[static_cast<std::size_t>(r.patch)].name.c_str() : "?",
                    static_cast<long long>(r.counters.acceleration_clamps),
                    static_cast<long long>(r.counters.displacement_clamps),
@@ -721,23 +754,120 @@ int RunRender(const RenderOptions& options) {
                    static_cast<long long>(r.counters.non_finite_resets));
     }
   }
-  if (o.print_outputs) std::printf("frames:        %s (%zu)\n", pattern.c_str(), num_frames);
-  if (sheet) {
-    const std::string sheet_path = (out_dir / "contact_sheet.png").string();
-    s = render::WriteImage(sheet->sheet(), sheet_path, {});
+}
+
+// After the frame loop: the exit code, once every frame handed to the writer
+// is finished (so none is left half-written) and the sheet and video are written.
+int FinishRender(const RenderScene& scene, const OutputGuard& guard, RenderOutputs& out,
+                 RenderTally& tally) {
+  base::Status s = out.writer.Finish();
+  if (!s.ok()) return ReportError(s.error());
+  s = out.side.Finish();
+  if (!s.ok()) return ReportError(s.error());
+  tally.progress.Finish();
+  if (guard.interrupted()) {
+    // The sheet and the video would be partial: the video writer's destructor
+    // removes its temporary file; --resume rebuilds both.
+    std::fprintf(stderr, "%s: %s\n", out.pattern.c_str(),
+                 guard
+                     .StopMessage(tally.last_done_number, tally.frames_done,
+                                  static_cast<int>(out.num_frames))
+                     .c_str());
+    return guard.exit_code();
+  }
+  WarnRenderElasticLimits(scene.bodies, scene.rig, out.write_options.source_file);
+  if (scene.o.print_outputs) {
+    std::printf("frames:        %s (%zu)\n", out.pattern.c_str(), out.num_frames);
+  }
+  if (out.sheet) {
+    const std::string sheet_path = (out.out_dir / "contact_sheet.png").string();
+    s = render::WriteImage(out.sheet->sheet(), sheet_path, {});
     if (!s.ok()) return ReportError(s.error());
     std::printf("contact sheet: %s\n", sheet_path.c_str());
   }
-  if (video) {
-    s = video->Close();
+  if (out.video) {
+    s = out.video->Close();
     if (!s.ok()) return ReportError(s.error());
-    std::printf("video:         %s (%s)\n", video->path().c_str(), render::VideoCodecName(video->codec()));
+    std::printf("video:         %s (%s)\n", out.video->path().c_str(),
+                render::VideoCodecName(out.video->codec()));
   }
-  if (o.stats) {
-    std::printf("stats:         first frame after %.3f s, peak memory %.1f MB\n", first_frame_s,
-                PeakResidentMb());
+  if (scene.o.stats) {
+    std::printf("stats:         first frame after %.3f s, peak memory %.1f MB\n",
+                tally.first_frame_s, PeakResidentMb());
   }
   return 0;
+}
+
+}  // namespace
+
+int RunRender(const RenderOptions& options) {
+  const auto started = std::chrono::steady_clock::now();
+  RenderOptions o = options;
+  const base::Result<std::optional<Rig>> loaded_rig = TakeRenderRig(o);
+  if (!loaded_rig.ok()) return ReportError(loaded_rig.error());
+  const Rig* rig = *loaded_rig ? &**loaded_rig : nullptr;
+  const base::Result<glm::ivec2> size = ParseSize(o.size);
+  if (!size.ok()) return ReportError(size.error());
+  const base::Result<Overlays> overlays = CheckRenderOptions(o, *size);
+  if (!overlays.ok()) return ReportError(overlays.error());
+  const base::Result<deform::GlobalMethod> method = ParseGlobalMethod(o.global);
+  if (!method.ok()) return ReportError(method.error());
+  const base::Result<TwoBodies> two = ChooseTwoBodies(o, rig, *method);
+  if (!two.ok()) return ReportError(two.error());
+  const base::Result<BodyKind> body_kind = ResolveRenderBody(o, rig);
+  if (!body_kind.ok()) return ReportError(body_kind.error());
+
+  // --- Input and the output frames ---------------------------------------------
+  const std::string name = o.input.empty() ? "demo"
+                           : rig           ? std::filesystem::path(rig->file).stem().string()
+                                           : std::filesystem::path(o.input).stem().string();
+  const base::Result<std::optional<mocap::UpAxis>> up = ParseUpAxis(o.up);
+  if (!up.ok()) return ReportError(up.error());
+  const base::Result<Character> character =
+      LoadCommandCharacter(o.input, o.motion, o.quiet, *up, o.joint_map, nullptr, *body_kind);
+  if (!character.ok()) return ReportError(character.error());
+  const Character& ch = *character;
+  // The output frames are computed one at a time (plan->At): a render of
+  // every frame of an hour-long capture holds no per-frame list (issue 8).
+  const base::Result<FramePlan> plan = PlanRenderFrames(options, o, rig, ch);
+  if (!plan.ok()) return ReportError(plan.error());
+  // Existing outputs are refused (or, with --resume, skipped) before anything renders.
+  OutputGuard guard({.overwrite = o.overwrite, .resume = o.resume});
+  const bool turntable = o.camera == "turntable";
+  const base::Result<std::string> pattern =
+      PlanRenderOutputs(o, "out/" + name + (turntable ? "_turntable" : ""), *plan, guard);
+  if (!pattern.ok()) return ReportError(pattern.error());
+
+  // --- The bodies (one, or the two of a comparison), their colours, the cameras ---
+  base::Result<RenderBodies> bodies = MakeRenderBodies(o, rig, ch, *two, *method);
+  if (!bodies.ok()) return ReportError(bodies.error());
+  base::Result<RenderOverlayColors> colors =
+      RenderOverlayColors::Create(*overlays, rig, ch, *bodies, o.threads);
+  if (!colors.ok()) return ReportError(colors.error());
+  const base::Result<render::CameraPlan> cameras =
+      PlanRenderCameras(o, rig, ch, *plan, *size, two->view == View::kCompare);
+  if (!cameras.ok()) return ReportError(cameras.error());
+
+  // --- Outputs, the frame loop and the finish -----------------------------------
+  RenderOutputs outputs;
+  base::Status s = OpenRenderOutputs(o, rig, *size, *plan, *pattern, cameras->ground_y(), outputs);
+  if (!s.ok()) return ReportError(s.error());
+  RenderScene scene{.o = o,
+                    .rig = rig,
+                    .ch = ch,
+                    .plan = *plan,
+                    .two = *two,
+                    .overlays = *overlays,
+                    .bodies = *bodies,
+                    .colors = *colors,
+                    .cameras = *cameras};
+  RenderTally tally{
+      .progress = Progress("render " + name, static_cast<int>(outputs.num_frames), o.quiet),
+      .started = started,
+      .frames_done = guard.num_skipped()};
+  s = RenderFrames(scene, guard, outputs, tally);
+  if (!s.ok()) return ReportError(s.error());
+  return FinishRender(scene, guard, outputs, tally);
 }
 
 }  // namespace app
