@@ -8,6 +8,10 @@
 # test preset's exclude list: label slurm, and ElasticPipeline.TenThousand*,
 # *LongCapture.*, ExportMemory.*, BenchCommand.*) run in the Release suite only:
 # the sanitizers find nothing there that the short runs of the same code miss.
+# So do the two sweeps of every capture in ../shared/data (CapturePose.
+# FollowCameraKeepsEveryRealCapture*, GeneratedBodyOfCaptures.*: a minute and a
+# half of CPU under ASan), which check framing and body geometry; the same
+# loaders, bodies and cameras run sanitized on real files in other tests.
 #
 # Any report fails the run: ASan aborts on the first error, UBSan halts
 # (-fno-sanitize-recover), and a child `patchskin` the app tests start inherits
