@@ -477,20 +477,19 @@ base::Result<Rig> AutoRigForCommand(const std::string& layer, const std::string&
                                     const std::string& motion, const std::string& body,
                                     const std::string& up, bool quiet) {
   if (layer != "auto") {
-    return base::MakeError(base::ErrorCode::kInvalidArgument, {"--layer", 0, 0, {}},
-                           "expected auto, found '" + layer + "'");
+    return base::InvalidArgument({"--layer", 0, 0, {}}, "expected auto, found '" + layer + "'");
   }
   if (std::filesystem::path(input).extension() == ".json") {
-    return base::MakeError(base::ErrorCode::kInvalidArgument, {"--layer", 0, 0, {}},
-                           "expected a capture (BVH) as the input, found the rig file " + input +
-                               " (a rig names its own patches)");
+    return base::InvalidArgument({"--layer", 0, 0, {}},
+                                 "expected a capture (BVH) as the input, found the rig file " +
+                                     input + " (a rig names its own patches)");
   }
   const std::string ext = std::filesystem::path(input).extension().string();
   if (motion.empty() && (ext == ".glb" || ext == ".gltf")) {
-    return base::MakeError(base::ErrorCode::kInvalidArgument, {"--layer", 0, 0, {}},
-                           "expected a BVH capture: give the glTF character's motion with "
-                           "--motion, or the capture as the input with --body " +
-                               input);
+    return base::InvalidArgument({"--layer", 0, 0, {}},
+                                 "expected a BVH capture: give the glTF character's motion with "
+                                 "--motion, or the capture as the input with --body " +
+                                     input);
   }
   const std::string& capture = motion.empty() ? input : motion;
   base::Result<AutoRig> made = MakeAutoRig(capture, motion.empty() ? body : input, up, quiet);

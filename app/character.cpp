@@ -15,15 +15,15 @@ base::Result<deform::GlobalMethod> ParseGlobalMethod(const std::string& name) {
   if (name == "ssd" || name == "lbs") return deform::GlobalMethod::kSsd;
   if (name == "dqs") return deform::GlobalMethod::kDqs;
   if (name == "swd") return deform::GlobalMethod::kSwd;
-  return base::MakeError(base::ErrorCode::kInvalidArgument, {"--global", 0, 0, {}},
-                         "expected ssd, dqs or swd, found '" + name + "'");
+  return base::InvalidArgument({"--global", 0, 0, {}},
+                               "expected ssd, dqs or swd, found '" + name + "'");
 }
 
 base::Result<BodyKind> ParseBodyKind(const std::string& name) {
   if (name == "tubes") return BodyKind::kTubes;
   if (name == "generated") return BodyKind::kGenerated;
-  return base::MakeError(base::ErrorCode::kInvalidArgument, {"--body", 0, 0, {}},
-                         "expected generated, tubes or a glTF/GLB file, found '" + name + "'");
+  return base::InvalidArgument(
+      {"--body", 0, 0, {}}, "expected generated, tubes or a glTF/GLB file, found '" + name + "'");
 }
 
 base::Result<Character> MakeCharacter(MotionSource&& source,

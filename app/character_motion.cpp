@@ -51,17 +51,15 @@ base::Result<deform::JointMapEntries> ReadJointMap(const std::string& path) {
                            "invalid JSON in the joint map: " + what);
   }
   if (!doc.is_object()) {
-    return base::MakeError(
-        base::ErrorCode::kInvalidArgument, loc,
-        "expected a joint map object {\"glTF joint\": \"BVH joint\", ...}, found " +
-            std::string(doc.type_name()));
+    return base::InvalidArgument(
+        loc, "expected a joint map object {\"glTF joint\": \"BVH joint\", ...}, found " +
+                 std::string(doc.type_name()));
   }
   deform::JointMapEntries out;
   for (const auto& [key, value] : doc.items()) {
     if (!value.is_string() && !value.is_null()) {
-      return base::MakeError(base::ErrorCode::kInvalidArgument, loc,
-                             "expected a BVH joint name or null for \"" + key + "\", found " +
-                                 std::string(value.type_name()));
+      return base::InvalidArgument(loc, "expected a BVH joint name or null for \"" + key +
+                                            "\", found " + std::string(value.type_name()));
     }
     out.emplace_back(key, value.is_string() ? value.get<std::string>() : std::string());
   }
@@ -74,14 +72,15 @@ base::Result<Character> MakeRetargetedCharacter(MotionSource&& character, Motion
   const std::string model_file = character.skeleton.info.source_file;
   const std::string motion_file = motion.skeleton.info.source_file;
   if (!character.gltf) {
-    return base::MakeError(base::ErrorCode::kInvalidArgument, {model_file, 0, 0, {}},
-                           "expected a glTF or GLB character to drive with a separate motion, "
-                           "found a " +
-                               character.format + " file");
+    return base::InvalidArgument(
+        {model_file, 0, 0, {}},
+        "expected a glTF or GLB character to drive with a separate motion, "
+        "found a " +
+            character.format + " file");
   }
   if (motion.format != "bvh") {
-    return base::MakeError(base::ErrorCode::kInvalidArgument, {motion_file, 0, 0, {}},
-                           "expected a BVH motion, found a " + motion.format + " file");
+    return base::InvalidArgument({motion_file, 0, 0, {}},
+                                 "expected a BVH motion, found a " + motion.format + " file");
   }
   deform::JointMapEntries overrides;
   if (!joint_map_file.empty()) {
@@ -134,8 +133,8 @@ base::Result<Character> LoadCommandCharacter(const std::string& input, const std
   };
   print(src->warnings, 0);
   if (motion.empty() && !joint_map_file.empty()) {
-    return base::MakeError(
-        base::ErrorCode::kInvalidArgument, {joint_map_file, 0, 0, {}},
+    return base::InvalidArgument(
+        {joint_map_file, 0, 0, {}},
         "expected a BVH motion (--motion) for the joint map to apply to, found none");
   }
   if (motion.empty()) return MakeCharacter(std::move(*src), {}, body);

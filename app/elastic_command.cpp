@@ -46,8 +46,7 @@ int RunElastic(const ElasticOptions& o) {
         base::MakeError(base::ErrorCode::kNotFound, loc, "no joint named '" + o.joint + "'"));
   }
   if (motion.num_frames < 2) {
-    return ReportError(
-        base::MakeError(base::ErrorCode::kInvalidArgument, loc, "expected at least 2 frames"));
+    return ReportError(base::InvalidArgument(loc, "expected at least 2 frames"));
   }
   auto kin = mocap::ComputeKinematics(skel, motion, o.cutoff_hz);
   if (!kin.ok()) return ReportError(kin.error());

@@ -17,7 +17,7 @@ namespace app {
 constexpr int kMaxImageSide = 16384;
 
 base::Error ArgError(const std::string& option, const std::string& message) {
-  return base::MakeError(base::ErrorCode::kInvalidArgument, {option, 0, 0, {}}, message);
+  return base::InvalidArgument({option, 0, 0, {}}, message);
 }
 
 std::optional<base::Error> CheckThreads(int threads) {

@@ -80,10 +80,9 @@ base::Result<MotionSource> LoadMotionSource(const std::string& path,
     } else {
       if (options.animation < 0 ||
           options.animation >= static_cast<int>(model->animations.size())) {
-        return base::MakeError(base::ErrorCode::kInvalidArgument, loc,
-                               "animation " + std::to_string(options.animation) +
-                                   " does not exist (the file has " +
-                                   std::to_string(model->animations.size()) + ")");
+        return base::InvalidArgument(loc, "animation " + std::to_string(options.animation) +
+                                              " does not exist (the file has " +
+                                              std::to_string(model->animations.size()) + ")");
       }
       base::Result<mocap::Motion> motion =
           deform::AnimationToMotion(*model, options.animation, options.frame_time_s);

@@ -52,9 +52,9 @@ struct OutputGuard::SavedHandlers {
 
 base::Status CheckRigOutputPattern(const std::string& pattern, const base::FileLoc& where) {
   const auto refuse = [&](const std::string& why) -> base::Status {
-    return base::MakeError(base::ErrorCode::kInvalidArgument, where,
-                           "expected a relative path inside the rig's output folder, found '" +
-                               pattern + "' (" + why + ")");
+    return base::InvalidArgument(
+        where, "expected a relative path inside the rig's output folder, found '" + pattern +
+                   "' (" + why + ")");
   };
   if (pattern.empty()) return refuse("empty");
   if (pattern.front() == '/' || pattern.front() == '\\') return refuse("an absolute path");
@@ -125,8 +125,8 @@ base::Status OutputGuard::Plan(
     }
   }
   if (existing > 0 && !options_.overwrite) {
-    return base::MakeError(
-        base::ErrorCode::kInvalidArgument, {first_existing, 0, 0, {}},
+    return base::InvalidArgument(
+        {first_existing, 0, 0, {}},
         "output file exists (" + std::to_string(existing) + " of this render's " +
             std::to_string(num_frames + other_paths.size()) +
             " outputs do); expected a free output path: pass --overwrite to replace them or "

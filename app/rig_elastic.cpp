@@ -18,7 +18,7 @@ struct ElasticCtx {
 
   std::string Field(const std::string& key) const { return path + "." + key; }
   base::Error Fail(const std::string& field, const std::string& message) const {
-    return base::MakeError(base::ErrorCode::kInvalidArgument, {file, 0, 0, field}, message);
+    return base::InvalidArgument({file, 0, 0, field}, message);
   }
   base::Error Expected(const std::string& field, const std::string& what, const json& found) const {
     std::string s = found.dump();

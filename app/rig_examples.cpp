@@ -38,10 +38,10 @@ base::Status ExampleLocals(const Rig& rig, const Character& ch, const RigExample
   const mocap::Skeleton& s = ch.skeleton;
   if (ex.pose.frame >= 0) {
     if (ex.pose.frame >= ch.motion.num_frames) {
-      return base::MakeError(base::ErrorCode::kInvalidArgument,
-                             {rig.file, 0, 0, ex.path + ".pose.frame"},
-                             "expected a frame in 0.." + std::to_string(ch.motion.num_frames - 1) +
-                                 " of the motion, found " + std::to_string(ex.pose.frame));
+      return base::InvalidArgument({rig.file, 0, 0, ex.path + ".pose.frame"},
+                                   "expected a frame in 0.." +
+                                       std::to_string(ch.motion.num_frames - 1) +
+                                       " of the motion, found " + std::to_string(ex.pose.frame));
     }
     const base::JobStatus st =
         mocap::LocalPoseJob{&s, ch.motion.frame(ex.pose.frame), locals}.Run();
@@ -86,10 +86,9 @@ base::Result<deform::PoseFeatureSpec> FeatureSpec(const Rig& rig, const Characte
     }
   }
   if (spec.joints.empty()) {
-    return base::MakeError(base::ErrorCode::kInvalidArgument,
-                           {rig.file, 0, 0, path + ".pose_space"},
-                           "no joint other than the root weights this patch: name the joints "
-                           "of theta in \"joints\"");
+    return base::InvalidArgument({rig.file, 0, 0, path + ".pose_space"},
+                                 "no joint other than the root weights this patch: name the joints "
+                                 "of theta in \"joints\"");
   }
   for (deform::PoseFeatureJoint& fj : spec.joints) fj.twist_axis = ChildBoneAxis(s, fj.joint);
   const base::Status checked = deform::CheckPoseFeatureSpec(s, spec);

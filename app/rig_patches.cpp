@@ -49,10 +49,10 @@ base::Result<std::vector<deform::PatchSetup>> BuildRigPatches(const Rig& rig,
         .border_width = p.border_width};
     std::vector<int> region;
     if (p.region.kind != RigRegion::Kind::kJoint && p.cylinder) {
-      return base::MakeError(base::ErrorCode::kInvalidArgument,
-                             {rig.file, 0, 0, path + ".parametrization"},
-                             "expected \"plane\" for a vertex-list or screen region (a cylinder "
-                             "needs a joint for its axis), found \"cylinder\"");
+      return base::InvalidArgument(
+          {rig.file, 0, 0, path + ".parametrization"},
+          "expected \"plane\" for a vertex-list or screen region (a cylinder "
+          "needs a joint for its axis), found \"cylinder\"");
     }
     if (p.region.kind == RigRegion::Kind::kScreen) {
       // The named view frames the bind mesh; the character faces +Z, its left is +X.

@@ -81,8 +81,8 @@ int RunSheet(const SheetOptions& o) {
   if (!o.overwrite) {
     for (const auto& [skip, path] : {std::pair{o.no_sheet, sheet_path}, std::pair{o.no_video, video_path}}) {
       if (!skip && std::filesystem::exists(path)) {
-        return ReportError(base::MakeError(base::ErrorCode::kInvalidArgument, {path, 0, 0, {}},
-                                           "exists; pass --overwrite to replace it"));
+        return ReportError(
+            base::InvalidArgument({path, 0, 0, {}}, "exists; pass --overwrite to replace it"));
       }
     }
   }
@@ -116,11 +116,11 @@ int RunSheet(const SheetOptions& o) {
         i == 0 ? std::move(first) : render::ReadImage(frames[static_cast<std::size_t>(i)].second);
     if (!image.ok()) return ReportError(image.error());
     if (image->width != width || image->height != height) {
-      return ReportError(base::MakeError(
-          base::ErrorCode::kInvalidArgument, {frames[static_cast<std::size_t>(i)].second, 0, 0, {}},
-          "expected " + std::to_string(width) + "x" + std::to_string(height) +
-              " like the first frame, found " + std::to_string(image->width) + "x" +
-              std::to_string(image->height)));
+      return ReportError(
+          base::InvalidArgument({frames[static_cast<std::size_t>(i)].second, 0, 0, {}},
+                                "expected " + std::to_string(width) + "x" + std::to_string(height) +
+                                    " like the first frame, found " + std::to_string(image->width) +
+                                    "x" + std::to_string(image->height)));
     }
     if (on_sheet) {
       const base::Status s = sheet->Add(*image, frames[static_cast<std::size_t>(i)].first);

@@ -106,6 +106,14 @@ class [[nodiscard]] Status {
 
 // Convenience constructor: MakeError(ErrorCode::kSyntax, loc, "expected ...").
 Error MakeError(ErrorCode code, FileLoc loc, std::string message);
+// The error of a caller's argument out of range (kInvalidArgument), with the
+// file position when one applies.
+inline Error InvalidArgument(FileLoc loc, std::string message) {
+  return MakeError(ErrorCode::kInvalidArgument, std::move(loc), std::move(message));
+}
+inline Error InvalidArgument(std::string message) {
+  return InvalidArgument({}, std::move(message));
+}
 
 // Outcome of a job's Validate(): a code plus a static description, so tests can
 // tell which check failed (ozz-animation's jobs return bool; we keep the reason).

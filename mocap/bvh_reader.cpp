@@ -597,8 +597,8 @@ namespace {
 base::Result<BvhFile> ParseBvhText(std::string_view text, const std::string& file_name,
                                    const BvhReadOptions& options, PageReleaser release) {
   if (!(options.scale >= 0.0f) || !std::isfinite(options.scale)) {
-    return base::MakeError(
-        base::ErrorCode::kInvalidArgument, base::FileLoc{file_name, 0, 0, {}},
+    return base::InvalidArgument(
+        base::FileLoc{file_name, 0, 0, {}},
         "scale must be finite and >= 0 (0 = automatic), got " + std::to_string(options.scale));
   }
   // Windows tools sometimes write a UTF-8 byte order mark; it is not part of the grammar.

@@ -48,11 +48,9 @@ base::Result<std::string> FormatBvh(const Skeleton& skeleton, const Motion& moti
   if (motion.num_channels != skeleton.num_channels || motion.num_frames < 0 ||
       motion.values.size() != static_cast<std::size_t>(motion.num_frames) *
                                   static_cast<std::size_t>(motion.num_channels)) {
-    return base::MakeError(base::ErrorCode::kInvalidArgument, {},
-                           "motion size does not match the skeleton's channels");
+    return base::InvalidArgument("motion size does not match the skeleton's channels");
   }
-  if (n == 0)
-    return base::MakeError(base::ErrorCode::kInvalidArgument, {}, "skeleton has no joints");
+  if (n == 0) return base::InvalidArgument("skeleton has no joints");
   std::vector<std::vector<int>> children(static_cast<std::size_t>(n));
   std::vector<std::vector<int>> end_sites(static_cast<std::size_t>(n));
   for (int j = 0; j < n; ++j) {

@@ -236,14 +236,13 @@ base::Result<std::vector<JointKinematics>> ComputeKinematics(const Skeleton& ske
       !(motion.frame_time_s > 0.0) ||
       motion.values.size() != static_cast<std::size_t>(motion.num_frames) *
                                   static_cast<std::size_t>(motion.num_channels)) {
-    return base::MakeError(base::ErrorCode::kInvalidArgument, loc,
-                           "expected a motion with frames, a positive frame time and " +
-                               std::to_string(skeleton.num_channels) + " channels per frame for " +
-                               std::to_string(nj) + " joints");
+    return base::InvalidArgument(loc, "expected a motion with frames, a positive frame time and " +
+                                          std::to_string(skeleton.num_channels) +
+                                          " channels per frame for " + std::to_string(nj) +
+                                          " joints");
   }
   const auto fail = [&](const char* what) {
-    return base::MakeError(base::ErrorCode::kInvalidArgument, loc,
-                           std::string("joint kinematics: ") + what);
+    return base::InvalidArgument(loc, std::string("joint kinematics: ") + what);
   };
   const std::size_t frames = static_cast<std::size_t>(motion.num_frames);
   std::vector<JointTransform> locals(nj);
@@ -282,8 +281,8 @@ base::Result<std::vector<JointKinematics>> ComputeKinematicsOf(const Skeleton& s
                                                                double cutoff_hz,
                                                                const glm::mat4& model_from_root) {
   const auto fail = [&](const std::string& what) {
-    return base::MakeError(base::ErrorCode::kInvalidArgument, {skeleton.info.source_file, 0, 0, {}},
-                           "joint kinematics: " + what);
+    return base::InvalidArgument({skeleton.info.source_file, 0, 0, {}},
+                                 "joint kinematics: " + what);
   };
   const std::size_t nj = static_cast<std::size_t>(skeleton.num_joints());
   const std::size_t nd = joints.size();

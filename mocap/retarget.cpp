@@ -120,8 +120,8 @@ base::Result<RetargetPlan> PlanByName(const Skeleton& target, const Skeleton& so
       list += (i ? ", " : "") + missing[i];
     }
     if (missing.size() > 12) list += ", ... (" + std::to_string(missing.size()) + " in all)";
-    return base::MakeError(
-        base::ErrorCode::kInvalidArgument, {source_file, 0, 0, {}},
+    return base::InvalidArgument(
+        {source_file, 0, 0, {}},
         "expected the joints of " + target_file +
             " that the motion must drive (matched by name, then case-insensitively "
             "without prefixes such as \"mixamorig:\"), found none for: " +
@@ -143,10 +143,10 @@ base::Result<RetargetPlan> PlanByName(const Skeleton& target, const Skeleton& so
   const float source_hips = HipHeight(source, 0);
   const float target_hips = HipHeight(target, plan.target_root);
   if (!(source_hips > 0.0f) || !(target_hips > 0.0f)) {
-    return base::MakeError(base::ErrorCode::kInvalidArgument,
-                           {source_hips > 0.0f ? target_file : source_file, 0, 0, {}},
-                           "expected the root joint above the lowest joint in the rest pose (a hip "
-                           "height > 0) to scale the root translation");
+    return base::InvalidArgument(
+        {source_hips > 0.0f ? target_file : source_file, 0, 0, {}},
+        "expected the root joint above the lowest joint in the rest pose (a hip "
+        "height > 0) to scale the root translation");
   }
   plan.translation_scale = target_hips / source_hips;
   return plan;
@@ -164,16 +164,16 @@ base::Result<RetargetedMotion> ApplyRetargetPlan(const Skeleton& target, const S
       (aligned && plan.align.size() != static_cast<std::size_t>(nt)) || plan.target_root < 0 ||
       plan.target_root >= nt || map[static_cast<std::size_t>(plan.target_root)] < 0 ||
       plan.source_root < 0 || static_cast<std::size_t>(plan.source_root) >= ns) {
-    return base::MakeError(
-        base::ErrorCode::kInvalidArgument, {source_file, 0, 0, {}},
+    return base::InvalidArgument(
+        {source_file, 0, 0, {}},
         "expected a retargeting plan with one entry per target joint and a mapped "
         "root joint");
   }
   for (const int b : map) {
     if (b >= static_cast<int>(ns)) {
-      return base::MakeError(base::ErrorCode::kInvalidArgument, {source_file, 0, 0, {}},
-                             "retargeting plan names source joint " + std::to_string(b) +
-                                 ", expected one of the motion's " + std::to_string(ns));
+      return base::InvalidArgument({source_file, 0, 0, {}},
+                                   "retargeting plan names source joint " + std::to_string(b) +
+                                       ", expected one of the motion's " + std::to_string(ns));
     }
   }
   auto mapped = [&map](int j) { return map[static_cast<std::size_t>(j)] >= 0; };

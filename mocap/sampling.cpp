@@ -184,19 +184,18 @@ base::Result<Motion> Resample(const Skeleton& skeleton, const Motion& motion,
                               double new_frame_time_s) {
   const base::FileLoc loc{skeleton.info.source_file, 0, 0, {}};
   if (!std::isfinite(new_frame_time_s) || new_frame_time_s <= 0.0) {
-    return base::MakeError(
-        base::ErrorCode::kInvalidArgument, loc,
-        "expected a positive finite frame time, found " + std::to_string(new_frame_time_s));
+    return base::InvalidArgument(
+        loc, "expected a positive finite frame time, found " + std::to_string(new_frame_time_s));
   }
   if (motion.num_channels != skeleton.num_channels || motion.num_frames < 1 ||
       motion.values.size() != static_cast<std::size_t>(motion.num_frames) *
                                   static_cast<std::size_t>(motion.num_channels) ||
       !(motion.frame_time_s > 0.0)) {
-    return base::MakeError(base::ErrorCode::kInvalidArgument, loc,
-                           "expected a motion with frames, a positive frame time and " +
-                               std::to_string(skeleton.num_channels) +
-                               " channels per frame, found " + std::to_string(motion.num_frames) +
-                               " frames of " + std::to_string(motion.num_channels) + " channels");
+    return base::InvalidArgument(loc, "expected a motion with frames, a positive frame time and " +
+                                          std::to_string(skeleton.num_channels) +
+                                          " channels per frame, found " +
+                                          std::to_string(motion.num_frames) + " frames of " +
+                                          std::to_string(motion.num_channels) + " channels");
   }
   const base::Status check = skeleton.Check();
   if (!check) return check.error();

@@ -60,7 +60,7 @@ float ProjectedExtent(const deform::Bounds& box, const Camera& camera) {
 }
 
 base::Error SettingError(const std::string& message) {
-  return base::MakeError(base::ErrorCode::kInvalidArgument, {}, "camera: " + message);
+  return base::InvalidArgument("camera: " + message);
 }
 
 std::optional<base::Error> CheckSettings(const CameraSettings& s, const CameraTimes& t) {

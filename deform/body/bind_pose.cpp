@@ -52,8 +52,7 @@ base::Result<BindPoseChoice> ChooseBindPose(const mocap::Skeleton& skeleton,
   const bool have_first = motion.num_frames > 0 && PoseMatrices(skeleton, motion, 0, first);
   base::Result<BodyChains> chains =
       have_rest ? BuildBodyChains(skeleton, rest, min_branch_extent)
-                : base::Result<BodyChains>(base::MakeError(base::ErrorCode::kInvalidArgument, {},
-                                                           "rest pose not evaluated"));
+                : base::Result<BodyChains>(base::InvalidArgument("rest pose not evaluated"));
   if (!chains.ok() && have_first) {
     base::Result<BodyChains> again = BuildBodyChains(skeleton, first, min_branch_extent);
     if (again.ok()) chains = std::move(again);

@@ -176,15 +176,14 @@ base::Result<BodyChains> BuildBodyChains(const mocap::Skeleton& skeleton,
                      "mannequin needs one rest matrix per joint: expected " + std::to_string(nj) +
                          ", found " + std::to_string(rest_model_from_joint.size()));
   }
-  if (nj == 0) return MakeError(ErrorCode::kInvalidArgument, {}, "skeleton has no joints");
+  if (nj == 0) return base::InvalidArgument("skeleton has no joints");
   std::vector<glm::vec3> joint_pos(static_cast<std::size_t>(nj));
   Bounds bounds;
   for (int j = 0; j < nj; ++j) {
     const int p = skeleton.parents[static_cast<std::size_t>(j)];
     if (p < mocap::kNoParent || p >= j) {
-      return MakeError(ErrorCode::kInvalidArgument, {},
-                       "joint " + std::to_string(j) + " has parent " + std::to_string(p) +
-                           ", expected a parent listed before it");
+      return base::InvalidArgument("joint " + std::to_string(j) + " has parent " +
+                                   std::to_string(p) + ", expected a parent listed before it");
     }
     const glm::mat4& m = rest_model_from_joint[static_cast<std::size_t>(j)];
     for (int c = 0; c < 4; ++c) {
@@ -211,9 +210,9 @@ base::Result<BodyChains> BuildBodyChains(const mocap::Skeleton& skeleton,
   const glm::vec3 extent = bounds.size();
   const float raw_size = std::max({extent.x, extent.y, extent.z});
   if (!(raw_size > 0.0f) || !std::isfinite(raw_size)) {
-    return MakeError(ErrorCode::kInvalidArgument, {},
-                     "skeleton has no bone of non-zero length (all joints at one point); "
-                     "cannot build a mannequin");
+    return base::InvalidArgument(
+        "skeleton has no bone of non-zero length (all joints at one point); "
+        "cannot build a mannequin");
   }
   const float merge_dist = kMergeFraction * raw_size;
 
@@ -347,8 +346,8 @@ base::Result<BodyChains> BuildBodyChains(const mocap::Skeleton& skeleton,
         body_point[static_cast<std::size_t>(point_of[static_cast<std::size_t>(j)])];
   }
   if (!(size > merge_dist)) {
-    return MakeError(ErrorCode::kInvalidArgument, {},
-                     "skeleton has no bone of non-zero length; cannot build a mannequin");
+    return base::InvalidArgument(
+        "skeleton has no bone of non-zero length; cannot build a mannequin");
   }
   std::vector<BodyChain>& chains = out.chains;
   for (std::size_t t = 0; t < todo.size(); ++t) {
@@ -403,8 +402,8 @@ base::Result<BodyChains> BuildBodyChains(const mocap::Skeleton& skeleton,
     chains.push_back(std::move(c));
   }
   if (chains.empty()) {
-    return MakeError(ErrorCode::kInvalidArgument, {},
-                     "skeleton has no bone of non-zero length; cannot build a mannequin");
+    return base::InvalidArgument(
+        "skeleton has no bone of non-zero length; cannot build a mannequin");
   }
 
   out.size = size;

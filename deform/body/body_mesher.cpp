@@ -165,7 +165,7 @@ base::Result<Mesh> MeshAtVoxelSize(const ImplicitBody& implicit, double h,
     }
   }
   if (mesh.triangles.empty()) {
-    return MakeError(ErrorCode::kInvalidArgument, {}, "the implicit body has no surface at this voxel size");
+    return base::InvalidArgument("the implicit body has no surface at this voxel size");
   }
   return mesh;
 }
@@ -176,12 +176,12 @@ base::Result<Mesh> MeshImplicitBody(const ImplicitBody& body, const BodyMeshOpti
   if (!(o.voxels_per_size >= 32.0f && o.voxels_per_size <= 512.0f) || !(o.band_voxels >= 2.0f && o.band_voxels <= 6.0f) ||
       !(o.adaptivity >= 0.0f && o.adaptivity <= 1.0f) || o.smoothing_passes < 0 || o.smoothing_passes > 8 ||
       o.max_triangles < 1000) {
-    return MakeError(ErrorCode::kInvalidArgument, {},
-                     "body mesh options out of range (voxels_per_size 32..512, band_voxels 2..6, "
-                     "adaptivity 0..1, smoothing_passes 0..8, max_triangles >= 1000)");
+    return base::InvalidArgument(
+        "body mesh options out of range (voxels_per_size 32..512, band_voxels 2..6, "
+        "adaptivity 0..1, smoothing_passes 0..8, max_triangles >= 1000)");
   }
   if (body.primitives().empty() || !(body.size() > 0.0f)) {
-    return MakeError(ErrorCode::kInvalidArgument, {}, "the implicit body is empty");
+    return base::InvalidArgument("the implicit body is empty");
   }
   InitializeOpenVdb();
   // The skeleton's scale sets the voxel; a body whose parts are huge next to S (joints

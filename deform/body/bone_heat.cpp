@@ -69,9 +69,9 @@ base::Result<BoneHeatWeights> ComputeBoneHeatWeights(
     const Mesh& mesh, std::span<const BodyBone> bones,
     const std::function<float(const glm::vec3&)>& distance, float size, const BoneHeatOptions& o) {
   if (!(o.heat > 0.0f) || o.max_influences < 1 || o.max_influences > 4 || !(o.inside_tolerance >= 0.0f)) {
-    return MakeError(ErrorCode::kInvalidArgument, {}, "bone heat options out of range (heat > 0, max_influences 1..4)");
+    return base::InvalidArgument("bone heat options out of range (heat > 0, max_influences 1..4)");
   }
-  if (bones.empty()) return MakeError(ErrorCode::kInvalidArgument, {}, "bone heat needs at least one bone");
+  if (bones.empty()) return base::InvalidArgument("bone heat needs at least one bone");
   const std::size_t nv = mesh.positions.size();
   // Joints that own bones, ascending: the unknowns' columns.
   std::vector<int> joints;
@@ -130,8 +130,8 @@ base::Result<BoneHeatWeights> ComputeBoneHeatWeights(
   system.setFromTriplets(entries.begin(), entries.end());
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(system);
   if (ldlt.info() != Eigen::Success) {
-    return MakeError(ErrorCode::kInvalidArgument, {},
-                     "bone heat: the surface's Laplacian could not be factorised (not one closed piece?)");
+    return base::InvalidArgument(
+        "bone heat: the surface's Laplacian could not be factorised (not one closed piece?)");
   }
 
   // Solve in blocks of joints, keeping each vertex's largest weights.

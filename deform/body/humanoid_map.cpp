@@ -286,9 +286,11 @@ base::Result<Humanoid> FindHumanoid(const mocap::Skeleton& skeleton,
   h.chains = std::move(*built);
   const BodyChains& c = h.chains;
   const auto fail = [&skeleton](const std::string& what) {
-    return MakeError(ErrorCode::kInvalidArgument, {skeleton.info.source_file, 0, 0, {}},
-                     "expected a humanoid skeleton (a spine with a pair of legs and, above them, "
-                     "a pair of arms), found " + what);
+    return base::InvalidArgument(
+        {skeleton.info.source_file, 0, 0, {}},
+        "expected a humanoid skeleton (a spine with a pair of legs and, above them, "
+        "a pair of arms), found " +
+            what);
   };
   int spine_chain = -1;
   std::vector<LimbPair> pairs;
@@ -441,8 +443,9 @@ base::Result<HumanoidMatch> MatchHumanoids(const mocap::Skeleton& target,
     body_turn = BodyTurn(*th, *sh);
     const float source_height = PelvisHeight(*sh), target_height = PelvisHeight(*th);
     if (!(source_height > 0.0f) || !(target_height > 0.0f)) {
-      return MakeError(ErrorCode::kInvalidArgument, {source_height > 0.0f ? target_file : source_file, 0, 0, {}},
-                       "expected the pelvis above the feet to scale the root translation");
+      return base::InvalidArgument(
+          {source_height > 0.0f ? target_file : source_file, 0, 0, {}},
+          "expected the pelvis above the feet to scale the root translation");
     }
     out.plan.translation_scale = target_height / source_height;
     for (const auto& [sides, file] : {std::pair{th->sides, target_file}, std::pair{sh->sides, source_file}}) {
@@ -473,9 +476,10 @@ base::Result<HumanoidMatch> MatchHumanoids(const mocap::Skeleton& target,
     const int sj = source_name.empty() ? -1 : source.FindJoint(source_name);
     if (tj < 0 || (!source_name.empty() && sj < 0)) {
       const bool bad_target = tj < 0;
-      return MakeError(ErrorCode::kInvalidArgument, {joint_map_file, 0, 0, {}},
-                       "expected joint map entries naming a joint of " + (bad_target ? target_file : source_file) +
-                           ", found \"" + (bad_target ? target_name : source_name) + "\"");
+      return base::InvalidArgument({joint_map_file, 0, 0, {}},
+                                   "expected joint map entries naming a joint of " +
+                                       (bad_target ? target_file : source_file) + ", found \"" +
+                                       (bad_target ? target_name : source_name) + "\"");
     }
     JointMatch& jm = match[static_cast<std::size_t>(tj)];
     jm = {};
@@ -486,9 +490,10 @@ base::Result<HumanoidMatch> MatchHumanoids(const mocap::Skeleton& target,
     }
   }
   if (out.plan.target_root >= 0 && match[static_cast<std::size_t>(out.plan.target_root)].source < 0) {
-    return MakeError(ErrorCode::kInvalidArgument, {joint_map.empty() ? source_file : joint_map_file, 0, 0, {}},
-                     "expected the character's root joint '" + target.names[static_cast<std::size_t>(out.plan.target_root)] +
-                         "' to be driven by the motion, found it left at rest");
+    return base::InvalidArgument({joint_map.empty() ? source_file : joint_map_file, 0, 0, {}},
+                                 "expected the character's root joint '" +
+                                     target.names[static_cast<std::size_t>(out.plan.target_root)] +
+                                     "' to be driven by the motion, found it left at rest");
   }
 
   // Per-bone rest alignment (topology only; names keep the documented identity).

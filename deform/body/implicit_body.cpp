@@ -260,9 +260,9 @@ base::Result<ImplicitBody> BuildImplicitBody(const mocap::Skeleton& skeleton,
                                              const ImplicitBodyOptions& o) {
   if (!(o.min_branch_extent >= 0.0f && o.min_branch_extent <= 0.5f) || !(o.blend >= 0.0f && o.blend <= 2.0f) ||
       !(o.radius_scale >= 0.5f && o.radius_scale <= 2.0f)) {
-    return MakeError(ErrorCode::kInvalidArgument, {},
-                     "body options out of range (min_branch_extent 0..0.5, blend 0..2, "
-                     "radius_scale 0.5..2)");
+    return base::InvalidArgument(
+        "body options out of range (min_branch_extent 0..0.5, blend 0..2, "
+        "radius_scale 0.5..2)");
   }
   base::Result<BodyChains> tree =
       BuildBodyChains(skeleton, rest_model_from_joint, o.min_branch_extent);

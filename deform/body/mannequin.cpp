@@ -50,10 +50,10 @@ base::Result<SkinnedMesh> BuildMannequin(const mocap::Skeleton& skeleton,
       o.target_vertices > kMaxVertices || !(o.radius_scale >= 0.25f && o.radius_scale <= 4.0f) ||
       !(o.min_branch_extent >= 0.0f && o.min_branch_extent <= 0.5f) ||
       !(o.blend_width > 0.0f && o.blend_width <= 4.0f)) {
-    return MakeError(ErrorCode::kInvalidArgument, {},
-                     "mannequin options out of range (ring_vertices 8..64, target_vertices "
-                     "10000..40000, radius_scale 0.25..4, min_branch_extent 0..0.5, "
-                     "blend_width in (0, 4])");
+    return base::InvalidArgument(
+        "mannequin options out of range (ring_vertices 8..64, target_vertices "
+        "10000..40000, radius_scale 0.25..4, min_branch_extent 0..0.5, "
+        "blend_width in (0, 4])");
   }
   base::Result<BodyChains> tree =
       BuildBodyChains(skeleton, rest_model_from_joint, o.min_branch_extent);

@@ -27,7 +27,7 @@ constexpr int kMaxGridSize = 16;
 using internal::Finite;
 
 Result<MassSpringNetwork> NetworkError(const std::string& what) {
-  return MakeError(ErrorCode::kInvalidArgument, FileLoc{}, "mass-spring network: " + what);
+  return base::InvalidArgument(FileLoc{}, "mass-spring network: " + what);
 }
 
 }  // namespace

@@ -58,27 +58,23 @@ double ProjectedRingArea(std::span<const glm::vec3> positions,
 base::Result<double> RingAreaRatio(std::span<const glm::vec3> rest_positions,
                                    std::span<const glm::vec3> positions, const ArtifactRing& ring) {
   if (rest_positions.size() != positions.size()) {
-    return MakeError(ErrorCode::kInvalidArgument, {},
-                     "expected as many deformed as rest positions (" +
-                         std::to_string(rest_positions.size()) + "), found " +
-                         std::to_string(positions.size()));
+    return base::InvalidArgument("expected as many deformed as rest positions (" +
+                                 std::to_string(rest_positions.size()) + "), found " +
+                                 std::to_string(positions.size()));
   }
   if (ring.vertices.size() < 3) {
-    return MakeError(ErrorCode::kInvalidArgument, {},
-                     "expected a ring of at least 3 vertices, found " +
-                         std::to_string(ring.vertices.size()));
+    return base::InvalidArgument("expected a ring of at least 3 vertices, found " +
+                                 std::to_string(ring.vertices.size()));
   }
   for (const std::uint32_t index : ring.vertices) {
     if (index >= positions.size()) {
-      return MakeError(ErrorCode::kInvalidArgument, {},
-                       "ring vertex " + std::to_string(index) + " is past the " +
-                           std::to_string(positions.size()) + " positions");
+      return base::InvalidArgument("ring vertex " + std::to_string(index) + " is past the " +
+                                   std::to_string(positions.size()) + " positions");
     }
   }
   const double rest_area = ProjectedRingArea(rest_positions, ring.vertices, ring.rest_plane);
   if (!(rest_area > 1e-12)) {
-    return MakeError(ErrorCode::kInvalidArgument, {},
-                     "ring has no area at rest in its plane");
+    return base::InvalidArgument("ring has no area at rest in its plane");
   }
   return ProjectedRingArea(positions, ring.vertices, ring.plane) / rest_area;
 }
@@ -93,7 +89,7 @@ base::Result<double> CandyWrapperFigure(std::span<const glm::vec3> rest_position
                                         std::span<const glm::vec3> positions,
                                         std::span<const ArtifactRing> rings) {
   if (rings.empty()) {
-    return MakeError(ErrorCode::kInvalidArgument, {}, "expected at least one ring, found none");
+    return base::InvalidArgument("expected at least one ring, found none");
   }
   double minimum = 0.0;
   for (std::size_t r = 0; r < rings.size(); ++r) {
@@ -112,7 +108,7 @@ base::Result<double> CappedVolume(std::span<const glm::vec3> positions,
                                   std::span<const glm::uvec3> triangles,
                                   std::span<const std::vector<std::uint32_t>> caps) {
   if (triangles.empty()) {
-    return MakeError(ErrorCode::kInvalidArgument, {}, "expected triangles, found none");
+    return base::InvalidArgument("expected triangles, found none");
   }
   // Directed edge -> use count; an edge whose reverse is absent is on the boundary.
   std::map<std::pair<std::uint32_t, std::uint32_t>, int> edges;
@@ -122,9 +118,8 @@ base::Result<double> CappedVolume(std::span<const glm::vec3> positions,
   };
   for (const glm::uvec3& t : triangles) {
     if (t.x >= positions.size() || t.y >= positions.size() || t.z >= positions.size()) {
-      return MakeError(ErrorCode::kInvalidArgument, {},
-                       "triangle index past the " + std::to_string(positions.size()) +
-                           " positions");
+      return base::InvalidArgument("triangle index past the " + std::to_string(positions.size()) +
+                                   " positions");
     }
     add_triangle(glm::dvec3(positions[t.x]), glm::dvec3(positions[t.y]),
                  glm::dvec3(positions[t.z]));
@@ -137,9 +132,8 @@ base::Result<double> CappedVolume(std::span<const glm::vec3> positions,
   for (std::size_t c = 0; c < caps.size(); ++c) {
     for (const std::uint32_t v : caps[c]) {
       if (v >= positions.size()) {
-        return MakeError(ErrorCode::kInvalidArgument, {},
-                         "cap " + std::to_string(c) + " vertex " + std::to_string(v) +
-                             " is past the positions");
+        return base::InvalidArgument("cap " + std::to_string(c) + " vertex " + std::to_string(v) +
+                                     " is past the positions");
       }
       cap_of[v] = c;
       centroids[c] += glm::dvec3(positions[v]);
@@ -150,9 +144,8 @@ base::Result<double> CappedVolume(std::span<const glm::vec3> positions,
     if (edges.count({edge.second, edge.first}) != 0) continue;  // interior edge
     const auto from = cap_of.find(edge.first), to = cap_of.find(edge.second);
     if (from == cap_of.end() || to == cap_of.end() || from->second != to->second) {
-      return MakeError(ErrorCode::kInvalidArgument, {},
-                       "boundary edge " + std::to_string(edge.first) + "-" +
-                           std::to_string(edge.second) + " is not on a cap ring");
+      return base::InvalidArgument("boundary edge " + std::to_string(edge.first) + "-" +
+                                   std::to_string(edge.second) + " is not on a cap ring");
     }
     // The cap triangle uses the edge reversed, so the closed surface stays consistent.
     for (int i = 0; i < count; ++i) {
@@ -168,15 +161,14 @@ base::Result<double> VolumeFigure(std::span<const glm::vec3> rest_positions,
                                   std::span<const glm::uvec3> triangles,
                                   std::span<const std::vector<std::uint32_t>> caps) {
   if (rest_positions.size() != positions.size()) {
-    return MakeError(ErrorCode::kInvalidArgument, {},
-                     "expected as many deformed as rest positions (" +
-                         std::to_string(rest_positions.size()) + "), found " +
-                         std::to_string(positions.size()));
+    return base::InvalidArgument("expected as many deformed as rest positions (" +
+                                 std::to_string(rest_positions.size()) + "), found " +
+                                 std::to_string(positions.size()));
   }
   base::Result<double> rest = CappedVolume(rest_positions, triangles, caps);
   if (!rest) return rest;
   if (!(*rest > 1e-12)) {
-    return MakeError(ErrorCode::kInvalidArgument, {}, "the section encloses no volume at rest");
+    return base::InvalidArgument("the section encloses no volume at rest");
   }
   base::Result<double> current = CappedVolume(positions, triangles, caps);
   if (!current) return current;

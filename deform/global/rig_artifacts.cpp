@@ -133,8 +133,7 @@ base::Result<std::vector<LimbArtifacts>> MeasureLimbArtifacts(
                      "artifact figures need #J bind matrices and the rig of this mesh");
   }
   if (rig.limbs().empty()) {
-    return MakeError(ErrorCode::kInvalidArgument, {},
-                     "the skeleton has no limb (a chain of two bones leaving a trunk)");
+    return base::InvalidArgument("the skeleton has no limb (a chain of two bones leaving a trunk)");
   }
   const glm::vec3 up = skeleton.info.up_axis == mocap::UpAxis::kZ ? glm::vec3(0, 0, 1)
                                                                    : glm::vec3(0, 1, 0);
@@ -162,8 +161,7 @@ base::Result<std::vector<LimbArtifacts>> MeasureLimbArtifacts(
     ring.vertices = NearestRing(rest, rig.bindings(), limb.chain, ring.rest_plane,
                                 kRingReach * lmin, kRingThickness * lmin);
     if (ring.vertices.size() < 3) {
-      return MakeError(ErrorCode::kInvalidArgument, {},
-                       "no mesh ring around joint '" + limb_out.joint + "'");
+      return base::InvalidArgument("no mesh ring around joint '" + limb_out.joint + "'");
     }
     for (double deg : bend_degrees) {
       const glm::quat q = glm::angleAxis(static_cast<float>(glm::radians(deg)), axis);
@@ -192,8 +190,8 @@ base::Result<std::vector<LimbArtifacts>> MeasureLimbArtifacts(
         if (r.vertices.size() >= 3) rings.push_back(std::move(r));
       }
       if (rings.empty()) {
-        return MakeError(ErrorCode::kInvalidArgument, {},
-                         "no mesh ring along the bone before '" + limb_out.end_joint + "'");
+        return base::InvalidArgument("no mesh ring along the bone before '" + limb_out.end_joint +
+                                     "'");
       }
       for (double deg : twist_degrees) {
         const glm::quat q = glm::angleAxis(static_cast<float>(glm::radians(deg)), a_out);

@@ -272,9 +272,9 @@ base::Status CheckSkinWeights(const SkinWeights& weights, int num_skin_joints, i
   using base::ErrorCode;
   using base::MakeError;
   if (weights.influences < 1 || weights.influences > kMaxInfluences) {
-    return MakeError(ErrorCode::kInvalidArgument, {},
-                     "skin weights have " + std::to_string(weights.influences) +
-                         " influences per vertex, expected 1.." + std::to_string(kMaxInfluences));
+    return base::InvalidArgument("skin weights have " + std::to_string(weights.influences) +
+                                 " influences per vertex, expected 1.." +
+                                 std::to_string(kMaxInfluences));
   }
   const std::size_t k = static_cast<std::size_t>(weights.influences);
   if (weights.weights.size() % k != 0 || weights.joints.size() != weights.weights.size()) {
@@ -294,21 +294,19 @@ base::Status CheckSkinWeights(const SkinWeights& weights, int num_skin_joints, i
     for (std::size_t i = 0; i < k; ++i) {
       const float w = weights.weights[v * k + i];
       if (!std::isfinite(w) || w < 0.0f) {
-        return MakeError(ErrorCode::kInvalidArgument, {},
-                         "vertex " + std::to_string(v) + " has a negative or non-finite weight");
+        return base::InvalidArgument("vertex " + std::to_string(v) +
+                                     " has a negative or non-finite weight");
       }
       if (weights.joints[v * k + i] >= num_skin_joints) {
-        return MakeError(ErrorCode::kInvalidArgument, {},
-                         "vertex " + std::to_string(v) + " names skin joint " +
-                             std::to_string(weights.joints[v * k + i]) + ", expected < " +
-                             std::to_string(num_skin_joints));
+        return base::InvalidArgument("vertex " + std::to_string(v) + " names skin joint " +
+                                     std::to_string(weights.joints[v * k + i]) + ", expected < " +
+                                     std::to_string(num_skin_joints));
       }
       sum += w;
     }
     if (std::abs(sum - 1.0) > 1e-4) {
-      return MakeError(ErrorCode::kInvalidArgument, {},
-                       "weights of vertex " + std::to_string(v) + " sum to " + std::to_string(sum) +
-                           ", expected 1");
+      return base::InvalidArgument("weights of vertex " + std::to_string(v) + " sum to " +
+                                   std::to_string(sum) + ", expected 1");
     }
   }
   return base::Status::Ok();

@@ -200,17 +200,15 @@ base::Result<SwdRig> BuildSwdRig(const mocap::Skeleton& skeleton,
                                  std::span<const glm::mat4> bind_model_from_joint,
                                  const Mesh& bind_mesh, const SwdRigOptions& options) {
   if (bind_mesh.positions.empty()) {
-    return MakeError(ErrorCode::kInvalidArgument, {}, "SWD rig: the mesh has no vertices");
+    return base::InvalidArgument("SWD rig: the mesh has no vertices");
   }
   if (!bind_mesh.normals.empty() && bind_mesh.normals.size() != bind_mesh.positions.size()) {
-    return MakeError(ErrorCode::kInvalidArgument, {},
-                     "SWD rig: expected one normal per vertex (" +
-                         std::to_string(bind_mesh.positions.size()) + "), found " +
-                         std::to_string(bind_mesh.normals.size()));
+    return base::InvalidArgument("SWD rig: expected one normal per vertex (" +
+                                 std::to_string(bind_mesh.positions.size()) + "), found " +
+                                 std::to_string(bind_mesh.normals.size()));
   }
   if (!(options.max_bend_rad > 0.0 && options.max_bend_rad <= 3.2)) {
-    return MakeError(ErrorCode::kInvalidArgument, {},
-                     "SWD rig: max_bend_rad must be in (0, 3.2]");
+    return base::InvalidArgument("SWD rig: max_bend_rad must be in (0, 3.2]");
   }
   base::Result<BodyChains> tree =
       BuildBodyChains(skeleton, bind_model_from_joint, options.min_branch_extent);
@@ -335,10 +333,9 @@ base::Result<SwdRig> BuildSwdRig(const mocap::Skeleton& skeleton,
   std::vector<std::uint8_t> placed;
   if (!options.vertex_chains.empty()) {
     if (options.vertex_chains.size() != nv) {
-      return MakeError(ErrorCode::kInvalidArgument, {},
-                       "SWD rig: expected one body chain coordinate per vertex (" +
-                           std::to_string(nv) + "), found " +
-                           std::to_string(options.vertex_chains.size()));
+      return base::InvalidArgument("SWD rig: expected one body chain coordinate per vertex (" +
+                                   std::to_string(nv) + "), found " +
+                                   std::to_string(options.vertex_chains.size()));
     }
     placements.resize(nv);
     placed.assign(nv, 0);
@@ -348,11 +345,11 @@ base::Result<SwdRig> BuildSwdRig(const mocap::Skeleton& skeleton,
       if (coord.chain >= static_cast<int>(body.size()) || !std::isfinite(coord.u) ||
           coord.u < 0.0f ||
           coord.u > static_cast<float>(body[static_cast<std::size_t>(coord.chain)].points.size() - 1)) {
-        return MakeError(ErrorCode::kInvalidArgument, {},
-                         "SWD rig: vertex " + std::to_string(v) + " lies on body chain " +
-                             std::to_string(coord.chain) + " at u = " + std::to_string(coord.u) +
-                             ", which the skeleton's " + std::to_string(body.size()) +
-                             " chains do not have (a mesh made for another skeleton or pose?)");
+        return base::InvalidArgument(
+            "SWD rig: vertex " + std::to_string(v) + " lies on body chain " +
+            std::to_string(coord.chain) + " at u = " + std::to_string(coord.u) +
+            ", which the skeleton's " + std::to_string(body.size()) +
+            " chains do not have (a mesh made for another skeleton or pose?)");
       }
       int p = first_piece[static_cast<std::size_t>(coord.chain)];
       while (p + 1 < static_cast<int>(pieces.size()) &&
@@ -400,9 +397,9 @@ base::Result<SwdRig> BuildSwdRig(const mocap::Skeleton& skeleton,
 base::Result<std::vector<SweepVertexBinding>> BindPointsLikeVertices(
     const SwdRig& rig, std::span<const glm::vec3> points, std::span<const int> guides) {
   if (points.size() != guides.size()) {
-    return MakeError(ErrorCode::kInvalidArgument, {},
-                     "SWD: expected one guide vertex per point (" + std::to_string(points.size()) +
-                         "), found " + std::to_string(guides.size()));
+    return base::InvalidArgument("SWD: expected one guide vertex per point (" +
+                                 std::to_string(points.size()) + "), found " +
+                                 std::to_string(guides.size()));
   }
   std::vector<int> trunk_of(rig.chains().size(), -1);
   for (const SweepJunction& j : rig.junctions()) {
@@ -412,10 +409,9 @@ base::Result<std::vector<SweepVertexBinding>> BindPointsLikeVertices(
   for (std::size_t i = 0; i < points.size(); ++i) {
     const int g = guides[i];
     if (g < 0 || g >= rig.num_vertices()) {
-      return MakeError(ErrorCode::kInvalidArgument, {},
-                       "SWD: point " + std::to_string(i) + " has guide vertex " +
-                           std::to_string(g) + ", expected 0.." +
-                           std::to_string(rig.num_vertices() - 1));
+      return base::InvalidArgument("SWD: point " + std::to_string(i) + " has guide vertex " +
+                                   std::to_string(g) + ", expected 0.." +
+                                   std::to_string(rig.num_vertices() - 1));
     }
     // The guide's sweeps: its own, its junction's trunk, and its second sweep.
     const SweepVertexBinding& guide = rig.bindings()[static_cast<std::size_t>(g)];

@@ -157,39 +157,35 @@ base::Result<SweepChain> BuildSweepChain(const SweepChainSpec& spec) {
   }
   const auto num_points = static_cast<std::size_t>(num_bones + 1);
   if (spec.rest_points.size() != num_points) {
-    return MakeError(ErrorCode::kInvalidArgument, {},
-                     "sweep chain expected " + std::to_string(num_points) +
-                         " rest points, found " + std::to_string(spec.rest_points.size()));
+    return base::InvalidArgument("sweep chain expected " + std::to_string(num_points) +
+                                 " rest points, found " + std::to_string(spec.rest_points.size()));
   }
   for (const auto* list : {&spec.half_widths, &spec.skin_radii}) {
     if (!list->empty() && list->size() != num_points) {
-      return MakeError(ErrorCode::kInvalidArgument, {},
-                       "sweep chain expected " + std::to_string(num_points) +
-                           " half-widths or skin radii, found " + std::to_string(list->size()));
+      return base::InvalidArgument("sweep chain expected " + std::to_string(num_points) +
+                                   " half-widths or skin radii, found " +
+                                   std::to_string(list->size()));
     }
   }
   if (!spec.twist_spread.empty() && spec.twist_spread.size() != num_points) {
-    return MakeError(ErrorCode::kInvalidArgument, {},
-                     "sweep chain expected " + std::to_string(num_points) +
-                         " twist assignments, found " + std::to_string(spec.twist_spread.size()));
+    return base::InvalidArgument("sweep chain expected " + std::to_string(num_points) +
+                                 " twist assignments, found " +
+                                 std::to_string(spec.twist_spread.size()));
   }
   SweepChain chain;
   chain.num_bones_ = num_bones;
   for (int k = 0; k < num_bones; ++k) {
     const auto ks = static_cast<std::size_t>(k);
     if (spec.joints[ks] < 0) {
-      return MakeError(ErrorCode::kInvalidArgument, {},
-                       "sweep bone " + std::to_string(k) + " has negative joint index");
+      return base::InvalidArgument("sweep bone " + std::to_string(k) + " has negative joint index");
     }
     if (!Finite(spec.rest_points[ks]) || !Finite(spec.rest_points[ks + 1])) {
-      return MakeError(ErrorCode::kInvalidArgument, {},
-                       "sweep joint " + std::to_string(k) + " position is not finite");
+      return base::InvalidArgument("sweep joint " + std::to_string(k) + " position is not finite");
     }
     const glm::dvec3 d = glm::dvec3(spec.rest_points[ks + 1]) - glm::dvec3(spec.rest_points[ks]);
     const double length = glm::length(d);
     if (!(length > 1e-6)) {
-      return MakeError(ErrorCode::kInvalidArgument, {},
-                       "sweep bone " + std::to_string(k) + " has zero length");
+      return base::InvalidArgument("sweep bone " + std::to_string(k) + " has zero length");
     }
     chain.joints_[ks] = spec.joints[ks];
     chain.lengths_[ks] = length;
@@ -210,10 +206,9 @@ base::Result<SweepChain> BuildSweepChain(const SweepChainSpec& spec) {
       h = DefaultHalfWidth(radius, kDefaultMaxBendRad, l_in, l_out);
     }
     if (!std::isfinite(h) || h <= 0.0 || h >= std::min(l_in, l_out)) {
-      return MakeError(ErrorCode::kInvalidArgument, {},
-                       "sweep joint " + std::to_string(k) +
-                           " region half-width must be in (0, shorter bone length), found " +
-                           std::to_string(h));
+      return base::InvalidArgument(
+          "sweep joint " + std::to_string(k) +
+          " region half-width must be in (0, shorter bone length), found " + std::to_string(h));
     }
     chain.hm_[ks] = h;
     chain.hp_[ks] = h;
@@ -226,9 +221,8 @@ base::Result<SweepChain> BuildSweepChain(const SweepChainSpec& spec) {
   for (int k = 0; k < num_bones; ++k) {
     const auto ks = static_cast<std::size_t>(k);
     if (!(chain.region_end_[ks] < chain.region_start_[ks + 1])) {
-      return MakeError(ErrorCode::kInvalidArgument, {},
-                       "sweep bone " + std::to_string(k) +
-                           " is shorter than the regions of its two joints");
+      return base::InvalidArgument("sweep bone " + std::to_string(k) +
+                                   " is shorter than the regions of its two joints");
     }
   }
   // The bind pose: identity rotations, J_0 at its rest position.

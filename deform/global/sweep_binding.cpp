@@ -172,28 +172,26 @@ base::Result<std::vector<SweepVertexBinding>> BindToSweeps(
     std::span<const glm::vec3> rest_positions, std::span<const std::uint8_t> primary_ok,
     std::span<const SweepPlacement> placements) {
   if (chains.empty() || chains.size() > std::numeric_limits<std::uint16_t>::max()) {
-    return MakeError(ErrorCode::kInvalidArgument, {},
-                     "expected 1..65535 sweep chains, found " + std::to_string(chains.size()));
+    return base::InvalidArgument("expected 1..65535 sweep chains, found " +
+                                 std::to_string(chains.size()));
   }
   if (!primary_ok.empty() &&
       (primary_ok.size() != chains.size() ||
        std::find(primary_ok.begin(), primary_ok.end(), std::uint8_t{1}) == primary_ok.end())) {
-    return MakeError(ErrorCode::kInvalidArgument, {},
-                     "expected one primary flag per chain, at least one set");
+    return base::InvalidArgument("expected one primary flag per chain, at least one set");
   }
   const int num_chains = static_cast<int>(chains.size());
   if (!placements.empty() && placements.size() != rest_positions.size()) {
-    return MakeError(ErrorCode::kInvalidArgument, {},
-                     "expected one placement per vertex (" +
-                         std::to_string(rest_positions.size()) + "), found " +
-                         std::to_string(placements.size()));
+    return base::InvalidArgument("expected one placement per vertex (" +
+                                 std::to_string(rest_positions.size()) + "), found " +
+                                 std::to_string(placements.size()));
   }
   for (std::size_t v = 0; v < placements.size(); ++v) {
     if (placements[v].chain >= num_chains || !std::isfinite(placements[v].u)) {
-      return MakeError(ErrorCode::kInvalidArgument, {},
-                       "placement of vertex " + std::to_string(v) +
-                           ": expected a chain below " + std::to_string(num_chains) +
-                           " and a finite u, found chain " + std::to_string(placements[v].chain));
+      return base::InvalidArgument("placement of vertex " + std::to_string(v) +
+                                   ": expected a chain below " + std::to_string(num_chains) +
+                                   " and a finite u, found chain " +
+                                   std::to_string(placements[v].chain));
     }
   }
   std::vector<const SweepJunction*> junction_of(chains.size(), nullptr);
@@ -202,25 +200,21 @@ base::Result<std::vector<SweepVertexBinding>> BindToSweeps(
     const std::string where = "junction " + std::to_string(j);
     if (junction.branch < 0 || junction.branch >= num_chains || junction.trunk < 0 ||
         junction.trunk >= num_chains || junction.branch == junction.trunk) {
-      return MakeError(ErrorCode::kInvalidArgument, {},
-                       where + ": expected two different chain indices below " +
-                           std::to_string(num_chains));
+      return base::InvalidArgument(where + ": expected two different chain indices below " +
+                                   std::to_string(num_chains));
     }
     const auto branch_bones = static_cast<float>(chains[static_cast<std::size_t>(junction.branch)]
                                                      .num_bones());
     if (!(junction.u_start >= 0.0f && junction.u_start < junction.u_end &&
           junction.u_end <= branch_bones)) {
-      return MakeError(ErrorCode::kInvalidArgument, {},
-                       where + ": expected 0 <= u_start < u_end <= branch bone count");
+      return base::InvalidArgument(where + ": expected 0 <= u_start < u_end <= branch bone count");
     }
     if (!(junction.seam_band >= 0.0f && std::isfinite(junction.seam_band))) {
-      return MakeError(ErrorCode::kInvalidArgument, {},
-                       where + ": expected a finite seam band >= 0");
+      return base::InvalidArgument(where + ": expected a finite seam band >= 0");
     }
     if (junction_of[static_cast<std::size_t>(junction.branch)] != nullptr) {
-      return MakeError(ErrorCode::kInvalidArgument, {},
-                       where + ": chain " + std::to_string(junction.branch) +
-                           " is already the branch of another junction");
+      return base::InvalidArgument(where + ": chain " + std::to_string(junction.branch) +
+                                   " is already the branch of another junction");
     }
     junction_of[static_cast<std::size_t>(junction.branch)] = &junction;
   }
@@ -242,8 +236,7 @@ base::Result<std::vector<SweepVertexBinding>> BindToSweeps(
   std::vector<SweepVertexBinding> bindings(rest_positions.size());
   for (std::size_t v = 0; v < rest_positions.size(); ++v) {
     if (!Finite(rest_positions[v])) {
-      return MakeError(ErrorCode::kInvalidArgument, {},
-                       "rest vertex " + std::to_string(v) + " is not finite");
+      return base::InvalidArgument("rest vertex " + std::to_string(v) + " is not finite");
     }
     const glm::dvec3 p(rest_positions[v]);
     SweepVertexBinding& binding = bindings[v];

@@ -1,7 +1,7 @@
 #pragma once
 // The input checks deform's jobs and builders share: finiteness of points and
-// the error a bad argument gets (kInvalidArgument, no file position unless one
-// is given). One definition each, so the layer's files can be compiled together.
+// the error a bad argument gets (base::InvalidArgument). One definition each,
+// so the layer's files can be compiled together.
 
 #include <cmath>
 #include <span>
@@ -29,12 +29,6 @@ inline bool AllFinite(std::span<const glm::vec3> points) {
   return true;
 }
 
-inline base::Error InvalidArgument(base::FileLoc loc, std::string message) {
-  return base::MakeError(base::ErrorCode::kInvalidArgument, std::move(loc), std::move(message));
-}
-
-inline base::Error InvalidArgument(std::string message) {
-  return InvalidArgument(base::FileLoc{}, std::move(message));
-}
+using base::InvalidArgument;
 
 }  // namespace deform::internal

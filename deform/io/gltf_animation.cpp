@@ -133,13 +133,13 @@ base::Result<mocap::Motion> AnimationToMotion(const GltfModel& model, int animat
   using base::ErrorCode;
   const base::FileLoc loc{model.skeleton.info.source_file, 0, 0, {}};
   if (animation < 0 || animation >= static_cast<int>(model.animations.size())) {
-    return base::MakeError(ErrorCode::kInvalidArgument, loc,
-                           "animation " + std::to_string(animation) + " requested, the model has " +
-                               std::to_string(model.animations.size()));
+    return base::InvalidArgument(loc, "animation " + std::to_string(animation) +
+                                          " requested, the model has " +
+                                          std::to_string(model.animations.size()));
   }
   const GltfAnimation& anim = model.animations[static_cast<std::size_t>(animation)];
   if (!std::isfinite(frame_time_s)) {
-    return base::MakeError(ErrorCode::kInvalidArgument, loc, "frame time must be finite");
+    return base::InvalidArgument(loc, "frame time must be finite");
   }
   if (frame_time_s <= 0.0) frame_time_s = DetectFrameTime(anim);
   const double intervals = anim.duration_s / frame_time_s;

@@ -47,7 +47,7 @@ constexpr std::size_t kCopyBlock = std::size_t{1} << 20;
 constexpr std::uint64_t kMaxGlbBytes = 0xFFFFFFFFu;
 
 base::Error GlbError(const std::string& what) {
-  return base::MakeError(base::ErrorCode::kInvalidArgument, {"glb", 0, 0, {}}, what);
+  return base::InvalidArgument({"glb", 0, 0, {}}, what);
 }
 
 using internal::AllFinite;
@@ -638,14 +638,14 @@ base::Status GltfSequenceWriter::Finish(const std::string& path) {
   Impl& m = *impl_;
   if (m.finished) return GlbError("the file was already written");
   if (m.added != m.num_frames) {
-    return base::MakeError(base::ErrorCode::kInvalidArgument, {path, 0, 0, {}},
-                           "expected " + std::to_string(m.num_frames) + " frames, " +
-                               std::to_string(m.added) + " were added");
+    return base::InvalidArgument({path, 0, 0, {}}, "expected " + std::to_string(m.num_frames) +
+                                                       " frames, " + std::to_string(m.added) +
+                                                       " were added");
   }
   if (m.options.camera && m.camera_translations.size() / 3 != static_cast<std::size_t>(m.num_frames)) {
-    return base::MakeError(base::ErrorCode::kInvalidArgument, {path, 0, 0, {}},
-                           "expected " + std::to_string(m.num_frames) + " camera poses, " +
-                               std::to_string(m.camera_translations.size() / 3) + " were added");
+    return base::InvalidArgument(
+        {path, 0, 0, {}}, "expected " + std::to_string(m.num_frames) + " camera poses, " +
+                              std::to_string(m.camera_translations.size() / 3) + " were added");
   }
   m.finished = true;  // the model is consumed below, whatever the outcome
   if (m.layout == GltfExportLayout::kBakedMeshes) {

@@ -48,8 +48,7 @@ void EvaluateWeights(const GltfWeightsChannel& channel, float t, std::span<float
 }
 
 base::Error ModelError(const GltfModel& model, const std::string& what) {
-  return base::MakeError(base::ErrorCode::kInvalidArgument,
-                         {model.skeleton.info.source_file, 0, 0, {}}, what);
+  return base::InvalidArgument({model.skeleton.info.source_file, 0, 0, {}}, what);
 }
 
 }  // namespace

@@ -10,7 +10,7 @@ namespace deform {
 namespace {
 
 base::Error ObjError(const std::string& what) {
-  return base::MakeError(base::ErrorCode::kInvalidArgument, {"obj", 0, 0, {}}, what);
+  return base::InvalidArgument({"obj", 0, 0, {}}, what);
 }
 
 using internal::AllFinite;
@@ -155,15 +155,14 @@ base::Status WriteObjMaterials(const std::string& path, std::span<const std::str
                                std::span<const glm::vec3> diffuse,
                                std::span<const std::string> texture_files) {
   if (diffuse.size() != names.size() || texture_files.size() != names.size()) {
-    return base::MakeError(base::ErrorCode::kInvalidArgument, {path, 0, 0, {}},
-                           "expected a colour and a texture file (or none) per material name");
+    return base::InvalidArgument(
+        {path, 0, 0, {}}, "expected a colour and a texture file (or none) per material name");
   }
   std::string out = "# patchskin materials: Kd is the linear base colour factor\n";
   for (std::size_t k = 0; k < names.size(); ++k) {
     if (names[k].empty() || HasSpace(names[k]) || HasSpace(texture_files[k])) {
-      return base::MakeError(
-          base::ErrorCode::kInvalidArgument, {path, 0, 0, {}},
-          "material '" + names[k] + "': names and files must be non-empty words");
+      return base::InvalidArgument(
+          {path, 0, 0, {}}, "material '" + names[k] + "': names and files must be non-empty words");
     }
     out += "newmtl " + names[k] + "\nKd";
     for (int c = 0; c < 3; ++c) {

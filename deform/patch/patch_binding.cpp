@@ -255,17 +255,16 @@ base::Result<BindResult> BindPatch(const BSplineSurface& surface,
     return MakeError(ErrorCode::kUnsupported, {}, "binding: expected a bicubic patch");
   }
   if (surface.num_u() < 4 || surface.num_v() < 4 || surface.num_u() > 256 || surface.num_v() > 256) {
-    return MakeError(ErrorCode::kInvalidArgument, {}, "binding: control grid must be 4..256 each way");
+    return base::InvalidArgument("binding: control grid must be 4..256 each way");
   }
   if (!region_uv.empty() && region_uv.size() != region.size()) {
-    return MakeError(ErrorCode::kInvalidArgument, {},
-                     "binding: expected " + std::to_string(region.size()) +
-                         " region parameters, found " + std::to_string(region_uv.size()));
+    return base::InvalidArgument("binding: expected " + std::to_string(region.size()) +
+                                 " region parameters, found " + std::to_string(region_uv.size()));
   }
   for (int vtx : region) {
     if (vtx < 0 || static_cast<size_t>(vtx) >= positions.size()) {
-      return MakeError(ErrorCode::kInvalidArgument, {},
-                       "binding: vertex index " + std::to_string(vtx) + " out of range");
+      return base::InvalidArgument("binding: vertex index " + std::to_string(vtx) +
+                                   " out of range");
     }
   }
   BindResult result;

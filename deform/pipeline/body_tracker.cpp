@@ -71,9 +71,10 @@ base::Result<BodyTracker> BodyTracker::Create(const Character& character,
   const int nv = mesh.bind.num_vertices();
   for (const int v : tracked) {
     if (v < 0 || v >= nv) {
-      return base::MakeError(base::ErrorCode::kInvalidArgument, {character.source, 0, 0, {}},
-                             "tracked vertex " + std::to_string(v) + " is not one of the mesh's " +
-                                 std::to_string(nv) + " vertices");
+      return base::InvalidArgument({character.source, 0, 0, {}},
+                                   "tracked vertex " + std::to_string(v) +
+                                       " is not one of the mesh's " + std::to_string(nv) +
+                                       " vertices");
     }
   }
   BodyTracker t(character);

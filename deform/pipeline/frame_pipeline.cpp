@@ -183,10 +183,9 @@ base::Status FramePipeline::SetPoseSpaces(std::vector<PatchPoseSpace> spaces) {
   Impl& m = *impl_;
   const base::FileLoc loc{m.character->source, 0, 0, {}};
   if (!spaces.empty() && spaces.size() != m.patches.size()) {
-    return base::MakeError(base::ErrorCode::kInvalidArgument, loc,
-                           "expected one pose space per patch (" +
-                               std::to_string(m.patches.size()) + "), found " +
-                               std::to_string(spaces.size()));
+    return base::InvalidArgument(loc, "expected one pose space per patch (" +
+                                          std::to_string(m.patches.size()) + "), found " +
+                                          std::to_string(spaces.size()));
   }
   std::size_t max_x = 0, max_c = 0;
   for (std::size_t p = 0; p < spaces.size(); ++p) {
@@ -200,9 +199,8 @@ base::Status FramePipeline::SetPoseSpaces(std::vector<PatchPoseSpace> spaces) {
     const RbfModel& model = spaces[p].model;
     const int dim = PoseFeatureDimension(m.character->skeleton, spaces[p].features);
     if (model.dimension != dim || model.num_values != 3 * m.patches[p].num_control()) {
-      return base::MakeError(base::ErrorCode::kInvalidArgument, loc,
-                             "pose space " + std::to_string(p) +
-                                 " does not fit its patch (features or control points)");
+      return base::InvalidArgument(loc, "pose space " + std::to_string(p) +
+                                            " does not fit its patch (features or control points)");
     }
     max_x = std::max(max_x, static_cast<std::size_t>(dim));
     max_c = std::max(max_c, m.patches[p].rest_control.size());

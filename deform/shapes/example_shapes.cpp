@@ -16,7 +16,7 @@ namespace {
 using base::ErrorCode;
 
 base::Error EditError(const ExampleEdit& e, const std::string& message) {
-  return base::MakeError(ErrorCode::kInvalidArgument, e.loc, message);
+  return base::InvalidArgument(e.loc, message);
 }
 
 using internal::Finite;
@@ -34,24 +34,22 @@ base::Result<SculptedExample> SculptExample(const PatchSetup& patch, const Skinn
   const std::size_t num_skin = mesh.skin_joints.size();
   if (pose.model_from_bind.size() != num_skin ||
       (!pose.dual_quats.empty() && pose.dual_quats.size() != num_skin)) {
-    return base::MakeError(ErrorCode::kInvalidArgument, {},
-                           "example pose: expected palettes of " + std::to_string(num_skin) +
-                               " skin joints, found " +
-                               std::to_string(pose.model_from_bind.size()));
+    return base::InvalidArgument("example pose: expected palettes of " + std::to_string(num_skin) +
+                                 " skin joints, found " +
+                                 std::to_string(pose.model_from_bind.size()));
   }
   if (edits.empty()) {
-    return base::MakeError(ErrorCode::kInvalidArgument, {},
-                           "expected at least one edit, found none");
+    return base::InvalidArgument("expected at least one edit, found none");
   }
 
   // G: the control points carried to the example pose (float, as per frame).
   std::vector<glm::vec3> carried(static_cast<std::size_t>(nc));
   base::JobStatus s =
       CarryControlPointsJob{.patch = &patch, .pose = pose, .control = carried}.Run();
-  if (!s) return base::MakeError(ErrorCode::kInvalidArgument, {}, s.what);
+  if (!s) return base::InvalidArgument(s.what);
   std::vector<glm::quat> rotations(static_cast<std::size_t>(nc));
   s = PatchControlRotations(patch, pose, rotations);
-  if (!s) return base::MakeError(ErrorCode::kInvalidArgument, {}, s.what);
+  if (!s) return base::InvalidArgument(s.what);
   BSplineSurface surface = patch.fit.surface;
   std::vector<glm::dvec3>& control = surface.mutable_control();
   for (int c = 0; c < nc; ++c) control[static_cast<std::size_t>(c)] = glm::dvec3(carried[static_cast<std::size_t>(c)]);

@@ -17,8 +17,7 @@ AsyncImageWriter::~AsyncImageWriter() { (void)Finish(); }
 Status AsyncImageWriter::Submit(Image image, std::string path, WriteOptions options) {
   std::unique_lock<std::mutex> lock(mutex_);
   if (finished_) {
-    return base::MakeError(base::ErrorCode::kInvalidArgument, base::InFile(path),
-                           "frame submitted after the writer finished");
+    return base::InvalidArgument(base::InFile(path), "frame submitted after the writer finished");
   }
   slot_free_.wait(lock, [&] { return in_flight_ < options_.max_in_flight || first_error_; });
   if (first_error_) return *first_error_;

@@ -18,7 +18,7 @@ using base::MakeError;
 constexpr std::int64_t kMaxSheetPixels = std::int64_t{1} << 26;
 
 base::Error SheetError(const std::string& what) {
-  return MakeError(ErrorCode::kInvalidArgument, FileLoc{}, "contact sheet: " + what);
+  return base::InvalidArgument(FileLoc{}, "contact sheet: " + what);
 }
 
 // Image rows as an OpenCV matrix without a copy (4 floats per pixel).

@@ -18,10 +18,10 @@ using base::FileLoc;
 using base::MakeError;
 
 base::Error SizeError(const Image& a, const Image& b) {
-  return MakeError(ErrorCode::kInvalidArgument, FileLoc{},
-                   "images differ in size: " + std::to_string(a.width) + "x" +
-                       std::to_string(a.height) + " and " + std::to_string(b.width) + "x" +
-                       std::to_string(b.height));
+  return base::InvalidArgument(FileLoc{}, "images differ in size: " + std::to_string(a.width) +
+                                              "x" + std::to_string(a.height) + " and " +
+                                              std::to_string(b.width) + "x" +
+                                              std::to_string(b.height));
 }
 
 bool Consistent(const Image& img) {
@@ -32,8 +32,7 @@ bool Consistent(const Image& img) {
 
 base::Status CheckPair(const Image& a, const Image& b) {
   if (!Consistent(a) || !Consistent(b)) {
-    return MakeError(ErrorCode::kInvalidArgument, FileLoc{},
-                     "cannot compare an empty or inconsistent image");
+    return base::InvalidArgument(FileLoc{}, "cannot compare an empty or inconsistent image");
   }
   if (a.width != b.width || a.height != b.height) return SizeError(a, b);
   return base::Status::Ok();

@@ -70,21 +70,21 @@ Status CheckImage(const Image& image, const std::string& path) {
   const auto pixels = static_cast<std::size_t>(std::max(image.width, 0)) *
                       static_cast<std::size_t>(std::max(image.height, 0));
   if (image.width <= 0 || image.height <= 0) {
-    return MakeError(ErrorCode::kInvalidArgument, base::InFile(path),
-                     "cannot write an empty image (" + std::to_string(image.width) + "x" +
-                         std::to_string(image.height) + ")");
+    return base::InvalidArgument(base::InFile(path), "cannot write an empty image (" +
+                                                         std::to_string(image.width) + "x" +
+                                                         std::to_string(image.height) + ")");
   }
   if (image.rgba.size() != pixels || (!image.depth.empty() && image.depth.size() != pixels)) {
-    return MakeError(ErrorCode::kInvalidArgument, base::InFile(path),
-                     "image buffers do not match its size " + std::to_string(image.width) + "x" +
-                         std::to_string(image.height));
+    return base::InvalidArgument(base::InFile(path), "image buffers do not match its size " +
+                                                         std::to_string(image.width) + "x" +
+                                                         std::to_string(image.height));
   }
   return Status::Ok();
 }
 
 Status CheckOptions(const WriteOptions& o, const std::string& path) {
   auto bad = [&](const std::string& what) {
-    return Status(MakeError(ErrorCode::kInvalidArgument, base::InFile(path), what));
+    return Status(base::InvalidArgument(base::InFile(path), what));
   };
   if (o.png_compression < 0 || o.png_compression > 9) {
     return bad("PNG compression must be 0..9, found " + std::to_string(o.png_compression));
@@ -458,10 +458,11 @@ bool HasFramePlaceholder(const std::string& pattern) {
 Result<std::string> ExpandFramePattern(const std::string& pattern, int frame) {
   const std::vector<Placeholder> found = FindPlaceholders(pattern);
   if (found.size() != 1) {
-    return MakeError(ErrorCode::kInvalidArgument, base::InFile(pattern),
-                     "expected exactly one frame placeholder ('####' or '%04d') in the output "
-                     "pattern, found " +
-                         std::to_string(found.size()));
+    return base::InvalidArgument(
+        base::InFile(pattern),
+        "expected exactly one frame placeholder ('####' or '%04d') in the output "
+        "pattern, found " +
+            std::to_string(found.size()));
   }
   char digits[128];
   std::snprintf(digits, sizeof(digits), "%0*d", found[0].width, frame);

@@ -18,7 +18,7 @@ using base::FileLoc;
 using base::MakeError;
 
 base::Error PlotError(const std::string& what) {
-  return MakeError(ErrorCode::kInvalidArgument, FileLoc{}, "plot: " + what);
+  return base::InvalidArgument(FileLoc{}, "plot: " + what);
 }
 
 // OpenCV draws anti-aliased lines on 8-bit images only: draw in 8-bit sRGB (BGR order).

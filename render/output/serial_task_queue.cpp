@@ -15,8 +15,7 @@ SerialTaskQueue::~SerialTaskQueue() { (void)Finish(); }
 base::Status SerialTaskQueue::Submit(Task task) {
   std::unique_lock<std::mutex> lock(mutex_);
   if (finished_) {
-    return base::MakeError(base::ErrorCode::kInvalidArgument, {},
-                           "task submitted after the queue finished");
+    return base::InvalidArgument("task submitted after the queue finished");
   }
   slot_free_.wait(lock, [&] { return pending_ < options_.max_queued || first_error_; });
   if (first_error_) return *first_error_;

@@ -57,10 +57,10 @@ Result<std::unique_ptr<VideoWriter>> VideoWriter::Open(const std::string& path, 
                                                        int height, const VideoOptions& options) {
   const FileLoc loc = base::InFile(path);
   if (width <= 0 || height <= 0 || !(options.fps > 0.0)) {
-    return MakeError(ErrorCode::kInvalidArgument, loc, "expected a positive size and fps");
+    return base::InvalidArgument(loc, "expected a positive size and fps");
   }
   if (options.codecs.empty()) {
-    return MakeError(ErrorCode::kInvalidArgument, loc, "expected at least one codec to try");
+    return base::InvalidArgument(loc, "expected at least one codec to try");
   }
   const std::filesystem::path parent = std::filesystem::path(path).parent_path();
   if (!parent.empty() && !std::filesystem::is_directory(parent)) {
@@ -123,9 +123,9 @@ Status VideoWriter::AddFrame(const Image& frame) {
   }
   if (frame.width < 1 || frame.height < 1 ||
       frame.rgba.size() != static_cast<std::size_t>(frame.width) * static_cast<std::size_t>(frame.height)) {
-    return MakeError(ErrorCode::kInvalidArgument, base::InFile(path_),
-                     "expected a frame with pixels, found " + std::to_string(frame.width) + "x" +
-                         std::to_string(frame.height));
+    return base::InvalidArgument(base::InFile(path_), "expected a frame with pixels, found " +
+                                                          std::to_string(frame.width) + "x" +
+                                                          std::to_string(frame.height));
   }
   // A frame of another size is cropped (its right and bottom edges) or padded
   // with black: an odd render size gives an even video one pixel smaller.

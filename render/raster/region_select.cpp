@@ -11,10 +11,6 @@
 namespace render {
 namespace {
 
-base::Error RegionError(std::string message) {
-  return base::MakeError(base::ErrorCode::kInvalidArgument, {}, std::move(message));
-}
-
 }  // namespace
 
 base::Result<std::vector<int>> SelectScreenRegion(const Camera& camera,
@@ -24,17 +20,18 @@ base::Result<std::vector<int>> SelectScreenRegion(const Camera& camera,
                                                   const ScreenRegionQuery& q) {
   const glm::vec4 r = q.rect;
   if (!(r.x >= 0.0f && r.z <= 1.0f && r.y >= 0.0f && r.w <= 1.0f && r.x < r.z && r.y < r.w)) {
-    return RegionError("screen region: expected a rectangle x0 < x1, y0 < y1 within [0,1]");
+    return base::InvalidArgument(
+        "screen region: expected a rectangle x0 < x1, y0 < y1 within [0,1]");
   }
   if (q.width < 16 || q.height < 16 || q.width > 4096 || q.height > 4096) {
-    return RegionError("screen region: depth image size must be 16..4096");
+    return base::InvalidArgument("screen region: depth image size must be 16..4096");
   }
   if (!normals.empty() && normals.size() != positions.size()) {
-    return RegionError("screen region: normals are not #V");
+    return base::InvalidArgument("screen region: normals are not #V");
   }
   for (const glm::uvec3& t : triangles) {
     if (t.x >= positions.size() || t.y >= positions.size() || t.z >= positions.size()) {
-      return RegionError("screen region: a triangle index is past #V");
+      return base::InvalidArgument("screen region: a triangle index is past #V");
     }
   }
   std::vector<glm::vec3> own_normals;
@@ -53,7 +50,8 @@ base::Result<std::vector<int>> SelectScreenRegion(const Camera& camera,
   settings.write_depth = true;
   const SceneMesh mesh{.positions = positions, .normals = normals, .triangles = triangles};
   const Image depth = Render(camera, {&mesh, 1}, {}, settings);
-  if (depth.depth.empty()) return RegionError("screen region: the camera or mesh was refused");
+  if (depth.depth.empty())
+    return base::InvalidArgument("screen region: the camera or mesh was refused");
 
   const glm::mat4 clip_from_world = camera.ClipFromWorld();
   const glm::vec3 forward = camera.Forward();
