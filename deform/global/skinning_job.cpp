@@ -13,7 +13,7 @@
 #if defined(__GNUC__) && defined(__x86_64__) && !defined(PATCHSKIN_NO_AVX_SKINNING)
 #include <immintrin.h>
 
-#include "deform/internal/cpu_features.h"
+#include "deform/simd.h"
 #define PATCHSKIN_SKINNING_AVX 1
 #endif
 #endif
@@ -174,9 +174,9 @@ void SkinSpan(const SkinningJob& job) {
 #endif
 
 template <int kN>
-void SkinDispatchNormals(const SkinningJob& job, [[maybe_unused]] bool allow_avx) {
+void SkinDispatchNormals(const SkinningJob& job) {
 #if defined(PATCHSKIN_SKINNING_AVX)
-  if (allow_avx && internal::CpuHasAvx()) {
+  if (UseAvx()) {
     if (job.rest_normals.empty()) {
       SkinSpanAvx<kN, false>(job);
     } else {
@@ -196,7 +196,7 @@ void SkinDispatchNormals(const SkinningJob& job, [[maybe_unused]] bool allow_avx
 
 const char* SkinningSimdPath() {
 #if defined(PATCHSKIN_SKINNING_AVX)
-  if (internal::CpuHasAvx()) return "avx";
+  if (UseAvx()) return "avx";
 #endif
 #if defined(PATCHSKIN_SKINNING_SSE2)
   return "sse2";
@@ -232,22 +232,18 @@ JobStatus SkinningJob::Validate() const {
   return base::kJobOk;
 }
 
-JobStatus SkinningJob::Run() const { return RunImpl(true); }
-
-JobStatus SkinningJob::RunWithoutAvx() const { return RunImpl(false); }
-
-JobStatus SkinningJob::RunImpl(bool allow_avx) const {
+JobStatus SkinningJob::Run() const {
   const JobStatus status = Validate();
   if (!status.ok() || rest_positions.empty()) return status;
   switch (influences) {
-    case 1: SkinDispatchNormals<1>(*this, allow_avx); break;
-    case 2: SkinDispatchNormals<2>(*this, allow_avx); break;
-    case 3: SkinDispatchNormals<3>(*this, allow_avx); break;
-    case 4: SkinDispatchNormals<4>(*this, allow_avx); break;
-    case 5: SkinDispatchNormals<5>(*this, allow_avx); break;
-    case 6: SkinDispatchNormals<6>(*this, allow_avx); break;
-    case 7: SkinDispatchNormals<7>(*this, allow_avx); break;
-    default: SkinDispatchNormals<8>(*this, allow_avx); break;
+    case 1: SkinDispatchNormals<1>(*this); break;
+    case 2: SkinDispatchNormals<2>(*this); break;
+    case 3: SkinDispatchNormals<3>(*this); break;
+    case 4: SkinDispatchNormals<4>(*this); break;
+    case 5: SkinDispatchNormals<5>(*this); break;
+    case 6: SkinDispatchNormals<6>(*this); break;
+    case 7: SkinDispatchNormals<7>(*this); break;
+    default: SkinDispatchNormals<8>(*this); break;
   }
   return base::kJobOk;
 }

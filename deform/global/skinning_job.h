@@ -16,8 +16,9 @@
 //
 // On x86-64 the inner loop uses SSE2 (part of the x86-64 baseline, so the
 // default build stays portable), and AVX for the matrix blend when the CPU
-// reports it at run time (a function compiled with target("avx"), bit-identical
-// to the SSE2 path; -DPATCHSKIN_NO_AVX_SKINNING removes it). Elsewhere, or with
+// reports it at run time and deform/simd.h's cap allows it (a function compiled
+// with target("avx"), bit-identical to the SSE2 path; -DPATCHSKIN_NO_AVX_SKINNING
+// removes it). Elsewhere, or with
 // the CMake option PATCHSKIN_SKINNING_SIMD=OFF, a scalar loop with the same
 // order of operations runs. Never -march=native, never FMA
 // (the project builds with -ffp-contract=off), so results match across paths.
@@ -60,15 +61,10 @@ struct SkinningJob {
   // Validate(), then skin every vertex. Never allocates; thread-safe for
   // disjoint outputs.
   [[nodiscard]] base::JobStatus Run() const;
-  // Run() without the AVX path (SSE2 or scalar only), so tests and benchmarks
-  // can compare the paths; the output bits are the same.
-  [[nodiscard]] base::JobStatus RunWithoutAvx() const;
-
- private:
-  [[nodiscard]] base::JobStatus RunImpl(bool allow_avx) const;
 };
 
-// The instruction set SkinningJob uses on this machine: "avx", "sse2" or "scalar".
+// The instruction set SkinningJob uses on this machine under the current
+// SetSimdCap (deform/simd.h): "avx", "sse2" or "scalar".
 const char* SkinningSimdPath();
 
 // Fills the #S skinning palette of `mesh`: model_from_bind[s] =
