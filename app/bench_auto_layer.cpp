@@ -8,6 +8,7 @@
 #include "app/character.h"
 #include "deform/pipeline/frame_pipeline.h"
 #include "app/rig_setup.h"
+#include "deform/patch/patch_binding.h"
 
 namespace app::bench {
 namespace {
@@ -36,6 +37,7 @@ void AddAutoLayerRows(const Budget& b, int frames, std::vector<Row>& rows, bool*
                 " joints), generated body"};
   std::optional<deform::FramePipeline> layered;
   std::size_t patches = 0;
+  Rig rig;
   for (int r = 0; r < b.runs; ++r) {
     const double t0 = Now(Clock::kCpu);
     base::Result<AutoRig> made = BuildAutoRig(ch, "generated", "demo_walk.bvh", "demo");
@@ -48,6 +50,7 @@ void AddAutoLayerRows(const Budget& b, int frames, std::vector<Row>& rows, bool*
     }
     setup.runs.push_back(Now(Clock::kCpu) - t0);
     patches = made->rig.patches.size();
+    rig = made->rig;
     layered.emplace(std::move(*p));
   }
   if (!layered) return;
@@ -72,6 +75,33 @@ void AddAutoLayerRows(const Budget& b, int frames, std::vector<Row>& rows, bool*
                "end-to-end frame with --layer auto's " + std::to_string(patches) +
                    " patches vs ssd alone, 1280x720 2x2, PNG, 1 thread, " +
                    std::to_string(frames) + " frames each"};
+  // The same patches' rebuilds on their own: the layer runs PatchRebuildJob
+  // twice per patch and frame (the displaced grid and the reference grid);
+  // its cost does not depend on where the control points are.
+  base::Result<RigLayers> layers = BuildRigLayers(rig, ch);
+  if (!layers.ok()) return void(ReportAutoLayer(layers.error(), failed));
+  std::vector<std::vector<glm::vec3>> rebuilt;
+  std::size_t bound = 0;
+  for (const deform::PatchSetup& p : layers->patches) {
+    rebuilt.emplace_back(p.bound.binding.size());
+    bound += p.bound.binding.size();
+  }
+  const auto time_rebuilds = [&] {
+    const double t0 = Now(Clock::kCpu);
+    for (int f = 0; f < 2 * frames; ++f) {
+      for (std::size_t k = 0; k < layers->patches.size(); ++k) {
+        const deform::PatchSetup& p = layers->patches[k];
+        *failed |= !deform::PatchRebuildJob{.control = p.rest_control,
+                                            .bindings = p.bound.binding.view(),
+                                            .positions = rebuilt[k]}
+                        .Run();
+      }
+    }
+    return Now(Clock::kCpu) - t0;
+  };
+  const std::string rebuild_note = "those patches' rebuilds (" + std::to_string(bound) +
+                                   " bound vertices, 2 per patch and frame) / the layered frame";
+  Row rebuild{"auto_layer_rebuild_share", "%", Clock::kCpu, {}, 1.0, "limit", rebuild_note};
   double base_s = 0.0, layer_s = 0.0;
   for (int r = 0; r < b.runs && !*failed; ++r) {
     const double base = time_frames(*global);
@@ -79,6 +109,7 @@ void AddAutoLayerRows(const Budget& b, int frames, std::vector<Row>& rows, bool*
     base_s += base;
     layer_s += with;
     overhead.runs.push_back(100.0 * (with / base - 1.0));
+    rebuild.runs.push_back(100.0 * time_rebuilds() / with);
   }
   if (base_s > 0.0 && layer_s > 0.0) {
     char note[96];
@@ -88,6 +119,7 @@ void AddAutoLayerRows(const Budget& b, int frames, std::vector<Row>& rows, bool*
   }
   rows.push_back(std::move(setup));
   rows.push_back(std::move(overhead));
+  rows.push_back(std::move(rebuild));
 }
 
 }  // namespace app::bench
