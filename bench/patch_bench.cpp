@@ -11,6 +11,7 @@
 
 #include "deform/patch/patch_binding.h"
 #include "deform/patch/patch_fit.h"
+#include "deform/simd.h"
 #include "support/patch_meshes.h"
 
 namespace {
@@ -68,12 +69,15 @@ void RebuildBench(benchmark::State& state, bool normals, bool simd) {
   std::vector<glm::vec3> control = deform::ControlPointsAsFloat(p.surface);
   for (glm::vec3& q : control) q *= 1.01f;  // a deformed frame
   std::vector<glm::vec3> pos(p.binding.size()), nrm(normals ? p.binding.size() : 0);
-  const deform::PatchRebuildJob job{.control = control, .bindings = p.binding.view(),
-                                    .allow_simd = simd, .positions = pos, .normals = nrm};
+  const deform::PatchRebuildJob job{
+      .control = control, .bindings = p.binding.view(), .positions = pos, .normals = nrm};
+  // simd = false: the scalar loop, the process capped to the baseline (deform/simd.h).
+  deform::SetSimdCap(simd ? deform::SimdLevel::kAvx : deform::SimdLevel::kBaseline);
   for (auto _ : state) {
     benchmark::DoNotOptimize(job.Run());
     benchmark::ClobberMemory();
   }
+  deform::SetSimdCap(deform::SimdLevel::kAvx);
   state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(p.binding.size()));
   state.counters["bytes_per_vertex"] = deform::PatchBinding::kStoredBytesPerVertex;
   state.counters["rebuild_bytes_per_vertex"] = deform::PatchBinding::kRebuildBytesPerVertex;

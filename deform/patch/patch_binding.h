@@ -156,8 +156,7 @@ std::vector<glm::vec3> ControlPointsAsFloat(const BSplineSurface& surface);
 struct PatchRebuildJob {
   // Inputs.
   std::span<const glm::vec3> control{};  // #M x #N control points Q (row-major, model space)
-  PatchBindingView bindings{};         // #B records (any slice of a PatchBinding)
-  bool allow_simd = true;              // false forces the scalar path (same results)
+  PatchBindingView bindings{};           // #B records (any slice of a PatchBinding)
   // Outputs.
   std::span<glm::vec3> positions{};    // #B rebuilt positions (model space)
   std::span<glm::vec3> normals{};      // #B patch normals, or empty

@@ -13,7 +13,7 @@
 
 #include <immintrin.h>
 
-#include "deform/internal/cpu_features.h"
+#include "deform/simd.h"
 #include "deform/patch/patch_binding.h"
 
 // The 8-lane helpers pass vectors by value, but all of them are internal and
@@ -225,7 +225,7 @@ base::JobStatus PatchRebuildJob::Validate() const {
 base::JobStatus PatchRebuildJob::Run() const {
   if (const base::JobStatus st = Validate(); !st) return st;
   const size_t n = bindings.size();
-  const bool simd = allow_simd && internal::CpuHasAvx();
+  const bool simd = UseAvx();  // deform/simd.h: the CPU has it and the cap allows it
   const std::uint16_t* first = bindings.first.data();
   size_t i = 0;
   while (i < n) {

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "deform/patch/patch_fit.h"
+#include "deform/simd.h"
 #include "support/patch_meshes.h"
 #include "support/tolerances.h"
 
@@ -53,11 +54,15 @@ std::vector<glm::vec3> Rebuild(const deform::PatchBinding& b, std::span<const gl
                                std::vector<glm::vec3>* normals = nullptr, bool simd = true) {
   std::vector<glm::vec3> out(b.size());
   if (normals != nullptr) normals->resize(b.size());
-  const PatchRebuildJob job{.control = control, .bindings = b.view(), .allow_simd = simd,
-                            .positions = out,
-                            .normals = normals != nullptr ? std::span<glm::vec3>(*normals)
-                                                          : std::span<glm::vec3>()};
+  const PatchRebuildJob job{
+      .control = control,
+      .bindings = b.view(),
+      .positions = out,
+      .normals = normals != nullptr ? std::span<glm::vec3>(*normals) : std::span<glm::vec3>()};
+  // simd = false: the process capped to the baseline, so the scalar loop runs.
+  deform::SetSimdCap(simd ? deform::SimdLevel::kAvx : deform::SimdLevel::kBaseline);
   EXPECT_TRUE(job.Run().ok());
+  deform::SetSimdCap(deform::SimdLevel::kAvx);
   return out;
 }
 
