@@ -117,13 +117,6 @@ TEST(ElasticPipeline, FramesDependOnTimeAloneWhateverTheOrderRangeOrThreads) {
   }
 }
 
-fs::path Dir(const std::string& name) {
-  const fs::path d = testsupport::TestOutputPath("elastic_pipeline/" + name + "/x").parent_path();
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
-
 std::vector<std::string> RenderArgs(const fs::path& rig, const fs::path& out,
                                     const std::string& frames, const std::string& threads) {
   return {"render", rig.string(), "--frames", frames, "--threads", threads, "--supersample", "1",
@@ -131,7 +124,7 @@ std::vector<std::string> RenderArgs(const fs::path& rig, const fs::path& out,
 }
 
 TEST(ElasticPipeline, ChunkedRenderGivesTheSameBytesAsTheWholeRange) {
-  const fs::path d = Dir("chunked");
+  const fs::path d = testsupport::FreshOutputDir("elastic_pipeline/chunked");
   const fs::path rig = SampleDataPath("belly_jump.json");
   for (const auto& [name, frames, threads] :
        {std::tuple{"whole", "0:19", "1"}, std::tuple{"chunk", "10:19", "1"},
@@ -239,7 +232,7 @@ TEST(ElasticPipeline, AGlitchyCaptureIsLimitedAndReported) {
   EXPECT_GT(l.layered->elastic_report().at(0).counters.acceleration_clamps, 0);
 
   // The command says so on stderr (and still renders).
-  const fs::path d = Dir("glitch");
+  const fs::path d = testsupport::FreshOutputDir("elastic_pipeline/glitch");
   auto source = app::LoadMotionSource(jump, {});
   ASSERT_TRUE(source.ok());
   AddGlitch(source->motion, source->skeleton);
