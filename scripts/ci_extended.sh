@@ -4,7 +4,7 @@
 # both the whole test suite and the fuzz targets, so the code is compiled once
 # for both. Then the suite under the sanitizers (scripts/test_sanitized.sh; the
 # tests that only time, measure peak memory or start a cluster run in the
-# Release suite only) and 20 s of fuzzing per parser with a
+# Release suite only) and 10 s of fuzzing per parser with a
 # seed taken from the commit (scripts/fuzz.sh), so every commit tries new inputs.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -14,4 +14,4 @@ export PATCHSKIN_SANITIZER_SETUP_DONE=1
 bash scripts/test_sanitized.sh
 seed=$((16#$(git rev-parse --short=7 HEAD 2>/dev/null || echo 1)))
 phase "fuzzing" env FUZZ_BUILD=build/asan FUZZ_SEED="${FUZZ_SEED:-$seed}" \
-  bash scripts/fuzz.sh "${FUZZ_SECONDS:-20}"
+  bash scripts/fuzz.sh "${FUZZ_SECONDS:-10}"

@@ -11,7 +11,10 @@
 # So do the two sweeps of every capture in ../shared/data (CapturePose.
 # FollowCameraKeepsEveryRealCapture*, GeneratedBodyOfCaptures.*: a minute and a
 # half of CPU under ASan), which check framing and body geometry; the same
-# loaders, bodies and cameras run sanitized on real files in other tests.
+# loaders, bodies and cameras run sanitized on real files in other tests. And two
+# byte-equality checks of whole renders (ElasticPipeline.ChunkedRenderGivesTheSame
+# Bytes*, AutoRig.RigRecordsTheUpAxis*: 30 s of CPU under ASan) whose render
+# paths ChunkedRender.* and AutoRig.RigFileRenders* run sanitized.
 #
 # Any report fails the run: ASan aborts on the first error, UBSan halts
 # (-fno-sanitize-recover), and a child `patchskin` the app tests start inherits
