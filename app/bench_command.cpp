@@ -46,7 +46,6 @@
 #include "render/output/async_writer.h"
 #include "render/output/contact_sheet.h"
 #include "render/output/serial_task_queue.h"
-#include "render/output/stored_image.h"
 #include "render/output/video_writer.h"
 #include "render/output/image_io.h"
 
@@ -431,12 +430,12 @@ int RunBench(const BenchOptions& o) {
     e2e_cpu.runs.push_back(e2e_frames / std::max(Now(Clock::kProcess) - c0, 1e-9));
   }
   // The default render's outputs (PNG frames, H.264 preview, contact sheet),
-  // wired as the render command wires them: PNGs on the async writer's two
-  // workers, video and sheet in frame order on a side thread. `next(i, img)`
-  // fills frame i: either rendered now, or copied from frames rendered before
-  // (encode only). Returns the wall-clock seconds, or < 0 on a failure.
+  // wired as the render command wires them: each frame sRGB-encoded once, the
+  // PNGs on the async writer's two workers, video and sheet in frame order on
+  // a side thread. `next(i)` gives frame i: either rendered now, or one rendered
+  // before (encode only). Returns the wall-clock seconds, or < 0 on a failure.
   const int out_frames = o.quick ? 4 : 12;
-  const auto run_outputs = [&](const std::function<base::Status(int, render::Image&)>& next) {
+  const auto run_outputs = [&](const std::function<const render::Image*(int)>& next) {
     const double t0 = Now(Clock::kWall);
     render::AsyncImageWriter writer({.num_workers = 2, .max_in_flight = 4});
     auto sheet = render::ContactSheetBuilder::Create(
@@ -444,22 +443,18 @@ int RunBench(const BenchOptions& o) {
     auto video = render::VideoWriter::Open((out_dir / "preview.mp4").string(), 1280, 720, {.fps = 30.0});
     if (!sheet.ok() || !video.ok()) return -1.0;
     render::SerialTaskQueue side({.max_queued = 2});
-    render::Image img;
     for (int i = 0; i < out_frames; ++i) {
-      base::Status s = next(i, img);
+      const render::Image* img = next(i);
+      if (img == nullptr) return -1.0;
+      auto bytes = std::make_shared<render::Srgb8Image>();
+      render::EncodeSrgb8(*img, bytes.get());
       char name[32];
       std::snprintf(name, sizeof(name), "frame_%04d.png", i);
-      if (s.ok()) s = writer.Submit(img, (out_dir / name).string(), png);
-      if (s.ok()) {
-        auto copy = std::make_shared<const render::Image>(img);
-        s = side.Submit([&, i, copy] {
-          const base::Result<render::Image> stored =
-              render::AsStored(*copy, render::ImageFormat::kPng, png);
-          if (!stored.ok()) return base::Status(stored.error());
-          if (base::Status st = (*sheet)->Add(*stored, i); !st.ok()) return st;
-          return (*video)->AddFrame(*copy);
-        });
-      }
+      base::Status s = side.Submit([&, i, bytes] {
+        if (base::Status st = (*sheet)->Add(render::DecodeSrgb8(*bytes), i); !st.ok()) return st;
+        return (*video)->AddFrame(*bytes);
+      });
+      if (s.ok()) s = writer.Submit(std::move(bytes), (out_dir / name).string(), png);
       if (!s.ok()) return -1.0;
     }
     if (!side.Finish().ok() || !writer.Finish().ok() || !(*video)->Close().ok()) return -1.0;
@@ -467,26 +462,29 @@ int RunBench(const BenchOptions& o) {
       return -1.0;
     return Now(Clock::kWall) - t0;
   };
+  render::Image drawn;
   const auto render_frame = [&](render::AntiAlias aa) {
-    return [&, aa](int i, render::Image& img) {
+    return [&, aa](int i) -> const render::Image* {
       const OutputFrame& of = plan->frames[static_cast<std::size_t>(i % e2e_frames)];
-      base::Status s = pipeline->Evaluate(of.time_s, frame);
-      if (!s.ok()) return s;
+      if (!pipeline->Evaluate(of.time_s, frame).ok()) return nullptr;
       render::RenderSettings settings = e2e_settings;
       settings.antialias = aa;
       FrameDrawOptions draw;
       draw.frame_number = of.number;
-      return DrawCharacterFrame(ch, frame, nullptr, cameras->At(of.camera), settings, draw,
-                                renderer, right_renderer, scratch, img);
+      const base::Status s =
+          DrawCharacterFrame(ch, frame, nullptr, cameras->At(of.camera), settings, draw, renderer,
+                             right_renderer, scratch, drawn);
+      return s.ok() ? &drawn : nullptr;
     };
   };
   std::vector<render::Image> rendered(static_cast<std::size_t>(out_frames));
   for (int i = 0; i < out_frames; ++i) {
-    if (base::Status s =
-            render_frame(render::AntiAlias::kSupersample)(i, rendered[static_cast<std::size_t>(i)]);
-        !s.ok()) {
-      return ReportError(s.error());
+    const render::Image* img = render_frame(render::AntiAlias::kSupersample)(i);
+    if (img == nullptr) {
+      return ReportError(base::MakeError(base::ErrorCode::kInternal, {"bench", 0, 0, {}},
+                                         "a default-render frame failed"));
     }
+    rendered[static_cast<std::size_t>(i)] = *img;
   }
   const std::string outputs_note = std::to_string(out_frames) + " demo frames, 1280x720, PNG level 1 + H.264 + sheet, " +
                                    std::to_string(threads) + " threads";
@@ -499,10 +497,8 @@ int RunBench(const BenchOptions& o) {
   Row bound_row{"encode_bound_ratio", "ratio", Clock::kWall, {}, 0.0, "",
                 "default render time / encode-only time, each repetition's pair (goal <= 1.3)"};
   for (int r = 0; r < (o.quick ? 1 : 5); ++r) {
-    const double t_encode = run_outputs([&](int i, render::Image& img) {
-      img = rendered[static_cast<std::size_t>(i)];
-      return base::Status::Ok();
-    });
+    const double t_encode =
+        run_outputs([&](int i) { return &rendered[static_cast<std::size_t>(i)]; });
     const double t_ssaa = run_outputs(render_frame(render::AntiAlias::kSupersample));
     const double t_msaa = run_outputs(render_frame(render::AntiAlias::kMultisample));
     if (t_encode <= 0.0 || t_ssaa <= 0.0 || t_msaa <= 0.0) {

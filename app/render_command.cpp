@@ -548,12 +548,32 @@ struct RenderOutputs {
   // before the members its tasks use go.
   render::SerialTaskQueue side{{.max_queued = 2}};
 
-  // Output frame i (file number `number`) to the sheet and the video, on the side queue.
+  // True when the frame files store 8-bit sRGB exactly (PNG, 8-bit TIFF): a
+  // frame is then encoded once, and its bytes feed the file, the sheet and
+  // the video, which would otherwise each convert it again.
+  bool EncodesOnce() const {
+    return frame_format == render::ImageFormat::kPng ||
+           (frame_format == render::ImageFormat::kTiff && write_options.tiff_bits == 8);
+  }
+
+  // Output frame i (file number `number`) to the sheet and the video, on the
+  // side queue: its linear values, or the bytes of its 8-bit file.
   base::Status Feed(std::size_t i, int number, std::shared_ptr<const render::Image> img,
                     bool read_back) {
     if (!sheet && !video) return base::Status::Ok();
     return side.Submit([this, i, number, img = std::move(img), read_back] {
       return FeedSheetAndVideo(i, number, *img, read_back);
+    });
+  }
+  base::Status Feed(std::size_t i, int number, std::shared_ptr<const render::Srgb8Image> bytes) {
+    if (!sheet && !video) return base::Status::Ok();
+    return side.Submit([this, i, number, bytes = std::move(bytes)] {
+      if (IsSheetFrame(i)) {
+        // The bytes decoded are what a read back file gives (AsStored).
+        if (base::Status st = sheet->Add(render::DecodeSrgb8(*bytes), number); !st.ok()) return st;
+        ++next_sheet;
+      }
+      return video ? video->AddFrame(*bytes) : base::Status::Ok();
     });
   }
 
@@ -572,11 +592,16 @@ struct RenderOutputs {
   // The sheet gets every frame as its file will read back (render/output/stored_image.h),
   // so a --resume that rebuilds it from finished frames on disk gives the same
   // bytes; formats whose round trip is not modelled (JPEG) use the frame as is.
+  bool IsSheetFrame(std::size_t i) const {
+    return sheet && next_sheet < sheet_count &&
+           static_cast<std::int64_t>(i) ==
+               render::ContactSheetPick(next_sheet, sheet_count,
+                                        static_cast<std::int64_t>(num_frames));
+  }
+
   base::Status FeedSheetAndVideo(std::size_t i, int number, const render::Image& img,
                                  bool read_back) {
-    if (sheet && next_sheet < sheet_count &&
-        static_cast<std::int64_t>(i) ==
-            render::ContactSheetPick(next_sheet, sheet_count, static_cast<std::int64_t>(num_frames))) {
+    if (IsSheetFrame(i)) {
       const render::Image* thumb_source = &img;
       base::Result<render::Image> stored = render::Image();
       if (!read_back && frame_format) {
@@ -704,18 +729,26 @@ base::Status RenderOutputFrame(std::size_t i, RenderScene& scene, const OutputGu
                          camera, out.settings, RenderFrameDraw(scene, of, *bar_scale), out.renderer,
                          out.right_renderer, out.right_image, out.image);
   if (!s.ok()) return s;
-  s = out.Feed(i, of.number, std::make_shared<const render::Image>(out.image),
-               /*read_back=*/false);
-  if (!s.ok()) return s;
   const base::Result<std::string> path = render::ExpandFramePattern(out.pattern, of.number);
   if (!path.ok()) return path.error();
   out.write_options.frame = of.number;
-  // The frame moves to the writer; the next one renders into the buffers
-  // of one already written (when there is one), so no frame-sized buffer is
-  // copied, allocated or first touched per frame.
-  s = out.writer.Submit(std::move(out.image), *path, out.write_options);
+  if (out.EncodesOnce()) {
+    // One sRGB encoding feeds all three outputs; the next frame renders into
+    // the same linear buffers.
+    auto bytes = std::make_shared<render::Srgb8Image>();
+    render::EncodeSrgb8(out.image, bytes.get());
+    s = out.Feed(i, of.number, bytes);
+    if (s.ok()) s = out.writer.Submit(std::move(bytes), *path, out.write_options);
+  } else {
+    s = out.Feed(i, of.number, std::make_shared<const render::Image>(out.image),
+                 /*read_back=*/false);
+    // The frame moves to the writer; the next one renders into the buffers
+    // of one already written (when there is one), so no frame-sized buffer is
+    // copied, allocated or first touched per frame.
+    if (s.ok()) s = out.writer.Submit(std::move(out.image), *path, out.write_options);
+    if (s.ok()) out.image = out.writer.TakeSpareImage();
+  }
   if (!s.ok()) return s;
-  out.image = out.writer.TakeSpareImage();
   ++tally.frames_done;
   if (tally.first_frame_s < 0.0) {
     tally.first_frame_s =

@@ -5,6 +5,7 @@
 // Optional depth holds camera-space distance along the view axis (+inf = empty).
 
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -27,6 +28,16 @@ struct Image {
   }
   glm::vec4& at(int x, int y) { return rgba[index(x, y)]; }
   const glm::vec4& at(int x, int y) const { return rgba[index(x, y)]; }
+};
+
+// A frame as 8-bit files store it: sRGB-encoded colour and straight alpha,
+// 4 bytes per pixel (R, G, B, A), row 0 at the top. Made once per frame by
+// render::EncodeSrgb8 (render/output/image_io.h) and shared by the frame file,
+// the preview video and the contact sheet, which would each convert it again.
+struct Srgb8Image {
+  int width = 0;
+  int height = 0;
+  std::vector<std::uint8_t> rgba;  // 4 * width * height bytes
 };
 
 }  // namespace render

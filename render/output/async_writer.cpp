@@ -15,13 +15,33 @@ AsyncImageWriter::AsyncImageWriter(AsyncWriterOptions options) : options_(option
 AsyncImageWriter::~AsyncImageWriter() { (void)Finish(); }
 
 Status AsyncImageWriter::Submit(Image image, std::string path, WriteOptions options) {
+  Job job;
+  job.image = std::move(image);
+  job.path = std::move(path);
+  job.options = std::move(options);
+  return Queue(std::move(job));
+}
+
+Status AsyncImageWriter::Submit(std::shared_ptr<const Srgb8Image> image, std::string path,
+                                WriteOptions options) {
+  if (image == nullptr) return base::InvalidArgument(base::InFile(path), "no frame to write");
+  Job job;
+  job.encoded = std::move(image);
+  job.path = std::move(path);
+  job.options = std::move(options);
+  return Queue(std::move(job));
+}
+
+Status AsyncImageWriter::Queue(Job job) {
   std::unique_lock<std::mutex> lock(mutex_);
   if (finished_) {
-    return base::InvalidArgument(base::InFile(path), "frame submitted after the writer finished");
+    return base::InvalidArgument(base::InFile(job.path),
+                                 "frame submitted after the writer finished");
   }
   slot_free_.wait(lock, [&] { return in_flight_ < options_.max_in_flight || first_error_; });
   if (first_error_) return *first_error_;
-  queue_.push_back(Job{std::move(image), std::move(path), std::move(options), next_sequence_++});
+  job.sequence = next_sequence_++;
+  queue_.push_back(std::move(job));
   ++in_flight_;
   peak_in_flight_ = std::max(peak_in_flight_, in_flight_);
   work_ready_.notify_one();
@@ -73,13 +93,15 @@ void AsyncImageWriter::WorkerLoop() {
       job = std::move(queue_.front());
       queue_.pop_front();
     }
-    const Status status = WriteImage(job.image, job.path, job.options);
+    const Status status = job.encoded ? WriteImage(*job.encoded, job.path, job.options)
+                                      : WriteImage(job.image, job.path, job.options);
     std::lock_guard<std::mutex> lock(mutex_);
     // Keep the buffers for TakeSpareImage, or release them before signalling a free slot.
-    if (static_cast<int>(spares_.size()) < options_.max_in_flight && !stopping_) {
+    if (!job.encoded && static_cast<int>(spares_.size()) < options_.max_in_flight && !stopping_) {
       spares_.push_back(std::move(job.image));
     }
     job.image = Image();
+    job.encoded.reset();
     if (status) {
       ++frames_written_;
     } else if (!first_error_ || job.sequence < first_error_sequence_) {

@@ -20,6 +20,7 @@
 #include <condition_variable>
 #include <cstdint>
 #include <deque>
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <string>
@@ -47,6 +48,10 @@ class AsyncImageWriter {
   // max_in_flight frames are pending. Returns the first error of any earlier frame,
   // after which nothing more is queued; also an error after Finish.
   [[nodiscard]] Status Submit(Image image, std::string path, WriteOptions options = {});
+  // The same for a frame already sRGB-encoded (8-bit formats only; see
+  // WriteImage), shared with its other consumers (the video, the sheet).
+  [[nodiscard]] Status Submit(std::shared_ptr<const Srgb8Image> image, std::string path,
+                              WriteOptions options = {});
 
   // Waits for every queued frame, stops the workers and returns the first error
   // (or Ok). Calling it again returns the same status.
@@ -65,11 +70,13 @@ class AsyncImageWriter {
 
  private:
   struct Job {
-    Image image;
+    Image image;                                // written when `encoded` is null
+    std::shared_ptr<const Srgb8Image> encoded;  // or these bytes
     std::string path;
     WriteOptions options;
     std::int64_t sequence = 0;  // submission order
   };
+  Status Queue(Job job);  // Submit's common part
   void WorkerLoop();
 
   AsyncWriterOptions options_;

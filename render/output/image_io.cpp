@@ -36,6 +36,7 @@ struct Srgb8Tables {
   std::array<float, 255> threshold{};
   std::array<std::uint8_t, kBuckets + 1> bucket_start{};
   std::array<float, 256> to_linear{};
+  std::array<float, 256> alpha_to_float{};  // as OpenImageIO reads an 8-bit alpha code
 
   Srgb8Tables() {
     auto decode = [](double c) {
@@ -46,6 +47,9 @@ struct Srgb8Tables {
     }
     for (int c = 0; c < 256; ++c) {
       to_linear[static_cast<std::size_t>(c)] = static_cast<float>(decode(c / 255.0));
+      const auto code = static_cast<std::uint8_t>(c);
+      OIIO::convert_pixel_values(OIIO::TypeDesc::UINT8, &code, OIIO::TypeDesc::FLOAT,
+                                 &alpha_to_float[static_cast<std::size_t>(c)], 1);
     }
     int code = 0;
     for (int b = 0; b <= kBuckets; ++b) {
@@ -106,6 +110,7 @@ struct Encoded {
   std::vector<float> floats;           // EXR (converted to half by the writer)
   const void* data = nullptr;
   OIIO::TypeDesc data_type;
+  OIIO::stride_t xstride = OIIO::AutoStride;  // bytes between pixels in data
 };
 
 // LinearToSrgb8 with the tables passed in (no static-guard check per call).
@@ -151,6 +156,38 @@ void EncodeSrgb8(const Image& image, int channels, std::vector<std::uint8_t>* ou
   } else {
     encode(std::integral_constant<int, 3>());
   }
+}
+
+// The format's compression settings and the metadata every frame file carries.
+void SetFileAttributes(ImageFormat format, const WriteOptions& o, OIIO::ImageSpec& spec) {
+  if (format == ImageFormat::kPng) {
+    spec.attribute("png:compressionLevel", o.png_compression);
+    spec.attribute("png:filter", static_cast<int>(o.png_filter));
+    spec.attribute("compression", "zip:" + std::to_string(std::max(o.png_compression, 1)));
+  } else if (format == ImageFormat::kJpeg) {
+    spec.attribute("compression", "jpeg:" + std::to_string(o.jpeg_quality));
+    spec.attribute("CompressionQuality", o.jpeg_quality);
+  } else if (format == ImageFormat::kTiff) {
+    spec.attribute("compression", "zip");
+  }
+  // Our colour is straight (not premultiplied); without this the PNG and TIFF
+  // writers would divide it by alpha once more.
+  spec.attribute("oiio:UnassociatedAlpha", 1);
+  spec.attribute("Software", kSoftware);
+  // The EXR and TIFF writers stamp the current time when DateTime is unset, so
+  // the same frame written twice would differ; a fixed stamp keeps output a
+  // function of the inputs alone.
+  spec.attribute("DateTime", "1970:01:01 00:00:00");
+  // A string: PNG text chunks hold only strings, and all formats should agree.
+  if (o.frame >= 0) spec.attribute("patchskin:frame", std::to_string(o.frame));
+  if (!o.source_file.empty()) spec.attribute("patchskin:source", o.source_file);
+  // TIFF keeps only its own tags: the description carries the same facts everywhere.
+  std::string description;
+  if (o.frame >= 0) description = "frame " + std::to_string(o.frame);
+  if (!o.source_file.empty()) {
+    description += (description.empty() ? "source " : ", source ") + o.source_file;
+  }
+  if (!description.empty()) spec.attribute("ImageDescription", description);
 }
 
 Encoded Encode(const Image& image, ImageFormat format, const WriteOptions& o) {
@@ -205,34 +242,20 @@ Encoded Encode(const Image& image, ImageFormat format, const WriteOptions& o) {
       break;
     }
   }
-  if (format == ImageFormat::kPng) {
-    e.spec.attribute("png:compressionLevel", o.png_compression);
-    e.spec.attribute("png:filter", static_cast<int>(o.png_filter));
-    e.spec.attribute("compression", "zip:" + std::to_string(std::max(o.png_compression, 1)));
-  } else if (format == ImageFormat::kJpeg) {
-    e.spec.attribute("compression", "jpeg:" + std::to_string(o.jpeg_quality));
-    e.spec.attribute("CompressionQuality", o.jpeg_quality);
-  } else if (format == ImageFormat::kTiff) {
-    e.spec.attribute("compression", "zip");
-  }
-  // Our colour is straight (not premultiplied); without this the PNG and TIFF
-  // writers would divide it by alpha once more.
-  e.spec.attribute("oiio:UnassociatedAlpha", 1);
-  e.spec.attribute("Software", kSoftware);
-  // The EXR and TIFF writers stamp the current time when DateTime is unset, so
-  // the same frame written twice would differ; a fixed stamp keeps output a
-  // function of the inputs alone.
-  e.spec.attribute("DateTime", "1970:01:01 00:00:00");
-  // A string: PNG text chunks hold only strings, and all formats should agree.
-  if (o.frame >= 0) e.spec.attribute("patchskin:frame", std::to_string(o.frame));
-  if (!o.source_file.empty()) e.spec.attribute("patchskin:source", o.source_file);
-  // TIFF keeps only its own tags: the description carries the same facts everywhere.
-  std::string description;
-  if (o.frame >= 0) description = "frame " + std::to_string(o.frame);
-  if (!o.source_file.empty()) {
-    description += (description.empty() ? "source " : ", source ") + o.source_file;
-  }
-  if (!description.empty()) e.spec.attribute("ImageDescription", description);
+  SetFileAttributes(format, o, e.spec);
+  return e;
+}
+
+// The file's samples straight from bytes EncodeSrgb8 made (JPEG skips alpha).
+Encoded Encode(const Srgb8Image& image, ImageFormat format, const WriteOptions& o) {
+  Encoded e;
+  e.spec = OIIO::ImageSpec(image.width, image.height, format == ImageFormat::kJpeg ? 3 : 4,
+                           OIIO::TypeDesc::UINT8);
+  e.data = image.rgba.data();
+  e.data_type = OIIO::TypeDesc::UINT8;
+  e.xstride = 4;
+  e.spec.attribute("oiio:ColorSpace", "sRGB");
+  SetFileAttributes(format, o, e.spec);
   return e;
 }
 
@@ -293,18 +316,14 @@ std::uint8_t LinearToSrgb8(float linear) { return ToSrgb8(Tables(), linear); }
 
 float Srgb8ToLinear(std::uint8_t code) { return Tables().to_linear[code]; }
 
-Status WriteImage(const Image& image, const std::string& path, const WriteOptions& options) {
-  if (Status s = CheckImage(image, path); !s) return s;
-  if (Status s = CheckOptions(options, path); !s) return s;
-  Result<ImageFormat> format = ImageFormatFromPath(path);
-  if (!format) return format.error();
+namespace {
 
+// Writes `encoded` to a temporary file beside `path` and renames it into place.
+Status WriteEncoded(const Encoded& encoded, ImageFormat format, const std::string& path) {
   const std::filesystem::path final_path(path);
   const std::filesystem::path temp_path = TemporaryPathFor(path);
-
-  const Encoded encoded = Encode(image, *format, options);
   // Created by format name: the temporary name's extension says nothing.
-  std::unique_ptr<OIIO::ImageOutput> out = OIIO::ImageOutput::create(OiioFormatName(*format));
+  std::unique_ptr<OIIO::ImageOutput> out = OIIO::ImageOutput::create(OiioFormatName(format));
   if (!out) return IoError(path, "OpenImageIO has no writer: " + OIIO::geterror());
   std::error_code ec;
   if (!out->open(temp_path.string(), encoded.spec)) {
@@ -312,7 +331,7 @@ Status WriteImage(const Image& image, const std::string& path, const WriteOption
     std::filesystem::remove(temp_path, ec);
     return IoError(path, "cannot create '" + temp_path.string() + "': " + why);
   }
-  const bool written = out->write_image(encoded.data_type, encoded.data);
+  const bool written = out->write_image(encoded.data_type, encoded.data, encoded.xstride);
   const bool closed = out->close();
   if (!written || !closed) {
     const std::string why = out->geterror();
@@ -326,6 +345,53 @@ Status WriteImage(const Image& image, const std::string& path, const WriteOption
     return IoError(path, "cannot rename the finished temporary file into place: " + ec.message());
   }
   return Status::Ok();
+}
+
+}  // namespace
+
+Status WriteImage(const Image& image, const std::string& path, const WriteOptions& options) {
+  if (Status s = CheckImage(image, path); !s) return s;
+  if (Status s = CheckOptions(options, path); !s) return s;
+  Result<ImageFormat> format = ImageFormatFromPath(path);
+  if (!format) return format.error();
+  return WriteEncoded(Encode(image, *format, options), *format, path);
+}
+
+Status WriteImage(const Srgb8Image& image, const std::string& path, const WriteOptions& options) {
+  const auto pixels = static_cast<std::size_t>(std::max(image.width, 0)) *
+                      static_cast<std::size_t>(std::max(image.height, 0));
+  if (image.width <= 0 || image.height <= 0 || image.rgba.size() != 4 * pixels) {
+    return base::InvalidArgument(
+        base::InFile(path), "expected 4 bytes per pixel of a non-empty " +
+                                std::to_string(image.width) + "x" + std::to_string(image.height) +
+                                " image, found " + std::to_string(image.rgba.size()) + " bytes");
+  }
+  if (Status s = CheckOptions(options, path); !s) return s;
+  Result<ImageFormat> format = ImageFormatFromPath(path);
+  if (!format) return format.error();
+  if (*format == ImageFormat::kExr || (*format == ImageFormat::kTiff && options.tiff_bits != 8)) {
+    return base::InvalidArgument(base::InFile(path),
+                                 "an 8-bit frame cannot be written as EXR or 16-bit TIFF: "
+                                 "those store the linear values");
+  }
+  return WriteEncoded(Encode(image, *format, options), *format, path);
+}
+
+void EncodeSrgb8(const Image& image, Srgb8Image* out) {
+  out->width = image.width;
+  out->height = image.height;
+  EncodeSrgb8(image, 4, &out->rgba);
+}
+
+Image DecodeSrgb8(const Srgb8Image& image) {
+  const Srgb8Tables& t = Tables();
+  Image out(image.width, image.height);
+  const std::uint8_t* p = image.rgba.data();
+  for (glm::vec4& q : out.rgba) {
+    q = {t.to_linear[p[0]], t.to_linear[p[1]], t.to_linear[p[2]], t.alpha_to_float[p[3]]};
+    p += 4;
+  }
+  return out;
 }
 
 Result<Image> ReadImage(const std::string& path, ReadInfo* info) {

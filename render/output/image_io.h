@@ -95,6 +95,21 @@ struct WriteOptions {
 [[nodiscard]] Status WriteImage(const Image& image, const std::string& path,
                                 const WriteOptions& options = {});
 
+// The bytes an 8-bit file (PNG, 8-bit TIFF, JPEG but for its alpha) stores
+// for `image`: LinearToSrgb8 of each colour channel, alpha rounded to
+// 0..255 (NaN: 0). Reuses out's buffer. Linear in the pixels.
+void EncodeSrgb8(const Image& image, Srgb8Image* out);
+
+// The image ReadImage returns for a file holding `image`'s bytes: colour by
+// Srgb8ToLinear, alpha as OpenImageIO converts the 8-bit code. No depth.
+Image DecodeSrgb8(const Srgb8Image& image);
+
+// WriteImage of a frame already encoded: for .png, 8-bit .tif and .jpg,
+// WriteImage(frame) and WriteImage(EncodeSrgb8(frame)) write the same bytes. Errors as WriteImage;
+// kInvalidArgument also for .exr and 16-bit TIFF, which need the linear values.
+[[nodiscard]] Status WriteImage(const Srgb8Image& image, const std::string& path,
+                                const WriteOptions& options = {});
+
 // The temporary name WriteImage uses for `final_path`: "<dir>/.<name>.tmp-<pid>",
 // followed by `suffix` (the video writer keeps the container's extension there).
 std::string TemporaryPathFor(const std::string& final_path, const std::string& suffix = "");

@@ -1,11 +1,12 @@
 #include "render/output/video_writer.h"
 
 #include <algorithm>
+#include <cstring>
 #include <filesystem>
-#include <limits>
 #include <system_error>
 
 #include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
 #include "render/output/image_io.h"
@@ -40,7 +41,9 @@ constexpr const char* kX264Preset = "veryfast";
 struct VideoWriter::Impl {
   std::unique_ptr<internal::H264Encoder> h264;  // H.264 through libavcodec, or
   cv::VideoWriter writer;                       // any codec through OpenCV
-  cv::Mat bgr;  // reused conversion buffer, height x width 8-bit BGR
+  Srgb8Image encoded;                           // AddFrame(Image)'s conversion, reused
+  Srgb8Image fitted;  // a frame of another size cropped or padded to the video's
+  cv::Mat bgr;        // OpenCV's input, height x width 8-bit BGR
   bool is_open() const { return h264 != nullptr || writer.isOpened(); }
 };
 
@@ -118,50 +121,57 @@ VideoWriter::~VideoWriter() {
 }
 
 Status VideoWriter::AddFrame(const Image& frame) {
+  if (frame.width < 1 || frame.height < 1 ||
+      frame.rgba.size() !=
+          static_cast<std::size_t>(frame.width) * static_cast<std::size_t>(frame.height)) {
+    return base::InvalidArgument(base::InFile(path_), "expected a frame with pixels, found " +
+                                                          std::to_string(frame.width) + "x" +
+                                                          std::to_string(frame.height));
+  }
+  EncodeSrgb8(frame, &impl_->encoded);
+  return AddFrame(impl_->encoded);
+}
+
+Status VideoWriter::AddFrame(const Srgb8Image& frame) {
   if (!impl_->is_open()) {
     return MakeError(ErrorCode::kIo, base::InFile(path_), "video is closed");
   }
   if (frame.width < 1 || frame.height < 1 ||
-      frame.rgba.size() != static_cast<std::size_t>(frame.width) * static_cast<std::size_t>(frame.height)) {
+      frame.rgba.size() !=
+          4 * static_cast<std::size_t>(frame.width) * static_cast<std::size_t>(frame.height)) {
     return base::InvalidArgument(base::InFile(path_), "expected a frame with pixels, found " +
                                                           std::to_string(frame.width) + "x" +
                                                           std::to_string(frame.height));
   }
   // A frame of another size is cropped (its right and bottom edges) or padded
   // with black: an odd render size gives an even video one pixel smaller.
-  cv::Mat& bgr = impl_->bgr;
-  bgr.create(height_, width_, CV_8UC3);
-  bgr.setTo(cv::Scalar(0, 0, 0));
-  const int w = std::min(width_, frame.width);
-  const int h = std::min(height_, frame.height);
-  for (int y = 0; y < h; ++y) {
-    auto* row = bgr.ptr<std::uint8_t>(y);
-    // Runs of equal pixels (background rows) reuse the previous pixel's
-    // bytes; NaN never compares equal, so it is always converted.
-    glm::vec3 last(std::numeric_limits<float>::quiet_NaN());
-    std::uint8_t b = 0, g = 0, r = 0;
-    for (int x = 0; x < w; ++x) {
-      const glm::vec3 p(frame.at(x, y));
-      if (!(p == last)) {
-        b = LinearToSrgb8(p.b);  // OpenCV stores BGR
-        g = LinearToSrgb8(p.g);
-        r = LinearToSrgb8(p.r);
-        last = p;
-      }
-      row[3 * x + 0] = b;
-      row[3 * x + 1] = g;
-      row[3 * x + 2] = r;
+  const Srgb8Image* fitted = &frame;
+  if (frame.width != width_ || frame.height != height_) {
+    Srgb8Image& f = impl_->fitted;
+    f.width = width_;
+    f.height = height_;
+    f.rgba.assign(4 * static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_), 0);
+    const auto row_bytes = 4 * static_cast<std::size_t>(std::min(width_, frame.width));
+    for (int y = 0; y < std::min(height_, frame.height); ++y) {
+      std::memcpy(
+          &f.rgba[4 * static_cast<std::size_t>(y) * static_cast<std::size_t>(width_)],
+          &frame.rgba[4 * static_cast<std::size_t>(y) * static_cast<std::size_t>(frame.width)],
+          row_bytes);
     }
+    fitted = &f;
   }
   if (impl_->h264 != nullptr) {
     std::string error;
-    if (!impl_->h264->Write(bgr.ptr<std::uint8_t>(0), static_cast<int>(bgr.step[0]), &error))
+    if (!impl_->h264->Write(fitted->rgba.data(), 4 * width_, &error))
       return MakeError(ErrorCode::kIo, base::InFile(path_), "FFmpeg: " + error);
     ++frames_;
     return Status::Ok();
   }
   try {
-    impl_->writer.write(bgr);
+    // OpenCV takes BGR; the Mat header borrows the bytes.
+    const cv::Mat rgba(height_, width_, CV_8UC4, const_cast<std::uint8_t*>(fitted->rgba.data()));
+    cv::cvtColor(rgba, impl_->bgr, cv::COLOR_RGBA2BGR);
+    impl_->writer.write(impl_->bgr);
   } catch (const cv::Exception& e) {
     return MakeError(ErrorCode::kIo, base::InFile(path_), std::string("OpenCV: ") + e.what());
   }

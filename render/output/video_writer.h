@@ -10,7 +10,8 @@
 //
 // Like frames, the video is written under a temporary name in the same folder
 // and renamed on Close(), so a half-written video never has the final name.
-// Frames are linear RGBA; they are sRGB-encoded to 8 bits (alpha dropped).
+// Frames are linear RGBA, sRGB-encoded to 8 bits (alpha dropped), or arrive
+// encoded (Srgb8Image).
 
 #include <memory>
 #include <string>
@@ -56,6 +57,9 @@ class VideoWriter {
   // bottom edges or padded there with black (an odd render size in an even
   // video). Errors: kInvalidArgument (an empty frame), kIo.
   [[nodiscard]] Status AddFrame(const Image& frame);
+  // The same frame already sRGB-encoded (EncodeSrgb8): the same video bytes
+  // as AddFrame(frame), without converting it again.
+  [[nodiscard]] Status AddFrame(const Srgb8Image& frame);
   // Finishes the file and renames it to path(). Errors: kIo.
   [[nodiscard]] Status Close();
 

@@ -117,6 +117,9 @@ inline constexpr float kUint16Step = 1.0f / 65535.0f;
 inline constexpr float kJpegFlatTol = 3.0f / 255.0f;
 // Lossy video codecs on flat grey frames: mean within 6 of 255 codes.
 inline constexpr double kVideoFlatTol8 = 6.0;
+// Lossy video codecs on saturated primaries (YUV 4:2:0, studio range), away
+// from the colour borders: within 24 of 255 codes (a swapped channel is 255 off).
+inline constexpr double kVideoColourTol8 = 24.0;
 // PSNR in dB (a log of a computed ratio).
 inline constexpr double kPsnrTolDb = 1e-3;
 // SWD: bind-pose rebuild error relative to the mesh size (ALGORITHMS.md 2.3 asks 1e-5).

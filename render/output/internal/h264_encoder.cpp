@@ -122,7 +122,7 @@ std::unique_ptr<H264Encoder> H264Encoder::Open(const std::string& path, int widt
   s.frame->width = width;
   s.frame->height = height;
   rc = av_frame_get_buffer(s.frame, 0);
-  s.sws = sws_getContext(width, height, AV_PIX_FMT_BGR24, width, height, AV_PIX_FMT_YUV420P,
+  s.sws = sws_getContext(width, height, AV_PIX_FMT_RGBA, width, height, AV_PIX_FMT_YUV420P,
                          SWS_BILINEAR, nullptr, nullptr, nullptr);
   if (rc < 0 || s.sws == nullptr) {
     *error = "cannot allocate the frame converter";
@@ -133,11 +133,11 @@ std::unique_ptr<H264Encoder> H264Encoder::Open(const std::string& path, int widt
 
 H264Encoder::~H264Encoder() = default;
 
-bool H264Encoder::Write(const std::uint8_t* bgr, int stride, std::string* error) {
+bool H264Encoder::Write(const std::uint8_t* rgba, int stride, std::string* error) {
   State& s = *s_;
   int rc = av_frame_make_writable(s.frame);
   if (rc >= 0) {
-    const std::uint8_t* const src[1] = {bgr};
+    const std::uint8_t* const src[1] = {rgba};
     const int src_stride[1] = {stride};
     sws_scale(s.sws, src, src_stride, 0, s.codec->height, s.frame->data, s.frame->linesize);
     s.frame->pts = s.next_pts++;

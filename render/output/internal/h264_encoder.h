@@ -6,8 +6,8 @@
 // faster for a file the same size to within tens of percent (a preview).
 //
 // One encoder thread, so the stream's bytes are a function of the frames
-// alone, and the render keeps the cores. Frames are 8-bit BGR, width x height
-// (both even), converted to YUV 4:2:0 with libswscale.
+// alone, and the render keeps the cores. Frames are 8-bit sRGB RGBA (alpha
+// ignored), width x height (both even), converted to YUV 4:2:0 with libswscale.
 
 #include <cstdint>
 #include <memory>
@@ -24,9 +24,9 @@ class H264Encoder {
                                            double fps, const char* preset, std::string* error);
   ~H264Encoder();  // frees everything; the file is left as written so far
 
-  // Encodes one frame of height rows of 3 * width bytes (B, G, R), rows
+  // Encodes one frame of height rows of 4 * width bytes (R, G, B, A), rows
   // `stride` bytes apart. False (with *error) on an encoder or write failure.
-  bool Write(const std::uint8_t* bgr, int stride, std::string* error);
+  bool Write(const std::uint8_t* rgba, int stride, std::string* error);
   // Flushes the encoder and writes the MP4 index. False (with *error) on failure.
   bool Close(std::string* error);
 

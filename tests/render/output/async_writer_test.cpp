@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <memory>
 #include <chrono>
 #include <thread>
 #include <string>
@@ -63,6 +64,37 @@ TEST(AsyncImageWriter, WritesTheSameBytesAsWriteImage) {
     ASSERT_TRUE(WriteImage(Frame(f), sync.string(), o));
     EXPECT_EQ(Bytes(dir / ("async_" + std::to_string(f) + ".png")), Bytes(sync)) << f;
   }
+}
+
+// Frames encoded once (shared with the video and the sheet in a render) are
+// written as the linear frames are; a missing frame is refused.
+TEST(AsyncImageWriter, WritesEncodedFramesAsTheLinearOnes) {
+  const fs::path dir = FreshDir("encoded");
+  constexpr int kFrames = 6;
+  WriteOptions o;
+  {
+    AsyncImageWriter writer({.num_workers = 2, .max_in_flight = 2});
+    for (int f = 0; f < kFrames; ++f) {
+      auto bytes = std::make_shared<Srgb8Image>();
+      EncodeSrgb8(Frame(f), bytes.get());
+      o.frame = f;
+      ASSERT_TRUE(writer.Submit(std::move(bytes),
+                                (dir / ("enc_" + std::to_string(f) + ".png")).string(), o));
+    }
+    EXPECT_FALSE(
+        writer.Submit(std::shared_ptr<const Srgb8Image>(), (dir / "none.png").string(), o));
+    ASSERT_TRUE(writer.Finish());
+    EXPECT_EQ(writer.frames_written(), kFrames);
+    EXPECT_EQ(writer.TakeSpareImage().rgba.capacity(), 0u)
+        << "encoded frames leave no linear buffers";
+  }
+  for (int f = 0; f < kFrames; ++f) {
+    o.frame = f;
+    const fs::path sync = dir / ("sync_" + std::to_string(f) + ".png");
+    ASSERT_TRUE(WriteImage(Frame(f), sync.string(), o));
+    EXPECT_EQ(Bytes(dir / ("enc_" + std::to_string(f) + ".png")), Bytes(sync)) << f;
+  }
+  EXPECT_FALSE(fs::exists(dir / "none.png"));
 }
 
 TEST(AsyncImageWriter, RaisesTooSmallLimits) {

@@ -4,10 +4,12 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
 #include <thread>
 
@@ -108,6 +110,71 @@ TEST(WriteImage, PngRoundTripIsExactAfterQuantization) {
     }
     ASSERT_EQ(back->rgba[i].a, std::round(src.rgba[i].a * 255.0f) / 255.0f) << i;
   }
+}
+
+// EncodeSrgb8 against the one-value conversions, and DecodeSrgb8 against
+// what ReadImage gives for the file WriteImage writes of the same frame.
+TEST(Srgb8Image, EncodesLikeTheFileAndDecodesLikeTheReadBack) {
+  const fs::path dir = testsupport::FreshOutputDir("image_io/srgb8");
+  Image src = TestPattern(29, 17);
+  src.at(3, 4) = glm::vec4(std::nanf(""), -1.0f, 2.0f, std::nanf(""));
+  src.at(5, 6).a = 0.7f;
+  Srgb8Image bytes;
+  bytes.rgba.assign(7, 99);  // stale contents are replaced
+  EncodeSrgb8(src, &bytes);
+  ASSERT_EQ(bytes.width, 29);
+  ASSERT_EQ(bytes.height, 17);
+  ASSERT_EQ(bytes.rgba.size(), 4u * 29u * 17u);
+  for (std::size_t i = 0; i < src.rgba.size(); ++i) {
+    for (int c = 0; c < 3; ++c)
+      ASSERT_EQ(bytes.rgba[4 * i + c], LinearToSrgb8(src.rgba[i][c])) << i;
+    const float a = std::isnan(src.rgba[i].a) ? 0.0f : std::clamp(src.rgba[i].a, 0.0f, 1.0f);
+    ASSERT_EQ(bytes.rgba[4 * i + 3], static_cast<std::uint8_t>(std::lround(a * 255.0f))) << i;
+  }
+  ASSERT_TRUE(WriteImage(src, (dir / "a.png").string()));
+  const Result<Image> back = ReadImage((dir / "a.png").string());
+  ASSERT_TRUE(back.ok()) << back.error().ToString();
+  const Image decoded = DecodeSrgb8(bytes);
+  ASSERT_EQ(decoded.rgba.size(), back->rgba.size());
+  for (std::size_t i = 0; i < decoded.rgba.size(); ++i) {
+    for (int c = 0; c < 4; ++c) ASSERT_EQ(decoded.rgba[i][c], back->rgba[i][c]) << i << " " << c;
+  }
+}
+
+// A frame encoded once writes the files the linear frame writes, byte for byte.
+TEST(WriteImage, EncodedFrameWritesTheSameBytesAsTheLinearOne) {
+  const fs::path dir = testsupport::FreshOutputDir("image_io/encoded");
+  const Image src = TestPattern(41, 19);
+  Srgb8Image bytes;
+  EncodeSrgb8(src, &bytes);
+  WriteOptions o;
+  o.frame = 12;
+  o.source_file = "walk.bvh";
+  auto file = [](const fs::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  };
+  for (const std::string ext : {"png", "tif", "jpg"}) {
+    const fs::path linear = dir / ("linear." + ext), encoded = dir / ("encoded." + ext);
+    ASSERT_TRUE(WriteImage(src, linear.string(), o)) << ext;
+    const Status s = WriteImage(bytes, encoded.string(), o);
+    ASSERT_TRUE(s) << ext << ": " << s.error().ToString();
+    EXPECT_EQ(file(linear), file(encoded)) << ext;
+  }
+  // Linear formats need the linear values; a buffer of the wrong size is refused.
+  const Status exr = WriteImage(bytes, (dir / "a.exr").string());
+  ASSERT_FALSE(exr);
+  EXPECT_NE(exr.error().message.find("EXR"), std::string::npos) << exr.error().ToString();
+  WriteOptions sixteen;
+  sixteen.tiff_bits = 16;
+  EXPECT_FALSE(WriteImage(bytes, (dir / "b.tif").string(), sixteen));
+  Srgb8Image short_buffer = bytes;
+  short_buffer.rgba.pop_back();
+  const Status bad = WriteImage(short_buffer, (dir / "c.png").string());
+  ASSERT_FALSE(bad);
+  EXPECT_EQ(bad.error().code, base::ErrorCode::kInvalidArgument);
+  EXPECT_FALSE(WriteImage(Srgb8Image{}, (dir / "d.png").string()));
+  EXPECT_FALSE(fs::exists(dir / "a.exr") || fs::exists(dir / "c.png") || fs::exists(dir / "d.png"));
 }
 
 TEST(WriteImage, PngCompressionLevelChangesSizeNotPixels) {

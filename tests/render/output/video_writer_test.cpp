@@ -4,6 +4,8 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -96,6 +98,88 @@ TEST(VideoWriter, CropsAFrameOnePixelLargerThanTheVideo) {
   cv::Mat bgr;
   ASSERT_TRUE(cap.read(bgr));
   EXPECT_NEAR(cv::mean(bgr)[1], 40 + 15 * 2, testsupport::kVideoFlatTol8);
+}
+
+// Red, green and blue thirds come back in their places through every codec
+// (the encoder takes R, G, B, A bytes; OpenCV's writer B, G, R).
+TEST(VideoWriter, KeepsEachColourInItsChannel) {
+  for (VideoCodec codec : {VideoCodec::kH264Mp4, VideoCodec::kMpeg4Mp4, VideoCodec::kMjpegAvi}) {
+    const fs::path dir = testsupport::FreshOutputDir(std::string("video/rgb") +
+                                                     std::to_string(static_cast<int>(codec)));
+    VideoOptions options;
+    options.codecs = {codec};
+    auto video = VideoWriter::Open((dir / "v.mp4").string(), kWidth, kHeight, options);
+    ASSERT_TRUE(video.ok()) << video.error().ToString();
+    Image frame(kWidth, kHeight);
+    for (int y = 0; y < kHeight; ++y) {
+      for (int x = 0; x < kWidth; ++x) {
+        const int third = 3 * x / kWidth;
+        frame.at(x, y) = glm::vec4(third == 0, third == 1, third == 2, 1.0f);
+      }
+    }
+    for (int f = 0; f < 3; ++f) ASSERT_TRUE((*video)->AddFrame(frame));
+    ASSERT_TRUE((*video)->Close());
+    cv::VideoCapture cap((*video)->path());
+    ASSERT_TRUE(cap.isOpened());
+    cv::Mat bgr;
+    ASSERT_TRUE(cap.read(bgr));
+    for (int third = 0; third < 3; ++third) {
+      // The middle of the third, away from chroma bleeding at the borders.
+      const int x = (2 * third + 1) * kWidth / 6;
+      const cv::Vec3b p = bgr.at<cv::Vec3b>(kHeight / 2, x);
+      const int rgb[3] = {p[2], p[1], p[0]};
+      for (int c = 0; c < 3; ++c) {
+        EXPECT_NEAR(rgb[c], c == third ? 255 : 0, testsupport::kVideoColourTol8)
+            << VideoCodecName(codec) << " third " << third << " channel " << c;
+      }
+    }
+  }
+}
+
+// A frame given as its sRGB bytes makes the same video, byte for byte, as the
+// linear frame; a smaller frame is padded with black at its right and bottom.
+TEST(VideoWriter, EncodedFramesMakeTheSameVideoAndSmallOnesArePadded) {
+  const fs::path dir = testsupport::FreshOutputDir("video/encoded");
+  auto write = [&](const std::string& name, bool encoded, int w, int h) {
+    auto video = VideoWriter::Open((dir / name).string(), kWidth, kHeight);
+    EXPECT_TRUE(video.ok());
+    if (!video.ok()) return std::string();
+    for (int f = 0; f < kFrames; ++f) {
+      const Image frame(w, h, Grey(f));
+      if (encoded) {
+        Srgb8Image bytes;
+        EncodeSrgb8(frame, &bytes);
+        EXPECT_TRUE((*video)->AddFrame(bytes));
+      } else {
+        EXPECT_TRUE((*video)->AddFrame(frame));
+      }
+    }
+    EXPECT_TRUE((*video)->Close());
+    std::ifstream in((*video)->path(), std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  };
+  const std::string linear = write("linear.mp4", false, kWidth, kHeight);
+  EXPECT_FALSE(linear.empty());
+  EXPECT_EQ(write("encoded.mp4", true, kWidth, kHeight), linear);
+  EXPECT_EQ(write("encoded_odd.mp4", true, kWidth + 1, kHeight + 1),
+            write("linear_odd.mp4", false, kWidth + 1, kHeight + 1));
+
+  write("small.mp4", true, kWidth / 2, kHeight / 2);
+  cv::VideoCapture cap((dir / "small.mp4").string());
+  ASSERT_TRUE(cap.isOpened());
+  cv::Mat bgr;
+  ASSERT_TRUE(cap.read(bgr));
+  EXPECT_NEAR(bgr.at<cv::Vec3b>(kHeight / 4, kWidth / 4)[1], 40, testsupport::kVideoFlatTol8);
+  EXPECT_NEAR(bgr.at<cv::Vec3b>(3 * kHeight / 4, 3 * kWidth / 4)[1], 0,
+              testsupport::kVideoFlatTol8);
+
+  auto video = VideoWriter::Open((dir / "bad.mp4").string(), kWidth, kHeight);
+  ASSERT_TRUE(video.ok());
+  Srgb8Image wrong;
+  wrong.width = 2;
+  wrong.height = 2;
+  wrong.rgba.assign(15, 0);
+  EXPECT_EQ((*video)->AddFrame(wrong).error().code, base::ErrorCode::kInvalidArgument);
 }
 
 TEST(VideoWriter, RejectsBadArgumentsAndUnwritablePaths) {
