@@ -77,6 +77,70 @@ bool PixelAllOf(const std::uint32_t* ids, int c0, int ss, std::uint32_t id) {
   return true;
 }
 
+}  // namespace
+
+// Multisampling: the whole pixels of a pixel row (`whole`, n sample columns)
+// into the tile's accumulators at out_row: each of its ss x ss samples adds
+// its colour color[first sample] in the order the per-sample loop adds them,
+// so a pixel gets the bytes supersampling gives a pixel of one colour; the
+// nearest depth over its samples (`depth`: the pixel row's first sample row,
+// stride kTileSize); and, for the tent resolve, its samples in `samples`.
+void Renderer::AccumulateWholePixels(int n, int ss_shift, const Whole* whole,
+                                     const glm::vec3* color, const float* depth,
+                                     std::size_t out_row, TileScratch& s, glm::vec4* samples,
+                                     std::size_t sample_stride) const {
+  const int ss = 1 << ss_shift;
+  for (int c0 = 0; c0 < n; c0 += ss) {
+    if (whole[c0 >> ss_shift] == Whole::kNo) continue;
+    const glm::vec4 sample(color[c0], 1.0f);
+    const std::size_t pixel = out_row + static_cast<std::size_t>(c0 >> ss_shift);
+    glm::vec4 acc = s.accum[pixel];
+    float nearest = s.nearest[pixel];
+    for (int r = 0; r < ss; ++r) {
+      const float* row = depth + static_cast<std::size_t>(r) * kTileSize + c0;
+      for (int c = 0; c < ss; ++c) {
+        acc += sample;
+        nearest = std::max(nearest, row[c]);
+        if (samples != nullptr)
+          samples[static_cast<std::size_t>(r) * sample_stride + static_cast<std::size_t>(c0 + c)] =
+              sample;
+      }
+    }
+    s.accum[pixel] = acc;
+    s.nearest[pixel] = nearest;
+  }
+}
+
+// Multisampling: what each pixel of a pixel row (n sample columns, the
+// pixel row's first sample row at `ids`, stride kTileSize) saw in all its
+// samples: one triangle, the ground (one or more of its triangles), or neither.
+void Renderer::ClassifyPixels(const std::uint32_t* ids, int n, int ss_shift,
+                              std::uint32_t ground_mesh, Whole* whole) const {
+  const int ss = 1 << ss_shift;
+  auto ground = [&](std::uint32_t id) {
+    return id != kNoTriangle && rasterizer_.triangle(id).mesh == ground_mesh;
+  };
+  for (int c0 = 0; c0 < n; c0 += ss) {
+    const std::uint32_t first = ids[c0];
+    Whole kind = Whole::kNo;
+    if (first != kNoTriangle && PixelAllOf(ids, c0, ss, first)) {
+      kind = ground(first) ? Whole::kGround : Whole::kTriangle;
+    } else if (ground(first)) {
+      kind = Whole::kGround;
+      for (int r = 0; r < ss && kind == Whole::kGround; ++r)
+        for (int c = 0; c < ss; ++c)
+          if (!ground(ids[static_cast<std::size_t>(r) * kTileSize +
+                          static_cast<std::size_t>(c0 + c)])) {
+            kind = Whole::kNo;
+            break;
+          }
+    }
+    whole[c0 >> ss_shift] = kind;
+  }
+}
+
+namespace {
+
 base::JobStatus Fail(base::JobStatus::Code code, const char* what) { return {code, what}; }
 
 base::JobStatus ValidateInputs(std::span<const SceneMesh> meshes, const RenderSettings& s) {
@@ -632,6 +696,18 @@ void Renderer::ShadeGroundRow(int x0, int sy, int n, const bool* ground, Store&&
 }
 
 template <class Store>
+void Renderer::ShadeGroundPixelRow(int x0, int sy, int n, int ss, const bool* whole,
+                                   Store&& store) const {
+  for (int p = 0; p < n; p += 4) {
+    if (!(whole[p] || whole[p + 1] || whole[p + 2] || whole[p + 3])) continue;
+    float r[4], g[4], b[4];
+    ground_shader_.ShadePixels4(x0 + p * ss, sy, ss, r, g, b);
+    for (int k = 0; k < 4 && p + k < n; ++k)
+      if (whole[p + k]) store((p + k) * ss, glm::vec3(r[k], g[k], b[k]));
+  }
+}
+
+template <class Store>
 void Renderer::ShadeSurfaceRow(int n, const bool* surface, SurfacePoints4* deferred,
                                Store&& store) const {
   for (int i = 0; i < n; i += 4) {
@@ -764,9 +840,8 @@ void Renderer::ShadeTile(int tile, const RenderSettings& settings,
   glm::vec4* samples = samples_.empty() ? nullptr : samples_.data() + static_cast<std::size_t>(y0) * sample_stride;
   const bool multisample = settings.antialias == AntiAlias::kMultisample;
   const auto ground_mesh = static_cast<std::uint32_t>(meshes.size());
-  // The colours of the current pixel row's sample rows (multisampling copies
-  // a colour from an earlier sample of the same pixel).
-  glm::vec3 color_rows[4][kTileSize];
+  glm::vec3 color[kTileSize];  // the current sample row's colours
+  Whole whole[kTileSize / 2];  // multisampling: the current pixel row's pixels
   for (int sy = y0; sy < y1; ++sy) {
     const glm::vec3 bg = background_rows_[static_cast<std::size_t>(sy)];
     const std::size_t row = static_cast<std::size_t>(sy - y0) * kTileSize;
@@ -774,29 +849,28 @@ void Renderer::ShadeTile(int tile, const RenderSettings& settings,
     const int j = (sy - y0) % ss;  // sample row within the pixel
     const std::uint32_t* pixel_row_ids = s.ids.data() + row - static_cast<std::size_t>(j) * kTileSize;
     // The row's colours first, so the ground's samples are shaded four at a time.
-    glm::vec3* color = color_rows[j];
-    int from[kTileSize];  // multisampling: where in color_rows this sample's colour is, or -1
     bool ground[kTileSize + 3] = {}, surface[kTileSize + 3] = {};
     SurfacePoints4 deferred[kTileSize / 4];
     bool any_ground = false, any_surface = false;
-    bool any_copy = false;
+    bool ground_pixel[kTileSize / 2 + 3] = {};  // multisampling: whole ground pixels of the row
+    bool any_ground_pixel = false;
+    if (multisample && j == 0) ClassifyPixels(pixel_row_ids, x1 - x0, ss_shift, ground_mesh, whole);
     for (int sx = x0; sx < x1; ++sx) {
       const std::uint32_t id = s.ids[row + static_cast<std::size_t>(sx - x0)];
       const int i = sx - x0;
-      from[i] = -1;
       if (id == kNoTriangle) continue;
       glm::vec2 at(static_cast<float>(sx), static_cast<float>(sy));
       // A pixel inside one triangle is shaded once, at its centre (where the
-      // mean of its samples' positions is); its other samples copy that
-      // colour. Pixels on an edge are shaded per sample, so edges are exactly
-      // supersampling's. The ground's grid lines are thinner than a pixel far
-      // away: it is shaded per sample everywhere.
-      if (multisample && rasterizer_.triangle(id).mesh != ground_mesh) {
-        const int c0 = i - i % ss;
-        if (PixelAllOf(pixel_row_ids, c0, ss, id)) {
-          if (i != c0 || j != 0) {
-            from[i] = c0;  // the pixel's first sample, row 0 of color_rows
-            any_copy = true;
+      // mean of its samples' positions is), and that colour is all of its
+      // samples'. Pixels on an edge are shaded per sample, so edges are
+      // exactly supersampling's. A pixel all ground is shaded once too, with
+      // its grid lines filtered over the pixel (GroundShader::ShadePixels4).
+      if (multisample) {
+        const Whole kind = whole[i >> ss_shift];
+        if (kind != Whole::kNo) {
+          if (j != 0 || (i & (ss - 1)) != 0) continue;  // not the pixel's first sample
+          if (kind == Whole::kGround) {
+            ground_pixel[i >> ss_shift] = any_ground_pixel = true;
             continue;
           }
           const float centre = 0.5f * static_cast<float>(ss - 1);
@@ -810,12 +884,16 @@ void Renderer::ShadeTile(int tile, const RenderSettings& settings,
     }
     auto store_color = [&](int i, const glm::vec3& c) { color[static_cast<std::size_t>(i)] = c; };
     if (any_ground) ShadeGroundRow(x0, sy, x1 - x0, ground, store_color);
+    if (any_ground_pixel) {
+      ShadeGroundPixelRow(x0, sy, (x1 - x0) >> ss_shift, ss, ground_pixel, store_color);
+    }
     if (any_surface) ShadeSurfaceRow(x1 - x0, surface, deferred, store_color);
-    if (any_copy) {
-      for (int i = 0; i < x1 - x0; ++i)
-        if (from[i] >= 0) color[i] = color_rows[from[i] / kTileSize][from[i] % kTileSize];
+    if (multisample && j == 0) {
+      AccumulateWholePixels(x1 - x0, ss_shift, whole, color, s.depth.data() + row, out_row, s,
+                            samples == nullptr ? nullptr : samples + x0, sample_stride);
     }
     for (int sx = x0; sx < x1; ++sx) {
+      if (multisample && whole[(sx - x0) >> ss_shift] != Whole::kNo) continue;  // done above
       const std::size_t at = row + static_cast<std::size_t>(sx - x0);
       const std::uint32_t id = s.ids[at];
       const std::size_t pixel = out_row + static_cast<std::size_t>((sx - x0) >> ss_shift);

@@ -76,12 +76,14 @@ enum class AntiAlias {
   kSupersample,
   // Multisampling: depth and coverage per sample as above, but a pixel whose
   // samples all see the same mesh triangle is shaded once, at its centre, and
-  // that colour goes to all of its samples; pixels on an edge and the ground
-  // (its grid lines get thinner than a pixel) are still shaded per sample, so
-  // edges equal supersampling's. Measured (bench/RESULTS.md) it is not faster
-  // on the demo, where the ground is 80% of the samples, and its interiors are
-  // a little further from a 4x4 reference than supersampling's (one shade
-  // instead of the mean of four): opt-in.
+  // that colour goes to all of its samples; so is a pixel all ground, with its
+  // grid lines box-filtered over the pixel and the cast shadow's visibility
+  // averaged over its samples (GroundShader::ShadePixels4). Pixels on an edge
+  // are shaded per sample, so edges equal supersampling's. Against a 4x4
+  // supersampled reference its mean and 99th-percentile errors are at most
+  // 2x2 supersampling's (tests/render/raster/multisample_test.cpp): one shade
+  // at the centre of a curved interior is a little further off than the mean
+  // of four, and filtered grid lines much closer.
   kMultisample,
 };
 
@@ -142,6 +144,17 @@ class Renderer {
   // holds n rounded up to 4 entries), the colour of ground sample (x0 + i, sy).
   template <class Store>
   void ShadeGroundRow(int x0, int sy, int n, const bool* ground, Store&& store) const;
+  // Multisampling: calls store(p * ss, colour) for every pixel p in [0, n)
+  // of sample row sy with whole[p] set (n rounded up to 4 entries), the
+  // colour of the ground pixel whose first sample is (x0 + p * ss, sy).
+  template <class Store>
+  void ShadeGroundPixelRow(int x0, int sy, int n, int ss, const bool* whole, Store&& store) const;
+  enum class Whole : std::uint8_t { kNo, kTriangle, kGround };
+  void AccumulateWholePixels(int n, int ss_shift, const Whole* whole, const glm::vec3* color,
+                             const float* depth, std::size_t out_row, TileScratch& s,
+                             glm::vec4* samples, std::size_t sample_stride) const;
+  void ClassifyPixels(const std::uint32_t* ids, int n, int ss_shift, std::uint32_t ground_mesh,
+                      Whole* whole) const;
   // Calls store(i, colour) for every i in [0, n) with surface[i] set: the
   // Blinn-Phong colour from the ShadeSurface inputs in lane i % 4 of
   // deferred[i / 4], four at a time (ShadeSurface4). Fills unused lanes.

@@ -61,7 +61,27 @@ class GroundShader {
   // The colour of one sample: lane 0 of Shade4.
   glm::vec3 Shade(int sx, int sy) const;
 
+  // Multisampling: linear RGB of four whole pixels of ss x ss samples, the
+  // pixels whose first samples are (sx + ss * k, sy), k = 0..3, shaded once
+  // at their centres. The grid lines there are box-filtered over the pixel's
+  // footprint on the ground (the pixel's two edge vectors projected, the
+  // trapezoid profile integrated in closed form), so a line thinner than a
+  // pixel is not lost between samples; contact shadows are smooth and read at
+  // the centre. The cast shadow's edge is sharper than a pixel: its
+  // visibility is the mean over the pixel's samples, as supersampling's.
+  void ShadePixels4(int sx, int sy, int ss, float* r, float* g, float* b) const;
+
  private:
+  // Shade4's and ShadePixels4's common end, four lanes of type V: contact
+  // shadows, the key light's visibility (null: fully lit) and the albedo of
+  // line weight `line`, stored in r, g, b.
+  template <class V>
+  void Finish4(V px, V pz, V line, const float* visibility, float* r, float* g, float* b) const;
+
+  // The key light's visibility of four pixels (as ShadePixels4), each the mean
+  // over its ss x ss samples.
+  void PixelVisibility4(int sx, int sy, int ss, float* visibility) const;
+
   struct Shadow {
     float cx, cz;        // centre, world xz
     float inv_rx, inv_rz;  // 1 / half-axes
@@ -80,6 +100,7 @@ class GroundShader {
   float inv_fade_ = 1.0f;        // 1 / fade start (spacings)
   glm::vec3 color_{0.0f}, line_delta_{0.0f};  // albedo between lines, line - between
   glm::vec3 light_{1.0f};
+  float line_area_ = 0.0f;  // the line profile's integral over one spacing
   const ShadowMap* shadow_map_ = nullptr;
   glm::ivec4 map_box_{0};  // samples (x0, y0, x1, y1), inclusive, the map can darken
   glm::vec3 key_light_{0.0f};
