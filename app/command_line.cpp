@@ -125,8 +125,8 @@ CLI::App* AddRenderCommand(CLI::App& parent, RenderOptions& o) {
          "Supersample filter: box (the pixel's own samples) or tent (radius one pixel, softer)")
       ->capture_default_str();
   cmd->add_option("--aa", o.aa,
-                  "How samples are shaded: ssaa (every sample) or msaa (once per pixel inside a "
-                  "triangle; edges and ground per sample)")
+                  "How samples are shaded: msaa (once per pixel inside one triangle or the "
+                  "ground; edge pixels per sample) or ssaa (every sample)")
       ->capture_default_str();
   cmd->add_option(
          "--shadows", o.shadows,
@@ -179,7 +179,7 @@ CLI::App* AddTurntableCommand(CLI::App& parent, RenderOptions& o) {
   cmd->add_option("--threads", o.threads, "Worker threads (0 = all cores)");
   cmd->add_option("--supersample", o.supersample, "Anti-aliasing samples per axis: 1, 2 or 4");
   cmd->add_option("--resolve", o.resolve, "Supersample filter: box or tent");
-  cmd->add_option("--aa", o.aa, "Sample shading: ssaa or msaa");
+  cmd->add_option("--aa", o.aa, "Sample shading: msaa or ssaa");
   cmd->add_option("--shadows", o.shadows, "Cast shadow on the ground and the body: on or off");
   cmd->add_flag("--no-sheet", o.no_sheet, "Do not write the contact sheet");
   cmd->add_flag("--no-video", o.no_video, "Do not write the preview video");

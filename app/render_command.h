@@ -35,7 +35,7 @@ struct RenderOptions {
   int threads = 0;                    // 0 = hardware concurrency
   int supersample = 2;                // 1, 2 or 4 samples per axis
   std::string resolve = "box";        // box | tent: how the samples of a pixel are filtered
-  std::string aa = "ssaa";            // ssaa | msaa: shade every sample, or once per interior pixel
+  std::string aa = "msaa";            // msaa | ssaa: shade once per whole pixel, or every sample
   std::string shadows = "on";         // on | off: the key light's cast shadow (ground and body)
   std::string textures = "on";        // on | off: a glTF character's base colour textures
   int png_compression = 1;            // zlib level for PNG frames
