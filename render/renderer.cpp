@@ -80,27 +80,34 @@ bool PixelAllOf(const std::uint32_t* ids, int c0, int ss, std::uint32_t id) {
 }  // namespace
 
 // Multisampling: the whole pixels of a pixel row (`whole`, n sample columns)
-// into the tile's accumulators at out_row: each of its ss x ss samples adds
-// its colour color[first sample] in the order the per-sample loop adds them,
-// so a pixel gets the bytes supersampling gives a pixel of one colour; the
-// nearest depth over its samples (`depth`: the pixel row's first sample row,
-// stride kTileSize); and, for the tent resolve, its samples in `samples`.
+// into the tile's accumulators at out_row, each of its ss x ss samples added
+// in the order the per-sample loop adds them, so a pixel gets the bytes
+// supersampling gives a pixel of one colour: a covered pixel's colour is
+// color[first sample] and its nearest depth the largest 1/w of its samples
+// (`depth`: the pixel row's first sample row, stride kTileSize); an empty
+// pixel's samples are its sample rows' background[r] (none when transparent).
+// For the tent resolve, the samples also go to `samples`.
 void Renderer::AccumulateWholePixels(int n, int ss_shift, const Whole* whole,
                                      const glm::vec3* color, const float* depth,
+                                     const glm::vec3* background, bool transparent,
                                      std::size_t out_row, TileScratch& s, glm::vec4* samples,
                                      std::size_t sample_stride) const {
   const int ss = 1 << ss_shift;
   for (int c0 = 0; c0 < n; c0 += ss) {
-    if (whole[c0 >> ss_shift] == Whole::kNo) continue;
-    const glm::vec4 sample(color[c0], 1.0f);
+    const Whole kind = whole[c0 >> ss_shift];
+    if (kind == Whole::kNo) continue;
     const std::size_t pixel = out_row + static_cast<std::size_t>(c0 >> ss_shift);
     glm::vec4 acc = s.accum[pixel];
     float nearest = s.nearest[pixel];
     for (int r = 0; r < ss; ++r) {
       const float* row = depth + static_cast<std::size_t>(r) * kTileSize + c0;
+      const bool empty = kind == Whole::kEmpty;
+      const glm::vec4 sample = !empty        ? glm::vec4(color[c0], 1.0f)
+                               : transparent ? glm::vec4(0.0f)
+                                             : glm::vec4(background[r], 0.0f);
       for (int c = 0; c < ss; ++c) {
-        acc += sample;
-        nearest = std::max(nearest, row[c]);
+        if (!empty || !transparent) acc += sample;
+        if (!empty) nearest = std::max(nearest, row[c]);
         if (samples != nullptr)
           samples[static_cast<std::size_t>(r) * sample_stride + static_cast<std::size_t>(c0 + c)] =
               sample;
@@ -113,7 +120,8 @@ void Renderer::AccumulateWholePixels(int n, int ss_shift, const Whole* whole,
 
 // Multisampling: what each pixel of a pixel row (n sample columns, the
 // pixel row's first sample row at `ids`, stride kTileSize) saw in all its
-// samples: one triangle, the ground (one or more of its triangles), or neither.
+// samples: one triangle, the ground (one or more of its triangles), nothing,
+// or a mix.
 void Renderer::ClassifyPixels(const std::uint32_t* ids, int n, int ss_shift,
                               std::uint32_t ground_mesh, Whole* whole) const {
   const int ss = 1 << ss_shift;
@@ -123,8 +131,10 @@ void Renderer::ClassifyPixels(const std::uint32_t* ids, int n, int ss_shift,
   for (int c0 = 0; c0 < n; c0 += ss) {
     const std::uint32_t first = ids[c0];
     Whole kind = Whole::kNo;
-    if (first != kNoTriangle && PixelAllOf(ids, c0, ss, first)) {
-      kind = ground(first) ? Whole::kGround : Whole::kTriangle;
+    if (PixelAllOf(ids, c0, ss, first)) {
+      kind = first == kNoTriangle ? Whole::kEmpty
+             : ground(first)      ? Whole::kGround
+                                  : Whole::kTriangle;
     } else if (ground(first)) {
       kind = Whole::kGround;
       for (int r = 0; r < ss && kind == Whole::kGround; ++r)
@@ -858,7 +868,6 @@ void Renderer::ShadeTile(int tile, const RenderSettings& settings,
     for (int sx = x0; sx < x1; ++sx) {
       const std::uint32_t id = s.ids[row + static_cast<std::size_t>(sx - x0)];
       const int i = sx - x0;
-      if (id == kNoTriangle) continue;
       glm::vec2 at(static_cast<float>(sx), static_cast<float>(sy));
       // A pixel inside one triangle is shaded once, at its centre (where the
       // mean of its samples' positions is), and that colour is all of its
@@ -868,7 +877,11 @@ void Renderer::ShadeTile(int tile, const RenderSettings& settings,
       if (multisample) {
         const Whole kind = whole[i >> ss_shift];
         if (kind != Whole::kNo) {
-          if (j != 0 || (i & (ss - 1)) != 0) continue;  // not the pixel's first sample
+          // Only the first sample row shades, at the pixel's first sample;
+          // the loop then goes on at the next pixel (ss divides x0).
+          const bool shade = j == 0 && kind != Whole::kEmpty;
+          sx |= ss - 1;
+          if (!shade) continue;
           if (kind == Whole::kGround) {
             ground_pixel[i >> ss_shift] = any_ground_pixel = true;
             continue;
@@ -877,6 +890,7 @@ void Renderer::ShadeTile(int tile, const RenderSettings& settings,
           at += glm::vec2(centre);
         }
       }
+      if (id == kNoTriangle) continue;
       const SampleShader::Kind kind =
           shader.ShadeSample(id, at.x, at.y, color[static_cast<std::size_t>(i)], deferred, i);
       if (kind == SampleShader::Kind::kGround) ground[i] = any_ground = true;
@@ -889,11 +903,15 @@ void Renderer::ShadeTile(int tile, const RenderSettings& settings,
     }
     if (any_surface) ShadeSurfaceRow(x1 - x0, surface, deferred, store_color);
     if (multisample && j == 0) {
-      AccumulateWholePixels(x1 - x0, ss_shift, whole, color, s.depth.data() + row, out_row, s,
+      AccumulateWholePixels(x1 - x0, ss_shift, whole, color, s.depth.data() + row,
+                            background_rows_.data() + sy, transparent, out_row, s,
                             samples == nullptr ? nullptr : samples + x0, sample_stride);
     }
     for (int sx = x0; sx < x1; ++sx) {
-      if (multisample && whole[(sx - x0) >> ss_shift] != Whole::kNo) continue;  // done above
+      if (multisample && whole[(sx - x0) >> ss_shift] != Whole::kNo) {
+        sx |= ss - 1;  // accumulated above
+        continue;
+      }
       const std::size_t at = row + static_cast<std::size_t>(sx - x0);
       const std::uint32_t id = s.ids[at];
       const std::size_t pixel = out_row + static_cast<std::size_t>((sx - x0) >> ss_shift);

@@ -149,10 +149,11 @@ class Renderer {
   // colour of the ground pixel whose first sample is (x0 + p * ss, sy).
   template <class Store>
   void ShadeGroundPixelRow(int x0, int sy, int n, int ss, const bool* whole, Store&& store) const;
-  enum class Whole : std::uint8_t { kNo, kTriangle, kGround };
+  enum class Whole : std::uint8_t { kNo, kTriangle, kGround, kEmpty };
   void AccumulateWholePixels(int n, int ss_shift, const Whole* whole, const glm::vec3* color,
-                             const float* depth, std::size_t out_row, TileScratch& s,
-                             glm::vec4* samples, std::size_t sample_stride) const;
+                             const float* depth, const glm::vec3* background, bool transparent,
+                             std::size_t out_row, TileScratch& s, glm::vec4* samples,
+                             std::size_t sample_stride) const;
   void ClassifyPixels(const std::uint32_t* ids, int n, int ss_shift, std::uint32_t ground_mesh,
                       Whole* whole) const;
   // Calls store(i, colour) for every i in [0, n) with surface[i] set: the
