@@ -42,6 +42,17 @@ std::string Bytes(const fs::path& p) {
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
+// Files <prefix>0.png .. of frames 0..n-1 hold what WriteImage writes of them.
+void ExpectWrittenAsWriteImage(const fs::path& dir, const std::string& prefix, int n,
+                               WriteOptions o) {
+  for (int f = 0; f < n; ++f) {
+    o.frame = f;
+    const fs::path sync = dir / ("sync_" + std::to_string(f) + ".png");
+    ASSERT_TRUE(WriteImage(Frame(f), sync.string(), o));
+    EXPECT_EQ(Bytes(dir / (prefix + std::to_string(f) + ".png")), Bytes(sync)) << f;
+  }
+}
+
 TEST(AsyncImageWriter, WritesTheSameBytesAsWriteImage) {
   const fs::path dir = FreshDir("bytes");
   constexpr int kFrames = 12;
@@ -58,12 +69,7 @@ TEST(AsyncImageWriter, WritesTheSameBytesAsWriteImage) {
     EXPECT_LE(writer.peak_in_flight(), 3) << "memory stays bounded";
     EXPECT_GE(writer.peak_in_flight(), 1);
   }
-  for (int f = 0; f < kFrames; ++f) {
-    o.frame = f;
-    const fs::path sync = dir / ("sync_" + std::to_string(f) + ".png");
-    ASSERT_TRUE(WriteImage(Frame(f), sync.string(), o));
-    EXPECT_EQ(Bytes(dir / ("async_" + std::to_string(f) + ".png")), Bytes(sync)) << f;
-  }
+  ExpectWrittenAsWriteImage(dir, "async_", kFrames, o);
 }
 
 // Frames encoded once (shared with the video and the sheet in a render) are
@@ -88,12 +94,7 @@ TEST(AsyncImageWriter, WritesEncodedFramesAsTheLinearOnes) {
     EXPECT_EQ(writer.TakeSpareImage().rgba.capacity(), 0u)
         << "encoded frames leave no linear buffers";
   }
-  for (int f = 0; f < kFrames; ++f) {
-    o.frame = f;
-    const fs::path sync = dir / ("sync_" + std::to_string(f) + ".png");
-    ASSERT_TRUE(WriteImage(Frame(f), sync.string(), o));
-    EXPECT_EQ(Bytes(dir / ("enc_" + std::to_string(f) + ".png")), Bytes(sync)) << f;
-  }
+  ExpectWrittenAsWriteImage(dir, "enc_", kFrames, o);
   EXPECT_FALSE(fs::exists(dir / "none.png"));
 }
 
