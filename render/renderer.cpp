@@ -125,8 +125,16 @@ void Renderer::AccumulateWholePixels(int n, int ss_shift, const Whole* whole,
 void Renderer::ClassifyPixels(const std::uint32_t* ids, int n, int ss_shift,
                               std::uint32_t ground_mesh, Whole* whole) const {
   const int ss = 1 << ss_shift;
+  // Neighbouring pixels mostly see the same triangle: remember the last answer.
+  std::uint32_t last_id = kNoTriangle;
+  bool last_ground = false;
   auto ground = [&](std::uint32_t id) {
-    return id != kNoTriangle && rasterizer_.triangle(id).mesh == ground_mesh;
+    if (id == kNoTriangle) return false;
+    if (id != last_id) {
+      last_id = id;
+      last_ground = rasterizer_.triangle(id).mesh == ground_mesh;
+    }
+    return last_ground;
   };
   for (int c0 = 0; c0 < n; c0 += ss) {
     const std::uint32_t first = ids[c0];
