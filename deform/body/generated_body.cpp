@@ -23,7 +23,7 @@ using base::MakeError;
 
 // Part of every cache key: bump it whenever the generated shape, mesh or
 // weights change, so that no cached body from an older build is read back.
-constexpr std::uint32_t kCacheVersion = 2;
+constexpr std::uint32_t kCacheVersion = 3;
 constexpr char kMagic[8] = {'p', 's', 'b', 'o', 'd', 'y', '0', '1'};
 
 // FNV-1a over raw bytes.

@@ -485,13 +485,22 @@ base::Result<ImplicitBody> BuildImplicitBody(const mocap::Skeleton& skeleton,
       prims.Ellipsoid(l.root() - 0.5f * thigh_r * fwd + 0.2f * hip_half * inward + 0.05f * torso_len * spine_dir,
                       trunk, {0.95f * thigh_r, 1.05f * thigh_r, 0.85f * thigh_r});  // buttock
     }
+    // The trunk reaches the shoulder joints, which usually sit above the
+    // spine point the arms leave (the clavicles climb): its volumes are laid
+    // out along the pelvis-to-shoulder-line height, not to that point.
+    float shoulder_h = 0.0f, upper_arm = 0.0f;
+    for (const Limb& l : arm) {
+      shoulder_h += 0.5f * glm::dot(l.root() - pelvis, spine_dir);
+      upper_arm += 0.5f * l.upper();
+    }
+    const float trunk_len = std::max(torso_len, shoulder_h);
     const float chest_lat = std::max(0.85f * shoulder_half_width, pelvis_lat * 0.95f);
-    prims.Ellipsoid(pelvis + 0.42f * torso_len * spine_dir + 0.12f * pelvis_lat * fwd, trunk,
-                    {0.88f * pelvis_lat, 0.36f * torso_len, 0.55f * pelvis_lat});  // belly
-    prims.Ellipsoid(pelvis + 0.74f * torso_len * spine_dir + 0.05f * chest_lat * fwd, trunk,
-                    {chest_lat, 0.4f * torso_len, 0.62f * chest_lat});  // rib cage
-    prims.Ellipsoid(chest + 0.02f * torso_len * spine_dir - 0.05f * chest_lat * fwd, trunk,
-                    {std::max(shoulder_half_width, chest_lat), 0.14f * torso_len, 0.4f * chest_lat});  // shoulders
+    prims.Ellipsoid(pelvis + 0.34f * trunk_len * spine_dir + 0.1f * pelvis_lat * fwd, trunk,
+                    {0.78f * pelvis_lat, 0.3f * trunk_len, 0.55f * pelvis_lat});  // belly
+    prims.Ellipsoid(pelvis + 0.6f * trunk_len * spine_dir + 0.04f * chest_lat * fwd, trunk,
+                    {0.92f * chest_lat, 0.3f * trunk_len, 0.65f * chest_lat});  // rib cage
+    prims.Ellipsoid(pelvis + 0.91f * trunk_len * spine_dir, trunk,
+                    {shoulder_half_width + 0.1f * upper_arm, 0.12f * trunk_len, 0.42f * chest_lat});  // shoulders
     const std::vector<glm::vec3> sp = positions(spine);
     for (std::size_t k = 0; k < static_cast<std::size_t>(last_branch[0]); ++k) {
       prims.Cone(0, sp[k], sp[k + 1], 0.5f * pelvis_lat, 0.5f * pelvis_lat);
