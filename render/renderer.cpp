@@ -77,6 +77,25 @@ bool PixelAllOf(const std::uint32_t* ids, int c0, int ss, std::uint32_t id) {
   return true;
 }
 
+// One sample's share of its pixel, as every resolve path adds it: a covered
+// sample adds (colour, 1) and raises the pixel's nearest 1/w; an empty one
+// adds the background with coverage 0, or nothing when transparent. Returns
+// the sample as the tent resolve stores it.
+inline glm::vec4 AddSample(bool covered, const glm::vec3& color, const glm::vec3& background,
+                           float inv_w, bool transparent, glm::vec4& acc, float& nearest) {
+  glm::vec4 sample(0.0f);
+  if (!covered) {
+    if (!transparent) sample = glm::vec4(background, 0.0f);
+  } else {
+    sample = glm::vec4(color, 1.0f);
+    // The largest 1/w; its reciprocal is the smallest of the samples'
+    // reciprocals (rounded division is monotone), one divide per pixel.
+    nearest = std::max(nearest, inv_w);
+  }
+  if (covered || !transparent) acc += sample;
+  return sample;
+}
+
 }  // namespace
 
 // Multisampling: the whole pixels of a pixel row (`whole`, n sample columns)
@@ -101,13 +120,9 @@ void Renderer::AccumulateWholePixels(int n, int ss_shift, const Whole* whole,
     float nearest = s.nearest[pixel];
     for (int r = 0; r < ss; ++r) {
       const float* row = depth + static_cast<std::size_t>(r) * kTileSize + c0;
-      const bool empty = kind == Whole::kEmpty;
-      const glm::vec4 sample = !empty        ? glm::vec4(color[c0], 1.0f)
-                               : transparent ? glm::vec4(0.0f)
-                                             : glm::vec4(background[r], 0.0f);
       for (int c = 0; c < ss; ++c) {
-        if (!empty || !transparent) acc += sample;
-        if (!empty) nearest = std::max(nearest, row[c]);
+        const glm::vec4 sample = AddSample(kind != Whole::kEmpty, color[c0], background[r], row[c],
+                                           transparent, acc, nearest);
         if (samples != nullptr)
           samples[static_cast<std::size_t>(r) * sample_stride + static_cast<std::size_t>(c0 + c)] =
               sample;
@@ -923,17 +938,9 @@ void Renderer::ShadeTile(int tile, const RenderSettings& settings,
       const std::size_t at = row + static_cast<std::size_t>(sx - x0);
       const std::uint32_t id = s.ids[at];
       const std::size_t pixel = out_row + static_cast<std::size_t>((sx - x0) >> ss_shift);
-      glm::vec4& acc = s.accum[pixel];
-      glm::vec4 sample(0.0f);
-      if (id == kNoTriangle) {
-        if (!transparent) sample = glm::vec4(bg, 0.0f);
-      } else {
-        sample = glm::vec4(color[static_cast<std::size_t>(sx - x0)], 1.0f);
-        // The largest 1/w; its reciprocal is the smallest of the samples'
-        // reciprocals (rounded division is monotone), one divide per pixel.
-        s.nearest[pixel] = std::max(s.nearest[pixel], s.depth[at]);
-      }
-      if (id != kNoTriangle || !transparent) acc += sample;
+      const glm::vec4 sample =
+          AddSample(id != kNoTriangle, color[static_cast<std::size_t>(sx - x0)], bg, s.depth[at],
+                    transparent, s.accum[pixel], s.nearest[pixel]);
       if (samples != nullptr) samples[static_cast<std::size_t>(sx)] = sample;
     }
     if (samples != nullptr) samples += sample_stride;

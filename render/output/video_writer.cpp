@@ -121,13 +121,8 @@ VideoWriter::~VideoWriter() {
 }
 
 Status VideoWriter::AddFrame(const Image& frame) {
-  if (frame.width < 1 || frame.height < 1 ||
-      frame.rgba.size() !=
-          static_cast<std::size_t>(frame.width) * static_cast<std::size_t>(frame.height)) {
-    return base::InvalidArgument(base::InFile(path_), "expected a frame with pixels, found " +
-                                                          std::to_string(frame.width) + "x" +
-                                                          std::to_string(frame.height));
-  }
+  // An inconsistent frame encodes to an inconsistent one, which the 8-bit
+  // AddFrame refuses (after the closed check, as before).
   EncodeSrgb8(frame, &impl_->encoded);
   return AddFrame(impl_->encoded);
 }
