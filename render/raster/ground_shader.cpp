@@ -166,6 +166,41 @@ inline __m128 FilteredLine4(__m128 u, __m128 w, const LineProfile& p) {
   return Clamp01(mean);
 }
 
+// The rays through sample positions (x[k], y) and where they meet the ground:
+// d = ray_c + ray_x x + ray_y y, p = eye + t d with t = height / d.y.
+struct GroundHits4 {
+  __m128 dx, dy, dz;  // the ray directions (unnormalized)
+  __m128 t;           // the ray parameter of the ground
+  __m128 ox, oz;      // p - eye, xz
+  __m128 px, pz;      // p, xz
+};
+
+inline GroundHits4 HitGround4(const glm::vec3& ray_c, const glm::vec3& ray_x,
+                              const glm::vec3& ray_y, const glm::vec3& eye, float height, __m128 x,
+                              float y) {
+  const glm::vec3 c = ray_c + ray_y * y;  // the row's part of the ray
+  GroundHits4 h;
+  h.dx = _mm_add_ps(_mm_set1_ps(c.x), _mm_mul_ps(_mm_set1_ps(ray_x.x), x));
+  h.dy = _mm_add_ps(_mm_set1_ps(c.y), _mm_mul_ps(_mm_set1_ps(ray_x.y), x));
+  h.dz = _mm_add_ps(_mm_set1_ps(c.z), _mm_mul_ps(_mm_set1_ps(ray_x.z), x));
+  h.t = _mm_div_ps(_mm_set1_ps(height), h.dy);
+  h.ox = _mm_mul_ps(h.dx, h.t);
+  h.oz = _mm_mul_ps(h.dz, h.t);
+  h.px = _mm_add_ps(_mm_set1_ps(eye.x), h.ox);
+  h.pz = _mm_add_ps(_mm_set1_ps(eye.z), h.oz);
+  return h;
+}
+
+// The grid lines' fade with the eye distance |(ox, height, oz)|, in spacings:
+// 1 up to fade_start spacings, 0 from twice that.
+inline __m128 LineFade4(__m128 ox, __m128 oz, float height, __m128 inv_spacing, float inv_fade) {
+  const __m128 one = _mm_set1_ps(1.0f);
+  const __m128 dist2 =
+      _mm_add_ps(_mm_add_ps(_mm_mul_ps(ox, ox), _mm_mul_ps(oz, oz)), _mm_set1_ps(height * height));
+  const __m128 spacings = _mm_mul_ps(_mm_sqrt_ps(dist2), inv_spacing);
+  return _mm_sub_ps(one, Clamp01(_mm_sub_ps(_mm_mul_ps(spacings, _mm_set1_ps(inv_fade)), one)));
+}
+
 }  // namespace
 
 template <>
@@ -198,15 +233,9 @@ void GroundShader::Finish4(__m128 px, __m128 pz, __m128 line, const float* visib
 
 void GroundShader::Shade4(int sx, int sy, float* r, float* g, float* b) const {
   const __m128 x = _mm_add_ps(_mm_set1_ps(static_cast<float>(sx)), _mm_setr_ps(0, 1, 2, 3));
-  const auto fy = static_cast<float>(sy);
-  const glm::vec3 c = ray_c_ + ray_y_ * fy;  // the row's part of the ray
-  const __m128 dx = _mm_add_ps(_mm_set1_ps(c.x), _mm_mul_ps(_mm_set1_ps(ray_x_.x), x));
-  const __m128 dy = _mm_add_ps(_mm_set1_ps(c.y), _mm_mul_ps(_mm_set1_ps(ray_x_.y), x));
-  const __m128 dz = _mm_add_ps(_mm_set1_ps(c.z), _mm_mul_ps(_mm_set1_ps(ray_x_.z), x));
-  const __m128 t = _mm_div_ps(_mm_set1_ps(height_), dy);  // ray parameter of the ground
-  const __m128 ox = _mm_mul_ps(dx, t), oz = _mm_mul_ps(dz, t);  // p - eye, xz
-  const __m128 px = _mm_add_ps(_mm_set1_ps(eye_.x), ox);
-  const __m128 pz = _mm_add_ps(_mm_set1_ps(eye_.z), oz);
+  const GroundHits4 h =
+      HitGround4(ray_c_, ray_x_, ray_y_, eye_, height_, x, static_cast<float>(sy));
+  const __m128 px = h.px, pz = h.pz;
 
   __m128 line = _mm_setzero_ps();  // grid line weight, 0..1
   if (grid_) {
@@ -219,11 +248,7 @@ void GroundShader::Shade4(int sx, int sy, float* r, float* g, float* b) const {
     if (simd::Any(near)) {
       const __m128 one = _mm_set1_ps(1.0f);
       line = _mm_sub_ps(one, Clamp01(_mm_mul_ps(from_edge, _mm_set1_ps(inv_soft_))));
-      const __m128 dist2 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(ox, ox), _mm_mul_ps(oz, oz)),
-                                      _mm_set1_ps(height_ * height_));
-      const __m128 spacings = _mm_mul_ps(_mm_sqrt_ps(dist2), inv_spacing);
-      const __m128 fade = _mm_sub_ps(
-          one, Clamp01(_mm_sub_ps(_mm_mul_ps(spacings, _mm_set1_ps(inv_fade_)), one)));
+      const __m128 fade = LineFade4(h.ox, h.oz, height_, inv_spacing, inv_fade_);
       line = _mm_and_ps(near, _mm_mul_ps(line, fade));
     }
   }
@@ -246,14 +271,9 @@ void GroundShader::ShadePixels4(int sx, int sy, int ss, float* r, float* g, floa
   const auto step = static_cast<float>(ss);
   const __m128 x = _mm_add_ps(_mm_set1_ps(static_cast<float>(sx) + centre),
                               _mm_mul_ps(_mm_set1_ps(step), _mm_setr_ps(0, 1, 2, 3)));
-  const glm::vec3 c = ray_c_ + ray_y_ * (static_cast<float>(sy) + centre);
-  const __m128 dx = _mm_add_ps(_mm_set1_ps(c.x), _mm_mul_ps(_mm_set1_ps(ray_x_.x), x));
-  const __m128 dy = _mm_add_ps(_mm_set1_ps(c.y), _mm_mul_ps(_mm_set1_ps(ray_x_.y), x));
-  const __m128 dz = _mm_add_ps(_mm_set1_ps(c.z), _mm_mul_ps(_mm_set1_ps(ray_x_.z), x));
-  const __m128 t = _mm_div_ps(_mm_set1_ps(height_), dy);
-  const __m128 ox = _mm_mul_ps(dx, t), oz = _mm_mul_ps(dz, t);
-  const __m128 px = _mm_add_ps(_mm_set1_ps(eye_.x), ox);
-  const __m128 pz = _mm_add_ps(_mm_set1_ps(eye_.z), oz);
+  const GroundHits4 h =
+      HitGround4(ray_c_, ray_x_, ray_y_, eye_, height_, x, static_cast<float>(sy) + centre);
+  const __m128 dx = h.dx, dy = h.dy, dz = h.dz, t = h.t, px = h.px, pz = h.pz;
 
   __m128 line = _mm_setzero_ps();
   if (grid_) {
@@ -285,11 +305,7 @@ void GroundShader::ShadePixels4(int sx, int sy, int ss, float* r, float* g, floa
       const __m128 lu = FilteredLine4(u, wu, profile), lv = FilteredLine4(v, wv, profile);
       // Either line: the union of the two axes' coverages.
       line = _mm_sub_ps(one, _mm_mul_ps(_mm_sub_ps(one, lu), _mm_sub_ps(one, lv)));
-      const __m128 dist2 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(ox, ox), _mm_mul_ps(oz, oz)),
-                                      _mm_set1_ps(height_ * height_));
-      const __m128 spacings = _mm_mul_ps(_mm_sqrt_ps(dist2), inv_spacing);
-      const __m128 fade =
-          _mm_sub_ps(one, Clamp01(_mm_sub_ps(_mm_mul_ps(spacings, _mm_set1_ps(inv_fade_)), one)));
+      const __m128 fade = LineFade4(h.ox, h.oz, height_, inv_spacing, inv_fade_);
       line = _mm_and_ps(near, _mm_mul_ps(line, fade));
     }
   }
@@ -305,18 +321,15 @@ void GroundShader::PixelVisibility4(int sx, int sy, int ss, float* visibility) c
   // Sample (i, j) of the four pixels sits ss samples apart in x.
   __m128 sum = _mm_setzero_ps();
   for (int j = 0; j < ss; ++j) {
-    const glm::vec3 c = ray_c_ + ray_y_ * static_cast<float>(sy + j);
     for (int i = 0; i < ss; ++i) {
       const __m128 x =
           _mm_add_ps(_mm_set1_ps(static_cast<float>(sx + i)),
                      _mm_mul_ps(_mm_set1_ps(static_cast<float>(ss)), _mm_setr_ps(0, 1, 2, 3)));
-      const __m128 dx = _mm_add_ps(_mm_set1_ps(c.x), _mm_mul_ps(_mm_set1_ps(ray_x_.x), x));
-      const __m128 dy = _mm_add_ps(_mm_set1_ps(c.y), _mm_mul_ps(_mm_set1_ps(ray_x_.y), x));
-      const __m128 dz = _mm_add_ps(_mm_set1_ps(c.z), _mm_mul_ps(_mm_set1_ps(ray_x_.z), x));
-      const __m128 t = _mm_div_ps(_mm_set1_ps(height_), dy);
+      const GroundHits4 h =
+          HitGround4(ray_c_, ray_x_, ray_y_, eye_, height_, x, static_cast<float>(sy + j));
       alignas(16) float x4[4], z4[4], v4[4];
-      _mm_store_ps(x4, _mm_add_ps(_mm_set1_ps(eye_.x), _mm_mul_ps(dx, t)));
-      _mm_store_ps(z4, _mm_add_ps(_mm_set1_ps(eye_.z), _mm_mul_ps(dz, t)));
+      _mm_store_ps(x4, h.px);
+      _mm_store_ps(z4, h.pz);
       shadow_map_->Visibility4(x4, ground_y_, z4, v4);
       sum = _mm_add_ps(sum, _mm_load_ps(v4));
     }
